@@ -1,0 +1,1 @@
+//! Cages that strictly enclose the input (dissertation ch. 4.5.2).

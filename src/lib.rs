@@ -1,0 +1,47 @@
+//! # pleat
+//!
+//! LODs by screen size, cages, and complex wrinkle fields, with a stable C ABI.
+//!
+//! Capabilities (each a cargo feature; `default` enables all):
+//! - `lod`: any triangle soup in, a watertight, manifold, self-intersection-free low-poly mesh
+//!   out that is indistinguishable from the input at a given screen size (dissertation ch. 4).
+//! - `cage`: the same, strictly enclosing the input without touching it (ch. 4.5.2).
+//! - `wrinkle`: complex wrinkle fields — evaluation, interpolation, design (ch. 3);
+//!   `tfw`: tension-field wrinkle statics (ch. 2).
+//! - `cli`: the `pleat` command-line tool; `io-gltf`: glTF 2.0 reading and writing.
+//!
+//! The mesh core ([`mesh`], [`spatial`]) is always present.
+//!
+//! ```
+//! use pleat::mesh::TriMesh;
+//! let m = TriMesh::new(
+//!     vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
+//!     vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+//! )?;
+//! assert_eq!(m.edges().len(), 6);
+//! # Ok::<(), pleat::Error>(())
+//! ```
+
+#![warn(missing_docs)]
+
+mod error;
+pub mod mesh;
+pub mod report;
+pub mod spatial;
+
+#[cfg(feature = "lod")]
+pub mod lowpoly;
+
+#[cfg(feature = "cage")]
+pub mod cage;
+
+#[cfg(feature = "wrinkle")]
+pub mod wrinkle;
+
+#[cfg(feature = "tfw")]
+pub mod tfw;
+
+pub mod ffi;
+
+pub use error::{Error, Result};
+pub use report::{Progress, Stats};

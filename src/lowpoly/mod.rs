@@ -1,0 +1,1 @@
+//! Low-poly meshes by screen size (dissertation ch. 4).

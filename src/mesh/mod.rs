@@ -1,0 +1,6 @@
+//! Mesh core: the indexed triangle mesh [`TriMesh`], file I/O, half-edge connectivity for local
+//! operations, and [`MeshReport`] validation of any triangle soup.
+
+mod trimesh;
+
+pub use trimesh::{Edge, EdgeList, TriMesh};

@@ -1,0 +1,71 @@
+//! [`Stats`]: what every long operation reports — wall time per stage, counts, achieved error and
+//! which guarantees were verified. This is how pleat reports "error against run time".
+
+use std::time::Instant;
+
+/// Timing and quality figures of one long operation.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Stats {
+    /// `(stage name, wall seconds)` in execution order.
+    pub stages: Vec<(String, f64)>,
+    /// Named counts (cells visited, faces out, flips, ...), in insertion order.
+    pub counts: Vec<(String, u64)>,
+    /// Named real-valued metrics (Hausdorff / bbox diagonal, max deviation / d, ...).
+    pub metrics: Vec<(String, f64)>,
+    /// Guarantees checked by independent code after the operation: `(name, holds)`.
+    pub verified: Vec<(String, bool)>,
+}
+
+impl Stats {
+    /// Runs `f`, records its wall time under `name`, and returns its result.
+    pub fn time<T>(&mut self, name: &str, f: impl FnOnce() -> T) -> T {
+        let t0 = Instant::now();
+        let r = f();
+        self.stages
+            .push((name.to_string(), t0.elapsed().as_secs_f64()));
+        r
+    }
+
+    /// Records a count.
+    pub fn count(&mut self, name: &str, value: u64) {
+        self.counts.push((name.to_string(), value));
+    }
+
+    /// Records a metric.
+    pub fn metric(&mut self, name: &str, value: f64) {
+        self.metrics.push((name.to_string(), value));
+    }
+
+    /// Records the outcome of an independent verification.
+    pub fn verify(&mut self, name: &str, holds: bool) {
+        self.verified.push((name.to_string(), holds));
+    }
+
+    /// Total seconds over all stages.
+    pub fn total_seconds(&self) -> f64 {
+        self.stages.iter().map(|s| s.1).sum()
+    }
+
+    /// Looks up a stage time, count, or metric by name.
+    pub fn get_metric(&self, name: &str) -> Option<f64> {
+        self.metrics.iter().find(|m| m.0 == name).map(|m| m.1)
+    }
+
+    /// Looks up a count by name.
+    pub fn get_count(&self, name: &str) -> Option<u64> {
+        self.counts.iter().find(|m| m.0 == name).map(|m| m.1)
+    }
+}
+
+/// Progress information passed to a progress callback.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress<'a> {
+    /// Name of the running stage.
+    pub stage: &'a str,
+    /// Fraction of the whole operation done, in `[0, 1]`.
+    pub fraction: f64,
+}
+
+/// A progress callback: return `true` to continue, `false` to cancel (the operation then
+/// returns `Error::Cancelled` promptly). Called on the calling thread only.
+pub type ProgressFn<'a> = dyn FnMut(Progress<'_>) -> bool + 'a;

@@ -1,0 +1,1 @@
+//! Spatial queries: BVH, closest points, exact triangle–triangle tests, winding numbers.

@@ -1,0 +1,1 @@
+//! Tension-field wrinkles (dissertation ch. 2).

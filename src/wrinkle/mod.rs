@@ -1,0 +1,1 @@
+//! Complex wrinkle fields (dissertation ch. 3).
