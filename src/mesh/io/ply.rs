@@ -38,10 +38,10 @@ pub(crate) fn read_ply_sized<R: BufRead>(
 ) -> Result<TriMesh> {
     let mut lines = LineReader::new(reader);
     let header = parse_header(&mut lines, name)?;
-    let roles = Roles::find(&header, name)?;
     if let Some(len) = total_len {
         check_counts_fit(&header, len.saturating_sub(lines.bytes_read()), name)?;
     }
+    let roles = Roles::find(&header, name)?;
     let (positions, triangles) = match header.encoding {
         Encoding::Ascii => {
             let mut src = AsciiSource {
