@@ -576,6 +576,19 @@ fn ply_absurd_counts_fail_before_allocating() {
     data.extend_from_slice(&[0; 64]);
     let msg = parse_err(ply(&data), "test.ply");
     assert!(msg.contains("u32"), "{msg}");
+    // An element without properties costs nothing however many items it claims.
+    let empty = "ply\nformat binary_little_endian 1.0\nelement nothing 1000000000000000\n\
+                 element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                 element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    let mut data = empty.as_bytes().to_vec();
+    for c in [0f32, 0., 0., 1., 0., 0., 0., 1., 0.] {
+        data.extend_from_slice(&c.to_le_bytes());
+    }
+    data.push(3);
+    for i in [0i32, 1, 2] {
+        data.extend_from_slice(&i.to_le_bytes());
+    }
+    assert_eq!(ply(&data).unwrap().triangle_count(), 1);
     let mid = header.replace("1000000000000", "400000000");
     let mut data = mid.into_bytes();
     data.extend_from_slice(&[0; 64]);
@@ -867,6 +880,49 @@ mod gltf_tests {
     }
 
     #[test]
+    fn gltf_reads_sparse_and_quantized_accessors() {
+        // Positions: 4 × u16 VEC3 normalized (24 bytes) then a sparse substitution of vertex 2:
+        // u8 index (padded to 4 bytes) and one f32 VEC3 for the f32 accessor.
+        let mut buf = Vec::new();
+        for p in [
+            [0u16, 0, 0],
+            [65535, 0, 0],
+            [65535, 65535, 0],
+            [0, 65535, 0],
+        ] {
+            for c in p {
+                buf.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        buf.extend_from_slice(&[2, 0, 0, 0]);
+        for c in [5f32, 6., 7.] {
+            buf.extend_from_slice(&c.to_le_bytes());
+        }
+        let json = format!(
+            r#"{{"asset":{{"version":"2.0"}},
+            "extensionsUsed":["KHR_mesh_quantization"],"extensionsRequired":["KHR_mesh_quantization"],
+            "buffers":[{{"byteLength":{len},"uri":"data:;base64,{data}"}}],
+            "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":24}},
+                           {{"buffer":0,"byteOffset":24,"byteLength":4}},
+                           {{"buffer":0,"byteOffset":28,"byteLength":12}}],
+            "accessors":[{{"bufferView":0,"componentType":5123,"normalized":true,"count":4,
+                           "type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+                         {{"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[5,6,7],
+                           "sparse":{{"count":1,"indices":{{"bufferView":1,"componentType":5121}},
+                                      "values":{{"bufferView":2}}}}}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"mode":6}},
+                                      {{"attributes":{{"POSITION":1}},"mode":4}}]}}]}}"#,
+            len = buf.len(),
+            data = b64(&buf)
+        );
+        let m = read_gltf_bytes(json.as_bytes(), None, "q.gltf").unwrap();
+        assert_eq!(m.position(2), [1.0, 1.0, 0.0]);
+        assert_eq!(m.position(6), [5.0, 6.0, 7.0]);
+        assert_eq!(m.position(7), [0.0, 0.0, 0.0]);
+        assert_eq!(tris(&m), vec![[0, 1, 2], [0, 2, 3], [4, 5, 6]]);
+    }
+
+    #[test]
     fn gltf_hostile_documents_are_errors() {
         let cyclic = r#""scene":0,"scenes":[{"nodes":[0]}],
             "nodes":[{"children":[1],"mesh":0},{"children":[0]}],"#;
@@ -895,6 +951,23 @@ mod gltf_tests {
         let doc = document(&format!("data:;base64,{}", b64(&bad_index)), "");
         let msg = parse_err(read_gltf_bytes(doc.as_bytes(), None, "i.gltf"), "i.gltf");
         assert!(msg.contains("out of range"), "{msg}");
+        let draco = document(
+            &data_uri(),
+            r#""extensionsRequired":["KHR_draco_mesh_compression"],"#,
+        );
+        let msg = parse_err(read_gltf_bytes(draco.as_bytes(), None, "d.gltf"), "d.gltf");
+        assert!(msg.contains("KHR_draco_mesh_compression"), "{msg}");
+        let unlit = document(
+            &data_uri(),
+            r#""extensionsRequired":["KHR_materials_unlit"],"#,
+        );
+        assert!(read_gltf_bytes(unlit.as_bytes(), None, "u.gltf").is_ok());
+        let invalid = document(&data_uri(), "").replace("\"bufferView\":1,", "\"bufferView\":7,");
+        let msg = parse_err(
+            read_gltf_bytes(invalid.as_bytes(), None, "v.gltf"),
+            "v.gltf",
+        );
+        assert!(msg.contains("invalid glTF"), "{msg}");
         for data in [
             &b"glTF"[..],
             b"glTF\x02\0\0\0\0\0\0\0",

@@ -12,6 +12,9 @@
 //! reversed, so that triangles keep their front side (the specification makes such instances
 //! clockwise).
 //!
+//! At most 2²⁸ vertices plus triangles are instantiated (instancing multiplies the stored
+//! geometry, so the file size alone does not bound the result); beyond that reading fails.
+//!
 //! Buffers come from the GLB `BIN` chunk, `data:` URIs (base64), or files relative to the
 //! `.gltf` file's folder (never absolute paths or other URI schemes; at most the declared
 //! `byteLength` is read). Accessors may be strided, sparse, or quantized (integer positions,
@@ -56,8 +59,10 @@ pub fn read_gltf(path: &Path) -> Result<TriMesh> {
 /// chunk and `data:` URIs are available.
 pub fn read_gltf_bytes(data: &[u8], base_dir: Option<&Path>, name: &str) -> Result<TriMesh> {
     check_glb_header(data, name)?;
-    let gltf = Gltf::from_slice(data).map_err(|e| parse_error(name, format!("glTF: {e}")))?;
+    let gltf = Gltf::from_slice_without_validation(data)
+        .map_err(|e| parse_error(name, format!("glTF: {e}")))?;
     let Gltf { document, blob } = gltf;
+    validate(&document, name)?;
     let buffers = load_buffers(&document, blob, base_dir, name)?;
     let mut soup = Soup::default();
     let ctx = Ctx {
@@ -120,6 +125,10 @@ pub fn gltf_embedded_string(mesh: &TriMesh) -> Result<String> {
 
 // ---------------------------------------------------------------------------------- reading --
 
+/// Most vertices plus triangles a document may instantiate (2²⁸, about 3 GiB of mesh): node
+/// instancing multiplies stored geometry, so the file size does not bound the result.
+const MAX_INSTANCED: usize = 1 << 28;
+
 /// Column-major 4×4 matrix, `m[column][row]`.
 type Mat4 = [[f64; 4]; 4];
 
@@ -166,6 +175,49 @@ fn check_glb_header(data: &[u8], name: &str) -> Result<()> {
         )),
         None => Err(parse_error(name, "GLB file truncated in its header")),
     }
+}
+
+/// Required extensions that change nothing this reader uses (materials, textures, lights), plus
+/// `KHR_mesh_quantization`, which it implements.
+fn extension_is_readable(ext: &str) -> bool {
+    ext.starts_with("KHR_materials_")
+        || ext.starts_with("KHR_texture_")
+        || matches!(
+            ext,
+            "KHR_mesh_quantization"
+                | "KHR_lights_punctual"
+                | "KHR_xmp_json_ld"
+                | "EXT_texture_webp"
+                | "EXT_texture_avif"
+                | "MSFT_texture_dds"
+        )
+}
+
+/// The `gltf` crate's validation (which keeps its accessors from panicking), except that
+/// required extensions are judged by [`extension_is_readable`] instead of by the crate's own
+/// list; any other required extension (Draco or meshopt compression, GPU instancing, ...) is an
+/// error, since ignoring it would silently give the wrong geometry.
+fn validate(doc: &Document, name: &str) -> Result<()> {
+    use ::gltf::json::validation::Validate;
+    let root = doc.as_json();
+    if let Some(ext) = root
+        .extensions_required
+        .iter()
+        .find(|e| !extension_is_readable(e))
+    {
+        return Err(parse_error(
+            name,
+            format!("the file requires glTF extension {ext}, which pleat cannot read"),
+        ));
+    }
+    let mut first_error = None;
+    root.validate(root, ::gltf::json::Path::new, &mut |path, error| {
+        let path = path();
+        if first_error.is_none() && !path.as_str().starts_with("extensionsRequired") {
+            first_error = Some(format!("invalid glTF: {path}: {error:?}"));
+        }
+    });
+    first_error.map_or(Ok(()), |e| Err(parse_error(name, e)))
 }
 
 fn load_buffers(
@@ -293,8 +345,12 @@ fn add_mesh(mesh: &::gltf::Mesh, world: &Mat4, ctx: &Ctx, soup: &mut Soup) -> Re
         }
         let values = read_accessor(&pos, ctx, &what)?;
         let base = soup.positions.len();
-        if base + pos.count() > u32::MAX as usize {
-            return Err(ctx.err(format!("{what}: more vertices than u32 indices allow")));
+        let n_indices = prim.indices().map_or(pos.count(), |a| a.count());
+        if base + pos.count() + soup.triangles.len() + n_indices > MAX_INSTANCED {
+            return Err(ctx.err(format!(
+                "{what}: instancing would create more than {MAX_INSTANCED} vertices and \
+                 triangles"
+            )));
         }
         for (i, p) in values.chunks_exact(3).enumerate() {
             let q = transform(world, [p[0], p[1], p[2]]);
@@ -531,7 +587,12 @@ fn det3(m: &Mat4) -> f64 {
 
 /// Positions as `f32` followed by `u32` indices, little endian.
 fn binary_buffer(mesh: &TriMesh) -> Result<Vec<u8>> {
-    super::stl::check_f32_range(mesh, "glTF output")?;
+    if let Some(i) = super::stl::first_beyond_f32(mesh) {
+        return Err(Error::InvalidArgument(format!(
+            "vertex {i} {:?} exceeds the f32 range of glTF positions",
+            mesh.positions()[i]
+        )));
+    }
     let mut bin = Vec::with_capacity(12 * (mesh.vertex_count() + mesh.triangle_count()));
     for p in mesh.positions() {
         for &c in p {

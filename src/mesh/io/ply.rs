@@ -524,6 +524,9 @@ fn skip_list<S: Source>(src: &mut S, count_ty: Scalar, item_ty: Scalar, at: &At)
 }
 
 fn skip_element<S: Source>(src: &mut S, e: &Element) -> Result<()> {
+    if e.props.is_empty() {
+        return Ok(()); // nothing to read, however many items the header claims
+    }
     for i in 0..e.count {
         let at = At {
             element: &e.name,

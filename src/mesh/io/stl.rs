@@ -82,7 +82,7 @@ pub fn read_stl_bytes(data: &[u8], name: &str) -> Result<TriMesh> {
 /// depend only on the mesh. `writer` is buffered internally.
 ///
 /// Coordinates beyond the `f32` range become infinite; [`write_mesh`](super::write_mesh)
-/// rejects such meshes first (see [`check_f32_range`]). Fails with
+/// rejects such meshes first. Fails with
 /// [`std::io::ErrorKind::InvalidInput`] beyond `u32::MAX` triangles.
 pub fn write_stl<W: Write>(mut writer: W, mesh: &TriMesh) -> std::io::Result<()> {
     let n = u32::try_from(mesh.triangle_count()).map_err(|_| {
@@ -112,18 +112,21 @@ pub fn write_stl<W: Write>(mut writer: W, mesh: &TriMesh) -> std::io::Result<()>
 
 /// Checks that every coordinate of `mesh` is finite as `f32` (needed by STL and glTF);
 /// errors with [`Error::InvalidArgument`] naming `name` otherwise.
-pub fn check_f32_range(mesh: &TriMesh, name: &str) -> Result<()> {
-    match mesh
-        .positions()
-        .iter()
-        .position(|p| p.iter().any(|&c| !(c as f32).is_finite()))
-    {
+pub(crate) fn check_f32_range(mesh: &TriMesh, name: &str) -> Result<()> {
+    match first_beyond_f32(mesh) {
         None => Ok(()),
         Some(i) => Err(Error::InvalidArgument(format!(
             "cannot write '{name}': vertex {i} {:?} exceeds the f32 range of the format",
             mesh.positions()[i]
         ))),
     }
+}
+
+/// The first vertex with a coordinate that overflows `f32`.
+pub(crate) fn first_beyond_f32(mesh: &TriMesh) -> Option<usize> {
+    mesh.positions()
+        .iter()
+        .position(|p| p.iter().any(|&c| !(c as f32).is_finite()))
 }
 
 fn unit_normal(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f64; 3] {
