@@ -13,16 +13,39 @@ use pleat::Error;
 
 // ------------------------------------------------------------------------------- helpers ----
 
-/// A unique path under the temp dir ending in `file_name`.
-fn tmp_path(file_name: &str) -> PathBuf {
+/// A unique path under the temp dir ending in `file_name`; its folder is removed on drop.
+struct TmpPath(PathBuf);
+
+impl std::ops::Deref for TmpPath {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for TmpPath {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TmpPath {
+    fn drop(&mut self) {
+        if let Some(dir) = self.0.parent() {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
+}
+
+fn tmp_path(file_name: &str) -> TmpPath {
     static COUNTER: AtomicUsize = AtomicUsize::new(0);
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
     let dir = std::env::temp_dir().join(format!("pleat-io-test-{}-{n}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("create temp dir");
-    dir.join(file_name)
+    TmpPath(dir.join(file_name))
 }
 
-fn write_tmp(file_name: &str, data: &[u8]) -> PathBuf {
+fn write_tmp(file_name: &str, data: &[u8]) -> TmpPath {
     let p = tmp_path(file_name);
     std::fs::write(&p, data).expect("write temp file");
     p

@@ -468,8 +468,8 @@ fn apply_sparse(
     let elem = ty.size() * dims;
     let n = sparse.count();
     let (indices, values) = (sparse.indices(), sparse.values());
-    let isize = indices.index_type().size();
-    let ity = match isize {
+    let index_size = indices.index_type().size();
+    let index_type = match index_size {
         1 => DataType::U8,
         2 => DataType::U16,
         _ => DataType::U32,
@@ -478,14 +478,18 @@ fn apply_sparse(
         &indices.view(),
         indices.offset(),
         n,
-        isize,
-        isize,
+        index_size,
+        index_size,
         ctx,
         what,
     )?;
     let val = view_slice(&values.view(), values.offset(), n, elem, elem, ctx, what)?;
     for k in 0..n {
-        let target = decode(&idx[k * isize..(k + 1) * isize], ity, false) as usize;
+        let target = decode(
+            &idx[k * index_size..(k + 1) * index_size],
+            index_type,
+            false,
+        ) as usize;
         if target >= acc.count() {
             return Err(ctx.err(format!(
                 "{what}: sparse index {target} is out of range ({} elements)",

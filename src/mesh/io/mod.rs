@@ -17,10 +17,12 @@
 //! - STL stores three points per facet; exactly-equal points (`-0.0 == 0.0`) are merged in
 //!   first-seen order, as CGAL's STL reader does.
 //!
-//! Whenever a read succeeds, its result is the checker's soup. Where the checker is lenient
-//! (it drops faces with out-of-range indices or fewer than three corners, and replaces
-//! unparsable OBJ vertices by the origin), these readers return [`Error::Parse`] instead, naming
-//! the file and, for text formats, the line.
+//! Whenever a read succeeds on a file the checker also loads, the result is the checker's soup
+//! (verified on the whole shared corpus, see `tests/io.rs`). Where the checker is lenient (it
+//! drops faces with out-of-range indices or fewer than three corners, and replaces unparsable
+//! OBJ vertices by the origin), these readers return [`Error::Parse`] instead, naming the file
+//! and, for text formats, the line. Conversely they read some files the checker rejects (PLY
+//! face lists with 8- or 16-bit indices, OBJ `l` lines).
 //!
 //! # Errors
 //!

@@ -72,8 +72,8 @@ pub fn read_obj<R: BufRead>(reader: R, name: &str) -> Result<TriMesh> {
     parser.finish()
 }
 
-/// Writes `mesh` as OBJ: `v x y z` lines with Rust's shortest round-trip float formatting (so
-/// reading the file back is bit-exact), then `f a b c` lines with 1-based indices. The bytes
+/// Writes `mesh` as OBJ: `v x y z` lines with Rust's shortest round-trip float formatting
+/// (`{:?}`: `0.1`, `-0.0`, `1e-7`; reading the file back is bit-exact), then `f a b c` lines with 1-based indices. The bytes
 /// depend only on the mesh. `writer` is buffered internally.
 pub fn write_obj<W: Write>(mut writer: W, mesh: &TriMesh) -> std::io::Result<()> {
     let mut w = BufWriter::with_capacity(1 << 16, &mut writer);
