@@ -577,6 +577,19 @@ fn header_len(ply: &[u8]) -> usize {
 }
 
 #[test]
+fn ply_binary_index_out_of_range_is_an_error() {
+    let mut data = square_ply(Ty("float"), Ty("uchar"), Ty("int"), false, "vertex_indices");
+    let end = data.len();
+    // The last face is `3 2 1 0` followed by the `other` list `1 42`: corrupt its last index.
+    data[end - 9..end - 5].copy_from_slice(&4i32.to_le_bytes());
+    let msg = parse_err(ply(&data), "test.ply");
+    assert!(
+        msg.contains("'face' element 1 of 2: vertex index 4 is out of range"),
+        "{msg}"
+    );
+}
+
+#[test]
 fn ply_absurd_counts_fail_before_allocating() {
     let header = "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\n\
                   property float x\nproperty float y\nproperty float z\n\
@@ -969,6 +982,11 @@ mod gltf_tests {
             "st.gltf",
         );
         assert!(msg.contains("stride"), "{msg}");
+        let mut nan = square_buffer();
+        nan[4..8].copy_from_slice(&f32::NAN.to_le_bytes());
+        let doc = document(&format!("data:;base64,{}", b64(&nan)), "");
+        let msg = parse_err(read_gltf_bytes(doc.as_bytes(), None, "n.gltf"), "n.gltf");
+        assert!(msg.contains("non-finite"), "{msg}");
         let mut bad_index = square_buffer();
         bad_index[58] = 9;
         let doc = document(&format!("data:;base64,{}", b64(&bad_index)), "");
