@@ -191,6 +191,29 @@ PleatStatus pleat_mesh_copy_indices(const struct PleatMesh *mesh,
                                     uint32_t *dst,
                                     size_t index_capacity);
 
+// Reads a mesh file: `.obj`, `.ply` (ascii/binary), `.off`, `.stl` (ascii/binary), and
+// `.glb`/`.gltf` when built with glTF support. The format is chosen by the (case-insensitive)
+// extension. The mesh is the soup exactly as stored (polygons fan-triangulated, all objects
+// merged, no welding except exact duplicates in STL).
+//
+// - `path`: NUL-terminated UTF-8 path; non-NULL.
+// - `out`: receives the new mesh; non-NULL.
+//
+// Returns `PLEAT_STATUS_IO` when the file cannot be read and `PLEAT_STATUS_PARSE` when its
+// content is invalid; the message names the file and, for text formats, the line.
+//
+// # Safety
+// `path` is NULL or NUL-terminated; `out` is NULL or valid for a write.
+PleatStatus pleat_mesh_read_file(const char *path, struct PleatMesh **out);
+
+// Writes a mesh file; the format is chosen by the extension: `.obj` and `.ply` (binary,
+// double precision) are lossless, `.off`, `.stl` (binary, float) and `.glb`/`.gltf` (float)
+// round coordinates to the format's precision.
+//
+// # Safety
+// `mesh` is NULL or live; `path` is NULL or NUL-terminated.
+PleatStatus pleat_mesh_write_file(const struct PleatMesh *mesh, const char *path);
+
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus

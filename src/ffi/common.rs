@@ -245,14 +245,14 @@ pub unsafe extern "C" fn pleat_has_feature(name: *const c_char) -> u32 {
     let Ok(name) = c_str_arg(name, "name") else {
         return 0;
     };
-    let on = match name {
-        "lod" => cfg!(feature = "lod"),
-        "cage" => cfg!(feature = "cage"),
-        "wrinkle" => cfg!(feature = "wrinkle"),
-        "tfw" => cfg!(feature = "tfw"),
-        "io-gltf" => cfg!(feature = "io-gltf"),
-        _ => false,
-    };
+    const BUILT: [(&str, bool); 5] = [
+        ("lod", cfg!(feature = "lod")),
+        ("cage", cfg!(feature = "cage")),
+        ("wrinkle", cfg!(feature = "wrinkle")),
+        ("tfw", cfg!(feature = "tfw")),
+        ("io-gltf", cfg!(feature = "io-gltf")),
+    ];
+    let on = BUILT.iter().any(|&(n, built)| n == name && built);
     on as u32
 }
 

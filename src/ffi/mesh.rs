@@ -314,3 +314,50 @@ pub unsafe extern "C" fn pleat_mesh_copy_indices(
         Ok(())
     })
 }
+
+/// Reads a mesh file: `.obj`, `.ply` (ascii/binary), `.off`, `.stl` (ascii/binary), and
+/// `.glb`/`.gltf` when built with glTF support. The format is chosen by the (case-insensitive)
+/// extension. The mesh is the soup exactly as stored (polygons fan-triangulated, all objects
+/// merged, no welding except exact duplicates in STL).
+///
+/// - `path`: NUL-terminated UTF-8 path; non-NULL.
+/// - `out`: receives the new mesh; non-NULL.
+///
+/// Returns `PLEAT_STATUS_IO` when the file cannot be read and `PLEAT_STATUS_PARSE` when its
+/// content is invalid; the message names the file and, for text formats, the line.
+///
+/// # Safety
+/// `path` is NULL or NUL-terminated; `out` is NULL or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_mesh_read_file(
+    path: *const std::ffi::c_char,
+    out: *mut *mut PleatMesh,
+) -> PleatStatus {
+    guard(|| {
+        let path = super::common::c_str_arg(path, "path")?;
+        if out.is_null() {
+            return Err(null_arg("out"));
+        }
+        let mesh = crate::mesh::io::read_mesh(std::path::Path::new(path))?;
+        emit_mesh(out, mesh);
+        Ok(())
+    })
+}
+
+/// Writes a mesh file; the format is chosen by the extension: `.obj` and `.ply` (binary,
+/// double precision) are lossless, `.off`, `.stl` (binary, float) and `.glb`/`.gltf` (float)
+/// round coordinates to the format's precision.
+///
+/// # Safety
+/// `mesh` is NULL or live; `path` is NULL or NUL-terminated.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_mesh_write_file(
+    mesh: *const PleatMesh,
+    path: *const std::ffi::c_char,
+) -> PleatStatus {
+    guard(|| {
+        let m = mesh_ref(mesh, "mesh")?;
+        let path = super::common::c_str_arg(path, "path")?;
+        crate::mesh::io::write_mesh(std::path::Path::new(path), m)
+    })
+}

@@ -2,7 +2,7 @@
 //!
 //! # Why not `tobj`
 //!
-//! pleat depends on `tobj`, and this module was meant to use `tobj::load_obj_buf` with
+//! The design (DESIGN.md) called for `tobj`, and this module was meant to use `tobj::load_obj_buf` with
 //! `triangulate: true, single_index: false`. Checked against tobj 4.0.5, that cannot give the
 //! checker's soup, even with the workaround of hiding `o`/`g`/`usemtl` lines so that tobj yields
 //! one model:
