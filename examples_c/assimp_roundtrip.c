@@ -109,7 +109,7 @@ int main(int argc, char **argv) {
 #endif
     exp = make_scene(mesh);
     CHECK(aiExportScene(exp, "obj", out, 0) == aiReturn_SUCCESS);
-    back = aiImportFile(out, aiProcess_Triangulate);
+    back = aiImportFile(out, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
     CHECK(back != NULL);
     if (back) {
         float *p2 = NULL;
@@ -117,7 +117,7 @@ int main(int argc, char **argv) {
         size_t nv2 = 0, ni2 = 0;
         CHECK(gather(back, &p2, &nv2, &i2, &ni2));
         printf("re-imported %s: %zu vertices, %zu triangles\n", out, nv2, ni2 / 3);
-        CHECK(ni2 == ni);
+        CHECK(ni2 == ni && nv2 == nv);
         free(p2);
         free(i2);
         aiReleaseImport(back);

@@ -191,6 +191,23 @@ fn c_programs_pass() {
         ran += 1;
     }
     assert!(ran > 0, "no C program ran");
+    run_python_bindings(&libdir);
+}
+
+/// Runs the ctypes package's tests against the same library.
+fn run_python_bindings(libdir: &Path) {
+    if !have("python3") {
+        println!("SKIPPED: python3 not found; the Python bindings were not tested");
+        return;
+    }
+    let o = Command::new("python3")
+        .arg(root().join("bindings/python/tests/test_pleat.py"))
+        .env("PLEAT_LIBRARY", libdir.join("libpleat.so"))
+        .output()
+        .expect("run python3");
+    print!("{}", String::from_utf8_lossy(&o.stdout));
+    eprint!("{}", String::from_utf8_lossy(&o.stderr));
+    assert!(o.status.success(), "Python binding tests failed");
 }
 
 #[test]
