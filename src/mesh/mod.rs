@@ -1,6 +1,8 @@
 //! Mesh core: the indexed triangle mesh [`TriMesh`], file I/O, half-edge connectivity for local
 //! operations, and [`MeshReport`] validation of any triangle soup.
 
+pub mod halfedge;
 mod trimesh;
 
+pub use halfedge::HalfEdgeMesh;
 pub use trimesh::{Edge, EdgeList, TriMesh};
