@@ -28,9 +28,11 @@
 //! # Ids and panics
 //!
 //! Accessors take ids below the matching `*_capacity()`; an id at or beyond it panics with a
-//! message naming the kind of id and the capacity. A *deleted* id never panics: accessors return
-//! [`INVALID`], `None` or an empty iterator, and the operations refuse it. The C ABI never exposes
-//! half-edge ids.
+//! message naming the kind of id and the capacity. A *deleted* id never panics in the
+//! connectivity accessors (they return [`INVALID`], `None` or an empty iterator) and the
+//! operations refuse it; only the face geometry helpers (`face_positions`, `face_normal`,
+//! `face_area`, `face_area_vector`) need a live face and panic on a deleted one. The C ABI never
+//! exposes half-edge ids.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -394,14 +396,19 @@ impl HalfEdgeMesh {
     /// isolated or deleted vertex. O(valence).
     #[track_caller]
     pub fn outgoing(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
-        let start = self.vertex_halfedge(v).unwrap_or(INVALID);
+        self.rotate(self.vertex_halfedge(v).unwrap_or(INVALID))
+    }
+
+    /// The half-edges leaving `origin(start)`, counter-clockwise from live half-edge `start`
+    /// (nothing when `start` is `INVALID`).
+    fn rotate(&self, start: u32) -> impl Iterator<Item = u32> + '_ {
         let mut cur = start;
         std::iter::from_fn(move || {
             if cur == INVALID {
                 return None;
             }
             let h = cur;
-            // twin(prev(h)) also leaves v: the next outgoing half-edge counter-clockwise.
+            // twin(prev(h)) also leaves origin(h): the next outgoing half-edge counter-clockwise.
             let n = self.halfedges[h as usize].prev ^ 1;
             cur = if n == start { INVALID } else { n };
             Some(h)

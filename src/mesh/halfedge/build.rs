@@ -20,10 +20,11 @@ pub struct Compaction {
 
 /// The corners of a triangle list grouped by the vertex they sit at (CSR). Corner `c = 3f + i`
 /// is corner `i` of triangle `f`; as a directed edge it runs from corner `i` to corner `i + 1`.
+/// Each entry stores `(corner, target vertex)` so that edge look-ups scan contiguous memory.
 struct CornerIndex<'a> {
     tris: &'a [[u32; 3]],
     start: Vec<u32>,
-    corners: Vec<u32>,
+    out: Vec<(u32, u32)>,
 }
 
 impl<'a> CornerIndex<'a> {
@@ -38,24 +39,21 @@ impl<'a> CornerIndex<'a> {
             start[v + 1] += start[v];
         }
         let mut fill = start.clone();
-        let mut corners = vec![0u32; 3 * tris.len()];
+        let mut out = vec![(0u32, 0u32); 3 * tris.len()];
         for (f, t) in tris.iter().enumerate() {
-            for (i, &v) in t.iter().enumerate() {
-                corners[fill[v as usize] as usize] = (3 * f + i) as u32;
-                fill[v as usize] += 1;
+            for i in 0..3 {
+                let v = t[i] as usize;
+                out[fill[v] as usize] = ((3 * f + i) as u32, t[(i + 1) % 3]);
+                fill[v] += 1;
             }
         }
-        CornerIndex {
-            tris,
-            start,
-            corners,
-        }
+        CornerIndex { tris, start, out }
     }
 
-    /// The corners at vertex `v`, in increasing corner order.
+    /// The `(corner, target)` pairs of the corners at vertex `v`, in increasing corner order.
     #[inline]
-    fn at(&self, v: u32) -> &[u32] {
-        &self.corners[self.start[v as usize] as usize..self.start[v as usize + 1] as usize]
+    fn at(&self, v: u32) -> &[(u32, u32)] {
+        &self.out[self.start[v as usize] as usize..self.start[v as usize + 1] as usize]
     }
 
     /// Vertex of corner `c`, `k` steps further along its triangle.
@@ -77,7 +75,7 @@ impl<'a> CornerIndex<'a> {
     /// Number of fans the triangles around `v` form (connected through shared edges at `v`).
     /// Error path only: O(d²) in the number `d` of triangles at `v`.
     fn fan_count(&self, v: u32) -> usize {
-        let cs = self.at(v);
+        let cs: Vec<u32> = self.at(v).iter().map(|&(c, _)| c).collect();
         let mut parent: Vec<usize> = (0..cs.len()).collect();
         fn root(p: &mut [usize], mut i: usize) -> usize {
             while p[i] != i {
@@ -140,18 +138,14 @@ struct Pairing {
 
 /// The error for an edge `a–b` used by more than two faces or twice in one direction.
 fn edge_error(idx: &CornerIndex, a: u32, b: u32) -> Error {
-    let along: Vec<u32> = idx
-        .at(a)
-        .iter()
-        .filter(|&&c| idx.target(c) == b)
-        .map(|&c| c / 3)
-        .collect();
-    let against: Vec<u32> = idx
-        .at(b)
-        .iter()
-        .filter(|&&c| idx.target(c) == a)
-        .map(|&c| c / 3)
-        .collect();
+    let faces_from = |x: u32, y: u32| -> Vec<u32> {
+        idx.at(x)
+            .iter()
+            .filter(|&&(_, t)| t == y)
+            .map(|&(c, _)| c / 3)
+            .collect()
+    };
+    let (along, against) = (faces_from(a, b), faces_from(b, a));
     if along.len() + against.len() > 2 {
         let mut faces: Vec<u32> = along.iter().chain(&against).copied().collect();
         faces.sort_unstable();
@@ -173,7 +167,7 @@ fn edge_error(idx: &CornerIndex, a: u32, b: u32) -> Error {
 /// corner running the other way `2e + 1`. Refuses edges with more than 2 faces, edges traversed
 /// twice in the same direction, and two faces on the same three vertices.
 fn pair_corners(idx: &CornerIndex) -> Result<Pairing> {
-    let nc = idx.corners.len() as u32;
+    let nc = idx.out.len() as u32;
     let mut corner_he = vec![INVALID; nc as usize];
     let mut boundary_corners = Vec::new();
     let mut edge_count = 0u32;
@@ -185,12 +179,12 @@ fn pair_corners(idx: &CornerIndex) -> Result<Pairing> {
         let same = idx
             .at(a)
             .iter()
-            .filter(|&&c2| c2 != c && idx.target(c2) == b)
+            .filter(|&&(c2, t)| t == b && c2 != c)
             .count();
         let mut opposite = INVALID;
         let mut n_opposite = 0;
-        for &c2 in idx.at(b) {
-            if idx.target(c2) == a {
+        for &(c2, t) in idx.at(b) {
+            if t == a {
                 n_opposite += 1;
                 opposite = c2;
             }
@@ -256,7 +250,7 @@ fn vertex_outgoing(idx: &CornerIndex, p: &Pairing, vertex_count: usize) -> Resul
     }
     for (v, out) in v_out.iter_mut().enumerate() {
         if *out == INVALID {
-            if let Some(&c) = idx.at(v as u32).first() {
+            if let Some(&(c, _)) = idx.at(v as u32).first() {
                 *out = p.corner_he[c as usize];
             }
         }

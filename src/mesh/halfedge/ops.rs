@@ -245,20 +245,6 @@ impl<'a> Editor<'a> {
 }
 
 impl HalfEdgeMesh {
-    /// The half-edges leaving `origin(start)`, counter-clockwise from `start`.
-    pub(super) fn rotate(&self, start: u32) -> impl Iterator<Item = u32> + '_ {
-        let mut cur = start;
-        std::iter::from_fn(move || {
-            if cur == INVALID {
-                return None;
-            }
-            let h = cur;
-            let n = self.halfedges[h as usize].prev ^ 1;
-            cur = if n == start { INVALID } else { n };
-            Some(h)
-        })
-    }
-
     /// The vertex opposite half-edge `h` in its face (`None` for a boundary half-edge).
     pub(super) fn opposite_vertex(&self, h: u32) -> Option<u32> {
         self.face(h).map(|_| self.target(self.next(h)))
@@ -295,31 +281,34 @@ impl HalfEdgeMesh {
         if interior && self.is_boundary_vertex(a) && self.is_boundary_vertex(b) {
             return Err(Refusal::BoundaryPinch);
         }
-        self.check_common_neighbours(a, b, c, d)?;
+        let valences = self.check_common_neighbours(a, b, c, d)?;
         match (c, d) {
             (Some(c), Some(d)) => self.check_not_tetrahedron(a, b, c, d)?,
             (Some(x), None) | (None, Some(x)) => self.check_not_lone_triangle(a, b, x)?,
             (None, None) => unreachable!("live edge {} has no face", h >> 1),
         }
-        self.check_collapse_valences(a, b, c, d, interior)
+        self.check_collapse_valences([a, b], valences, c, d, interior)
     }
 
     /// Link condition on vertices: every common neighbour of `a` and `b` is `c` or `d`.
+    /// Returns the valences of `a` and `b`.
     fn check_common_neighbours(
         &self,
         a: u32,
         b: u32,
         c: Option<u32>,
         d: Option<u32>,
-    ) -> std::result::Result<(), Refusal> {
+    ) -> std::result::Result<[usize; 2], Refusal> {
         let mut around_a: Vec<u32> = self.vertex_neighbors(a).collect();
         around_a.sort_unstable();
+        let mut valence_b = 0;
         for x in self.vertex_neighbors(b) {
+            valence_b += 1;
             if Some(x) != c && Some(x) != d && around_a.binary_search(&x).is_ok() {
                 return Err(Refusal::LinkCondition { vertex: x });
             }
         }
-        Ok(())
+        Ok([around_a.len(), valence_b])
     }
 
     /// Link condition on edges: edge `c–d` must not have faces on both `a` and `b` (that makes
@@ -358,14 +347,14 @@ impl HalfEdgeMesh {
     /// keep a manifold valence.
     fn check_collapse_valences(
         &self,
-        a: u32,
-        b: u32,
+        [a, b]: [u32; 2],
+        [valence_a, valence_b]: [usize; 2],
         c: Option<u32>,
         d: Option<u32>,
         interior: bool,
     ) -> std::result::Result<(), Refusal> {
         let faces = 1 + interior as usize;
-        let merged = (self.valence(a) + self.valence(b)).saturating_sub(2 + faces);
+        let merged = (valence_a + valence_b).saturating_sub(2 + faces);
         let merged_min = self.min_valence(a).min(self.min_valence(b));
         if merged < merged_min {
             return Err(Refusal::Valence {
@@ -412,7 +401,7 @@ impl HalfEdgeMesh {
         Ok(self.apply_collapse(h, new_position))
     }
 
-    fn apply_collapse(&mut self, h: u32, p: [f64; 3]) -> CollapseRecord {
+    pub(super) fn apply_collapse(&mut self, h: u32, p: [f64; 3]) -> CollapseRecord {
         let o = h ^ 1;
         let (a, b) = (self.origin(h), self.origin(o));
         let around_b: Vec<u32> = self.outgoing(b).collect();
@@ -531,7 +520,7 @@ impl HalfEdgeMesh {
         Ok(self.apply_flip(h))
     }
 
-    fn apply_flip(&mut self, h: u32) -> FlipRecord {
+    pub(super) fn apply_flip(&mut self, h: u32) -> FlipRecord {
         let o = h ^ 1;
         let (h1, h2) = (self.next(h), self.prev(h)); // b→c, c→a
         let (o1, o2) = (self.next(o), self.prev(o)); // a→d, d→b

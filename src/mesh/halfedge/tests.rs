@@ -354,6 +354,66 @@ fn deleted_ids_do_not_panic() {
     assert!(m.set_position(v, [0.; 3]).is_err());
 }
 
+fn assert_detects(m: &HalfEdgeMesh, what: &str) {
+    match m.check_invariants() {
+        Err(e @ Error::Internal(_)) => assert!(e.to_string().contains(what), "{e}"),
+        other => panic!("corruption not detected (wanted '{what}'): {other:?}"),
+    }
+}
+
+#[test]
+fn check_invariants_detects_corruption() {
+    let good = build(&grid(3, 3));
+    let mut m = good.clone();
+    let n = m.halfedges[0].next;
+    m.halfedges[0].next = m.halfedges[n as usize].next;
+    assert_detects(&m, "prev(next(0))");
+
+    let mut m = good.clone();
+    let v = 1; // on the bottom border
+    let inner = m.outgoing(v).nth(1).unwrap();
+    m.v_out[v as usize] = inner;
+    assert_detects(&m, "is not its boundary half-edge");
+
+    let mut m = good.clone();
+    m.n_faces += 1;
+    assert_detects(&m, "live counts");
+
+    let mut m = good.clone();
+    m.positions[4][1] = f64::INFINITY;
+    assert_detects(&m, "vertex 4 has a non-finite position");
+
+    let mut m = good.clone();
+    m.halfedges[3] = HalfEdge::DELETED;
+    assert_detects(&m, "half-edge 2 is live but its twin is deleted");
+
+    // Unchecked operations that the guards refuse break the invariants detectably.
+    let mut t = build(&tet());
+    t.apply_flip(0);
+    assert_detects(&t, "have the same three vertices");
+    // A flip onto an existing edge c–d whose faces avoid a and b duplicates only the edge.
+    let (mut m, _) = random_ops(&icosphere(2), 400, 21);
+    let dup = m.halfedges().find(|&h| {
+        let Err(Refusal::EdgeExists { a: c, b: d }) = m.can_flip(h) else {
+            return false;
+        };
+        let cd = m.find_halfedge(c, d).unwrap();
+        let ab = [Some(m.origin(h)), Some(m.target(h))];
+        !ab.contains(&m.opposite_vertex(cd)) && !ab.contains(&m.opposite_vertex(cd ^ 1))
+    });
+    m.apply_flip(dup.expect("some flip would duplicate an edge"));
+    assert_detects(&m, "two edges join vertices");
+    let mut t = build(&tet());
+    t.apply_collapse(0, [0.; 3]);
+    assert!(t.check_invariants().is_err());
+    let mut g = build(&grid(3, 3));
+    g.apply_collapse(g.find_halfedge(2, 7).unwrap(), [0.; 3]);
+    assert!(
+        g.check_invariants().is_err(),
+        "a boundary pinch must be detected"
+    );
+}
+
 // ---------------------------------------------------------------------------------------------
 // Refusals.
 
