@@ -296,8 +296,9 @@ fn check_single_fans(idx: &CornerIndex, v_out: &[u32], he: &[HalfEdge]) -> Resul
 }
 
 impl HalfEdgeMesh {
-    /// Builds half-edge connectivity for `mesh`. O(n) time and memory for n triangles (about
-    /// 0.1 s per million triangles in release builds).
+    /// Builds half-edge connectivity for `mesh`. O(n) time and memory for n triangles (0.2–0.3 s
+    /// per million triangles in release builds on a busy 2-core machine). Memory: about 70 bytes
+    /// per triangle for a typical closed mesh, about 110 at the peak while building.
     ///
     /// Vertex and face ids are those of `mesh`. Edge ids follow the first corner (in
     /// `3·face + corner` order) that uses the edge; that corner's half-edge is `2e`.

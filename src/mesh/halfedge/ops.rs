@@ -69,6 +69,8 @@ impl fmt::Display for Refusal {
     }
 }
 
+impl std::error::Error for Refusal {}
+
 /// One saved record, restored by [`HalfEdgeMesh::undo`].
 #[derive(Debug, Clone, Copy)]
 enum Saved {

@@ -644,6 +644,13 @@ fn specific_refusals() {
     assert_eq!(g.can_collapse(inner), Ok(()));
     let border = g.find_halfedge(0, 1).unwrap();
     assert_eq!(g.can_flip(border), Err(Refusal::BoundaryEdge));
+    // A boundary endpoint may drop to valence 2 by a flip: corner 0 then has a single face.
+    let mut corner = g.clone();
+    let diagonal = corner.find_halfedge(0, 5).unwrap();
+    assert_eq!(corner.valence(0), 3);
+    corner.flip_edge(diagonal).unwrap();
+    corner.check_invariants().unwrap();
+    assert_eq!((corner.valence(0), corner.vertex_faces(0).count()), (2, 1));
     // Collapsing the boundary edge 0→1 keeps the corner vertex 0 and removes 1.
     assert_eq!(g.can_collapse(border), Ok(()));
     g.collapse_edge(border, g.position(0)).unwrap();
