@@ -25,6 +25,33 @@
 //! - There is at most one edge between two vertices, no two faces have the same three vertices
 //!   (the mesh is a simplicial 2-manifold with boundary), and every position is finite.
 //!
+//! # Example
+//!
+//! ```
+//! use pleat::mesh::{HalfEdgeMesh, TriMesh};
+//! // A unit square split along the diagonal 0–2.
+//! let quad = TriMesh::new(
+//!     vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]],
+//!     vec![[0, 1, 2], [0, 2, 3]],
+//! )?;
+//! let mut m = HalfEdgeMesh::from_trimesh(&quad)?;
+//! assert_eq!((m.euler_characteristic(), m.boundary_loop_count()), (1, 1));
+//!
+//! // Collapse the boundary edge 0→1 (vertex 1 merges into 0), then revert it.
+//! let h = m.find_halfedge(0, 1).unwrap();
+//! assert!(m.can_collapse(h).is_ok());
+//! let rec = m.collapse_edge(h, [0.5, 0., 0.])?;
+//! assert_eq!((rec.kept_vertex, rec.removed_vertex, m.face_count()), (0, 1, 1));
+//! m.undo(rec.undo)?;
+//! assert_eq!(m.to_trimesh(), quad);
+//!
+//! // Flip the diagonal: 0→2 lies in face (0, 2, 3), so it becomes 3→1.
+//! let rec = m.flip_edge(m.find_halfedge(0, 2).unwrap())?;
+//! assert_eq!(rec.new_vertices, [3, 1]);
+//! m.check_invariants()?;
+//! # Ok::<(), pleat::Error>(())
+//! ```
+//!
 //! # Ids and panics
 //!
 //! Accessors take ids below the matching `*_capacity()`; an id at or beyond it panics with a
