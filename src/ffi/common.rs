@@ -272,3 +272,100 @@ pub struct PleatProgress {
 pub type PleatProgressFn = Option<
     unsafe extern "C" fn(user_data: *mut std::ffi::c_void, info: *const PleatProgress) -> i32,
 >;
+
+// ---------------------------------------------------------------------------------------------
+// Long operations with progress and cancellation
+
+/// Calls the C progress callback; returns `true` to continue.
+///
+/// # Safety
+/// `cb` and `user_data` are as the caller of the pleat entry point passed them.
+unsafe fn call_progress(
+    cb: PleatProgressFn,
+    user_data: *mut std::ffi::c_void,
+    stage: &str,
+    fraction: f64,
+) -> bool {
+    let Some(f) = cb else { return true };
+    let stage = CString::new(stage.replace('\0', "")).unwrap_or_default();
+    let info = PleatProgress {
+        stage: stage.as_ptr(),
+        fraction: fraction.clamp(0.0, 1.0),
+    };
+    f(user_data, &info) == 0
+}
+
+enum Msg {
+    Progress(String, f64),
+    Done(std::thread::Result<crate::Result<()>>),
+}
+
+/// The panic fence for long operations that report progress.
+///
+/// `f` receives a Rust progress closure (return `false` = cancel). The C callback `cb` is always
+/// invoked on the calling thread: without a custom pool `f` runs on the calling thread; with a
+/// pool set by `pleat_set_thread_count`, `f` runs on a pool worker while the calling thread
+/// relays progress messages to `cb` and signals cancellation back through an atomic flag.
+pub(crate) fn guard_progress(
+    cb: PleatProgressFn,
+    user_data: *mut std::ffi::c_void,
+    f: impl FnOnce(&mut dyn FnMut(crate::Progress<'_>) -> bool) -> crate::Result<()>,
+) -> PleatStatus {
+    let result = match current_pool() {
+        None => catch_unwind(AssertUnwindSafe(|| {
+            // SAFETY: cb/user_data come straight from the C caller, on its thread.
+            let mut relay = |p: crate::Progress<'_>| unsafe {
+                call_progress(cb, user_data, p.stage, p.fraction)
+            };
+            f(&mut relay)
+        })),
+        Some(pool) => run_on_pool(&pool, cb, user_data, f),
+    };
+    match result {
+        Ok(Ok(())) => {
+            set_last_error("");
+            PleatStatus::Ok
+        }
+        Ok(Err(e)) => fail(e),
+        Err(p) => fail(Error::Internal(format!("panic: {}", panic_message(&*p)))),
+    }
+}
+
+fn run_on_pool(
+    pool: &rayon::ThreadPool,
+    cb: PleatProgressFn,
+    user_data: *mut std::ffi::c_void,
+    f: impl FnOnce(&mut dyn FnMut(crate::Progress<'_>) -> bool) -> crate::Result<()>,
+) -> std::thread::Result<crate::Result<()>> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let (tx, rx) = std::sync::mpsc::channel::<Msg>();
+    let cancel = AtomicBool::new(false);
+    let job = AssertSend(f);
+    pool.in_place_scope(|s| {
+        let cancel = &cancel;
+        s.spawn(move |_| {
+            let job = job;
+            let progress_tx = tx.clone();
+            let r = catch_unwind(AssertUnwindSafe(|| {
+                let mut relay = |p: crate::Progress<'_>| {
+                    let _ = progress_tx.send(Msg::Progress(p.stage.to_string(), p.fraction));
+                    !cancel.load(Ordering::Relaxed)
+                };
+                (job.0)(&mut relay)
+            }));
+            let _ = tx.send(Msg::Done(r));
+        });
+        loop {
+            match rx.recv() {
+                Ok(Msg::Progress(stage, fraction)) => {
+                    // SAFETY: on the calling thread, with the caller's callback.
+                    if !unsafe { call_progress(cb, user_data, &stage, fraction) } {
+                        cancel.store(true, Ordering::Relaxed);
+                    }
+                }
+                Ok(Msg::Done(r)) => return r,
+                Err(_) => return Ok(Err(Error::Internal("worker vanished".into()))),
+            }
+        }
+    })
+}
