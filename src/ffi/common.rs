@@ -85,7 +85,12 @@ fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
 /// The panic fence: runs `f` on pleat's thread pool, catches panics, maps errors to statuses and
 /// records the message. Every `extern "C"` function that can fail goes through here.
 pub(crate) fn guard(f: impl FnOnce() -> crate::Result<()>) -> PleatStatus {
-    let result = catch_unwind(AssertUnwindSafe(|| with_pool(f)));
+    status_of(catch_unwind(AssertUnwindSafe(|| with_pool(f))))
+}
+
+/// Maps the outcome of a fenced call to its status, recording the message of a failure (and
+/// clearing it on success).
+fn status_of(result: std::thread::Result<crate::Result<()>>) -> PleatStatus {
     match result {
         Ok(Ok(())) => {
             set_last_error("");
@@ -321,14 +326,7 @@ pub(crate) fn guard_progress(
         })),
         Some(pool) => run_on_pool(&pool, cb, user_data, f),
     };
-    match result {
-        Ok(Ok(())) => {
-            set_last_error("");
-            PleatStatus::Ok
-        }
-        Ok(Err(e)) => fail(e),
-        Err(p) => fail(Error::Internal(format!("panic: {}", panic_message(&*p)))),
-    }
+    status_of(result)
 }
 
 fn run_on_pool(
