@@ -24,7 +24,9 @@
 //!   scaled by the same non-zero factor `n · (q − p)`).
 //! - Coplanar configurations: projection to the coordinate plane in which the reference
 //!   triangle's projection has non-zero exact area (an affine bijection of the common plane, so
-//!   all 2D orientations keep their meaning), then 2D closed tests with `orient2d`.
+//!   all 2D orientations keep their meaning), then the separating-axis theorem for convex
+//!   polygons with `orient2d`: closed convex polygons are disjoint iff the line of some edge of
+//!   either one strictly separates them.
 //! - Face pairs of a mesh: CGAL 5.5 `internal::do_faces_intersect`
 //!   (`Polygon_mesh_processing/self_intersections.h`) and `meshcheck.cpp`'s
 //!   `soup_faces_intersect`: same three vertices ⇒ intersect; shared edge ⇒ intersect iff the
@@ -40,6 +42,19 @@ pub type Point3 = [f64; 3];
 /// `det[b − a, c − a, d − a]`. Exact (Shewchuk's adaptive `orient3d`).
 #[inline]
 pub fn orient3d(a: Point3, b: Point3, c: Point3, d: Point3) -> i8 {
+    // Fast exact path for a plane normal to a coordinate axis k (common in CAD models, where
+    // Shewchuk's adaptive stages are slow for exactly coplanar points): with (b − a)_k =
+    // (c − a)_k = 0, det[b − a, c − a, d − a] = (d_k − a_k) · ((b − a) × (c − a))_k, and the
+    // latter factor is the orientation of the projection dropping axis k.
+    for k in 0..3 {
+        if a[k] == b[k] && a[k] == c[k] {
+            return match d[k].partial_cmp(&a[k]) {
+                Some(std::cmp::Ordering::Greater) => orient2d(proj(a, k), proj(b, k), proj(c, k)),
+                Some(std::cmp::Ordering::Less) => -orient2d(proj(a, k), proj(b, k), proj(c, k)),
+                _ => 0,
+            };
+        }
+    }
     // Shewchuk's orient3d(pa, pb, pc, pd) = det[pa − pd, pb − pd, pc − pd], which is positive when
     // pd lies *below* the plane (pa, pb, pc counter-clockwise seen from above): the opposite of
     // our convention.
@@ -98,12 +113,12 @@ pub fn triangles_intersect(a: &[Point3; 3], b: &[Point3; 3]) -> bool {
     if strictly_one_side(da) {
         return false;
     }
+    if da == [0, 0, 0] {
+        return coplanar_triangles_intersect(a, b);
+    }
     let db = sides(a, b);
     if strictly_one_side(db) {
         return false;
-    }
-    if da == [0, 0, 0] {
-        return coplanar_triangles_intersect(a, b);
     }
     // Non-coplanar: an edge of one triangle meets the other triangle.
     (0..3).any(|i| {
@@ -193,9 +208,7 @@ pub fn faces_intersect(positions: &[Point3], a: [u32; 3], b: [u32; 3]) -> bool {
         Sharing::Vertex { ia, ib } => {
             let ta = [p(a[0]), p(a[1]), p(a[2])];
             let tb = [p(b[0]), p(b[1]), p(b[2])];
-            let s_a = [ta[(ia + 1) % 3], ta[(ia + 2) % 3]];
-            let s_b = [tb[(ib + 1) % 3], tb[(ib + 2) % 3]];
-            segment_triangle_intersect(s_b, &ta) || segment_triangle_intersect(s_a, &tb)
+            shared_vertex_faces_intersect(&ta, &tb, ia, ib)
         }
         Sharing::None => {
             triangles_intersect(&[p(a[0]), p(a[1]), p(a[2])], &[p(b[0]), p(b[1]), p(b[2])])
@@ -205,6 +218,24 @@ pub fn faces_intersect(positions: &[Point3], a: [u32; 3], b: [u32; 3]) -> bool {
 
 // ---------------------------------------------------------------------------------------------
 // internals
+
+/// Faces sharing exactly the vertex `ta[ia] == tb[ib]`: intersect iff the edge of `tb` opposite
+/// the shared vertex meets `ta` or the edge of `ta` opposite it meets `tb`. When `tb` lies in
+/// `ta`'s plane both tests are planar and share one projection.
+fn shared_vertex_faces_intersect(ta: &[Point3; 3], tb: &[Point3; 3], ia: usize, ib: usize) -> bool {
+    let s_a = [ta[(ia + 1) % 3], ta[(ia + 2) % 3]];
+    let s_b = [tb[(ib + 1) % 3], tb[(ib + 2) % 3]];
+    let sp = orient3d(ta[0], ta[1], ta[2], s_b[0]);
+    let sq = orient3d(ta[0], ta[1], ta[2], s_b[1]);
+    if sp == 0 && sq == 0 {
+        let d = projection_axis(ta);
+        let ta2 = ta.map(|x| proj(x, d));
+        let tb2 = tb.map(|x| proj(x, d));
+        return segment_triangle_intersect_2d(s_b.map(|x| proj(x, d)), &ta2)
+            || segment_triangle_intersect_2d(s_a.map(|x| proj(x, d)), &tb2);
+    }
+    segment_triangle_with_sides(s_b, ta, sp, sq) || segment_triangle_intersect(s_a, tb)
+}
 
 #[inline]
 fn sign(v: f64) -> i8 {
@@ -298,10 +329,7 @@ fn segment_triangle_with_sides(s: [Point3; 2], t: &[Point3; 3], sp: i8, sq: i8) 
 fn coplanar_segment_triangle(s: [Point3; 2], t: &[Point3; 3]) -> bool {
     let d = projection_axis(t);
     let t2 = [proj(t[0], d), proj(t[1], d), proj(t[2], d)];
-    let (p, q) = (proj(s[0], d), proj(s[1], d));
-    point_in_triangle_2d(p, &t2)
-        || point_in_triangle_2d(q, &t2)
-        || (0..3).any(|i| segments_intersect_2d(p, q, t2[i], t2[(i + 1) % 3]))
+    segment_triangle_intersect_2d([proj(s[0], d), proj(s[1], d)], &t2)
 }
 
 fn coplanar_triangles_intersect(a: &[Point3; 3], b: &[Point3; 3]) -> bool {
@@ -311,45 +339,34 @@ fn coplanar_triangles_intersect(a: &[Point3; 3], b: &[Point3; 3]) -> bool {
     triangles_intersect_2d(&a2, &b2)
 }
 
-/// Closed 2D triangles meet iff an edge of one meets an edge of the other, or one contains a
-/// vertex of the other (the containment case).
+/// Closed 2D triangles (non-degenerate) are disjoint iff the line of some edge of either one
+/// strictly separates them (separating-axis theorem for convex polygons: the candidate axes are
+/// the edge normals).
 fn triangles_intersect_2d(a: &[[f64; 2]; 3], b: &[[f64; 2]; 3]) -> bool {
-    for i in 0..3 {
-        for j in 0..3 {
-            if segments_intersect_2d(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3]) {
-                return true;
-            }
-        }
-    }
-    point_in_triangle_2d(a[0], b) || point_in_triangle_2d(b[0], a)
+    !(edge_separates(a, b) || edge_separates(b, a))
 }
 
-/// Closed point-in-triangle for a non-degenerate 2D triangle.
-fn point_in_triangle_2d(p: [f64; 2], t: &[[f64; 2]; 3]) -> bool {
+/// True when some edge line of `t` has all of `pts` strictly on its outer side.
+fn edge_separates(t: &[[f64; 2]; 3], pts: &[[f64; 2]]) -> bool {
     let o = orient2d(t[0], t[1], t[2]);
-    (0..3).all(|i| orient2d(t[i], t[(i + 1) % 3], p) * o >= 0)
+    (0..3).any(|i| {
+        let (p, q) = (t[i], t[(i + 1) % 3]);
+        pts.iter().all(|&x| orient2d(p, q, x) * o < 0)
+    })
 }
 
-/// Closed segment–segment intersection in 2D (segments may be points).
-fn segments_intersect_2d(p: [f64; 2], q: [f64; 2], r: [f64; 2], s: [f64; 2]) -> bool {
-    let d1 = orient2d(p, q, r);
-    let d2 = orient2d(p, q, s);
-    let d3 = orient2d(r, s, p);
-    let d4 = orient2d(r, s, q);
-    if d1 * d2 < 0 && d3 * d4 < 0 {
+/// Closed segment (possibly a point) against a closed non-degenerate triangle in 2D: disjoint
+/// iff an edge line of the triangle or the segment's own line strictly separates them (the
+/// edges of their Minkowski difference are parallel to those lines).
+fn segment_triangle_intersect_2d(s: [[f64; 2]; 2], t: &[[f64; 2]; 3]) -> bool {
+    if edge_separates(t, &s) {
+        return false;
+    }
+    if s[0] == s[1] {
         return true;
     }
-    (d1 == 0 && in_box(p, q, r))
-        || (d2 == 0 && in_box(p, q, s))
-        || (d3 == 0 && in_box(r, s, p))
-        || (d4 == 0 && in_box(r, s, q))
-}
-
-/// For `x` collinear with `p, q`: whether `x` lies on the closed segment `pq` (exact coordinate
-/// comparisons; a zero-length `pq` contains only itself).
-#[inline]
-fn in_box(p: [f64; 2], q: [f64; 2], x: [f64; 2]) -> bool {
-    (0..2).all(|k| p[k].min(q[k]) <= x[k] && x[k] <= p[k].max(q[k]))
+    let sides = t.map(|x| orient2d(s[0], s[1], x));
+    !(sides.iter().all(|&o| o > 0) || sides.iter().all(|&o| o < 0))
 }
 
 #[cfg(test)]

@@ -612,3 +612,48 @@ fn sat_oracle_sanity() {
         &[[2, 0, 0], [3, 0, 0]]
     ));
 }
+
+#[test]
+fn random_shared_vertex_pairs_match_segment_rule() {
+    // faces_intersect's shared-vertex branch (one projection for coplanar pairs) against the
+    // plain CGAL rule written with two independent segment–triangle tests.
+    let mut rng = Rng(7);
+    let mut hits = 0;
+    for round in 0..40_000 {
+        let v = rng.point(2);
+        let a = [v, rng.point(2), rng.point(2)];
+        let mut b = [v, rng.point(2), rng.point(2)];
+        if round % 2 == 0 {
+            let (u, w) = (isub(a[1], a[0]), isub(a[2], a[0]));
+            for p in &mut b[1..] {
+                let (i, j) = (rng.coord(1), rng.coord(1));
+                *p = [0, 1, 2].map(|k| a[0][k] + i * u[k] + j * w[k]);
+            }
+        }
+        if !non_degenerate(&a) || !non_degenerate(&b) || a[1..].iter().any(|p| b.contains(p)) {
+            continue;
+        }
+        let positions: Vec<Point3> = a
+            .iter()
+            .chain(&b[1..])
+            .map(|&p| to_f(p, 0.5, 8.0))
+            .collect();
+        let (fa, fb) = ([0u32, 1, 2], [0u32, 3, 4]);
+        let ta = [positions[0], positions[1], positions[2]];
+        let tb = [positions[0], positions[3], positions[4]];
+        let expected = segment_triangle_intersect([tb[1], tb[2]], &ta)
+            || segment_triangle_intersect([ta[1], ta[2]], &tb);
+        hits += expected as usize;
+        assert_eq!(
+            faces_intersect(&positions, fa, fb),
+            expected,
+            "a={a:?} b={b:?}"
+        );
+        assert_eq!(
+            faces_intersect(&positions, fb, fa),
+            expected,
+            "swapped a={a:?} b={b:?}"
+        );
+    }
+    assert!(hits > 2_000, "{hits}");
+}
