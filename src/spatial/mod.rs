@@ -4,6 +4,7 @@
 pub mod bvh;
 pub mod self_intersect;
 pub mod tritri;
+pub mod winding;
 
 pub use bvh::{ClosestPoint, TriangleBvh};
 pub use self_intersect::{
@@ -13,4 +14,7 @@ pub use self_intersect::{
 pub use tritri::{
     are_coplanar, coplanar_same_side, faces_intersect, is_collinear, orient2d, orient3d,
     segment_triangle_intersect, sharing, triangles_intersect, Point3, Sharing,
+};
+pub use winding::{
+    solid_angle, winding_number, winding_number_in, winding_numbers, FastWindingNumber,
 };
