@@ -1,6 +1,7 @@
 //! Mesh core: the indexed triangle mesh [`TriMesh`], file I/O, half-edge connectivity for local
 //! operations, and [`MeshReport`] validation of any triangle soup.
 
+pub mod io;
 mod report;
 mod trimesh;
 mod weld;
