@@ -90,6 +90,10 @@ pub struct MeshReport {
     /// Edges with ≥ 2 incident sides whose sides do not pair up into opposite directions
     /// (number traversed `a→b` ≠ number traversed `b→a`) (`n_misoriented_edges`).
     pub n_misoriented_edges: usize,
+    /// Edges with exactly two incident sides that run in the same direction (not in
+    /// meshcheck; the corpus MANIFEST's `n_inconsistent_edges`, which ignores non-manifold
+    /// edges).
+    pub n_misoriented_manifold_edges: usize,
     /// Vertices whose incident non-degenerate triangles form more than one fan — more than one
     /// group connected through edges at the vertex (`n_nonmanifold_vertices`).
     pub n_nonmanifold_vertices: usize,
@@ -221,6 +225,7 @@ impl MeshReport {
             n_nonmanifold_edges: edges.n_nonmanifold,
             max_faces_per_edge: edges.max_faces,
             n_misoriented_edges: edges.n_misoriented,
+            n_misoriented_manifold_edges: edges.n_misoriented_manifold,
             n_nonmanifold_vertices,
             is_closed,
             is_edge_manifold,
@@ -270,6 +275,10 @@ impl MeshReport {
         j.num("n_nonmanifold_edges", self.n_nonmanifold_edges);
         j.num("max_faces_per_edge", self.max_faces_per_edge);
         j.num("n_misoriented_edges", self.n_misoriented_edges);
+        j.num(
+            "n_misoriented_manifold_edges",
+            self.n_misoriented_manifold_edges,
+        );
         j.num("n_nonmanifold_vertices", self.n_nonmanifold_vertices);
         j.boolean("is_closed", self.is_closed);
         j.boolean("is_edge_manifold", self.is_edge_manifold);
@@ -526,6 +535,7 @@ struct EdgePass {
     n_nonmanifold: usize,
     max_faces: usize,
     n_misoriented: usize,
+    n_misoriented_manifold: usize,
     edges_per_component: Vec<i64>,
     /// Per face, the faces across its 2-manifold edges (`u32::MAX` = none) and whether the
     /// neighbour traverses the shared edge in the same direction (an orientation conflict).
@@ -545,6 +555,7 @@ impl EdgePass {
             n_nonmanifold: 0,
             max_faces: 0,
             n_misoriented: 0,
+            n_misoriented_manifold: 0,
             edges_per_component: vec![0; comps.count],
             adjacency: vec![[(u32::MAX, false); 3]; tris.len()],
             offsets,
@@ -572,7 +583,7 @@ impl EdgePass {
     }
 
     fn scan_edges(&mut self, tris: &[[u32; 3]], comps: &Components) {
-        let mut stats = [0usize; 5];
+        let mut stats = [0usize; 6];
         let mut per_comp = std::mem::take(&mut self.edges_per_component);
         let mut adjacency = std::mem::take(&mut self.adjacency);
         self.for_each_edge(|a, _b, group| {
@@ -583,6 +594,7 @@ impl EdgePass {
             stats[2] += (n > 2) as usize;
             stats[3] = stats[3].max(n);
             stats[4] += (n >= 2 && 2 * forward != n) as usize;
+            stats[5] += (n == 2 && forward != 1) as usize;
             per_comp[comps.of_vertex[a as usize] as usize] += 1;
             if n == 2 && side_face(group[0]) != side_face(group[1]) {
                 let same = side_is_forward(tris, group[0]) == side_is_forward(tris, group[1]);
@@ -600,6 +612,7 @@ impl EdgePass {
             self.n_nonmanifold,
             self.max_faces,
             self.n_misoriented,
+            self.n_misoriented_manifold,
         ] = stats;
         self.edges_per_component = per_comp;
         self.adjacency = adjacency;
