@@ -71,11 +71,20 @@ fn run(name: &str, mesh: &TriMesh) -> MeshReport {
     r
 }
 
-/// The `large_*` meshes of the shared corpus, when present.
+/// The `large_*` meshes of the shared corpus, when present (`$PLEAT_MESHES`, else
+/// `../shared/meshes`, else `../../shared/meshes` from the crate root).
 fn corpus(repeat: usize) {
-    let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes"));
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        println!("corpus: {} not found, skipped", dir.display());
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let candidates = [
+        std::env::var_os("PLEAT_MESHES").map(std::path::PathBuf::from),
+        Some(root.join("../shared/meshes")),
+        Some(root.join("../../shared/meshes")),
+    ];
+    let Some(dir) = candidates.into_iter().flatten().find(|d| d.is_dir()) else {
+        println!("corpus: ../shared/meshes not found (set PLEAT_MESHES), skipped");
+        return;
+    };
+    let Ok(entries) = std::fs::read_dir(&dir) else {
         return;
     };
     let mut files: Vec<_> = entries

@@ -449,22 +449,23 @@ impl Rng {
 /// A soup of small random triangles (many crossing), some sharing a vertex or an edge with the
 /// previous triangle, coordinates on a coarse grid so that exact duplicates, touching and
 /// coplanar cases occur.
-fn random_soup(n: usize, seed: u64) -> TriMesh {
+fn random_soup(n: usize, seed: u64, spread: f64) -> TriMesh {
     let mut rng = Rng(seed);
-    let side = 4.0 * (n as f64 / 600.0).cbrt(); // about 50 box overlaps per triangle
+    let side = spread * 4.0 * (n as f64 / 600.0).cbrt(); // spread 1: ~50 overlaps per triangle
     let mut p: Vec<P> = Vec::new();
     let mut t: Vec<[u32; 3]> = Vec::new();
     let grid = |x: f64| (x * 16.0).round() / 16.0;
     for _ in 0..n {
-        let prev = t.last().copied();
-        let mut c = [rng.next() * side, rng.next() * side, rng.next() * side];
+        // Half of the triangles start at a corner of the previous one and may share its corners.
+        let prev = t.last().copied().filter(|_| rng.next() < 0.5);
+        let c = match prev {
+            Some(q) => p[q[0] as usize],
+            None => [rng.next() * side, rng.next() * side, rng.next() * side],
+        };
         let mut tri = [0u32; 3];
         for v in &mut tri {
             match prev {
-                Some(q) if rng.next() < 0.3 => {
-                    *v = q[(rng.next() * 3.0) as usize % 3]; // share a vertex
-                    c = p[*v as usize];
-                }
+                Some(q) if rng.next() < 0.3 => *v = q[(rng.next() * 3.0) as usize % 3],
                 _ => {
                     p.push([0, 1, 2].map(|k| grid(c[k] + rng.next() - 0.5)));
                     *v = p.len() as u32 - 1;
@@ -501,7 +502,7 @@ fn brute_force(m: &TriMesh) -> (Vec<(u32, u32)>, Vec<u32>) {
 #[test]
 fn self_intersections_match_brute_force() {
     for seed in 1..6 {
-        let m = random_soup(600, seed);
+        let m = random_soup(600, seed, 1.0);
         let si = find_self_intersections(&m);
         let (pairs, deg) = brute_force(&m);
         assert!(pairs.len() > 50, "seed {seed}: only {} pairs", pairs.len());
@@ -516,7 +517,7 @@ fn self_intersections_match_brute_force() {
 
 #[test]
 fn results_do_not_depend_on_thread_count() {
-    let m = random_soup(20_000, 99);
+    let m = random_soup(20_000, 99, 1.0);
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

@@ -166,8 +166,8 @@ impl MeshReport {
     }
 
     /// The report with the given options, recording the wall time of each phase in `stats`
-    /// (stages `weld`, `faces`, `components`, `edges`, `fans`, `orientability`,
-    /// `self_intersections`).
+    /// (stages `weld`, `faces`, `components`, `edges`, `fans`, `orientability`, then
+    /// `si_prepare`, `si_bvh`, `si_pairs_and_tests` for the self-intersection pass).
     pub fn compute_timed(mesh: &TriMesh, options: &ReportOptions, stats: &mut Stats) -> MeshReport {
         let positions = mesh.positions();
         let weld = stats.time("weld", || ExactWeld::compute(positions));
@@ -187,11 +187,9 @@ impl MeshReport {
             edges.count_nonmanifold_vertices(tris, &faces.comb_degenerate)
         });
         let orientable = stats.time("orientability", || edges.is_orientable());
-        let si = options.self_intersections.then(|| {
-            stats.time("self_intersections", || {
-                find_self_intersections_welded(positions, mesh.triangles(), &weld)
-            })
-        });
+        let si = options
+            .self_intersections
+            .then(|| find_self_intersections_welded(positions, mesh.triangles(), &weld, stats));
 
         let is_edge_manifold = edges.n_nonmanifold == 0;
         let is_closed = edges.n_boundary == 0 && is_edge_manifold;

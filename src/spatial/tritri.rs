@@ -227,6 +227,11 @@ fn shared_vertex_faces_intersect(ta: &[Point3; 3], tb: &[Point3; 3], ia: usize, 
     let s_b = [tb[(ib + 1) % 3], tb[(ib + 2) % 3]];
     let sp = orient3d(ta[0], ta[1], ta[2], s_b[0]);
     let sq = orient3d(ta[0], ta[1], ta[2], s_b[1]);
+    if sp == sq && sp != 0 {
+        // `tb` meets `ta`'s plane only at the shared vertex, so `ta ∩ tb` is that vertex: the
+        // second test (edge of `ta` against `tb`) is false too, since that edge avoids it.
+        return false;
+    }
     if sp == 0 && sq == 0 {
         let d = projection_axis(ta);
         let ta2 = ta.map(|x| proj(x, d));
