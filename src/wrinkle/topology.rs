@@ -142,6 +142,18 @@ impl Topology {
         }
     }
 
+    /// A topology with nothing in it (a placeholder for the last level, which needs none).
+    pub fn empty() -> Topology {
+        Topology::from_parts(
+            0,
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+        )
+    }
+
     /// Number of edges.
     #[inline]
     pub fn n_edges(&self) -> usize {

@@ -192,3 +192,79 @@ pub fn sci(v: &[f64]) -> String {
     let s: Vec<String> = v.iter().map(|x| format!("{x:.1e}")).collect();
     format!("[{}]", s.join(", "))
 }
+
+/// A regular hexagonal patch of the triangular lattice (spacing 1/`rings`, radius 1) centred at
+/// the origin: the centre vertex (index 0) has six equal neighbours.
+pub fn hex_disk(rings: i64) -> TriMesh {
+    let inside = |i: i64, j: i64| i.abs().max(j.abs()).max((i + j).abs()) <= rings;
+    let mut index = std::collections::HashMap::new();
+    let mut p = Vec::new();
+    let mut coords = vec![(0i64, 0i64)];
+    for i in -rings..=rings {
+        for j in -rings..=rings {
+            if inside(i, j) && (i, j) != (0, 0) {
+                coords.push((i, j));
+            }
+        }
+    }
+    let h = 1.0 / rings as f64;
+    for (n, &(i, j)) in coords.iter().enumerate() {
+        index.insert((i, j), n as u32);
+        p.push([
+            h * (i as f64 + 0.5 * j as f64),
+            h * (j as f64 * 3f64.sqrt() / 2.0),
+            0.0,
+        ]);
+    }
+    let mut t = Vec::new();
+    for i in -rings..=rings {
+        for j in -rings..=rings {
+            let tri = [
+                [(i, j), (i + 1, j), (i, j + 1)],
+                [(i + 1, j), (i + 1, j + 1), (i, j + 1)],
+            ];
+            for c in tri {
+                if c.iter().all(|&(a, b)| inside(a, b)) {
+                    t.push(c.map(|k| index[&k]));
+                }
+            }
+        }
+    }
+    TriMesh::new(p, t).unwrap()
+}
+
+/// The boundary loop of a disk-like mesh as an ordered vertex list.
+pub fn boundary_loop(m: &TriMesh) -> Vec<u32> {
+    let el = m.edges();
+    let mut count = vec![0u32; el.len()];
+    el.face_edges
+        .iter()
+        .flatten()
+        .for_each(|&e| count[e as usize] += 1);
+    let mut next = std::collections::HashMap::new();
+    for (f, t) in m.triangles().iter().enumerate() {
+        for c in 0..3 {
+            if count[el.face_edges[f][c] as usize] == 1 {
+                next.insert(t[c], t[(c + 1) % 3]);
+            }
+        }
+    }
+    let start = *next.keys().min().unwrap();
+    let mut out = vec![start];
+    let mut v = next[&start];
+    while v != start {
+        out.push(v);
+        v = next[&v];
+    }
+    out
+}
+
+/// Winding number of the complex values `z` along the closed vertex loop `lp`.
+pub fn winding(z: &[pleat::wrinkle::Complex], lp: &[u32]) -> f64 {
+    let mut total = 0.0;
+    for i in 0..lp.len() {
+        let (a, b) = (z[lp[i] as usize], z[lp[(i + 1) % lp.len()] as usize]);
+        total += (a.conj() * b).arg();
+    }
+    total / std::f64::consts::TAU
+}

@@ -1,0 +1,181 @@
+//! Wrinkle evaluation (§3.5): incompatible input, vortices, stiff and extreme inputs,
+//! determinism across thread counts.
+
+mod common;
+
+use common::*;
+use pleat::mesh::TriMesh;
+use pleat::wrinkle::{Complex, Cwf, EvalOptions, Evaluated};
+
+fn with_z() -> EvalOptions {
+    EvalOptions {
+        want_z: true,
+        want_normals: true,
+        want_amplitude: true,
+        want_phase: true,
+        ..Default::default()
+    }
+}
+
+fn all_finite(e: &Evaluated) -> bool {
+    e.mesh.positions().iter().flatten().all(|c| c.is_finite())
+        && e.z.as_ref().unwrap().iter().all(|z| z.is_finite())
+        && e.normals
+            .as_ref()
+            .unwrap()
+            .iter()
+            .flatten()
+            .all(|c| c.is_finite())
+        && e.amplitude.as_ref().unwrap().iter().all(|c| c.is_finite())
+}
+
+/// Largest change of `f` across an edge of `m`.
+fn max_jump<T: Copy>(m: &TriMesh, f: &[T], dist: impl Fn(T, T) -> f64) -> f64 {
+    m.edges()
+        .edges
+        .iter()
+        .map(|e| dist(f[e.0[0] as usize], f[e.0[1] as usize]))
+        .fold(0.0, f64::max)
+}
+
+fn displacement_jump(e: &Evaluated) -> f64 {
+    let s = e.smooth_positions.as_ref().unwrap();
+    let d: Vec<[f64; 3]> = e
+        .mesh
+        .positions()
+        .iter()
+        .zip(s)
+        .map(|(p, q)| [p[0] - q[0], p[1] - q[1], p[2] - q[2]])
+        .collect();
+    max_jump(&e.mesh, &d, |a, b| {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    })
+}
+
+fn plane_wave_omega(m: &TriMesh, k: [f64; 3]) -> Vec<f64> {
+    let p = m.positions();
+    m.edges()
+        .edges
+        .iter()
+        .map(|e| {
+            let (a, b) = (p[e.0[0] as usize], p[e.0[1] as usize]);
+            k[0] * (b[0] - a[0]) + k[1] * (b[1] - a[1]) + k[2] * (b[2] - a[2])
+        })
+        .collect()
+}
+
+#[test]
+fn incompatible_input_gives_finite_smooth_output() {
+    let m = irregular_grid(8, 0.3, 21);
+    let n = m.vertex_count();
+    let mut rng = Rng::new(5);
+    let zeta: Vec<Complex> = (0..n).map(|_| Complex::cis(rng.range(-3.2, 3.2))).collect();
+    let omega = plane_wave_omega(&m, [40.0, 10.0, 0.0]);
+    let cwf = Cwf::new(m, omega, vec![0.02; n], zeta).unwrap();
+    println!("incompatible: E_compat = {:.3}", cwf.compatibility_energy());
+    let mut jumps = vec![];
+    for levels in 1..=5 {
+        let (e, _) = cwf.evaluate(levels, &with_z()).unwrap();
+        assert!(all_finite(&e));
+        let z = e.z.as_ref().unwrap();
+        jumps.push(max_jump(&e.mesh, z, |a, b| (a - b).abs()));
+    }
+    println!(
+        "incompatible: max |z_a - z_b| over edges, levels 1..5: {}",
+        sci(&jumps)
+    );
+    // a continuous limit: jumps shrink geometrically once the wave is resolved
+    assert!(
+        jumps[4] < 0.6 * jumps[3] && jumps[3] < 0.7 * jumps[2],
+        "{jumps:?}"
+    );
+}
+
+fn vortex_cwf(m: &TriMesh, c: [f64; 2], winding: f64, singular_vertex: Option<usize>) -> Cwf {
+    let theta: Vec<f64> = m
+        .positions()
+        .iter()
+        .map(|p| winding * (p[1] - c[1]).atan2(p[0] - c[0]))
+        .collect();
+    let wrap = |x: f64| {
+        x - std::f64::consts::TAU * ((x + std::f64::consts::PI) / std::f64::consts::TAU).floor()
+    };
+    let omega: Vec<f64> = m
+        .edges()
+        .edges
+        .iter()
+        .map(|e| {
+            let [a, b] = e.0.map(|v| v as usize);
+            if Some(a) == singular_vertex || Some(b) == singular_vertex {
+                0.0
+            } else {
+                wrap(theta[b] - theta[a])
+            }
+        })
+        .collect();
+    let zeta: Vec<Complex> = (0..m.vertex_count())
+        .map(|j| {
+            if Some(j) == singular_vertex {
+                Complex::ZERO
+            } else {
+                Complex::cis(theta[j])
+            }
+        })
+        .collect();
+    Cwf::new(m.clone(), omega, vec![0.05; m.vertex_count()], zeta).unwrap()
+}
+
+#[test]
+fn vortices_vanish_at_the_singularity() {
+    let grid = irregular_grid(10, 0.25, 31);
+    let disk = hex_disk(4);
+    type Case<'a> = (&'a str, &'a TriMesh, [f64; 2], f64, Option<usize>);
+    let cases: Vec<Case> = vec![
+        ("in face, +1", &grid, [0.512, 0.487], 1.0, None),
+        ("in face, -1", &grid, [0.431, 0.566], -1.0, None),
+        ("at vertex, +1", &disk, [0.0, 0.0], 1.0, Some(0)),
+        ("at vertex, -1", &disk, [0.0, 0.0], -1.0, Some(0)),
+    ];
+    for (name, m, c, w, sv) in cases {
+        let cwf = vortex_cwf(m, c, w, sv);
+        let mut near = vec![];
+        let mut jumps = vec![];
+        for levels in 1..=5 {
+            let (e, _) = cwf.evaluate(levels, &with_z()).unwrap();
+            assert!(all_finite(&e), "{name}");
+            let z = e.z.as_ref().unwrap();
+            let x = e.smooth_positions.as_ref().unwrap();
+            // smallest |z| within 0.05 of the singularity, relative to the amplitude
+            let zmin = x
+                .iter()
+                .zip(z)
+                .filter(|(p, _)| (p[0] - c[0]).hypot(p[1] - c[1]) < 0.05)
+                .map(|(_, z)| z.abs() / 0.05)
+                .fold(f64::INFINITY, f64::min);
+            near.push(zmin);
+            jumps.push(displacement_jump(&e));
+            if levels == 5 {
+                let wn = winding(z, &boundary_loop(&e.mesh));
+                println!("vortex {name:14}: winding number along the level-5 boundary {wn:+.6}");
+                assert!((wn - w).abs() < 1e-9);
+                if let Some(v) = sv {
+                    println!(
+                        "vortex {name:14}: |z| at the singular vertex {:.1e}",
+                        z[v].abs()
+                    );
+                    assert!(z[v].abs() < 1e-12);
+                }
+            }
+        }
+        println!(
+            "vortex {name:14}: min |z|/a near the singularity, levels 1..5: {}",
+            sci(&near)
+        );
+        println!(
+            "vortex {name:14}: max displacement jump across an edge, levels 1..5: {}",
+            sci(&jumps)
+        );
+        assert!(near[4] < 0.1, "{name}: {near:?}");
+        assert!(jumps[4] < 0.5 * jumps[2], "{name}: {jumps:?}");
+    }
+}
