@@ -179,3 +179,153 @@ fn vortices_vanish_at_the_singularity() {
         assert!(jumps[4] < 0.5 * jumps[2], "{name}: {jumps:?}");
     }
 }
+
+fn scaled(m: &TriMesh, s: f64) -> TriMesh {
+    let p = m.positions().iter().map(|p| p.map(|c| c * s)).collect();
+    TriMesh::new(p, m.triangles().to_vec()).unwrap()
+}
+
+/// Max |z − a e^{ik·x}| / a over the level-`levels` vertices for a compatible plane wave.
+fn plane_wave_eval_error(m: &TriMesh, k: [f64; 3], levels: usize) -> f64 {
+    let n = m.vertex_count();
+    let zeta = m
+        .positions()
+        .iter()
+        .map(|p| Complex::cis(k[0] * p[0] + k[1] * p[1] + k[2] * p[2]))
+        .collect();
+    let a = 0.25;
+    let cwf = Cwf::new(m.clone(), plane_wave_omega(m, k), vec![a; n], zeta).unwrap();
+    let (e, _) = cwf.evaluate(levels, &with_z()).unwrap();
+    assert!(all_finite(&e));
+    let x = e.smooth_positions.as_ref().unwrap();
+    e.z.as_ref()
+        .unwrap()
+        .iter()
+        .zip(x)
+        .map(|(z, p)| {
+            (*z - Complex::cis(k[0] * p[0] + k[1] * p[1] + k[2] * p[2]).scale(a)).abs() / a
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn stiff_and_extreme_inputs() {
+    let mut rng = Rng::new(77);
+    // zero amplitude everywhere: no displacement at all, z stays exactly zero
+    let m = torus(12, 8, 2);
+    let (n, ne) = (m.vertex_count(), m.edges().len());
+    let omega: Vec<f64> = (0..ne).map(|_| rng.range(-1e3, 1e3)).collect();
+    let zeta: Vec<Complex> = (0..n).map(|_| Complex::cis(rng.range(-3.0, 3.0))).collect();
+    let cwf = Cwf::new(m.clone(), omega, vec![0.0; n], zeta.clone()).unwrap();
+    let (e, _) = cwf.evaluate(3, &with_z()).unwrap();
+    assert!(e.z.as_ref().unwrap().iter().all(|z| *z == Complex::ZERO));
+    assert_eq!(e.mesh.positions(), &e.smooth_positions.unwrap()[..]);
+    println!(
+        "a = 0: z ≡ 0 and zero displacement on {} vertices",
+        e.mesh.vertex_count()
+    );
+
+    // huge frequencies: finite, bounded by the amplitude
+    let omega: Vec<f64> = (0..ne).map(|_| rng.range(-1e6, 1e6)).collect();
+    let cwf = Cwf::new(m.clone(), omega, vec![0.1; n], zeta).unwrap();
+    let (e, _) = cwf.evaluate(3, &with_z()).unwrap();
+    assert!(all_finite(&e));
+    let zmax =
+        e.z.as_ref()
+            .unwrap()
+            .iter()
+            .map(|z| z.abs())
+            .fold(0.0, f64::max);
+    println!("|ω| ≤ 1e6: finite, max |z| = {zmax:.3} (amplitude 0.1)");
+    assert!(zmax <= 0.1 * (1.0 + 1e-12));
+
+    // nearly degenerate triangles: an interior vertex 1e-12 off the line of two neighbours
+    let g = irregular_grid(6, 0.0, 1);
+    let mut p = g.positions().to_vec();
+    let id = |i: usize, j: usize| j * 7 + i;
+    p[id(3, 3)] = [0.5, 0.5 + 1e-12, 0.0];
+    p[id(2, 3)] = [0.5 - 1.0 / 6.0, 0.5, 0.0];
+    p[id(4, 3)] = [0.5 + 1.0 / 6.0, 0.5, 0.0];
+    p[id(3, 2)] = [0.5, 0.5 - 1e-12, 0.0];
+    let sliver = TriMesh::new(p, g.triangles().to_vec()).unwrap();
+    let min_area = (0..sliver.triangle_count())
+        .map(|t| sliver.triangle_area(t))
+        .fold(f64::INFINITY, f64::min);
+    let err = plane_wave_eval_error(&sliver, [30.0, 20.0, 0.0], 4);
+    println!("slivers (min area {min_area:.1e}): plane-wave error after 4 levels {err:.1e}");
+    assert!(err < 1e-10);
+
+    // scale invariance: coordinates × 1e-6 and × 1e6 with k / s
+    let base = irregular_grid(6, 0.3, 12);
+    for s in [1e-6, 1.0, 1e6] {
+        let err = plane_wave_eval_error(&scaled(&base, s), [50.0 / s, -20.0 / s, 0.0], 4);
+        println!("coordinates × {s:.0e}: plane-wave error after 4 levels {err:.1e}");
+        assert!(err < 1e-11);
+    }
+
+    // a single triangle
+    let err = plane_wave_eval_error(&single_triangle(), [40.0, 25.0, 0.0], 5);
+    println!("single triangle: plane-wave error after 5 levels {err:.1e}");
+    assert!(err < 1e-11);
+
+    // a non-manifold base is refused with a clear error
+    let p = vec![
+        [0.; 3],
+        [1., 0., 0.],
+        [0., 1., 0.],
+        [0., -1., 0.],
+        [0., 0., 1.],
+    ];
+    let nm = TriMesh::new(p, vec![[0, 1, 2], [1, 0, 3], [0, 4, 1]]).unwrap();
+    let err = Cwf::new(nm, vec![0.0; 7], vec![1.0; 5], vec![Complex::ONE; 5]).unwrap_err();
+    println!("non-manifold base: {err}");
+    assert!(err.to_string().contains("more than two triangles"));
+}
+
+#[test]
+fn output_bytes_do_not_depend_on_thread_count() {
+    let m = torus(16, 10, 4);
+    let n = m.vertex_count();
+    let mut rng = Rng::new(8);
+    let omega = plane_wave_omega(&m, [7.0, 3.0, 5.0]);
+    let zeta: Vec<Complex> = (0..n).map(|_| Complex::cis(rng.range(-3.0, 3.0))).collect();
+    let cwf = Cwf::new(m, omega, vec![0.05; n], zeta).unwrap();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| cwf.evaluate(4, &with_z()).unwrap().0)
+    };
+    let (a, b) = (run(1), run(2));
+    let bits = |e: &Evaluated| {
+        let mut v: Vec<u64> = e
+            .mesh
+            .positions()
+            .iter()
+            .flatten()
+            .map(|c| c.to_bits())
+            .collect();
+        v.extend(
+            e.z.as_ref()
+                .unwrap()
+                .iter()
+                .flat_map(|z| [z.re.to_bits(), z.im.to_bits()]),
+        );
+        v.extend(
+            e.normals
+                .as_ref()
+                .unwrap()
+                .iter()
+                .flatten()
+                .map(|c| c.to_bits()),
+        );
+        v
+    };
+    assert_eq!(bits(&a), bits(&b));
+    assert_eq!(a.mesh.triangles(), b.mesh.triangles());
+    println!(
+        "1 vs 2 threads: {} output values identical bit for bit",
+        bits(&a).len()
+    );
+}

@@ -68,7 +68,7 @@
 use rayon::prelude::*;
 
 use super::complex::Complex;
-use super::topology::{add, dot, norm, scale, sub, Topology, NONE};
+use super::topology::{add, cross, dot, norm, scale, sub, Topology, NONE};
 use crate::mesh::TriMesh;
 use crate::{Error, Result};
 
@@ -429,9 +429,13 @@ pub(crate) fn exterior_derivative(topo: &Topology, f: &[f64]) -> Vec<f64> {
 
 /// Per face and corner `t`, the tangent vector `g_t` of App. B.3 (eqs. B.50–B.52): the vector
 /// in the face plane with `g_t·(x_{t+1} − x_t) = ω(t→t+1)` and `g_t·(x_{t+2} − x_t) = ω(t→t+2)`.
-/// `ω(P)(d) = Σ_t α_t g_t·d` (B.49) is the cotangent vector at `P = Σ α_t x_t`. On a nearly
-/// degenerate face (Gram determinant below 1e-12 of its scale) the 2×2 Gram system is solved
-/// in the least-squares sense along its dominant direction, so no value blows up.
+/// `ω(P)(d) = Σ_t α_t g_t·d` (B.49) is the cotangent vector at `P = Σ α_t x_t`.
+///
+/// A nearly degenerate face (Gram determinant below `1e-12` of its squared trace, i.e. height
+/// below ~1e-6 of its length) cannot tell the component of ω across it; its corners use instead
+/// the least-squares gradient of ω over the corner vertex's one-ring edges, in the tangent
+/// plane of the vertex's area-weighted normal ([`ring_gradient`]). Both are exact for
+/// `ω = d(k·x)` with `k` tangent, so plane waves stay exact.
 pub(crate) fn face_gradients(topo: &Topology, x: &[[f64; 3]], omega: &[f64]) -> Vec<[[f64; 3]; 3]> {
     (0..topo.n_faces())
         .into_par_iter()
@@ -445,27 +449,84 @@ pub(crate) fn face_gradients(topo: &Topology, x: &[[f64; 3]], omega: &[f64]) -> 
                 let e2 = sub(x[t[(c + 2) % 3] as usize], o);
                 // ω(c→c+1) = w[c]; ω(c→c+2) = −ω(c+2→c) = −w[c+2]
                 corner_gradient(e1, e2, w[c], -w[(c + 2) % 3])
+                    .unwrap_or_else(|| ring_gradient(topo, x, omega, t[c]))
             })
         })
         .collect()
 }
 
-/// Solves `g·e1 = r1, g·e2 = r2` for `g = x e1 + y e2` (eq. B.52).
-fn corner_gradient(e1: [f64; 3], e2: [f64; 3], r1: f64, r2: f64) -> [f64; 3] {
+/// Solves `g·e1 = r1, g·e2 = r2` for `g = x e1 + y e2` (eq. B.52); `None` when the Gram
+/// matrix is numerically singular.
+fn corner_gradient(e1: [f64; 3], e2: [f64; 3], r1: f64, r2: f64) -> Option<[f64; 3]> {
     let (a, b, c) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
+    let det = a * c - b * b;
+    let tr = a + c;
+    if det.is_nan() || det <= 1e-12 * tr * tr {
+        return None;
+    }
+    let x = (c * r1 - b * r2) / det;
+    let y = (a * r2 - b * r1) / det;
+    Some(add(scale(e1, x), scale(e2, y)))
+}
+
+/// Least-squares tangent gradient of ω at vertex `v`: `g = argmin Σ_u (g·(x_u − x_v) − ω(v→u))²`
+/// over the edges at `v`, with `g` in the plane orthogonal to the area-weighted vertex normal.
+/// A rank-deficient system is solved along its dominant direction only; no value blows up.
+fn ring_gradient(topo: &Topology, x: &[[f64; 3]], omega: &[f64], v: u32) -> [f64; 3] {
+    let o = x[v as usize];
+    let mut n = [0.0; 3];
+    for &f in topo.vert_faces.row(v as usize) {
+        let t = topo.faces[f as usize];
+        let p = x[t[0] as usize];
+        n = add(n, cross(sub(x[t[1] as usize], p), sub(x[t[2] as usize], p)));
+    }
+    let (t1, t2) = tangent_basis(n);
+    let (mut a, mut b, mut c, mut r1, mut r2) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for &e in topo.vert_edges.row(v as usize) {
+        let d = sub(x[topo.other_end(e as usize, v) as usize], o);
+        let (p, q) = (dot(d, t1), dot(d, t2));
+        let w = topo.omega_from(omega, e as usize, v);
+        a += p * p;
+        b += p * q;
+        c += q * q;
+        r1 += p * w;
+        r2 += q * w;
+    }
+    let (s1, s2) = solve_sym2_robust(a, b, c, r1, r2);
+    add(scale(t1, s1), scale(t2, s2))
+}
+
+/// An orthonormal pair spanning the plane orthogonal to `n` (any pair when `n = 0`).
+fn tangent_basis(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let l = norm(n);
+    let n = if l > 0.0 && l.is_finite() {
+        scale(n, 1.0 / l)
+    } else {
+        [0.0, 0.0, 1.0]
+    };
+    let helper = if n[0].abs() < 0.6 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let t1 = cross(n, helper);
+    let t1 = scale(t1, 1.0 / norm(t1));
+    (t1, cross(n, t1))
+}
+
+/// Solves `[[a, b], [b, c]] s = r` for symmetric PSD input; along the dominant eigenvector only
+/// when the matrix is numerically rank one, and `0` when it is zero.
+fn solve_sym2_robust(a: f64, b: f64, c: f64, r1: f64, r2: f64) -> (f64, f64) {
     let tr = a + c;
     let det = a * c - b * b;
-    if tr <= 0.0 {
-        return [0.0; 3];
+    if tr.is_nan() || tr <= 0.0 || !tr.is_finite() {
+        return (0.0, 0.0);
     }
     if det > 1e-12 * tr * tr {
-        let x = (c * r1 - b * r2) / det;
-        let y = (a * r2 - b * r1) / det;
-        return add(scale(e1, x), scale(e2, y));
+        return ((c * r1 - b * r2) / det, (a * r2 - b * r1) / det);
     }
-    // Rank-one pseudo-inverse: G ≈ λ u uᵀ with the dominant eigenpair of [[a, b], [b, c]].
     let lambda = 0.5 * (tr + ((a - c).powi(2) + 4.0 * b * b).sqrt());
-    let (ux, uy) = if (a - lambda).abs() + b.abs() > 0.0 && b != 0.0 {
+    let (ux, uy) = if b != 0.0 {
         let (ux, uy) = (b, lambda - a);
         let l = ux.hypot(uy);
         (ux / l, uy / l)
@@ -475,7 +536,7 @@ fn corner_gradient(e1: [f64; 3], e2: [f64; 3], r1: f64, r2: f64) -> [f64; 3] {
         (0.0, 1.0)
     };
     let s = (ux * r1 + uy * r2) / lambda;
-    add(scale(e1, s * ux), scale(e2, s * uy))
+    (s * ux, s * uy)
 }
 
 /// What the z rules read on the coarse level.
@@ -816,12 +877,12 @@ mod tests {
         let k = [0.3, -1.7, 0.0];
         let e1 = [1.0, 0.2, 0.0];
         let e2 = [-0.4, 0.9, 0.0];
-        let g = corner_gradient(e1, e2, dot(k, e1), dot(k, e2));
+        let g = corner_gradient(e1, e2, dot(k, e1), dot(k, e2)).unwrap();
         assert!(norm(sub(g, k)) < 1e-14);
-        // degenerate: collinear edges stay finite
-        let g = corner_gradient(e1, scale(e1, 2.0), 1.0, 2.0);
-        assert!(g.iter().all(|c| c.is_finite()));
-        assert!((dot(g, e1) - 1.0).abs() < 1e-12);
+        // degenerate: collinear edges are refused; the robust 2×2 solve stays finite
+        assert!(corner_gradient(e1, scale(e1, 2.0), 1.0, 2.0).is_none());
+        let (s1, s2) = solve_sym2_robust(1.0, 2.0, 4.0, 1.0, 2.0);
+        assert!((s1 + 2.0 * s2 - 1.0).abs() < 1e-15 && (2.0 * s1 - s2).abs() < 1e-15);
     }
 
     #[test]
