@@ -69,7 +69,8 @@ impl Default for EvalOptions {
 pub struct Evaluated {
     /// The displaced mesh `x_i + s Re(z_i) n̂_i`.
     pub mesh: TriMesh,
-    /// The S0-subdivided amplitude `a` (eq. 3.23 rules applied to `a`).
+    /// The S0-subdivided amplitude `a` (eq. 3.23 rules applied to `a`; subdivided only when
+    /// requested — the displacement needs only `z`, which carries the amplitude).
     pub amplitude: Option<Vec<f64>>,
     /// `arg z_i` in `(−π, π]` (0 where `z_i = 0`).
     pub phase: Option<Vec<f64>>,
@@ -94,9 +95,12 @@ struct Level<'a> {
 }
 
 impl Cwf {
-    /// Evaluates the wrinkled surface after `levels` Loop refinements (§3.5): `Stats` records
-    /// the wall time of each level (`"level k"`) and of the displacement, and counts
-    /// `"level k vertices"` / `"level k faces"`. Errors with
+    /// Evaluates the wrinkled surface after `levels` Loop refinements (§3.5). `Stats` records
+    /// the wall time of each part of each level as stages `"level k: positions"`,
+    /// `"level k: cotangent vectors"`, `"level k: z"`, `"level k: topology"`,
+    /// `"level k: one-form"` (or `"level k: triangles"` on the last level) and `"displace"`,
+    /// the metric `"level k seconds"` (whole level), and counts `"level k vertices"` /
+    /// `"level k faces"`. Errors with
     /// [`crate::Error::LimitExceeded`] above [`EvalOptions::max_output_faces`] and
     /// [`crate::Error::InvalidArgument`] for a non-finite displacement scale.
     pub fn evaluate(&self, levels: usize, opts: &EvalOptions) -> Result<(Evaluated, Stats)> {
@@ -108,14 +112,25 @@ impl Cwf {
         }
         check_output_size(self.topo.n_faces(), levels, opts.max_output_faces)?;
         let mut stats = Stats::default();
-        let mut level = stats.time("setup", || self.base_level(&opts.subdivision));
+        let mut level = stats.time("setup", || {
+            self.base_level(&opts.subdivision, opts.want_amplitude)
+        });
         let mut faces = self.topo.faces.clone();
         for l in 0..levels {
             let last = l + 1 == levels;
             let keep_topology = !last || opts.want_omega;
-            let (next, next_faces) = stats.time(&format!("level {}", l + 1), || {
-                refine_level(&level, keep_topology, opts.subdivision.boundary)
-            });
+            let t0 = std::time::Instant::now();
+            let (next, next_faces) = refine_level(
+                &level,
+                keep_topology,
+                opts.subdivision.boundary,
+                &mut stats,
+                l + 1,
+            );
+            stats.metric(
+                &format!("level {} seconds", l + 1),
+                t0.elapsed().as_secs_f64(),
+            );
             stats.count(&format!("level {} vertices", l + 1), next.x.len() as u64);
             stats.count(&format!("level {} faces", l + 1), next_faces.len() as u64);
             level = next;
@@ -125,7 +140,7 @@ impl Cwf {
         Ok((out, stats))
     }
 
-    fn base_level(&self, sub_opts: &SubdivisionOptions) -> Level<'_> {
+    fn base_level(&self, sub_opts: &SubdivisionOptions, want_amplitude: bool) -> Level<'_> {
         let topo = if sub_opts.boundary == BoundaryRule::Smooth {
             let mut t = self.topo.clone();
             t.mark_corners(self.base().positions(), sub_opts.corner_angle);
@@ -146,46 +161,49 @@ impl Cwf {
             x: self.base().positions().to_vec(),
             omega: self.omega().to_vec(),
             z,
-            amplitude: self.amplitude().to_vec(),
+            amplitude: if want_amplitude {
+                self.amplitude().to_vec()
+            } else {
+                Vec::new()
+            },
         }
     }
 }
 
-/// One Loop step of every field. Without `keep_topology` only the fine triangles are built
-/// (the last level needs no adjacency and no one-form).
+/// One Loop step of every field, timing its parts as `"level k: <part>"` in `stats`. Without
+/// `keep_topology` only the fine triangles are built (the last level needs no adjacency and no
+/// one-form).
 fn refine_level<'a>(
     c: &Level<'_>,
     keep_topology: bool,
     boundary: BoundaryRule,
+    stats: &mut Stats,
+    k: usize,
 ) -> (Level<'a>, Vec<[u32; 3]>) {
     let topo = c.topo.as_ref();
-    let x = apply_s0(topo, &c.rules, &c.x);
-    let amplitude = apply_s0(topo, &c.rules, &c.amplitude);
+    let name = |part: &str| format!("level {k}: {part}");
+    let x = stats.time(&name("positions"), || apply_s0(topo, &c.rules, &c.x));
+    let amplitude = stats.time(&name("amplitude"), || {
+        if c.amplitude.is_empty() {
+            Vec::new()
+        } else {
+            apply_s0(topo, &c.rules, &c.amplitude)
+        }
+    });
+    let faces = stats.time(&name("cotangent vectors"), || {
+        face_gradients(topo, &c.x, &c.omega)
+    });
     let ctx = ZContext {
         topo,
         rules: &c.rules,
         x: &c.x,
         omega: &c.omega,
         z: &c.z,
-        grads: face_gradients(topo, &c.x, &c.omega),
+        faces,
     };
-    let z = apply_z(&ctx, &x);
-    if keep_topology {
-        let fine = topo.refine();
-        let omega = apply_s1(topo, &fine, &c.rules, &c.omega);
-        let rules = vertex_rules(&fine, boundary);
-        let faces = fine.faces.clone();
-        let next = Level {
-            topo: std::borrow::Cow::Owned(fine),
-            rules,
-            x,
-            omega,
-            z,
-            amplitude,
-        };
-        (next, faces)
-    } else {
-        let faces = topo.refine_faces();
+    let z = stats.time(&name("z"), || apply_z(&ctx, &x));
+    if !keep_topology {
+        let faces = stats.time(&name("triangles"), || topo.refine_faces());
         let next = Level {
             topo: std::borrow::Cow::Owned(empty_topology()),
             rules: Vec::new(),
@@ -194,8 +212,23 @@ fn refine_level<'a>(
             z,
             amplitude,
         };
-        (next, faces)
+        return (next, faces);
     }
+    let fine = stats.time(&name("topology"), || topo.refine());
+    let omega = stats.time(&name("one-form"), || {
+        apply_s1(topo, &fine, &c.rules, &c.omega)
+    });
+    let rules = vertex_rules(&fine, boundary);
+    let faces = fine.faces.clone();
+    let next = Level {
+        topo: std::borrow::Cow::Owned(fine),
+        rules,
+        x,
+        omega,
+        z,
+        amplitude,
+    };
+    (next, faces)
 }
 
 fn empty_topology() -> Topology {

@@ -436,23 +436,31 @@ pub(crate) fn exterior_derivative(topo: &Topology, f: &[f64]) -> Vec<f64> {
 /// the least-squares gradient of ω over the corner vertex's one-ring edges, in the tangent
 /// plane of the vertex's area-weighted normal ([`ring_gradient`]). Both are exact for
 /// `ω = d(k·x)` with `k` tangent, so plane waves stay exact.
-pub(crate) fn face_gradients(topo: &Topology, x: &[[f64; 3]], omega: &[f64]) -> Vec<[[f64; 3]; 3]> {
+pub(crate) fn face_gradients(topo: &Topology, x: &[[f64; 3]], omega: &[f64]) -> Vec<FaceField> {
     (0..topo.n_faces())
         .into_par_iter()
         .map(|f| {
             let t = topo.faces[f];
             let fe = topo.face_edges[f];
             let w = [0, 1, 2].map(|c| topo.omega_from(omega, fe[c] as usize, t[c]));
-            [0, 1, 2].map(|c| {
+            let g = [0, 1, 2].map(|c| {
                 let o = x[t[c] as usize];
                 let e1 = sub(x[t[(c + 1) % 3] as usize], o);
                 let e2 = sub(x[t[(c + 2) % 3] as usize], o);
                 // ω(c→c+1) = w[c]; ω(c→c+2) = −ω(c+2→c) = −w[c+2]
                 corner_gradient(e1, e2, w[c], -w[(c + 2) % 3])
                     .unwrap_or_else(|| ring_gradient(topo, x, omega, t[c]))
-            })
+            });
+            FaceField { w, g }
         })
         .collect()
+}
+
+/// Per face: `w[c] = ω(c → c+1)` in corner order and the corner tangent vectors `g[c]` (B.52).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FaceField {
+    w: [f64; 3],
+    g: [[f64; 3]; 3],
 }
 
 /// Solves `g·e1 = r1, g·e2 = r2` for `g = x e1 + y e2` (eq. B.52); `None` when the Gram
@@ -546,30 +554,32 @@ pub(crate) struct ZContext<'a> {
     pub x: &'a [[f64; 3]],
     pub omega: &'a [f64],
     pub z: &'a [Complex],
-    pub grads: Vec<[[f64; 3]; 3]>,
+    pub faces: Vec<FaceField>,
 }
 
 impl ZContext<'_> {
-    /// Eq. 3.19: `z` at the point of barycentric coordinates `b` in face `f`.
-    fn z_in_face(&self, f: usize, b: [f64; 3]) -> Complex {
+    /// `z(P) e^{iψ}` with `z(P)` of eq. 3.19 at barycentric `b` in face `f`: each corner's vote
+    /// `b_c z_c e^{i(b_{c+1} ω(c→c+1) + b_{c+2} ω(c→c+2))}` is rotated by the extrapolation
+    /// phase `ψ` in the same `cis` (one transcendental per corner).
+    fn vote_with_phase(&self, f: usize, b: [f64; 3], psi: f64) -> Complex {
         let t = self.topo.faces[f];
-        let fe = self.topo.face_edges[f];
-        let w = [0, 1, 2].map(|c| self.topo.omega_from(self.omega, fe[c] as usize, t[c]));
+        let w = self.faces[f].w;
         let mut acc = Complex::ZERO;
         for c in 0..3 {
-            let (n, p) = ((c + 1) % 3, (c + 2) % 3);
-            if b[c] == 0.0 {
+            let zc = self.z[t[c] as usize];
+            if b[c] == 0.0 || zc == Complex::ZERO {
                 continue;
             }
-            let phase = b[n] * w[c] - b[p] * w[p];
-            acc += self.z[t[c] as usize] * Complex::cis(phase) * b[c];
+            let (n, p) = ((c + 1) % 3, (c + 2) % 3);
+            let phase = b[n] * w[c] - b[p] * w[p] + psi;
+            acc += zc * Complex::cis(phase) * b[c];
         }
         acc
     }
 
     /// Eq. B.49: `ω(P)(d)` at barycentric coordinates `b` in face `f`.
     fn omega_at(&self, f: usize, b: [f64; 3], d: [f64; 3]) -> f64 {
-        let g = &self.grads[f];
+        let g = &self.faces[f].g;
         b[0] * dot(g[0], d) + b[1] * dot(g[1], d) + b[2] * dot(g[2], d)
     }
 
@@ -583,8 +593,8 @@ impl ZContext<'_> {
     /// `z(P) e^{iω(P)(target − P)}` for `P` at barycentric `b` in `f` (projected displacement).
     fn vote(&self, f: usize, b: [f64; 3], target: [f64; 3]) -> Complex {
         let p = self.position(f, b);
-        let phase = self.omega_at(f, b, sub(target, p));
-        self.z_in_face(f, b) * Complex::cis(phase)
+        let psi = self.omega_at(f, b, sub(target, p));
+        self.vote_with_phase(f, b, psi)
     }
 
     fn all_zero(&self, vs: impl IntoIterator<Item = u32>) -> bool {
@@ -652,8 +662,8 @@ impl ZContext<'_> {
             let mut bc = [0.375; 3];
             bc[topo.corner_of(f, opp)] = 0.25;
             // P1* − P0 = (d* − c)/4; the text's step is half of it.
-            let phase = self.omega_at(f, bc, scale(offset, 0.125));
-            self.z_in_face(f, bc) * Complex::cis(phase)
+            let psi = self.omega_at(f, bc, scale(offset, 0.125));
+            self.vote_with_phase(f, bc, psi)
         };
         (half(f0, c, dc) + half(f1, d, cd)).scale(0.5)
     }
@@ -807,7 +817,7 @@ impl LoopHierarchy {
             x,
             omega,
             z,
-            grads: face_gradients(topo, x, omega),
+            faces: face_gradients(topo, x, omega),
         };
         Ok(apply_z(&ctx, &self.positions[level + 1]))
     }

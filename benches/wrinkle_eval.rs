@@ -1,0 +1,385 @@
+//! Wrinkle evaluation benchmark (plain `std::time`, `cargo bench --bench wrinkle_eval`):
+//!
+//! 1. evaluation time per level on the coarse corpus meshes (`/work/shared/meshes/coarse_*`,
+//!    or `$PLEAT_MESHES`) up to ~1M output faces, with 1 and 2 rayon threads;
+//! 2. error against run time for the plane-wave test (max phase error vs level vs seconds);
+//! 3. the effect of zero-amplitude regions (z work skipped where the stencil is all zero).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use pleat::mesh::TriMesh;
+use pleat::wrinkle::{Complex, Cwf, EvalOptions, FrequencyField, KnoppelOptions};
+
+const MAX_FACES: usize = 1_100_000;
+const REPEATS: usize = 3;
+
+fn main() {
+    let dir = std::env::var("PLEAT_MESHES").unwrap_or_else(|_| "/work/shared/meshes".into());
+    if std::env::var("PLEAT_BENCH_ONLY").as_deref() == Ok("profile") {
+        // one 1M-face evaluation on one thread, for `perf record`
+        let cwf =
+            swirl_cwf(load(&Path::new(&dir).join("coarse_decimated-knight.off")).unwrap()).unwrap();
+        let t = best_time(&cwf, 5, 1);
+        println!("knight level 5, 1 thread: {t:.4} s");
+        let t = best_time(&cwf, 5, 2);
+        println!("knight level 5, 2 threads: {t:.4} s");
+        let (_, stats) = in_pool(1, || cwf.evaluate(5, &EvalOptions::default()).unwrap());
+        for (n, s) in &stats.stages {
+            println!("  {n:32} {s:.4}");
+        }
+        return;
+    }
+    corpus(Path::new(&dir));
+    plane_wave_error_vs_time();
+    zero_amplitude_regions(Path::new(&dir));
+}
+
+fn corpus(dir: &Path) {
+    let files = coarse_files(dir);
+    if files.is_empty() {
+        println!(
+            "[corpus] no coarse_* meshes under {} — skipped",
+            dir.display()
+        );
+        return;
+    }
+    println!("[corpus] evaluation time per level (best of {REPEATS}), 1 and 2 threads");
+    println!(
+        "{:28} {:>5} {:>9} {:>9} {:>10} {:>10} {:>7}",
+        "mesh", "level", "vertices", "faces", "1 thread s", "2 threads s", "speedup"
+    );
+    for path in files {
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let mesh = match load(&path) {
+            Ok(m) => m,
+            Err(e) => {
+                println!("{name:28} skipped: {e}");
+                continue;
+            }
+        };
+        let cwf = match swirl_cwf(mesh) {
+            Ok(c) => c,
+            Err(e) => {
+                println!("{name:28} skipped: {e}");
+                continue;
+            }
+        };
+        let f0 = cwf.base().triangle_count();
+        let mut level = 1;
+        while f0 << (2 * level) <= MAX_FACES {
+            let t1 = best_time(&cwf, level, 1);
+            let t2 = best_time(&cwf, level, 2);
+            let (e, _) = cwf.evaluate(level, &EvalOptions::default()).unwrap();
+            println!(
+                "{name:28} {level:>5} {:>9} {:>9} {t1:>10.4} {t2:>10.4} {:>7.2}",
+                e.mesh.vertex_count(),
+                e.mesh.triangle_count(),
+                t1 / t2
+            );
+            level += 1;
+        }
+        let (_, stats) = in_pool(2, || {
+            cwf.evaluate(level - 1, &EvalOptions::default()).unwrap()
+        });
+        let stages: Vec<String> = stats
+            .stages
+            .iter()
+            .map(|(n, s)| format!("{n} {s:.4}"))
+            .collect();
+        println!(
+            "{name:28} stages at level {} (2 threads): {}",
+            level - 1,
+            stages.join(", ")
+        );
+    }
+}
+
+fn best_time(cwf: &Cwf, levels: usize, threads: usize) -> f64 {
+    (0..REPEATS)
+        .map(|_| {
+            in_pool(threads, || {
+                let t = Instant::now();
+                let r = cwf.evaluate(levels, &EvalOptions::default()).unwrap();
+                std::hint::black_box(r);
+                t.elapsed().as_secs_f64()
+            })
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+/// A CWF from a smooth tangent swirl (wave length ~ diag/25) with Knöppel's phase; amplitude
+/// 0.4% of the diagonal.
+fn swirl_cwf(mesh: TriMesh) -> pleat::Result<Cwf> {
+    let diag = mesh.bbox_diagonal();
+    let (lo, hi) = mesh.bbox();
+    let c = [
+        0.5 * (lo[0] + hi[0]),
+        0.5 * (lo[1] + hi[1]),
+        0.5 * (lo[2] + hi[2]),
+    ];
+    let k = 2.0 * std::f64::consts::PI * 25.0 / diag;
+    let normals = vertex_normals(&mesh);
+    let v: Vec<[f64; 3]> = mesh
+        .positions()
+        .iter()
+        .zip(&normals)
+        .map(|(p, n)| {
+            let d = [p[0] - c[0] + 0.3 * diag, p[1] - c[1], p[2] - c[2]];
+            let t = [d[1] - d[2], d[2] - d[0], d[0] - d[1]]; // a smooth non-integrable field
+            let tn = t[0] * n[0] + t[1] * n[1] + t[2] * n[2];
+            let tt = [t[0] - tn * n[0], t[1] - tn * n[1], t[2] - tn * n[2]];
+            let l = (tt[0] * tt[0] + tt[1] * tt[1] + tt[2] * tt[2])
+                .sqrt()
+                .max(1e-12 * diag);
+            [k * tt[0] / l, k * tt[1] / l, k * tt[2] / l]
+        })
+        .collect();
+    let n = mesh.vertex_count();
+    let t = Instant::now();
+    let (cwf, rep, _) = Cwf::from_frequency_field(
+        mesh,
+        FrequencyField::PerVertex(&v),
+        vec![0.004 * diag; n],
+        &KnoppelOptions::default(),
+    )?;
+    println!(
+        "  knoppel: {n} vertices, {:.3} s, {} iterations, λ = {:.3e}, residual {:.1e}",
+        t.elapsed().as_secs_f64(),
+        rep.iterations,
+        rep.eigenvalue,
+        rep.residual
+    );
+    Ok(cwf)
+}
+
+fn vertex_normals(m: &TriMesh) -> Vec<[f64; 3]> {
+    let p = m.positions();
+    let mut n = vec![[0.0; 3]; m.vertex_count()];
+    for t in m.triangles() {
+        let [a, b, c] = t.map(|v| p[v as usize]);
+        let (u, w) = (
+            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+        );
+        let x = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        for &v in t {
+            for k in 0..3 {
+                n[v as usize][k] += x[k];
+            }
+        }
+    }
+    n.iter()
+        .map(|v| {
+            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            if l > 0.0 {
+                [v[0] / l, v[1] / l, v[2] / l]
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect()
+}
+
+fn plane_wave_error_vs_time() {
+    println!("\n[plane wave] 32×32 irregular grid (2048 faces), |k|·h = 2, max phase error vs level vs time (2 threads)");
+    println!(
+        "{:>5} {:>9} {:>10} {:>12}",
+        "level", "faces", "seconds", "max error"
+    );
+    let m = grid(32, 0.3);
+    let h = 1.0 / 32.0;
+    let k = [2.0 / h * 0.8, 2.0 / h * 0.6, 0.0];
+    let ph = |p: &[f64; 3]| k[0] * p[0] + k[1] * p[1];
+    let el = m.edges();
+    let p = m.positions();
+    let omega = el
+        .edges
+        .iter()
+        .map(|e| ph(&p[e.0[1] as usize]) - ph(&p[e.0[0] as usize]))
+        .collect();
+    let zeta = p.iter().map(|q| Complex::cis(ph(q))).collect();
+    let n = m.vertex_count();
+    let cwf = Cwf::new(m, omega, vec![1.0; n], zeta).unwrap();
+    let opts = EvalOptions {
+        want_z: true,
+        ..Default::default()
+    };
+    for level in 0..=6 {
+        let (t, (e, _)) = in_pool(2, || {
+            let t = Instant::now();
+            let r = cwf.evaluate(level, &opts).unwrap();
+            (t.elapsed().as_secs_f64(), r)
+        });
+        let err =
+            e.z.as_ref()
+                .unwrap()
+                .iter()
+                .zip(e.smooth_positions.as_ref().unwrap())
+                .map(|(z, q)| (*z * Complex::cis(-ph(q))).arg().abs())
+                .fold(0.0, f64::max);
+        println!(
+            "{level:>5} {:>9} {t:>10.4} {err:>12.2e}",
+            e.mesh.triangle_count()
+        );
+    }
+}
+
+fn zero_amplitude_regions(dir: &Path) {
+    let path = dir.join("coarse_spot_1k.obj");
+    let Ok(mesh) = load(&path) else {
+        println!("\n[zero amplitude] {} not found — skipped", path.display());
+        return;
+    };
+    let Ok(cwf) = swirl_cwf(mesh) else { return };
+    println!("\n[zero amplitude] coarse_spot_1k, 5 levels, 2 threads: full amplitude vs amplitude zero on a fraction of the vertices");
+    let (b, w, a, z) = (
+        cwf.base().clone(),
+        cwf.omega().to_vec(),
+        cwf.amplitude().to_vec(),
+        cwf.zeta().to_vec(),
+    );
+    let xs: Vec<f64> = b.positions().iter().map(|p| p[0]).collect();
+    let mut sorted = xs.clone();
+    sorted.sort_by(f64::total_cmp);
+    for frac in [0.0, 0.5, 0.9, 1.0] {
+        let cut = if frac == 0.0 {
+            f64::NEG_INFINITY
+        } else {
+            sorted[((sorted.len() - 1) as f64 * frac) as usize]
+        };
+        let amp: Vec<f64> = a
+            .iter()
+            .zip(&xs)
+            .map(|(&a, &x)| if x <= cut { 0.0 } else { a })
+            .collect();
+        let c = Cwf::new(b.clone(), w.clone(), amp, z.clone()).unwrap();
+        let t = best_time(&c, 5, 2);
+        println!(
+            "  zero on {:>3.0}% of base vertices: {t:.4} s",
+            100.0 * frac
+        );
+    }
+}
+
+fn grid(n: usize, jitter: f64) -> TriMesh {
+    let mut s = 12345u64;
+    let mut rnd = || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let h = 1.0 / n as f64;
+    let mut p = vec![];
+    for j in 0..=n {
+        for i in 0..=n {
+            let inner = i > 0 && j > 0 && i < n && j < n;
+            let (dx, dy) = if inner {
+                (2.0 * jitter * h * rnd(), 2.0 * jitter * h * rnd())
+            } else {
+                (0.0, 0.0)
+            };
+            p.push([i as f64 * h + dx, j as f64 * h + dy, 0.0]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let mut t = vec![];
+    for j in 0..n {
+        for i in 0..n {
+            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    TriMesh::new(p, t).unwrap()
+}
+
+fn coarse_files(dir: &Path) -> Vec<PathBuf> {
+    let Ok(rd) = std::fs::read_dir(dir) else {
+        return vec![];
+    };
+    let mut v: Vec<PathBuf> = rd
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let n = p.file_name().unwrap().to_string_lossy();
+            n.starts_with("coarse_") && (n.ends_with(".obj") || n.ends_with(".off"))
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+/// A tiny loader: OBJ through tobj (triangulated, f64), OFF by hand (fan-triangulated).
+fn load(path: &Path) -> Result<TriMesh, String> {
+    if path.extension().is_some_and(|e| e == "off") {
+        return load_off(path);
+    }
+    let (models, _) = tobj::load_obj(
+        path,
+        &tobj::LoadOptions {
+            triangulate: true,
+            single_index: true,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    let mut pos = vec![];
+    let mut tri = vec![];
+    for m in models {
+        let base = pos.len() as u32;
+        pos.extend(m.mesh.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+        tri.extend(
+            m.mesh
+                .indices
+                .chunks_exact(3)
+                .map(|c| [base + c[0], base + c[1], base + c[2]]),
+        );
+    }
+    TriMesh::new(pos, tri).map_err(|e| e.to_string())
+}
+
+fn load_off(path: &Path) -> Result<TriMesh, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
+    let mut tok = text
+        .lines()
+        .map(|l| l.split('#').next().unwrap().trim())
+        .filter(|l| !l.is_empty())
+        .flat_map(|l| l.split_whitespace());
+    if tok.next() != Some("OFF") {
+        return Err("not an OFF file".into());
+    }
+    let mut num = || -> Result<f64, String> {
+        tok.next()
+            .ok_or("truncated")?
+            .parse::<f64>()
+            .map_err(|e| e.to_string())
+    };
+    let (nv, nf, _) = (num()? as usize, num()? as usize, num()?);
+    let mut pos = Vec::with_capacity(nv);
+    for _ in 0..nv {
+        pos.push([num()?, num()?, num()?]);
+    }
+    let mut tri = vec![];
+    for _ in 0..nf {
+        let k = num()? as usize;
+        let idx: Vec<u32> = (0..k)
+            .map(|_| num().map(|x| x as u32))
+            .collect::<Result<_, _>>()?;
+        for i in 1..k.saturating_sub(1) {
+            tri.push([idx[0], idx[i], idx[i + 1]]);
+        }
+    }
+    TriMesh::new(pos, tri).map_err(|e| e.to_string())
+}
