@@ -1,6 +1,8 @@
 //! CWF representation (§3.3): energies (3.5, 3.6), the ω split (3.17), Knöppel phase from
 //! frequency, the `.cwf` file format, and validation errors.
 
+#![cfg(feature = "wrinkle")]
+
 mod common;
 
 use common::*;

@@ -1,6 +1,8 @@
 //! Wrinkle evaluation (§3.5): incompatible input, vortices, stiff and extreme inputs,
 //! determinism across thread counts.
 
+#![cfg(feature = "wrinkle")]
+
 mod common;
 
 use common::*;
@@ -262,6 +264,15 @@ fn stiff_and_extreme_inputs() {
         println!("coordinates × {s:.0e}: plane-wave error after 4 levels {err:.1e}");
         assert!(err < 1e-11);
     }
+
+    // an unreferenced vertex is carried along unchanged
+    let mut p = single_triangle().positions().to_vec();
+    p.push([5.0, 5.0, 5.0]);
+    let lonely = TriMesh::new(p, vec![[0, 1, 2]]).unwrap();
+    let cwf = Cwf::new(lonely, vec![1.0; 3], vec![0.1; 4], vec![Complex::ONE; 4]).unwrap();
+    let (e, _) = cwf.evaluate(2, &with_z()).unwrap();
+    assert!(all_finite(&e));
+    assert_eq!(e.mesh.positions()[3], [5.0, 5.0, 5.0]);
 
     // a single triangle
     let err = plane_wave_eval_error(&single_triangle(), [40.0, 25.0, 0.0], 5);

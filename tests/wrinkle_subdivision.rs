@@ -1,6 +1,8 @@
 //! Subdivision exterior calculus and z upsampling (dissertation §3.5): `S1 d = d S0` on closed
 //! and open meshes, and exact reproduction of plane waves.
 
+#![cfg(feature = "wrinkle")]
+
 mod common;
 
 use common::*;

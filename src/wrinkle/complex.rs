@@ -110,7 +110,9 @@ fn fast_sin_cos(x: f64) -> (f64, f64) {
     const PIO2_2: f64 = 6.077_100_506_303_965_976_60e-11;
     const PIO2_2T: f64 = 2.022_266_248_795_950_631_54e-21;
     const INV_PIO2: f64 = std::f64::consts::FRAC_2_PI;
-    let k = (x * INV_PIO2).round();
+    // round to nearest (ties to even) without a libm call: valid for |x·2/π| < 2^51
+    const SHIFTER: f64 = 6_755_399_441_055_744.0; // 1.5 · 2^52
+    let k = (x * INV_PIO2 + SHIFTER) - SHIFTER;
     let r = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_2T;
     let (s, c) = (kernel_sin(r), kernel_cos(r));
     match (k as i64) & 3 {

@@ -107,8 +107,9 @@ impl Default for SubdivisionOptions {
 pub(crate) enum VertexRule {
     /// The vertex keeps its value (fixed boundary, corner, or isolated vertex).
     Keep,
-    /// Interior Loop rule with weight `alpha` for each of the `n` neighbours.
-    Interior { alpha: f64 },
+    /// Interior Loop rule with weight `alpha` for each of the `n` neighbours; `gamma = nα/2`
+    /// is the z rule's weight (eq. 3.24).
+    Interior { alpha: f64, gamma: f64 },
     /// B-spline boundary rule along the two boundary edges.
     Boundary { edges: [u32; 2] },
 }
@@ -137,8 +138,10 @@ pub(crate) fn vertex_rules(topo: &Topology, boundary: BoundaryRule) -> Vec<Verte
             if n == 0 || topo.corner[v] {
                 VertexRule::Keep
             } else if !topo.boundary_vertex[v] {
+                let alpha = loop_alpha(n);
                 VertexRule::Interior {
-                    alpha: loop_alpha(n),
+                    alpha,
+                    gamma: 0.5 * n as f64 * alpha,
                 }
             } else if boundary == BoundaryRule::Fixed {
                 VertexRule::Keep
@@ -203,7 +206,7 @@ pub(crate) fn opposite_vertices(topo: &Topology, e: usize) -> [u32; 2] {
 pub(crate) fn s0_even<T: Blend>(topo: &Topology, rules: &[VertexRule], v: usize, f: &[T]) -> T {
     match rules[v] {
         VertexRule::Keep => f[v],
-        VertexRule::Interior { alpha } => {
+        VertexRule::Interior { alpha, .. } => {
             let row = topo.vert_edges.row(v);
             let mut acc = f[v].times(1.0 - row.len() as f64 * alpha);
             for &e in row {
@@ -285,7 +288,7 @@ impl OneForm<'_> {
         let topo = self.topo;
         match self.rules[v as usize] {
             VertexRule::Keep => 0.0,
-            VertexRule::Interior { alpha } => {
+            VertexRule::Interior { alpha, .. } => {
                 let row = topo.vert_edges.row(v as usize);
                 alpha
                     * row
@@ -483,8 +486,8 @@ fn corner_gradient(e1: [f64; 3], e2: [f64; 3], r1: f64, r2: f64) -> Option<[f64;
 fn ring_gradient(topo: &Topology, x: &[[f64; 3]], omega: &[f64], v: u32) -> [f64; 3] {
     let o = x[v as usize];
     let mut n = [0.0; 3];
-    for &f in topo.vert_faces.row(v as usize) {
-        let t = topo.faces[f as usize];
+    for &k in topo.vert_corners.row(v as usize) {
+        let t = topo.faces[k as usize / 3];
         let p = x[t[0] as usize];
         n = add(n, cross(sub(x[t[1] as usize], p), sub(x[t[2] as usize], p)));
     }
@@ -590,8 +593,15 @@ impl ZContext<'_> {
         add(p, scale(self.x[t[2] as usize], b[2]))
     }
 
-    /// `z(P) e^{iω(P)(target − P)}` for `P` at barycentric `b` in `f` (projected displacement).
+    /// `z(P) e^{iω(P)(target − P)}` for `P` at barycentric `b` in `f` (projected displacement);
+    /// exactly zero, and cheap, when the face's three `z` are zero.
     fn vote(&self, f: usize, b: [f64; 3], target: [f64; 3]) -> Complex {
+        if self.topo.faces[f]
+            .iter()
+            .all(|&v| self.z[v as usize] == Complex::ZERO)
+        {
+            return Complex::ZERO;
+        }
         let p = self.position(f, b);
         let psi = self.omega_at(f, b, sub(target, p));
         self.vote_with_phase(f, b, psi)
@@ -601,24 +611,33 @@ impl ZContext<'_> {
         vs.into_iter().all(|v| self.z[v as usize] == Complex::ZERO)
     }
 
-    /// Even vertex `v` moving to `target` (eqs. 3.23–3.24 and the boundary rules).
-    pub fn even(&self, v: usize, target: [f64; 3]) -> Complex {
+    /// The interior even-rule votes of face `f` (eq. 3.24), one per corner whose vertex follows
+    /// the interior rule (zero otherwise): `z(P) e^{iω(P)(v' − P)}` with
+    /// `P = (1 − 2γ) v + γ (u + w)` and `v'` the vertex's new position. Computed face by face so
+    /// the per-face data is read sequentially.
+    fn corner_votes(&self, f: usize, fine_x: &[[f64; 3]]) -> [Complex; 3] {
+        let t = self.topo.faces[f];
+        [0, 1, 2].map(|c| match self.rules[t[c] as usize] {
+            VertexRule::Interior { gamma, .. } => {
+                let mut b = [gamma; 3];
+                b[c] = 1.0 - 2.0 * gamma;
+                self.vote(f, b, fine_x[t[c] as usize])
+            }
+            _ => Complex::ZERO,
+        })
+    }
+
+    /// Even vertex `v` moving to `target` (eqs. 3.23–3.24 and the boundary rules); `votes` are
+    /// the [`ZContext::corner_votes`] of every face.
+    fn even(&self, v: usize, target: [f64; 3], votes: &[[Complex; 3]]) -> Complex {
         let topo = self.topo;
         match self.rules[v] {
             VertexRule::Keep => self.z[v],
-            VertexRule::Interior { alpha } => {
-                let ring = topo.vert_edges.row(v);
-                let ring_v = ring.iter().map(|&e| topo.other_end(e as usize, v as u32));
-                if self.all_zero(ring_v.chain([v as u32])) {
-                    return Complex::ZERO;
-                }
-                let fan = topo.vert_faces.row(v);
-                let gamma = 0.5 * alpha * ring.len() as f64;
+            VertexRule::Interior { .. } => {
+                let fan = topo.vert_corners.row(v);
                 let mut acc = Complex::ZERO;
-                for &f in fan {
-                    let mut b = [gamma; 3];
-                    b[topo.corner_of(f as usize, v as u32)] = 1.0 - 2.0 * gamma;
-                    acc += self.vote(f as usize, b, target);
+                for &k in fan {
+                    acc += votes[k as usize / 3][k as usize % 3];
                 }
                 acc.scale(1.0 / fan.len() as f64)
             }
@@ -715,12 +734,16 @@ fn unfold(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> ([f64; 3], [f64
 
 /// All odd and even z values of the next level. `fine_x` are the S0 positions of the next level.
 pub(crate) fn apply_z(ctx: &ZContext<'_>, fine_x: &[[f64; 3]]) -> Vec<Complex> {
+    let votes: Vec<[Complex; 3]> = (0..ctx.topo.n_faces())
+        .into_par_iter()
+        .map(|f| ctx.corner_votes(f, fine_x))
+        .collect();
     let nv = ctx.topo.n_vertices;
     (0..nv + ctx.topo.n_edges())
         .into_par_iter()
         .map(|i| {
             if i < nv {
-                ctx.even(i, fine_x[i])
+                ctx.even(i, fine_x[i], &votes)
             } else {
                 ctx.odd(i - nv)
             }

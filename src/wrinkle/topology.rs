@@ -48,6 +48,11 @@ impl Csr {
         Csr { offsets, items }
     }
 
+    /// Counting sort of `n_items` items into `n_rows` rows, item `i` going to row `row_of(i)`.
+    fn build_items(n_rows: usize, n_items: usize, row_of: impl Fn(usize) -> u32) -> Csr {
+        Csr::build(n_rows, n_items, |i| [row_of(i)])
+    }
+
     /// Row `i`.
     #[inline]
     pub fn row(&self, i: usize) -> &[u32] {
@@ -75,8 +80,8 @@ pub(crate) struct Topology {
     pub edge_faces: Vec<[u32; 2]>,
     /// Per vertex, incident edges in increasing edge order.
     pub vert_edges: Csr,
-    /// Per vertex, incident faces in increasing face order.
-    pub vert_faces: Csr,
+    /// Per vertex, its face corners `3f + c` (face `f`, corner `c`) in increasing order.
+    pub vert_corners: Csr,
     /// Per edge, the rank of the edge in `vert_edges` of its endpoint 0 and endpoint 1.
     pub edge_rank: Vec<[u32; 2]>,
     /// True for vertices on a boundary edge.
@@ -119,7 +124,7 @@ impl Topology {
         corner: Vec<bool>,
     ) -> Topology {
         let vert_edges = Csr::build(n_vertices, edges.len(), |e| edges[e]);
-        let vert_faces = Csr::build(n_vertices, faces.len(), |f| faces[f]);
+        let vert_corners = Csr::build_items(n_vertices, 3 * faces.len(), |i| faces[i / 3][i % 3]);
         let edge_rank = edge_ranks(&vert_edges, &edges);
         let mut boundary_vertex = vec![false; n_vertices];
         for (e, ef) in edge_faces.iter().enumerate() {
@@ -135,7 +140,7 @@ impl Topology {
             face_edges,
             edge_faces,
             vert_edges,
-            vert_faces,
+            vert_corners,
             edge_rank,
             boundary_vertex,
             corner,
@@ -262,10 +267,10 @@ impl Topology {
             if !self.boundary_vertex[v] {
                 continue;
             }
-            let fan = self.vert_faces.row(v);
+            let fan = self.vert_corners.row(v);
             let angle_sum: f64 = fan
                 .iter()
-                .map(|&f| corner_angle(positions, self.faces[f as usize], v as u32))
+                .map(|&k| corner_angle(positions, self.faces[k as usize / 3], v as u32))
                 .sum();
             self.corner[v] =
                 fan.len() == 1 || (angle_sum - std::f64::consts::PI).abs() > angle_tolerance;
@@ -415,7 +420,7 @@ impl Topology {
 
     fn check_vertex_fans(&self) -> Result<()> {
         for v in 0..self.n_vertices {
-            let n_faces = self.vert_faces.len(v);
+            let n_faces = self.vert_corners.len(v);
             if n_faces == 0 {
                 continue;
             }
@@ -445,11 +450,11 @@ impl Topology {
     /// Number of faces reached by rotating around `v` across the edges at `v`, starting from
     /// the face of boundary edge `start_edge` (or from the first face of `v`).
     fn walk_fan(&self, v: u32, start_edge: Option<u32>) -> usize {
-        let n = self.vert_faces.len(v as usize);
+        let n = self.vert_corners.len(v as usize);
         let (start, mut came) = match start_edge {
             Some(e) => (self.edge_faces[e as usize][0], e),
             None => {
-                let f = self.vert_faces.row(v as usize)[0];
+                let f = self.vert_corners.row(v as usize)[0] / 3;
                 (
                     f,
                     self.face_edges[f as usize][self.corner_of(f as usize, v)],

@@ -260,6 +260,7 @@ pub fn boundary_loop(m: &TriMesh) -> Vec<u32> {
 }
 
 /// Winding number of the complex values `z` along the closed vertex loop `lp`.
+#[cfg(feature = "wrinkle")]
 pub fn winding(z: &[pleat::wrinkle::Complex], lp: &[u32]) -> f64 {
     let mut total = 0.0;
     for i in 0..lp.len() {
