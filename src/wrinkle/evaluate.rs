@@ -11,6 +11,14 @@
 //!
 //! Work is parallel with rayon per vertex / edge / face; every output value is computed by
 //! one task from inputs only, so the bytes do not depend on the number of threads.
+//!
+//! **Zero amplitude.** Every z rule is a sum of votes `b_c z_c e^{iφ}`, so a vote whose face
+//! has `z = 0` at all three corners is exactly zero; such votes are skipped (no
+//! transcendental, no cotangent-vector evaluation). The mesh itself is always refined
+//! everywhere, so the output has no cracks or T-junctions whatever the amplitude, and
+//! zero-amplitude regions come out exactly undisplaced. Refining only the faces near non-zero
+//! amplitude (red–green closure) would additionally save the topology, position and normal
+//! work there; `benches/wrinkle_eval.rs` measures both effects.
 
 use rayon::prelude::*;
 
