@@ -607,29 +607,52 @@ impl ZContext<'_> {
         self.vote_with_phase(f, b, psi)
     }
 
-    fn all_zero(&self, vs: impl IntoIterator<Item = u32>) -> bool {
-        vs.into_iter().all(|v| self.z[v as usize] == Complex::ZERO)
-    }
-
-    /// The interior even-rule votes of face `f` (eq. 3.24), one per corner whose vertex follows
-    /// the interior rule (zero otherwise): `z(P) e^{iω(P)(v' − P)}` with
-    /// `P = (1 − 2γ) v + γ (u + w)` and `v'` the vertex's new position. Computed face by face so
-    /// the per-face data is read sequentially.
-    fn corner_votes(&self, f: usize, fine_x: &[[f64; 3]]) -> [Complex; 3] {
+    /// The votes of face `f` for the next level: per corner, the interior even-rule vote
+    /// (eq. 3.24) `z(P) e^{iω(P)(v' − P)}` with `P = (1 − 2γ) v + γ (u + w)` and `v'` the new
+    /// position (zero unless the corner's vertex follows the interior rule); per edge slot, the
+    /// interior odd-rule vote (eqs. 3.20–3.21) `z(P₀) e^{iω(P₀)(P₁* − P₀)/2}` with
+    /// `P₀ = 3/8 (a + b) + 1/4 c` (zero on boundary edges). Computed face by face so the
+    /// per-face data is read sequentially; zero (and cheap) where the face's `z` all vanish.
+    fn face_votes(&self, f: usize, fine_x: &[[f64; 3]]) -> FaceVotes {
         let t = self.topo.faces[f];
-        [0, 1, 2].map(|c| match self.rules[t[c] as usize] {
+        if t.iter().all(|&v| self.z[v as usize] == Complex::ZERO) {
+            return FaceVotes::default();
+        }
+        let corner = [0, 1, 2].map(|c| match self.rules[t[c] as usize] {
             VertexRule::Interior { gamma, .. } => {
                 let mut b = [gamma; 3];
                 b[c] = 1.0 - 2.0 * gamma;
                 self.vote(f, b, fine_x[t[c] as usize])
             }
             _ => Complex::ZERO,
-        })
+        });
+        let edge = [0, 1, 2].map(|s| self.edge_vote(f, s));
+        FaceVotes { corner, edge }
+    }
+
+    /// The odd-rule vote of face `f` for its edge in slot `s` (eqs. 3.20–3.21).
+    fn edge_vote(&self, f: usize, s: usize) -> Complex {
+        let topo = self.topo;
+        let e = topo.face_edges[f][s] as usize;
+        let k = usize::from(topo.edge_faces[e][0] != f as u32);
+        let g = topo.edge_faces[e][1 - k];
+        if g == NONE {
+            return Complex::ZERO;
+        }
+        let t = topo.faces[f];
+        let d = topo.faces[g as usize][(topo.edge_face_slot[e][1 - k] as usize + 2) % 3];
+        let [a, b, c] = [t[s], t[(s + 1) % 3], t[(s + 2) % 3]].map(|v| self.x[v as usize]);
+        let dc = unfold(a, b, c, self.x[d as usize]);
+        let mut bc = [0.375; 3];
+        bc[(s + 2) % 3] = 0.25;
+        // P₁* − P₀ = (d* − c)/4; the text's step is half of it.
+        let psi = self.omega_at(f, bc, scale(dc, 0.125));
+        self.vote_with_phase(f, bc, psi)
     }
 
     /// Even vertex `v` moving to `target` (eqs. 3.23–3.24 and the boundary rules); `votes` are
-    /// the [`ZContext::corner_votes`] of every face.
-    fn even(&self, v: usize, target: [f64; 3], votes: &[[Complex; 3]]) -> Complex {
+    /// the [`ZContext::face_votes`] of every face.
+    fn even(&self, v: usize, target: [f64; 3], votes: &[FaceVotes]) -> Complex {
         let topo = self.topo;
         match self.rules[v] {
             VertexRule::Keep => self.z[v],
@@ -637,7 +660,7 @@ impl ZContext<'_> {
                 let fan = topo.vert_corners.row(v);
                 let mut acc = Complex::ZERO;
                 for &k in fan {
-                    acc += votes[k as usize / 3][k as usize % 3];
+                    acc += votes[k as usize / 3].corner[k as usize % 3];
                 }
                 acc.scale(1.0 / fan.len() as f64)
             }
@@ -656,48 +679,41 @@ impl ZContext<'_> {
         }
     }
 
-    /// Odd vertex of edge `e` (eqs. 3.18, 3.20–3.22).
-    pub fn odd(&self, e: usize) -> Complex {
+    /// Odd vertex of edge `e` (eqs. 3.18, 3.22): the boundary rule, or the mean of the two
+    /// faces' [`ZContext::edge_vote`]s.
+    fn odd(&self, e: usize, votes: &[FaceVotes]) -> Complex {
         let topo = self.topo;
-        let [a, b] = topo.edges[e];
-        let [c, d] = opposite_vertices(topo, e);
-        if d == NONE {
+        let [f0, f1] = topo.edge_faces[e];
+        if f1 == NONE {
+            let [a, b] = topo.edges[e];
             let w = self.omega[e];
             return (self.z[a as usize] * Complex::cis(0.5 * w)
                 + self.z[b as usize] * Complex::cis(-0.5 * w))
             .scale(0.5);
         }
-        if self.all_zero([a, b, c, d]) {
-            return Complex::ZERO;
-        }
-        let [f0, f1] = topo.edge_faces[e].map(|f| f as usize);
-        let (dc, cd) = unfold(
-            self.x[a as usize],
-            self.x[b as usize],
-            self.x[c as usize],
-            self.x[d as usize],
-        );
-        let half = |f: usize, opp: u32, offset: [f64; 3]| {
-            let mut bc = [0.375; 3];
-            bc[topo.corner_of(f, opp)] = 0.25;
-            // P1* − P0 = (d* − c)/4; the text's step is half of it.
-            let psi = self.omega_at(f, bc, scale(offset, 0.125));
-            self.vote_with_phase(f, bc, psi)
-        };
-        (half(f0, c, dc) + half(f1, d, cd)).scale(0.5)
+        let [s0, s1] = topo.edge_face_slot[e].map(usize::from);
+        (votes[f0 as usize].edge[s0] + votes[f1 as usize].edge[s1]).scale(0.5)
     }
 }
 
-/// Rigid unfolding across edge `ab` of the diamond `abc | abd` (eq. 3.21): returns
-/// `(d* − c, c* − d)`, where `d*` is `d` rotated about `ab` into the plane of `abc` (on the other
-/// side of `ab` from `c`), and `c*` is `c` rotated into the plane of `abd`. Degenerate pieces fall
-/// back gracefully: a zero-length `ab` gives the plain differences, and a triangle of zero
-/// height takes its perpendicular direction from the other triangle.
-fn unfold(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+/// The six votes one face casts for the next level (see [`ZContext::face_votes`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct FaceVotes {
+    corner: [Complex; 3],
+    edge: [Complex; 3],
+}
+
+/// Rigid unfolding across edge `ab` of the diamond `abc | abd` (eq. 3.21): returns `d* − c`,
+/// where `d*` is `d` rotated about `ab` into the plane of `abc`, on the other side of `ab` from
+/// `c`. With `ê` the unit vector along `ab`, `s_q = (q − a)·ê` and `h_q` the distance of `q` from
+/// the line `ab`: `d* − c = (s_d − s_c) ê + (h_d + h_c) n̂`, `n̂` the unit in-plane normal of `ab`
+/// pointing away from `c`. Degenerate pieces fall back gracefully: a zero-length `ab` gives
+/// `d − c`, and a zero-height `abc` takes `n̂` towards `d`.
+fn unfold(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> [f64; 3] {
     let ab = sub(b, a);
     let len = norm(ab);
     if len == 0.0 || !len.is_finite() {
-        return (sub(d, c), sub(c, d));
+        return sub(d, c);
     }
     let axis = scale(ab, 1.0 / len);
     let split = |q: [f64; 3]| {
@@ -709,34 +725,21 @@ fn unfold(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> ([f64; 3], [f64
     let (sc, pc, hc) = split(c);
     let (sd, pd, hd) = split(d);
     let tiny = 1e-300;
-    let unit = |p: [f64; 3], h: f64| {
-        if h > tiny {
-            scale(p, 1.0 / h)
-        } else {
-            [0.0; 3]
-        }
-    };
-    // In-plane unit normals to ab pointing away from c (in abc) and away from d (in abd).
     let away_c = if hc > tiny {
-        scale(unit(pc, hc), -1.0)
+        scale(pc, -1.0 / hc)
+    } else if hd > tiny {
+        scale(pd, 1.0 / hd)
     } else {
-        unit(pd, hd)
+        [0.0; 3]
     };
-    let away_d = if hd > tiny {
-        scale(unit(pd, hd), -1.0)
-    } else {
-        unit(pc, hc)
-    };
-    let dc = add(scale(axis, sd - sc), scale(away_c, hd + hc));
-    let cd = add(scale(axis, sc - sd), scale(away_d, hc + hd));
-    (dc, cd)
+    add(scale(axis, sd - sc), scale(away_c, hd + hc))
 }
 
 /// All odd and even z values of the next level. `fine_x` are the S0 positions of the next level.
 pub(crate) fn apply_z(ctx: &ZContext<'_>, fine_x: &[[f64; 3]]) -> Vec<Complex> {
-    let votes: Vec<[Complex; 3]> = (0..ctx.topo.n_faces())
+    let votes: Vec<FaceVotes> = (0..ctx.topo.n_faces())
         .into_par_iter()
-        .map(|f| ctx.corner_votes(f, fine_x))
+        .map(|f| ctx.face_votes(f, fine_x))
         .collect();
     let nv = ctx.topo.n_vertices;
     (0..nv + ctx.topo.n_edges())
@@ -745,7 +748,7 @@ pub(crate) fn apply_z(ctx: &ZContext<'_>, fine_x: &[[f64; 3]]) -> Vec<Complex> {
             if i < nv {
                 ctx.even(i, fine_x[i], &votes)
             } else {
-                ctx.odd(i - nv)
+                ctx.odd(i - nv, &votes)
             }
         })
         .collect()
@@ -921,12 +924,11 @@ mod tests {
     #[test]
     fn unfolding_is_identity_on_flat_diamond() {
         let (a, b, c, d) = ([0.0; 3], [1.0, 0.1, 0.0], [0.3, 0.8, 0.0], [0.6, -0.7, 0.0]);
-        let (dc, cd) = unfold(a, b, c, d);
-        assert!(norm(sub(dc, sub(d, c))) < 1e-15);
-        assert!(norm(sub(cd, sub(c, d))) < 1e-15);
+        assert!(norm(sub(unfold(a, b, c, d), sub(d, c))) < 1e-15);
+        assert!(norm(sub(unfold(b, a, d, c), sub(c, d))) < 1e-15);
         // folded 90°: the unfolded distance is the intrinsic one
         let d = [0.5, 0.0, -0.7];
-        let (dc, _) = unfold(a, [1.0, 0.0, 0.0], [0.5, 0.7, 0.0], d);
+        let dc = unfold(a, [1.0, 0.0, 0.0], [0.5, 0.7, 0.0], d);
         assert!(norm(sub(dc, [0.0, -1.4, 0.0])) < 1e-15);
     }
 }

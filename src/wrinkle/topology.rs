@@ -78,6 +78,8 @@ pub(crate) struct Topology {
     pub face_edges: Vec<[u32; 3]>,
     /// Per edge, its one or two faces (`[f, NONE]` on the boundary).
     pub edge_faces: Vec<[u32; 2]>,
+    /// Per edge, its slot in each of `edge_faces` (`face_edges[edge_faces[e][k]][slot] == e`).
+    pub edge_face_slot: Vec<[u8; 2]>,
     /// Per vertex, incident edges in increasing edge order.
     pub vert_edges: Csr,
     /// Per vertex, its face corners `3f + c` (face `f`, corner `c`) in increasing order.
@@ -126,6 +128,13 @@ impl Topology {
         let vert_edges = Csr::build(n_vertices, edges.len(), |e| edges[e]);
         let vert_corners = Csr::build_items(n_vertices, 3 * faces.len(), |i| faces[i / 3][i % 3]);
         let edge_rank = edge_ranks(&vert_edges, &edges);
+        let mut edge_face_slot = vec![[0u8; 2]; edges.len()];
+        for (f, fe) in face_edges.iter().enumerate() {
+            for (slot, &e) in fe.iter().enumerate() {
+                let k = usize::from(edge_faces[e as usize][0] != f as u32);
+                edge_face_slot[e as usize][k] = slot as u8;
+            }
+        }
         let mut boundary_vertex = vec![false; n_vertices];
         for (e, ef) in edge_faces.iter().enumerate() {
             if ef[1] == NONE {
@@ -139,6 +148,7 @@ impl Topology {
             edges,
             face_edges,
             edge_faces,
+            edge_face_slot,
             vert_edges,
             vert_corners,
             edge_rank,
