@@ -882,11 +882,21 @@ impl LoopHierarchy {
 /// Errors with [`Error::LimitExceeded`] when `levels` refinements of `faces` triangles would
 /// exceed `max_faces` or the u32 vertex index range.
 pub(crate) fn check_output_size(faces: usize, levels: usize, max_faces: usize) -> Result<()> {
-    let out = (faces as u128) << (2 * levels.min(60));
-    // V ≈ F/2 + boundary; 3F bounds V + E on any triangle mesh.
-    if levels >= 60 || out > max_faces as u128 || 3 * out > u32::MAX as u128 {
+    // 4^32 · 2^64 < 2^128: no overflow below 33 levels, and 33 levels are absurd anyway
+    let out = if levels <= 32 {
+        (faces as u128) << (2 * levels)
+    } else {
+        u128::MAX
+    };
+    // 3F bounds V + E on any triangle mesh, and vertex indices are u32.
+    if out > max_faces as u128 || 3 * out.min(u64::MAX as u128) > u32::MAX as u128 {
+        let shown = if levels <= 32 {
+            out.to_string()
+        } else {
+            "more than 2^64".into()
+        };
         return Err(Error::LimitExceeded(format!(
-            "{levels} subdivision levels of {faces} triangles give {out} triangles, above the \
+            "{levels} subdivision levels of {faces} triangles give {shown} triangles, above the \
              limit of {} (or the u32 index range)",
             max_faces.min(u32::MAX as usize / 3)
         )));
@@ -897,6 +907,15 @@ pub(crate) fn check_output_size(faces: usize, levels: usize, max_faces: usize) -
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn output_size_limit() {
+        assert!(check_output_size(1000, 5, 1 << 26).is_ok());
+        assert!(check_output_size(1000, 12, 1 << 26).is_err());
+        assert!(check_output_size(1024, 59, usize::MAX).is_err());
+        assert!(check_output_size(1, 200, usize::MAX).is_err());
+        assert!(check_output_size(1 << 20, 6, usize::MAX).is_err()); // > u32 indices
+    }
 
     #[test]
     fn loop_weights() {
