@@ -44,7 +44,7 @@ pub enum PhaseWeights {
     EdgeArea = 1,
 }
 
-/// Parameters of [`knoppel_phase`].
+/// Parameters of the Knöppel phase solve ([`Cwf::from_one_form`](super::Cwf::from_one_form)).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KnoppelOptions {
     /// Edge weights; default cotangent.
@@ -69,7 +69,7 @@ impl Default for KnoppelOptions {
     }
 }
 
-/// What [`knoppel_phase`] did.
+/// What the Knöppel phase solve did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KnoppelReport {
     /// Smallest generalized eigenvalue `λ = z^H L z / z^H M z` found.

@@ -1,16 +1,17 @@
 //! Complex wrinkle fields (dissertation ch. 3): representation, energies, phase from frequency,
 //! and evaluation of the wrinkled surface by Loop upsampling.
 //!
-//! - [`Cwf`] (`cwf.rs`): the representation of §3.3.1 — frequency one-form `ω` per edge,
+//! - [`Cwf`] ([`cwf`]): the representation of §3.3.1 — frequency one-form `ω` per edge,
 //!   amplitude `a` and phase `z̃` per vertex on a validated manifold base mesh — with
 //!   `E_compat` (eq. 3.5), `E_unit` (eq. 3.6) and the split `ω = ω_com + δω` (eq. 3.17).
-//! - `knoppel.rs`: `z̃` from `ω` (Knöppel et al. 2015) by inverse iteration on a cached sparse
+//! - [`knoppel`]: `z̃` from `ω` (Knöppel et al. 2015) by inverse iteration on a cached sparse
 //!   Cholesky factorization; [`Cwf::from_frequency_field`] builds a CWF from wave vectors.
-//! - `subdivide.rs`: Loop subdivision S0, the one-form subdivision S1 with `S1 d = d S0`, and
-//!   the z rules of eqs. 3.18–3.24; [`LoopHierarchy`] exposes them level by level.
-//! - `evaluate.rs`: [`Cwf::evaluate`] — `levels` refinements, then the displacement
+//! - [`subdivide`]: Loop subdivision S0, the one-form subdivision S1 with `S1 d = d S0`, and
+//!   the z rules of eqs. 3.18–3.24 (derivations in its docs); [`LoopHierarchy`] exposes them
+//!   level by level.
+//! - [`evaluate`]: [`Cwf::evaluate`] — `levels` refinements, then the displacement
 //!   `Re(z) n̂` of §3.5.
-//! - `io.rs`: the `.cwf` text format ([`write_cwf`], [`read_cwf`]).
+//! - [`io`]: the `.cwf` text format ([`write_cwf`], [`read_cwf`]).
 //!
 //! **Edge convention.** Every one-form (input, file, outputs, every subdivision level) is one
 //! value per edge of [`TriMesh::edges`](crate::mesh::TriMesh::edges): edges sorted by
@@ -33,11 +34,11 @@
 //! ```
 
 mod complex;
-mod cwf;
-mod evaluate;
-mod io;
-mod knoppel;
-mod subdivide;
+pub mod cwf;
+pub mod evaluate;
+pub mod io;
+pub mod knoppel;
+pub mod subdivide;
 mod topology;
 
 pub use complex::Complex;

@@ -52,7 +52,8 @@
 //! - interior odd vertex (3.20–3.22): `P₀ = 1/4 c + 3/8 (a + b)` in triangle `abc`, `P₁` likewise
 //!   in `abd`; `z' = ½ (z(P₀) e^{iω(P₀)(P₁* − P₀)/2} + z(P₁) e^{iω(P₁)(P₀* − P₁)/2})`, where `P₁*`
 //!   is `P₁` after rigidly unfolding `abd` about `ab` into the plane of `abc` (and vice versa),
-//!   and `ω(P)` is the cotangent vector of App. B.3 (see [`face_gradients`]);
+//!   and `ω(P)` is the cotangent vector of App. B.3 (eqs. B.48–B.52, per face corner; on
+//!   degenerate faces a one-ring least-squares gradient replaces it);
 //! - interior even vertex (3.23–3.24): `P_j = (1 − 2γ) v + γ (v_{j+1} + v_{j+2})` in each
 //!   triangle of the fan, `γ = nα/2`; `z' = (1/n) Σ_j z(P_j) e^{iω(P_j)(v' − P_j)}`. Here the
 //!   displacement `v' − P_j` is applied to the in-plane cotangent vector, i.e. projected onto the
