@@ -340,3 +340,32 @@ fn output_bytes_do_not_depend_on_thread_count() {
         bits(&a).len()
     );
 }
+
+#[test]
+fn progress_reports_and_cancels() {
+    let m = irregular_grid(4, 0.2, 3);
+    let n = m.vertex_count();
+    let cwf = Cwf::new(
+        m,
+        plane_wave_omega(&irregular_grid(4, 0.2, 3), [5.0, 0.0, 0.0]),
+        vec![0.1; n],
+        vec![Complex::ONE; n],
+    )
+    .unwrap();
+    let mut seen = vec![];
+    let (e, stats) = cwf
+        .evaluate_with_progress(3, &EvalOptions::default(), &mut |p| {
+            seen.push((p.stage.to_string(), p.fraction));
+            true
+        })
+        .unwrap();
+    assert_eq!(e.mesh.triangle_count(), 32 * 64);
+    assert_eq!(seen.len(), 4);
+    assert!(seen.windows(2).all(|w| w[0].1 < w[1].1) && seen[3].1 == 1.0);
+    assert_eq!(stats.get_count("level 3 faces"), Some(2048));
+    let err = cwf
+        .evaluate_with_progress(3, &EvalOptions::default(), &mut |p| p.stage != "level 2")
+        .unwrap_err();
+    assert_eq!(err, pleat::Error::Cancelled);
+    println!("progress: {seen:?}");
+}

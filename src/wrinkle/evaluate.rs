@@ -30,7 +30,7 @@ use super::subdivide::{
 };
 use super::topology::{add, cross, norm, scale, sub, Topology};
 use crate::mesh::TriMesh;
-use crate::report::Stats;
+use crate::report::{Progress, ProgressFn, Stats};
 use crate::Result;
 
 /// Options of [`Cwf::evaluate`].
@@ -112,6 +112,19 @@ impl Cwf {
     /// [`crate::Error::LimitExceeded`] above [`EvalOptions::max_output_faces`] and
     /// [`crate::Error::InvalidArgument`] for a non-finite displacement scale.
     pub fn evaluate(&self, levels: usize, opts: &EvalOptions) -> Result<(Evaluated, Stats)> {
+        self.evaluate_with_progress(levels, opts, &mut |_| true)
+    }
+
+    /// [`Cwf::evaluate`] with a progress callback, called on the calling thread after each
+    /// level and before the displacement with the stage name and the fraction done (by output
+    /// size: level `k` of `n` costs about `4^k`). Returning `false` stops the evaluation
+    /// promptly with [`crate::Error::Cancelled`].
+    pub fn evaluate_with_progress(
+        &self,
+        levels: usize,
+        opts: &EvalOptions,
+        progress: &mut ProgressFn<'_>,
+    ) -> Result<(Evaluated, Stats)> {
         if !opts.displacement_scale.is_finite() {
             return crate::invalid_arg!(
                 "displacement_scale is {} (must be finite)",
@@ -143,8 +156,21 @@ impl Cwf {
             stats.count(&format!("level {} faces", l + 1), next_faces.len() as u64);
             level = next;
             faces = next_faces;
+            let stage = format!("level {}", l + 1);
+            if !progress(Progress {
+                stage: &stage,
+                fraction: work_done(l + 1, levels),
+            }) {
+                return Err(crate::Error::Cancelled);
+            }
         }
         let out = stats.time("displace", || finish(level, faces, opts));
+        if !progress(Progress {
+            stage: "displace",
+            fraction: 1.0,
+        }) {
+            return Err(crate::Error::Cancelled);
+        }
         Ok((out, stats))
     }
 
@@ -176,6 +202,14 @@ impl Cwf {
             },
         }
     }
+}
+
+/// Fraction of the work done after `k` of `n` levels (level `j` costs about `4^j`; the
+/// displacement is counted as one more finest level).
+fn work_done(k: usize, n: usize) -> f64 {
+    let cost = |j: usize| 4f64.powi(j as i32);
+    let total: f64 = (1..=n).map(cost).sum::<f64>() + cost(n);
+    (1..=k).map(cost).sum::<f64>() / total
 }
 
 /// One Loop step of every field, timing its parts as `"level k: <part>"` in `stats`. Without
