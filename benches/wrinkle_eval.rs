@@ -33,6 +33,10 @@ fn main() {
         }
         return;
     }
+    if std::env::var("PLEAT_BENCH_ONLY").as_deref() == Ok("render") {
+        render_examples(Path::new(&dir));
+        return;
+    }
     corpus(Path::new(&dir));
     plane_wave_error_vs_time();
     zero_amplitude_regions(Path::new(&dir));
@@ -440,4 +444,148 @@ fn load_off(path: &Path) -> Result<TriMesh, String> {
         }
     }
     TriMesh::new(pos, tri).map_err(|e| e.to_string())
+}
+
+/// Renders a few evaluated surfaces to `$PLEAT_RENDER_DIR` (default `/tmp`) as PNG, for a look.
+fn render_examples(dir: &Path) {
+    let out = PathBuf::from(std::env::var("PLEAT_RENDER_DIR").unwrap_or_else(|_| "/tmp".into()));
+    for (name, levels) in [
+        ("coarse_spot_1k.obj", 4),
+        ("coarse_decimated-knight.off", 4),
+    ] {
+        let Ok(mesh) = load(&dir.join(name)) else {
+            continue;
+        };
+        let cwf = swirl_cwf(mesh).unwrap();
+        let (e, _) = cwf.evaluate(levels, &EvalOptions::default()).unwrap();
+        let path = out.join(format!("wrinkle_{}.png", name.split('.').next().unwrap()));
+        write_png(&path, &rasterize(&e.mesh, 900));
+        println!("wrote {}", path.display());
+    }
+}
+
+/// Orthographic z-buffered Lambert rendering (view along −z after a fixed tilt), greyscale.
+fn rasterize(m: &TriMesh, size: usize) -> Vec<u8> {
+    let (s, c) = 0.5f64.sin_cos();
+    let view = |p: [f64; 3]| [p[0], c * p[1] - s * p[2], s * p[1] + c * p[2]];
+    let pts: Vec<[f64; 3]> = m.positions().iter().map(|&p| view(p)).collect();
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &pts {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let scale = 0.95 * size as f64 / (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let px = |p: [f64; 3]| {
+        [
+            (p[0] - lo[0]) * scale + 0.025 * size as f64,
+            size as f64 - ((p[1] - lo[1]) * scale + 0.025 * size as f64),
+            p[2],
+        ]
+    };
+    let mut depth = vec![f64::NEG_INFINITY; size * size];
+    let mut img = vec![255u8; size * size];
+    for t in m.triangles() {
+        let [a, b, cc] = t.map(|v| pts[v as usize]);
+        let (u, w) = (
+            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+            [cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]],
+        );
+        let n = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        if l == 0.0 {
+            continue;
+        }
+        let light = [0.3, 0.5, 0.81];
+        let shade = ((n[0] * light[0] + n[1] * light[1] + n[2] * light[2]) / l).abs();
+        let grey = (40.0 + 215.0 * shade) as u8;
+        let [p0, p1, p2] = [a, b, cc].map(px);
+        let (x0, x1) = (
+            p0[0].min(p1[0]).min(p2[0]).max(0.0) as usize,
+            (p0[0].max(p1[0]).max(p2[0]) as usize).min(size - 1),
+        );
+        let (y0, y1) = (
+            p0[1].min(p1[1]).min(p2[1]).max(0.0) as usize,
+            (p0[1].max(p1[1]).max(p2[1]) as usize).min(size - 1),
+        );
+        let area = (p1[0] - p0[0]) * (p2[1] - p0[1]) - (p2[0] - p0[0]) * (p1[1] - p0[1]);
+        if area.abs() < 1e-12 {
+            continue;
+        }
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let (fx, fy) = (x as f64 + 0.5, y as f64 + 0.5);
+                let w0 = ((p1[0] - fx) * (p2[1] - fy) - (p2[0] - fx) * (p1[1] - fy)) / area;
+                let w1 = ((p2[0] - fx) * (p0[1] - fy) - (p0[0] - fx) * (p2[1] - fy)) / area;
+                let w2 = 1.0 - w0 - w1;
+                if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
+                    continue;
+                }
+                let z = w0 * p0[2] + w1 * p1[2] + w2 * p2[2];
+                let i = y * size + x;
+                if z > depth[i] {
+                    depth[i] = z;
+                    img[i] = grey;
+                }
+            }
+        }
+    }
+    img
+}
+
+/// A greyscale PNG with stored (uncompressed) deflate blocks: no compression library needed.
+fn write_png(path: &Path, grey: &[u8]) {
+    let size = (grey.len() as f64).sqrt() as usize;
+    let mut raw = Vec::with_capacity(grey.len() + size);
+    for row in grey.chunks_exact(size) {
+        raw.push(0u8);
+        raw.extend_from_slice(row);
+    }
+    let mut z = vec![0x78, 0x01];
+    let blocks: Vec<&[u8]> = raw.chunks(65_535).collect();
+    for (i, b) in blocks.iter().enumerate() {
+        z.push(u8::from(i + 1 == blocks.len()));
+        z.extend_from_slice(&(b.len() as u16).to_le_bytes());
+        z.extend_from_slice(&(!(b.len() as u16)).to_le_bytes());
+        z.extend_from_slice(b);
+    }
+    let (mut s1, mut s2) = (1u32, 0u32);
+    for &b in &raw {
+        s1 = (s1 + b as u32) % 65_521;
+        s2 = (s2 + s1) % 65_521;
+    }
+    z.extend_from_slice(&((s2 << 16) | s1).to_be_bytes());
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = Vec::new();
+    ihdr.extend_from_slice(&(size as u32).to_be_bytes());
+    ihdr.extend_from_slice(&(size as u32).to_be_bytes());
+    ihdr.extend_from_slice(&[8, 0, 0, 0, 0]);
+    for (kind, data) in [(b"IHDR", ihdr), (b"IDAT", z), (b"IEND", vec![])] {
+        png.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        let mut chunk = kind.to_vec();
+        chunk.extend_from_slice(&data);
+        png.extend_from_slice(&chunk);
+        png.extend_from_slice(&crc32(&chunk).to_be_bytes());
+    }
+    std::fs::write(path, png).unwrap();
+}
+
+fn crc32(data: &[u8]) -> u32 {
+    let mut c = 0xFFFF_FFFFu32;
+    for &b in data {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 != 0 {
+                0xEDB8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
 }
