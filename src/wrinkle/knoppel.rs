@@ -72,7 +72,8 @@ impl Default for KnoppelOptions {
 /// What the Knöppel phase solve did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KnoppelReport {
-    /// Smallest generalized eigenvalue `λ = z^H L z / z^H M z` found.
+    /// Smallest generalized eigenvalue `λ = z^H L z / z^H M z` found (the largest of these
+    /// over the mesh's connected components, each of which is solved independently).
     pub eigenvalue: f64,
     /// Inverse-iteration steps taken.
     pub iterations: usize,
@@ -99,12 +100,13 @@ pub(crate) fn knoppel_phase(
     let mass = floored(&vertex_area);
     let (llt, sigma) = factor_shifted(topo, &w, omega, &mass, opts.shift)?;
     let apply_l = |u: &[f64]| connection_laplacian_apply(topo, &w, omega, u);
+    let (comp, n_comp) = components(topo);
     let mut u: Vec<f64> = (0..2 * n)
         .map(|i| if i % 2 == 0 { 1.0 } else { 0.5 })
         .collect();
-    normalize_m(&mut u, &mass);
+    normalize_m(&mut u, &mass, &comp, n_comp);
     let scale = max_ratio(topo, &w, &mass);
-    let mut lambda = f64::INFINITY;
+    let mut lambda = vec![f64::INFINITY; n_comp];
     let mut report = KnoppelReport {
         eigenvalue: 0.0,
         iterations: 0,
@@ -120,14 +122,19 @@ pub(crate) fn knoppel_phase(
                 "inverse iteration produced a non-finite vector".into(),
             ));
         }
-        normalize_m(&mut u, &mass);
+        normalize_m(&mut u, &mass, &comp, n_comp);
         let lu = apply_l(&u);
-        let new_lambda: f64 = u.iter().zip(&lu).map(|(a, b)| a * b).sum();
-        let residual = residual_m(&lu, &u, new_lambda, &mass) / scale;
-        let change = (new_lambda - lambda).abs() / scale;
+        let new_lambda = rayleigh_quotients(&u, &lu, &comp, n_comp);
+        let residual = residual_m(&lu, &u, &new_lambda, &mass, &comp) / scale;
+        let change = new_lambda
+            .iter()
+            .zip(&lambda)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+            / scale;
         lambda = new_lambda;
         report = KnoppelReport {
-            eigenvalue: lambda,
+            eigenvalue: lambda.iter().copied().fold(f64::NEG_INFINITY, f64::max),
             iterations: it,
             residual,
             shift: sigma,
@@ -244,21 +251,72 @@ fn max_ratio(topo: &Topology, w: &[f64], mass: &[f64]) -> f64 {
     }
 }
 
-fn normalize_m(u: &mut [f64], mass: &[f64]) {
-    let n2: f64 = u.iter().enumerate().map(|(i, v)| mass[i / 2] * v * v).sum();
-    let s = 1.0 / n2.sqrt();
-    if s.is_finite() {
-        u.iter_mut().for_each(|v| *v *= s);
+/// Connected components (union–find over edges): a label per vertex and their number. The
+/// connection Laplacian is block-diagonal over components, so normalizing each component
+/// separately runs independent inverse iterations: every component gets its own smallest
+/// eigenvector instead of decaying towards the component with the smallest eigenvalue.
+fn components(topo: &Topology) -> (Vec<u32>, usize) {
+    let n = topo.n_vertices;
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn find(p: &mut [u32], mut v: u32) -> u32 {
+        while p[v as usize] != v {
+            p[v as usize] = p[p[v as usize] as usize];
+            v = p[v as usize];
+        }
+        v
+    }
+    for &[a, b] in &topo.edges {
+        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+        if ra != rb {
+            parent[ra.max(rb) as usize] = ra.min(rb);
+        }
+    }
+    let mut label = vec![u32::MAX; n];
+    let mut count = 0u32;
+    let comp = (0..n as u32)
+        .map(|v| {
+            let r = find(&mut parent, v) as usize;
+            if label[r] == u32::MAX {
+                label[r] = count;
+                count += 1;
+            }
+            label[r]
+        })
+        .collect();
+    (comp, count as usize)
+}
+
+/// Scales each component of `u` to unit M-norm.
+fn normalize_m(u: &mut [f64], mass: &[f64], comp: &[u32], n_comp: usize) {
+    let mut n2 = vec![0.0; n_comp];
+    for (i, v) in u.iter().enumerate() {
+        n2[comp[i / 2] as usize] += mass[i / 2] * v * v;
+    }
+    let s: Vec<f64> = n2.iter().map(|x| 1.0 / x.sqrt()).collect();
+    for (i, v) in u.iter_mut().enumerate() {
+        let f = s[comp[i / 2] as usize];
+        if f.is_finite() {
+            *v *= f;
+        }
     }
 }
 
-/// `‖L u − λ M u‖_{M⁻¹}` for M-normalized `u`.
-fn residual_m(lu: &[f64], u: &[f64], lambda: f64, mass: &[f64]) -> f64 {
+/// Per component, `u_cᵀ L u_c` (u is M-normalized per component).
+fn rayleigh_quotients(u: &[f64], lu: &[f64], comp: &[u32], n_comp: usize) -> Vec<f64> {
+    let mut q = vec![0.0; n_comp];
+    for (i, (a, b)) in u.iter().zip(lu).enumerate() {
+        q[comp[i / 2] as usize] += a * b;
+    }
+    q
+}
+
+/// `‖L u − λ M u‖_{M⁻¹}` with each component's own `λ`.
+fn residual_m(lu: &[f64], u: &[f64], lambda: &[f64], mass: &[f64], comp: &[u32]) -> f64 {
     lu.iter()
         .zip(u)
         .enumerate()
         .map(|(i, (l, v))| {
-            let r = l - lambda * mass[i / 2] * v;
+            let r = l - lambda[comp[i / 2] as usize] * mass[i / 2] * v;
             r * r / mass[i / 2]
         })
         .sum::<f64>()
