@@ -830,9 +830,11 @@ impl JsonLine {
     }
 }
 
+/// Shortest round-trip form; exponent notation for very small or large magnitudes (`1e-7`),
+/// which JSON accepts; `null` when not finite.
 fn float_to_json(v: f64) -> String {
     if v.is_finite() {
-        format!("{v}")
+        format!("{v:?}")
     } else {
         "null".to_string()
     }
@@ -840,4 +842,28 @@ fn float_to_json(v: f64) -> String {
 
 fn opt_to_json<T: ToString>(v: Option<T>) -> String {
     v.map_or_else(|| "null".to_string(), |x| x.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_numbers() {
+        assert_eq!(float_to_json(1.0), "1.0");
+        assert_eq!(float_to_json(0.1), "0.1");
+        assert_eq!(float_to_json(-2.5e-300), "-2.5e-300");
+        assert_eq!(float_to_json(f64::NAN), "null");
+        assert_eq!(float_to_json(f64::INFINITY), "null");
+        assert_eq!(opt_to_json::<usize>(None), "null");
+        let mut j = JsonLine::default();
+        j.int_list("l", Some(&(0..150).collect::<Vec<i64>>()));
+        j.int_list("n", None);
+        j.float_list("f", &[1.0, -0.5]);
+        let s = j.finish();
+        assert!(
+            s.starts_with("{\"l\": [0,1,2,") && s.contains(",99], \"n\": null, \"f\": [1.0,-0.5]}"),
+            "{s}"
+        );
+    }
 }
