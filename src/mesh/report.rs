@@ -167,7 +167,8 @@ impl MeshReport {
     }
 
     /// The report with the given options, recording the wall time of each phase in `stats`
-    /// (stages `weld`, `faces`, `components`, `edges`, `fans`, `orientability`, then
+    /// (stages `weld`, `faces`, `components`, `edges`, `fans`, `orientability`,
+    /// `duplicate_faces`, then
     /// `si_prepare`, `si_bvh`, `si_pairs_and_tests` for the self-intersection pass).
     pub fn compute_timed(mesh: &TriMesh, options: &ReportOptions, stats: &mut Stats) -> MeshReport {
         let positions = mesh.positions();
@@ -188,6 +189,7 @@ impl MeshReport {
             edges.count_nonmanifold_vertices(tris, &faces.comb_degenerate)
         });
         let orientable = stats.time("orientability", || edges.is_orientable());
+        let n_duplicate_faces = stats.time("duplicate_faces", || count_duplicate_faces(tris));
         let si = options
             .self_intersections
             .then(|| find_self_intersections_welded(positions, mesh.triangles(), &weld, stats));
@@ -218,7 +220,7 @@ impl MeshReport {
             n_degenerate_faces: faces.n_geom_degenerate,
             n_combinatorially_degenerate_faces: faces.n_comb_degenerate,
             surface_area: faces.area,
-            n_duplicate_faces: count_duplicate_faces(tris),
+            n_duplicate_faces,
             n_edges: edges.n_edges,
             n_boundary_edges: edges.n_boundary,
             n_nonmanifold_edges: edges.n_nonmanifold,
