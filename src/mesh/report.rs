@@ -47,8 +47,9 @@ impl Default for ReportOptions {
 /// [`MeshReport::n_coincident_vertices`] and [`MeshReport::n_misoriented_manifold_edges`] are
 /// additions.
 ///
-/// Cost: O(F log F), dominated by the self-intersection pass (about 2 s for 1.3 M triangles on
-/// 2 cores; see `benches/report.rs`). Deterministic whatever the number of threads.
+/// Cost: O(F log F), dominated by the self-intersection pass: 2.2 s for a closed 1.3 M-triangle
+/// mesh on the 2-core development machine, 4 s on one core (`benches/report.rs`).
+/// Deterministic whatever the number of threads.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshReport {
     /// Number of vertices in the buffer, referenced or not (`n_vertices`).
