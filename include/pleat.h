@@ -12,9 +12,6 @@
 #include <stddef.h>
 #include <stdint.h>
 
-// The id meaning "no element" (a boundary half-edge's face, a deleted element's links, ...).
-#define INVALID UINT32_MAX
-
 // Version of the C ABI. Incremented on any incompatible change to a function signature or to
 // the layout of an existing struct field. Adding functions or appending struct fields (behind
 // `struct_size`) does not change it.
