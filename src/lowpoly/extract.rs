@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 use super::distance::{brick_coords, brick_key, DistanceGrid, InputDistance, BRICK};
 use super::features::{cube_geometry, CubeFlags};
-use super::geom::{lerp, normalized, scale, sub, V3};
+use super::geom::{add, lerp, normalized, scale, sub, V3};
 use super::mc33::tables::{CORNER_POS, EDGE_AXIS, EDGE_CORNERS};
 use super::mc33::triangulate::{fan, LocalTri};
 use super::mc33::{decide, topology, trilinear, CubeTopology};
@@ -327,6 +327,7 @@ pub(crate) fn extract(
     };
     let ctx = CubeCtx {
         grid,
+        input,
         keys: &keys,
         iso: &iso,
         p,
@@ -441,6 +442,7 @@ fn refine(
 
 struct CubeCtx<'a> {
     grid: &'a DistanceGrid,
+    input: &'a InputDistance,
     keys: &'a [u64],
     iso: &'a [(V3, V3, bool)],
     p: &'a ExtractParams,
@@ -480,6 +482,7 @@ fn cube_patches(
     out: &mut BrickPatches,
 ) {
     let h = ctx.grid.spec.h;
+    let d = ctx.p.d;
     let origin = ctx.grid.spec.point(g);
     let mut ids = [NONE; 12];
     let mut local = [[0.0; 3]; 12];
@@ -502,7 +505,18 @@ fn cube_patches(
         };
     }
     let normals = ctx.p.features.then_some(&normals);
-    let (patches, flags) = cube_geometry(topo, &local, normals);
+    let project = |x: V3| -> Option<V3> {
+        let w = [
+            origin[0] + h * x[0],
+            origin[1] + h * x[1],
+            origin[2] + h * x[2],
+        ];
+        let c = ctx.input.closest(w, 2.0 * ctx.grid.cap)?;
+        let n = normalized(sub(w, c.point))?;
+        let y = lerp(c.point, add(c.point, n), d);
+        Some(scale(sub(y, origin), 1.0 / h))
+    };
+    let (patches, flags) = cube_geometry(topo, &local, normals, Some(&project));
     out.counts.add_flags(&flags);
     let world = |x: V3| {
         [

@@ -284,13 +284,19 @@ pub(crate) struct CubeFlags {
     pub unresolved: bool,
 }
 
+/// Maps a cube-local point onto the exact iso-surface (`None` when it cannot).
+pub(crate) type Projector<'a> = &'a dyn Fn(V3) -> Option<V3>;
+
 /// Geometry of all patches of one cube. `iso[e]` is the iso-point of crossed edge `e` and
 /// `normals[e]` its unit normal (eq. 4.3), both in cube-local coordinates (unit cube);
-/// `normals = None` computes no feature vertices.
+/// `normals = None` computes no feature vertices. With `project`, each apex (feature or
+/// center vertex) is moved onto the exact iso-surface when the moved point still satisfies its
+/// polyhedron's constraints (so the embedding argument is unaffected).
 pub(crate) fn cube_geometry(
     topo: &CubeTopology,
     iso: &[V3; 12],
     normals: Option<&[V3; 12]>,
+    project: Option<Projector<'_>>,
 ) -> (Vec<PatchGeom>, CubeFlags) {
     let mut flags = CubeFlags::default();
     let groups = patch_groups(topo, iso, &mut flags);
@@ -333,7 +339,7 @@ pub(crate) fn cube_geometry(
             let ok = strip(a, ea, b, eb, &[], &mut g.plain);
             debug_assert!(ok, "strip was validated in patch_groups");
         } else {
-            disk_geometry(&mut g, &pts[k], &cons[k], separated[k], normals);
+            disk_geometry(&mut g, &pts[k], &cons[k], separated[k], normals, project);
         }
         out.push(g);
     }
@@ -402,18 +408,25 @@ fn disk_geometry(
     cons: &[HalfSpace],
     separated: bool,
     normals: Option<&[V3; 12]>,
+    project: Option<Projector<'_>>,
 ) {
     let c = centroid(pts);
     let cons: &[HalfSpace] = if separated { cons } else { &cons[..6] };
+    let onto_surface = |x: V3| {
+        project
+            .and_then(|f| f(x))
+            .filter(|y| cons.iter().all(|h| dot(h.n, *y) <= h.c))
+            .unwrap_or(x)
+    };
     if let (Some(nrm), true) = (normals, separated) {
-        g.feature = feature_vertex(pts, &g.edges, nrm, c, cons);
+        g.feature = feature_vertex(pts, &g.edges, nrm, c, cons).map(onto_surface);
     }
     if !plain_disk(pts, &g.edges, &mut g.plain) {
         // Template needs a center: the centroid projected into the polyhedron.
         let w = REGULARIZATION * pts.len() as f64;
         let a = [[w, 0.0, 0.0], [0.0, w, 0.0], [0.0, 0.0, w]];
         let x = solve_qp(a, scale(c, w), cons).unwrap_or_else(|| clamp_into_cube(c));
-        g.center = Some(x);
+        g.center = Some(onto_surface(x));
         fan(pts.len(), &mut g.plain);
     }
 }
