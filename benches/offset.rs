@@ -21,30 +21,8 @@ fn corpus_dir() -> Option<PathBuf> {
     cands.into_iter().flatten().find(|p| p.is_dir())
 }
 
-/// OBJ reader for the benchmark (the crate's own reader lives in `mesh::io`).
 fn load(path: &Path) -> Option<TriMesh> {
-    let (models, _) = tobj::load_obj(
-        path,
-        &tobj::LoadOptions {
-            triangulate: true,
-            single_index: false,
-            ..Default::default()
-        },
-    )
-    .ok()?;
-    let mut pos = Vec::new();
-    let mut tris = Vec::new();
-    for m in models {
-        let base = pos.len() as u32;
-        pos.extend(m.mesh.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
-        tris.extend(
-            m.mesh
-                .indices
-                .chunks_exact(3)
-                .map(|c| [c[0] + base, c[1] + base, c[2] + base]),
-        );
-    }
-    TriMesh::new(pos, tris).ok()
+    pleat::mesh::io::read_mesh(path).ok()
 }
 
 fn peak_rss_bytes() -> u64 {
@@ -118,7 +96,10 @@ fn main() {
     let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
         .map(|r| r.flatten().map(|e| e.path()).collect())
         .unwrap_or_default();
-    files.retain(|p| p.extension().is_some_and(|e| e == "obj"));
+    files.retain(|p| {
+        p.extension()
+            .is_some_and(|e| ["obj", "ply", "off", "stl"].contains(&e.to_string_lossy().as_ref()))
+    });
     files.sort();
     let exe = std::env::current_exe().expect("own path");
     for np in nps {

@@ -523,7 +523,12 @@ fn sharp_features_and_normal_error() {
         let mut err = Vec::new();
         for features in [false, true] {
             let p = OffsetParams { features, ..np(n) };
-            let (out, _, _) = run_and_check(name, &input, &p, 2000);
+            let (out, st, _) = run_and_check(name, &input, &p, 2000);
+            eprintln!(
+                "  flips {:?}, feature vertices kept {:?}",
+                st.get_count("flips"),
+                st.get_count("feature_vertices_kept")
+            );
             err.push(normal_error(&input, &out));
         }
         eprintln!(
@@ -647,10 +652,13 @@ fn corpus_offsets_are_closed_manifolds() {
         .flatten()
         .map(|e| e.path())
         .collect();
-    files.retain(|p| p.extension().is_some_and(|e| e == "obj"));
+    files.retain(|p| {
+        p.extension()
+            .is_some_and(|e| ["obj", "ply", "off", "stl"].contains(&e.to_string_lossy().as_ref()))
+    });
     files.sort();
     for f in files {
-        let Some(mesh) = load_obj(&f) else { continue };
+        let Some(mesh) = load(&f) else { continue };
         if mesh.triangle_count() > 200_000 {
             continue;
         }
@@ -661,30 +669,6 @@ fn corpus_offsets_are_closed_manifolds() {
     }
 }
 
-fn load_obj(path: &std::path::Path) -> Option<TriMesh> {
-    let (models, _) = tobj::load_obj(
-        path,
-        &tobj::LoadOptions {
-            triangulate: true,
-            ..Default::default()
-        },
-    )
-    .ok()?;
-    let mut s = Soup::default();
-    for m in models {
-        let p: Vec<V3> = m
-            .mesh
-            .positions
-            .chunks_exact(3)
-            .map(|c| [c[0], c[1], c[2]])
-            .collect();
-        let t: Vec<[u32; 3]> = m
-            .mesh
-            .indices
-            .chunks_exact(3)
-            .map(|c| [c[0], c[1], c[2]])
-            .collect();
-        s.add(&p, &t);
-    }
-    TriMesh::new(s.pos, s.tris).ok()
+fn load(path: &std::path::Path) -> Option<TriMesh> {
+    pleat::mesh::io::read_mesh(path).ok()
 }

@@ -75,6 +75,8 @@ pub(crate) struct PatchSet {
     pub center: Vec<u32>,
     /// Feature vertex, or [`NONE`].
     pub feature: Vec<u32>,
+    /// Patch of each feature vertex id.
+    pub feature_patch: std::collections::HashMap<u32, u32>,
     /// Counters.
     pub counts: ExtractCounts,
 }
@@ -342,6 +344,13 @@ pub(crate) fn extract(
         }
     }
     set.counts.add(&counts);
+    set.feature_patch = set
+        .feature
+        .iter()
+        .enumerate()
+        .filter(|(_, &f)| f != NONE)
+        .map(|(p, &f)| (f, p as u32))
+        .collect();
     Ok(set)
 }
 

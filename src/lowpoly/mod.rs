@@ -8,6 +8,8 @@ pub(crate) mod distance;
 mod exact;
 mod extract;
 pub(crate) mod features;
+mod filter;
+mod flips;
 mod geom;
 mod interior;
 pub(crate) mod mc33;

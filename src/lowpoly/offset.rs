@@ -9,9 +9,11 @@ use super::distance::{
     InputDistance, BRICK_BYTES,
 };
 use super::extract::{deviation, extract, ExtractParams, PatchSet};
+use super::filter::vertices_on_real_curves;
+use super::flips::{flip_to_features, FlipCounts};
 use super::geom::V3;
 use super::interior::{components, visible_components};
-use crate::mesh::TriMesh;
+use crate::mesh::{HalfEdgeMesh, TriMesh};
 use crate::report::{Progress, ProgressFn, Stats};
 use crate::{Error, Result};
 
@@ -166,8 +168,8 @@ pub fn offset_surface_with_progress(
     record_extraction(&mut stats, &set);
     let mut peak = grid.memory_bytes() + patchset_bytes(&set);
     drop(grid);
-    step(progress, "assemble", 0.85)?;
-    let (pos, tris, _) = stats.time("assemble", || set.assemble(&|_| true));
+    step(progress, "features", 0.85)?;
+    let (pos, tris) = surface_with_features(&set, params, r.h, &mut stats)?;
     if tris.is_empty() {
         return Err(Error::InvalidMesh("the offset surface is empty".into()));
     }
@@ -250,6 +252,76 @@ fn distance_field(
     stats.count("bricks", grid.keys.len() as u64);
     stats.count("grid_points", grid.stored_points());
     Ok(grid)
+}
+
+/// Phase 1: every feature vertex, flips (Algorithm 2), feature filtering; phase 2: real
+/// feature vertices only, flips again (§4.3.1). Without features: the MC33 templates.
+fn surface_with_features(
+    set: &PatchSet,
+    params: &OffsetParams,
+    h: f64,
+    stats: &mut Stats,
+) -> Result<(Vec<V3>, Vec<[u32; 3]>)> {
+    if !params.features {
+        let (pos, tris, _) = stats.time("assemble", || set.assemble(&|_| false));
+        return Ok((pos, tris));
+    }
+    let t = Instant::now();
+    let (pos, tris, back) = set.assemble(&|_| true);
+    let cos_sharp = (180.0 - params.theta0_deg).to_radians().cos();
+    let (mesh, flips1) = flipped(pos, tris, &back, set, h, Some(cos_sharp))?;
+    stats
+        .stages
+        .push(("flips".into(), t.elapsed().as_secs_f64()));
+    let t = Instant::now();
+    let real = vertices_on_real_curves(&mesh, params.theta0_deg, params.l0);
+    let mut keep = vec![false; set.len()];
+    for (v, &id) in back.iter().enumerate() {
+        if real[v] {
+            if let Some(&p) = set.feature_patch.get(&id) {
+                keep[p as usize] = true;
+            }
+        }
+    }
+    drop(mesh);
+    stats
+        .stages
+        .push(("filter".into(), t.elapsed().as_secs_f64()));
+    let t = Instant::now();
+    let (pos, tris, back) = set.assemble(&|p| keep[p]);
+    let (mesh, flips2) = flipped(pos, tris, &back, set, h, None)?;
+    stats
+        .stages
+        .push(("flips_filtered".into(), t.elapsed().as_secs_f64()));
+    stats.count("flip_candidates", flips1.candidates);
+    stats.count("flips", flips1.flipped);
+    stats.count("flips_refused_geometry", flips1.refused_geometry);
+    stats.count(
+        "feature_vertices_kept",
+        keep.iter().filter(|&&k| k).count() as u64,
+    );
+    stats.count("flips_filtered", flips2.flipped);
+    Ok(mesh.to_trimesh().into_parts())
+}
+
+/// Builds the half-edge mesh and runs Algorithm 2 with the patch set's feature vertices.
+fn flipped(
+    pos: Vec<V3>,
+    tris: Vec<[u32; 3]>,
+    back: &[u32],
+    set: &PatchSet,
+    h: f64,
+    sharp_only: Option<f64>,
+) -> Result<(HalfEdgeMesh, FlipCounts)> {
+    let tm = TriMesh::new(pos, tris)?;
+    let mut mesh = HalfEdgeMesh::from_trimesh(&tm)
+        .map_err(|e| Error::Internal(format!("offset surface is not manifold: {e}")))?;
+    let is_feature: Vec<bool> = back
+        .iter()
+        .map(|id| set.feature_patch.contains_key(id))
+        .collect();
+    let counts = flip_to_features(&mut mesh, &is_feature, h, sharp_only);
+    Ok((mesh, counts))
 }
 
 fn record_extraction(stats: &mut Stats, set: &PatchSet) {
