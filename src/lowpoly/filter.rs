@@ -5,6 +5,8 @@
 //! with more than l0 edges (default 4) is "real"; a feature vertex is kept only when it lies on
 //! a real curve, every other patch reverts to its MC33 template.
 
+use rayon::prelude::*;
+
 use super::geom::{dot, normalized, V3};
 use crate::mesh::HalfEdgeMesh;
 
@@ -78,15 +80,23 @@ fn walk_curve(
 /// apart.)
 fn sharp_edges(mesh: &HalfEdgeMesh, theta0_deg: f64) -> Vec<bool> {
     let cos_limit = (180.0 - theta0_deg).to_radians().cos();
-    let normal = |f: u32| -> Option<V3> { normalized(mesh.face_area_vector(f)) };
-    let mut sharp = vec![false; mesh.edge_capacity()];
-    for e in mesh.edges() {
-        let h = mesh.edge_halfedge(e);
-        if let (Some(f), Some(g)) = (mesh.face(h), mesh.face(h ^ 1)) {
-            if let (Some(a), Some(b)) = (normal(f), normal(g)) {
-                sharp[e as usize] = dot(a, b) < cos_limit;
+    let normals: Vec<Option<V3>> = (0..mesh.face_capacity() as u32)
+        .into_par_iter()
+        .map(|f| {
+            mesh.is_face_live(f)
+                .then(|| normalized(mesh.face_area_vector(f)))
+                .flatten()
+        })
+        .collect();
+    (0..mesh.edge_capacity() as u32)
+        .into_par_iter()
+        .map(|e| {
+            if !mesh.is_edge_live(e) {
+                return false;
             }
-        }
-    }
-    sharp
+            let h = mesh.edge_halfedge(e);
+            let n = |h: u32| mesh.face(h).and_then(|f| normals[f as usize]);
+            matches!((n(h), n(h ^ 1)), (Some(a), Some(b)) if dot(a, b) < cos_limit)
+        })
+        .collect()
 }

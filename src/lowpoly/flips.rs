@@ -17,7 +17,7 @@
 //! bounding boxes with cells of the voxel size (triangles of the offset span at most a few
 //! voxels), updated after every accepted flip.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use super::exact::{is_degenerate, triangles_conflict};
 use super::geom::{dot, normalized, tri_normal, V3};
@@ -40,6 +40,8 @@ pub(crate) struct FlipCounts {
 struct TriangleHash {
     inv: f64,
     cells: HashMap<[i64; 3], Vec<u32>>,
+    /// Cells whose faces are all indexed.
+    relevant: HashSet<[i64; 3]>,
 }
 
 impl TriangleHash {
@@ -47,6 +49,7 @@ impl TriangleHash {
         TriangleHash {
             inv: 1.0 / cell,
             cells: HashMap::new(),
+            relevant: HashSet::new(),
         }
     }
 
@@ -90,13 +93,17 @@ impl TriangleHash {
         }
     }
 
-    /// Faces whose cells overlap the box of `t` (may repeat).
-    fn candidates(&self, t: &[V3; 3], out: &mut Vec<u32>) {
+    /// Faces whose cells overlap the box of `t` (may repeat); `false` when the box reaches a
+    /// cell that is not indexed.
+    fn candidates(&self, t: &[V3; 3], out: &mut Vec<u32>) -> bool {
+        let mut complete = true;
         self.for_cells(t, |c| {
+            complete &= self.relevant.contains(&c);
             if let Some(v) = self.cells.get(&c) {
                 out.extend_from_slice(v);
             }
         });
+        complete
     }
 }
 
@@ -108,6 +115,45 @@ fn boxes_overlap(a: &[V3; 3], b: &[V3; 3]) -> bool {
         let bhi = b.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
         alo <= bhi && blo <= ahi
     })
+}
+
+/// A hash of the faces that can matter to the candidate flips: those whose box overlaps a
+/// cell touched by a candidate's quad. A flip only ever creates triangles inside its quad's
+/// box, so every later query stays within these cells.
+fn candidate_hash(mesh: &HalfEdgeMesh, queue: &[u32], cell: f64) -> TriangleHash {
+    let mut hash = TriangleHash::new(cell);
+    let mut relevant: HashSet<[i64; 3]> = HashSet::new();
+    for &e in queue {
+        let h = mesh.edge_halfedge(e);
+        let [a, b, c] = mesh.face_positions(mesh.face(h).unwrap_or(0));
+        let d = opposite(mesh, h ^ 1).map_or(a, |v| mesh.position(v));
+        hash.for_cells(&[a, b, c], |k| {
+            relevant.insert(k);
+        });
+        hash.for_cells(&[a, b, d], |k| {
+            relevant.insert(k);
+        });
+    }
+    for f in mesh.faces() {
+        let t = mesh.face_positions(f);
+        let mut hit = false;
+        hash.for_cells(&t, |k| hit |= relevant.contains(&k));
+        if hit {
+            hash.insert(f, &t);
+        }
+    }
+    hash.relevant = relevant;
+    hash
+}
+
+/// Would the edge `c–d` created by flipping `h = a→b` be sharp (normals of `(c, d, b)` and
+/// `(d, c, a)` with cosine below `cos_limit`)?
+fn flip_is_sharp(mesh: &HalfEdgeMesh, h: u32, c: u32, d: u32, cos_limit: f64) -> bool {
+    let (a, b) = (mesh.origin(h), mesh.target(h));
+    let p = |v: u32| mesh.position(v);
+    let n1 = normalized(tri_normal(p(c), p(d), p(b)));
+    let n2 = normalized(tri_normal(p(d), p(c), p(a)));
+    matches!((n1, n2), (Some(x), Some(y)) if dot(x, y) < cos_limit)
 }
 
 /// Vertex opposite half-edge `h` in its face.
@@ -131,17 +177,22 @@ pub(crate) fn flip_to_features(
         .edges()
         .filter(|&e| {
             let h = mesh.edge_halfedge(e);
-            matches!((opposite(mesh, h), opposite(mesh, h ^ 1)), (Some(c), Some(d)) if feature(c) && feature(d))
+            match (opposite(mesh, h), opposite(mesh, h ^ 1)) {
+                (Some(c), Some(d)) => {
+                    feature(c)
+                        && feature(d)
+                        && sharp_only.is_none_or(|cl| flip_is_sharp(mesh, h, c, d, cl))
+                }
+                _ => false,
+            }
         })
         .collect();
     counts.candidates = queue.len() as u64;
     if queue.is_empty() {
         return counts;
     }
-    let mut hash = TriangleHash::new(cell);
-    for f in mesh.faces() {
-        hash.insert(f, &mesh.face_positions(f));
-    }
+    let hash = candidate_hash(mesh, &queue, cell);
+    let mut hash = hash;
     let mut cand = Vec::new();
     for e in queue {
         let h = mesh.edge_halfedge(e);
@@ -156,12 +207,8 @@ pub(crate) fn flip_to_features(
         let old = [mesh.face(h), mesh.face(h ^ 1)].map(|f| f.unwrap_or(u32::MAX));
         let new_ids = [[c, d, b], [d, c, a]];
         let new_geo = new_ids.map(|t| t.map(|v| mesh.position(v)));
-        if let Some(cos_limit) = sharp_only {
-            let n = new_geo.map(|t| normalized(tri_normal(t[0], t[1], t[2])));
-            let sharp = matches!(n, [Some(x), Some(y)] if dot(x, y) < cos_limit);
-            if !sharp {
-                continue;
-            }
+        if sharp_only.is_some_and(|cl| !flip_is_sharp(mesh, h, c, d, cl)) {
+            continue;
         }
         if new_geo.iter().any(is_degenerate)
             || triangles_conflict(new_ids[0], &new_geo[0], new_ids[1], &new_geo[1])
@@ -198,7 +245,9 @@ fn conflicts_with_mesh(
 ) -> bool {
     for (t, g) in ids.iter().zip(geo) {
         cand.clear();
-        hash.candidates(g, cand);
+        if !hash.candidates(g, cand) {
+            return true;
+        }
         cand.sort_unstable();
         cand.dedup();
         for &f in cand.iter() {
