@@ -36,6 +36,17 @@ fn peak_rss_bytes() -> u64 {
         .map_or(0, |kb| kb * 1024)
 }
 
+/// User + system CPU seconds of this process.
+fn cpu_seconds() -> f64 {
+    // SAFETY: getrusage only writes into the struct we pass.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
+        return 0.0;
+    }
+    let t = |tv: libc::timeval| tv.tv_sec as f64 + tv.tv_usec as f64 * 1e-6;
+    t(u.ru_utime) + t(u.ru_stime)
+}
+
 fn child(path: &Path, np: f64) {
     let Some(mesh) = load(path) else {
         println!("SKIP");
@@ -47,16 +58,18 @@ fn child(path: &Path, np: f64) {
         ..Default::default()
     };
     let t = Instant::now();
+    let cpu0 = cpu_seconds();
     match offset_surface(&mesh, &params) {
         Ok((out, stats)) => {
             let total = t.elapsed().as_secs_f64();
+            let cpu = cpu_seconds() - cpu0;
             let stages: Vec<String> = stats
                 .stages
                 .iter()
                 .map(|(n, s)| format!("{n}={s:.3}"))
                 .collect();
             println!(
-                "OK {total:.3} {} {} {} {}",
+                "OK {total:.3} {} {} {} {cpu:.3} {}",
                 peak_rss_bytes(),
                 out.triangle_count(),
                 stats.get_metric("peak_memory_bytes").unwrap_or(0.0) as u64,
@@ -104,6 +117,7 @@ fn main() {
     let exe = std::env::current_exe().expect("own path");
     for np in nps {
         let mut totals = Vec::new();
+        let mut cpus = Vec::new();
         let mut peaks = Vec::new();
         for f in &files {
             let name = f
@@ -121,27 +135,32 @@ fn main() {
             let Ok(out) = out else { continue };
             let line = String::from_utf8_lossy(&out.stdout).trim().to_string();
             let w: Vec<&str> = line.split_whitespace().collect();
-            if w.first() == Some(&"OK") && w.len() >= 6 {
+            if w.first() == Some(&"OK") && w.len() >= 7 {
                 let total: f64 = w[1].parse().unwrap_or(0.0);
                 let rss: u64 = w[2].parse().unwrap_or(0);
+                let cpu: f64 = w[5].parse().unwrap_or(0.0);
                 totals.push(total);
+                cpus.push(cpu);
                 peaks.push(rss);
                 println!(
-                    "n_p={np:<4} {name:<32} {total:7.3} s  peak {:7.1} MiB  (est {:6.1} MiB)  {:>8} tris  {}",
+                    "n_p={np:<4} {name:<32} {total:7.3} s (cpu {cpu:6.2} s)  peak {:7.1} MiB  (est {:6.1} MiB)  {:>8} tris  {}",
                     rss as f64 / 1048576.0,
                     w[4].parse::<f64>().unwrap_or(0.0) / 1048576.0,
                     w[3],
-                    w[5]
+                    w[6]
                 );
             } else {
                 println!("n_p={np:<4} {name:<32} {line}");
             }
         }
         totals.sort_by(f64::total_cmp);
+        cpus.sort_by(f64::total_cmp);
         if !totals.is_empty() {
             println!(
-                "n_p={np}: median {:.3} s, max {:.3} s, max peak {:.1} MiB over {} meshes",
+                "n_p={np}: median {:.3} s wall ({:.3} s cpu on {} threads), max {:.3} s, max peak {:.1} MiB over {} meshes",
                 totals[totals.len() / 2],
+                cpus[cpus.len() / 2],
+                rayon::current_num_threads(),
                 totals[totals.len() - 1],
                 peaks.iter().max().copied().unwrap_or(0) as f64 / 1048576.0,
                 totals.len()

@@ -183,6 +183,8 @@ pub(crate) struct Closest {
     pub dist: f64,
     /// The closest point on the input.
     pub point: V3,
+    /// Index of the input primitive (triangle) it lies on.
+    pub prim: u32,
 }
 
 impl BvhLeafCost for Closest {
@@ -210,20 +212,42 @@ impl InputDistance {
 
     /// Closest input point to `p` if it is closer than `max_dist`.
     pub(crate) fn closest(&self, p: V3, max_dist: f64) -> Option<Closest> {
+        self.closest_hinted(p, max_dist, None)
+    }
+
+    /// Distance from `p` to primitive `i`.
+    fn closest_on(&self, i: u32, p: V3) -> Option<Closest> {
+        let q = self.prims.get(i as usize)?.closest(p);
+        Some(Closest {
+            dist: dist(p, q),
+            point: q,
+            prim: i,
+        })
+    }
+
+    /// [`InputDistance::closest`] seeded with primitive `hint` (typically the closest
+    /// primitive of a nearby point): its exact distance bounds the search, so the BVH prunes
+    /// everything farther. The result is the same as without the hint up to ties.
+    pub(crate) fn closest_hinted(
+        &self,
+        p: V3,
+        max_dist: f64,
+        hint: Option<u32>,
+    ) -> Option<Closest> {
+        let seed = hint
+            .and_then(|i| self.closest_on(i, p))
+            .filter(|c| c.dist < max_dist);
+        let bound = seed.map_or(max_dist, |c| c.dist);
         let pv = to_vec(p);
-        self.bvh
+        let found = self
+            .bvh
             .find_best(
-                max_dist,
+                bound,
                 |node, _| aabb_distance(node.mins(), node.maxs(), pv),
-                |leaf, _| {
-                    let q = self.prims.get(leaf as usize)?.closest(p);
-                    Some(Closest {
-                        dist: dist(p, q),
-                        point: q,
-                    })
-                },
+                |leaf, _| self.closest_on(leaf, p),
             )
-            .map(|(_, c)| c)
+            .map(|(_, c)| c);
+        found.or(seed)
     }
 
     /// `min(f(p), max_dist)`.
@@ -523,17 +547,25 @@ pub(crate) fn evaluate_band(
     })
 }
 
+/// Capped distances of one brick's points, each query seeded with the closest primitive of
+/// the previous point (grid points `h` apart nearly always share it).
 fn brick_values(input: &InputDistance, spec: &GridSpec, key: u64, cap: f64) -> Vec<f64> {
     let b = brick_coords(key);
     let mut out = vec![cap; BRICK_POINTS];
+    let mut hint = None;
     for z in 0..BRICK {
         for y in 0..BRICK {
             for x in 0..BRICK {
+                // Serpentine order keeps consecutive points adjacent.
+                let x = if y % 2 == 1 { BRICK - 1 - x } else { x };
                 let gp = [b[0] * BRICK + x, b[1] * BRICK + y, b[2] * BRICK + z];
                 if gp[0] >= spec.dims[0] || gp[1] >= spec.dims[1] || gp[2] >= spec.dims[2] {
                     continue;
                 }
-                out[local_index(gp)] = input.distance_capped(spec.point(gp), cap);
+                if let Some(c) = input.closest_hinted(spec.point(gp), cap, hint) {
+                    out[local_index(gp)] = c.dist;
+                    hint = Some(c.prim);
+                }
             }
         }
     }

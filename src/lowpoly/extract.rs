@@ -311,17 +311,17 @@ pub(crate) fn extract(
     keys.par_sort_unstable();
     keys.dedup();
     // Iso-points and their normals (eq. 4.3).
-    let iso: Vec<(V3, V3, bool)> = keys
+    let iso: Vec<IsoPoint> = keys
         .par_iter()
         .map(|&k| iso_point(grid, input, k, p))
         .collect();
-    counts.gradient_normals = iso.iter().filter(|x| x.2).count() as u64;
+    counts.gradient_normals = iso.iter().filter(|x| x.gradient).count() as u64;
     if !keep_going(0.5) {
         return Err(Error::Cancelled);
     }
     // Pass 2: patches.
     let mut set = PatchSet {
-        positions: iso.iter().map(|x| x.0).collect(),
+        positions: iso.iter().map(|x| x.pos).collect(),
         n_iso: keys.len(),
         loop_off: vec![0],
         plain_off: vec![0],
@@ -354,14 +354,20 @@ pub(crate) fn extract(
     Ok(set)
 }
 
-/// Position of the iso-point of edge `k`, its unit normal, and whether the normal came from
-/// the trilinear gradient.
-fn iso_point(
-    grid: &DistanceGrid,
-    input: &InputDistance,
-    k: u64,
-    p: &ExtractParams,
-) -> (V3, V3, bool) {
+/// An iso-point with its normal (eq. 4.3).
+#[derive(Debug, Clone, Copy)]
+struct IsoPoint {
+    pos: V3,
+    /// Unit normal `(p − p*)/‖p − p*‖`, or the edge direction when `gradient`.
+    normal: V3,
+    /// The normal must come from the trilinear gradient (no usable closest point).
+    gradient: bool,
+    /// Input primitive of the closest point (`u32::MAX` when unknown).
+    prim: u32,
+}
+
+/// The iso-point of edge `k` with its normal.
+fn iso_point(grid: &DistanceGrid, input: &InputDistance, k: u64, p: &ExtractParams) -> IsoPoint {
     let (g, a) = edge_from_key(k);
     let mut g1 = g;
     g1[a as usize] += 1;
@@ -373,18 +379,29 @@ fn iso_point(
     }
     let t = t.clamp(ISO_EPS, 1.0 - ISO_EPS);
     let x = lerp(x0, x1, t);
+    let mut prim = u32::MAX;
     if p.features {
         if let Some(c) = input.closest(x, grid.cap * 2.0) {
+            prim = c.prim;
             if let Some(n) = normalized(sub(x, c.point)) {
-                return (x, n, false);
+                return IsoPoint {
+                    pos: x,
+                    normal: n,
+                    gradient: false,
+                    prim,
+                };
             }
         }
     }
     // The direction of increasing f along the edge is a usable fallback normal.
-    let n = if f1 > f0 { 1.0 } else { -1.0 };
     let mut nv = [0.0; 3];
-    nv[a as usize] = n;
-    (x, nv, p.features)
+    nv[a as usize] = if f1 > f0 { 1.0 } else { -1.0 };
+    IsoPoint {
+        pos: x,
+        normal: nv,
+        gradient: p.features,
+        prim,
+    }
 }
 
 /// Linear-interpolation parameter of `d` between `f0` and `f1` (which straddle `d`).
@@ -453,7 +470,7 @@ struct CubeCtx<'a> {
     grid: &'a DistanceGrid,
     input: &'a InputDistance,
     keys: &'a [u64],
-    iso: &'a [(V3, V3, bool)],
+    iso: &'a [IsoPoint],
     p: &'a ExtractParams,
 }
 
@@ -496,6 +513,7 @@ fn cube_patches(
     let mut ids = [NONE; 12];
     let mut local = [[0.0; 3]; 12];
     let mut normals = [[0.0; 3]; 12];
+    let mut hint = None;
     for e in 0..12 {
         let ec = EDGE_CORNERS[e];
         if (v[ec[0] as usize] < 0.0) == (v[ec[1] as usize] < 0.0) {
@@ -505,13 +523,16 @@ fn cube_patches(
             continue;
         };
         ids[e] = i as u32;
-        let (x, n, grad) = ctx.iso[i];
-        local[e] = scale(sub(x, origin), 1.0 / h);
-        normals[e] = if grad {
-            trilinear_gradient(v, local[e]).unwrap_or(n)
+        let ip = ctx.iso[i];
+        local[e] = scale(sub(ip.pos, origin), 1.0 / h);
+        normals[e] = if ip.gradient {
+            trilinear_gradient(v, local[e]).unwrap_or(ip.normal)
         } else {
-            n
+            ip.normal
         };
+        if ip.prim != u32::MAX {
+            hint = Some(ip.prim);
+        }
     }
     let normals = ctx.p.features.then_some(&normals);
     let project = |x: V3| -> Option<V3> {
@@ -520,7 +541,7 @@ fn cube_patches(
             origin[1] + h * x[1],
             origin[2] + h * x[2],
         ];
-        let c = ctx.input.closest(w, 2.0 * ctx.grid.cap)?;
+        let c = ctx.input.closest_hinted(w, 2.0 * ctx.grid.cap, hint)?;
         let n = normalized(sub(w, c.point))?;
         let y = lerp(c.point, add(c.point, n), d);
         Some(scale(sub(y, origin), 1.0 / h))

@@ -36,20 +36,43 @@ pub(crate) struct FlipCounts {
     pub refused_geometry: u64,
 }
 
+/// Multiply–rotate hasher for small integer keys (the default SipHash showed in profiles).
+#[derive(Default, Clone, Copy)]
+struct CellHasher(u64);
+
+impl std::hash::Hasher for CellHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_i64(&mut self, x: i64) {
+        self.write_u64(x as u64);
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+type CellBuild = std::hash::BuildHasherDefault<CellHasher>;
+
 /// Uniform grid of triangle boxes.
 struct TriangleHash {
     inv: f64,
-    cells: HashMap<[i64; 3], Vec<u32>>,
+    cells: HashMap<[i64; 3], Vec<u32>, CellBuild>,
     /// Cells whose faces are all indexed.
-    relevant: HashSet<[i64; 3]>,
+    relevant: HashSet<[i64; 3], CellBuild>,
 }
 
 impl TriangleHash {
     fn new(cell: f64) -> TriangleHash {
         TriangleHash {
             inv: 1.0 / cell,
-            cells: HashMap::new(),
-            relevant: HashSet::new(),
+            cells: HashMap::default(),
+            relevant: HashSet::default(),
         }
     }
 
@@ -122,7 +145,7 @@ fn boxes_overlap(a: &[V3; 3], b: &[V3; 3]) -> bool {
 /// box, so every later query stays within these cells.
 fn candidate_hash(mesh: &HalfEdgeMesh, queue: &[u32], cell: f64) -> TriangleHash {
     let mut hash = TriangleHash::new(cell);
-    let mut relevant: HashSet<[i64; 3]> = HashSet::new();
+    let mut relevant: HashSet<[i64; 3], CellBuild> = HashSet::default();
     for &e in queue {
         let h = mesh.edge_halfedge(e);
         let [a, b, c] = mesh.face_positions(mesh.face(h).unwrap_or(0));
