@@ -360,7 +360,7 @@ fn patch_groups(
     for p in 0..topo.n_patches as usize {
         let [l0, l1] = topo.patches[p];
         let e0 = topo.loop_edges(l0 as usize).to_vec();
-        if l1 == NO_LOOP {
+        if !topo.is_annulus(p) {
             let n = e0.len();
             groups.push((e0, n));
             continue;
@@ -460,30 +460,24 @@ fn feature_vertex(
 
 /// Exact check of a cube whose patches could not all be separated.
 fn cube_is_embedded(patches: &[PatchGeom], iso: &[V3; 12]) -> bool {
-    use super::exact::triangles_conflict;
-    let mut tris: Vec<([u32; 3], [V3; 3])> = Vec::new();
+    // Point ids: iso-point of edge e is e, the center of patch k is 12 + k.
+    let mut pos: Vec<V3> = iso.to_vec();
+    pos.extend(patches.iter().map(|g| g.center.unwrap_or([0.5; 3])));
+    let mut tris: Vec<[u32; 3]> = Vec::new();
     for (k, g) in patches.iter().enumerate() {
-        let id = |i: u8| -> (u32, V3) {
-            if (i as usize) < g.edges.len() {
-                let e = g.edges[i as usize];
-                (e as u32, iso[e as usize])
-            } else {
-                (100 + k as u32, g.center.unwrap_or([0.5; 3]))
+        let id = |i: u8| -> u32 {
+            match g.edges.get(i as usize) {
+                Some(&e) => e as u32,
+                None => 12 + k as u32,
             }
         };
-        for t in &g.plain {
-            let v = t.map(id);
-            tris.push((v.map(|x| x.0), v.map(|x| x.1)));
-        }
+        tris.extend(g.plain.iter().map(|t| t.map(id)));
     }
-    for (x, a) in tris.iter().enumerate() {
-        for b in &tris[x + 1..] {
-            if triangles_conflict(a.0, &a.1, b.0, &b.1) {
-                return false;
-            }
-        }
-    }
-    true
+    tris.iter().enumerate().all(|(x, &a)| {
+        tris[x + 1..]
+            .iter()
+            .all(|&b| !crate::spatial::faces_intersect(&pos, a, b))
+    })
 }
 
 #[cfg(test)]

@@ -70,19 +70,6 @@ pub(crate) fn tri_normal(a: V3, b: V3, c: V3) -> V3 {
     cross(sub(b, a), sub(c, a))
 }
 
-/// Exact orientation of `d` relative to the plane through `a, b, c` (Shewchuk's predicate):
-/// positive when `d` lies below the plane, i.e. on the side opposite to `(b − a) × (c − a)`,
-/// negative above, zero when coplanar.
-#[inline]
-pub(crate) fn orient3d(a: V3, b: V3, c: V3, d: V3) -> f64 {
-    let p = |v: V3| robust::Coord3D {
-        x: v[0],
-        y: v[1],
-        z: v[2],
-    };
-    robust::orient3d(p(a), p(b), p(c), p(d))
-}
-
 /// Exact 2D orientation: positive when `a, b, c` are counter-clockwise.
 #[inline]
 pub(crate) fn orient2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {

@@ -5,7 +5,6 @@
 //! topology (`mc33`), feature vertices (`features`), interior removal (`interior`).
 
 pub(crate) mod distance;
-mod exact;
 mod extract;
 pub(crate) mod features;
 mod filter;

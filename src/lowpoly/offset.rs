@@ -4,6 +4,8 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use super::distance::{
     band_bricks, band_radius, estimate_bricks, evaluate_band, BandParams, DistanceGrid, GridSpec,
     InputDistance, BRICK_BYTES,
@@ -13,7 +15,7 @@ use super::filter::vertices_on_real_curves;
 use super::flips::{flip_to_features, FlipCounts};
 use super::geom::V3;
 use super::interior::{components, visible_components};
-use crate::mesh::{HalfEdgeMesh, TriMesh};
+use crate::mesh::{HalfEdgeMesh, MeshReport, ReportOptions, TriMesh};
 use crate::report::{Progress, ProgressFn, Stats};
 use crate::{Error, Result};
 
@@ -385,62 +387,25 @@ fn drop_interior(pos: &[V3], tris: &[[u32; 3]]) -> (Vec<V3>, Vec<[u32; 3]>, u64,
     (new_pos, kept, removed, n as u64)
 }
 
-/// Independent checks of the output: edge manifoldness and watertightness, vertex
-/// manifoldness, and the distance of every vertex to the input.
+/// Independent checks of the output ([`MeshReport`], code independent of this stage):
+/// watertight, manifold, consistently oriented, self-intersection-free; plus the exact
+/// distance of every vertex to the input (`|f(v) − d| ≤ h`).
 fn verify(out: &TriMesh, input: &InputDistance, r: Resolved, stats: &mut Stats) {
-    let (watertight, manifold) = closed_manifold(out.vertex_count(), out.triangles());
-    stats.verify("watertight", watertight);
-    stats.verify("manifold", manifold);
+    let report = MeshReport::compute_with(out, &ReportOptions::default());
+    stats.verify("watertight", report.is_watertight);
+    stats.verify("manifold", report.is_manifold);
+    stats.verify("consistently_oriented", report.consistently_oriented);
+    stats.verify(
+        "self_intersection_free",
+        report.self_intersection_free == Some(true),
+    );
+    stats.count("output_components", report.n_components as u64);
     let cap = r.d + 4.0 * r.h;
     let max_dev = out
         .positions()
-        .iter()
+        .par_iter()
         .map(|&x| deviation(input, x, r.d, cap))
-        .fold(0.0f64, f64::max);
+        .reduce(|| 0.0, f64::max);
     stats.metric("max_deviation_over_d", max_dev / r.d);
     stats.verify("vertices_within_h_of_offset", max_dev <= r.h);
-}
-
-/// Every undirected edge in exactly two triangles with opposite directions (watertight and
-/// consistently oriented), and the triangles around every vertex form one fan (manifold).
-pub(crate) fn closed_manifold(nv: usize, tris: &[[u32; 3]]) -> (bool, bool) {
-    let mut directed: Vec<(u32, u32)> = tris
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
-        .collect();
-    directed.sort_unstable();
-    let dup = directed.windows(2).any(|w| w[0] == w[1]);
-    let paired = directed
-        .iter()
-        .all(|&(a, b)| directed.binary_search(&(b, a)).is_ok());
-    let watertight = !dup
-        && paired
-        && tris
-            .iter()
-            .all(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
-    // Vertex fans: follow "next edge around v" through the directed edge map.
-    let mut next_around: Vec<Vec<(u32, u32)>> = vec![Vec::new(); nv];
-    for t in tris {
-        for k in 0..3 {
-            // Around t[k]: from t[k+1] to t[k+2].
-            next_around[t[k] as usize].push((t[(k + 1) % 3], t[(k + 2) % 3]));
-        }
-    }
-    let manifold = watertight
-        && next_around.iter().all(|ring| {
-            if ring.is_empty() {
-                return true;
-            }
-            let mut cur = ring[0].1;
-            let mut steps = 1;
-            while cur != ring[0].0 && steps <= ring.len() {
-                match ring.iter().find(|e| e.0 == cur) {
-                    Some(e) => cur = e.1,
-                    None => return false,
-                }
-                steps += 1;
-            }
-            steps == ring.len()
-        });
-    (watertight, manifold)
 }

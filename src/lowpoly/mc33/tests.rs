@@ -1,10 +1,10 @@
 use super::tables::*;
 use super::triangulate::{fan, LocalTri};
 use super::*;
-use crate::lowpoly::exact::triangles_conflict;
 use crate::lowpoly::features::{cube_geometry, CubeFlags};
 use crate::lowpoly::geom::normalized;
 use crate::lowpoly::geom::{lerp, V3};
+use crate::spatial::faces_intersect;
 use std::collections::HashMap;
 
 /// Deterministic SplitMix64.
@@ -89,6 +89,8 @@ fn check_loops(dec: &Decisions, topo: &CubeTopology) {
 /// Triangulates a cube the way the extractor does (`cube_geometry`), with feature fans where
 /// available, and returns triangles over point ids (iso-points are `e`, extra vertices
 /// `100 + k`), positions, and the flags.
+///
+/// [`no_conflicts`] checks such a cube with the exact `spatial::faces_intersect`.
 pub(crate) fn triangulate_cube(
     topo: &CubeTopology,
     iso: &[V3; 12],
@@ -124,6 +126,23 @@ pub(crate) fn triangulate_cube(
         }
     }
     (tris, pos, flags)
+}
+
+/// No two triangles of the cube intersect beyond what they share (exact).
+fn no_conflicts(tris: &[[u32; 3]], pos: &HashMap<u32, V3>) -> Result<(), String> {
+    let mut ids: Vec<u32> = pos.keys().copied().collect();
+    ids.sort_unstable();
+    let dense: Vec<V3> = (0..=ids.last().copied().unwrap_or(0))
+        .map(|i| pos.get(&i).copied().unwrap_or([f64::NAN; 3]))
+        .collect();
+    for (x, a) in tris.iter().enumerate() {
+        for b in &tris[x + 1..] {
+            if faces_intersect(&dense, *a, *b) {
+                return Err(format!("{a:?} x {b:?}"));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Oriented-edge bookkeeping: boundary edges (loop segments, in loop direction) exactly once,
@@ -191,15 +210,8 @@ fn every_configuration_and_resolution_gives_closed_patches() {
                     unresolved += 1;
                     continue;
                 }
-                for (x, a) in tris.iter().enumerate() {
-                    for b in &tris[x + 1..] {
-                        let ga = a.map(|i| pos[&i]);
-                        let gb = b.map(|i| pos[&i]);
-                        assert!(
-                            !triangles_conflict(*a, &ga, *b, &gb),
-                            "{dec:?}: {a:?} x {b:?}"
-                        );
-                    }
+                if let Err(e) = no_conflicts(&tris, &pos) {
+                    panic!("{dec:?}: {e}");
                 }
             }
             n_cases += 1;
@@ -355,12 +367,8 @@ fn value_consistent_cubes_separate_and_embed() {
         stats[3] += (0..topo.n_patches as usize)
             .filter(|&p| topo.is_annulus(p))
             .count();
-        for (x, a) in tris.iter().enumerate() {
-            for b in &tris[x + 1..] {
-                let ga = a.map(|i| pos[&i]);
-                let gb = b.map(|i| pos[&i]);
-                assert!(!triangles_conflict(*a, &ga, *b, &gb), "{v:?}");
-            }
+        if let Err(e) = no_conflicts(&tris, &pos) {
+            panic!("{v:?}: {e}");
         }
     }
     eprintln!(

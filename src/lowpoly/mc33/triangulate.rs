@@ -19,8 +19,8 @@
 //!   intersection inside the strip or with the cube's other triangles.
 
 use super::tables::edges_share_face;
-use crate::lowpoly::exact::{is_degenerate, triangles_conflict};
 use crate::lowpoly::geom::{dist, orient2d, V3};
+use crate::spatial::{faces_intersect, is_collinear, triangles_intersect};
 
 /// A triangle as local point indices.
 pub(crate) type LocalTri = [u8; 3];
@@ -227,21 +227,30 @@ fn zip(a: &[V3], b: &[V3], s: usize, out: &mut Vec<LocalTri>) {
 }
 
 fn strip_is_embedded(tris: &[LocalTri], pos: &dyn Fn(usize) -> V3, others: &[[V3; 3]]) -> bool {
-    let geo = |t: &LocalTri| t.map(|i| pos(i as usize));
+    let n = tris
+        .iter()
+        .flat_map(|t| t.iter())
+        .map(|&i| i as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let local: Vec<V3> = (0..n).map(pos).collect();
     let ids = |t: &LocalTri| t.map(u32::from);
-    if tris.iter().any(|t| is_degenerate(&geo(t))) {
+    let geo = |t: &LocalTri| t.map(|i| local[i as usize]);
+    if tris.iter().any(|t| {
+        let g = geo(t);
+        is_collinear(g[0], g[1], g[2])
+    }) {
         return false;
     }
     for (x, tx) in tris.iter().enumerate() {
-        for ty in &tris[x + 1..] {
-            if triangles_conflict(ids(tx), &geo(tx), ids(ty), &geo(ty)) {
-                return false;
-            }
+        if tris[x + 1..]
+            .iter()
+            .any(|ty| faces_intersect(&local, ids(tx), ids(ty)))
+        {
+            return false;
         }
-        for o in others {
-            if crate::lowpoly::exact::triangles_intersect(&geo(tx), o) {
-                return false;
-            }
+        if others.iter().any(|o| triangles_intersect(&geo(tx), o)) {
+            return false;
         }
     }
     true
