@@ -16,8 +16,12 @@
 
 mod common;
 mod mesh;
+mod offset;
 mod report;
+mod stats;
 
 pub use common::*;
 pub use mesh::*;
+pub use offset::*;
 pub use report::*;
+pub use stats::*;
