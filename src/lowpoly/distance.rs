@@ -150,7 +150,7 @@ pub(crate) fn closest_on_triangle(p: V3, a: V3, b: V3, c: V3) -> V3 {
         return add(b, scale(sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
     }
     let denom = va + vb + vc;
-    if !(denom > 0.0) {
+    if denom.is_nan() || denom <= 0.0 {
         // Only reachable through rounding on slivers: fall back to the best edge point.
         return best_of(
             [
@@ -484,7 +484,7 @@ fn triangle_bricks(
         let a = ((lo[k] - reach - spec.origin[k]) / side).floor().max(0.0);
         let b = ((hi[k] + reach - spec.origin[k]) / side).floor();
         let b = b.min(bdims[k] as f64 - 1.0);
-        if !(a <= b) {
+        if a.is_nan() || b.is_nan() || a > b {
             return Vec::new();
         }
         range[k] = [a as u32, b as u32];

@@ -140,11 +140,12 @@ fn gauss_solve(m: &mut [[f64; 4]; 3], k: usize) -> Option<[f64; 3]> {
             return None;
         }
         m.swap(col, piv);
-        for r in 0..k {
+        let pivot_row = m[col];
+        for (r, row) in m.iter_mut().enumerate().take(k) {
             if r != col {
-                let f = m[r][col] / m[col][col];
-                for c in col..4 {
-                    m[r][c] -= f * m[col][c];
+                let f = row[col] / pivot_row[col];
+                for (x, p) in row.iter_mut().zip(pivot_row.iter()).skip(col) {
+                    *x -= f * p;
                 }
             }
         }
@@ -167,7 +168,7 @@ fn inverse3(a: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
         a[r1][s1] * a[r2][s2] - a[r1][s2] * a[r2][s1]
     };
     let det = a[0][0] * c(0, 0) + a[0][1] * c(0, 1) + a[0][2] * c(0, 2);
-    if !(det.abs() > 1e-300) || !det.is_finite() {
+    if !det.is_finite() || det.abs() <= 1e-300 {
         return None;
     }
     Some(std::array::from_fn(|r| {

@@ -88,7 +88,7 @@ impl OffsetParams {
                     return crate::invalid_arg!("screen size n_p must be finite and > 0, got {np}");
                 }
                 let l = mesh.bbox_diagonal();
-                if !(l > 0.0) {
+                if l.is_nan() || l <= 0.0 {
                     return crate::invalid_arg!(
                         "the input's bounding-box diagonal is 0 (a point): pass an explicit \
                          OffsetDistance::Absolute"

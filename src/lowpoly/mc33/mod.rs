@@ -239,7 +239,7 @@ fn slice_joins(cols: [(f64, f64); 4], outside: bool) -> bool {
         lo = lo.max(s);
         hi = hi.min(e);
     }
-    if !(lo < hi) {
+    if lo >= hi {
         return false;
     }
     let q = |t: f64| {

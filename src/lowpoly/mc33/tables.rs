@@ -145,9 +145,9 @@ mod tests {
             assert_eq!(edge_between(c[1], c[0]) as usize, e);
             assert!(EDGE_FACES[e][1] != u8::MAX && EDGE_FACES[e][0] < EDGE_FACES[e][1]);
         }
-        for f in 0..6 {
+        for (f, fc) in FACE_CORNERS.iter().enumerate() {
             let (a, s) = (f / 2, f % 2);
-            let p: Vec<[f64; 3]> = FACE_CORNERS[f]
+            let p: Vec<[f64; 3]> = fc
                 .iter()
                 .map(|&c| CORNER_POS[c as usize].map(f64::from))
                 .collect();
@@ -169,10 +169,9 @@ mod tests {
         for e in 0..12u8 {
             let dirs: Vec<(u8, u8)> = (0..6)
                 .flat_map(|f| {
-                    (0..4).filter_map(move |i| {
-                        (FACE_EDGES[f][i] == e)
-                            .then(|| (FACE_CORNERS[f][i], FACE_CORNERS[f][(i + 1) % 4]))
-                    })
+                    (0..4)
+                        .filter(move |&i| FACE_EDGES[f][i] == e)
+                        .map(move |i| (FACE_CORNERS[f][i], FACE_CORNERS[f][(i + 1) % 4]))
                 })
                 .collect();
             assert_eq!(dirs.len(), 2);
