@@ -383,67 +383,9 @@ fn coarse_files(dir: &Path) -> Vec<PathBuf> {
     v
 }
 
-/// A tiny loader: OBJ through tobj (triangulated, f64), OFF by hand (fan-triangulated).
+/// Loads a corpus mesh with pleat's own reader.
 fn load(path: &Path) -> Result<TriMesh, String> {
-    if path.extension().is_some_and(|e| e == "off") {
-        return load_off(path);
-    }
-    let (models, _) = tobj::load_obj(
-        path,
-        &tobj::LoadOptions {
-            triangulate: true,
-            single_index: true,
-            ..Default::default()
-        },
-    )
-    .map_err(|e| e.to_string())?;
-    let mut pos = vec![];
-    let mut tri = vec![];
-    for m in models {
-        let base = pos.len() as u32;
-        pos.extend(m.mesh.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
-        tri.extend(
-            m.mesh
-                .indices
-                .chunks_exact(3)
-                .map(|c| [base + c[0], base + c[1], base + c[2]]),
-        );
-    }
-    TriMesh::new(pos, tri).map_err(|e| e.to_string())
-}
-
-fn load_off(path: &Path) -> Result<TriMesh, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
-    let mut tok = text
-        .lines()
-        .map(|l| l.split('#').next().unwrap().trim())
-        .filter(|l| !l.is_empty())
-        .flat_map(|l| l.split_whitespace());
-    if tok.next() != Some("OFF") {
-        return Err("not an OFF file".into());
-    }
-    let mut num = || -> Result<f64, String> {
-        tok.next()
-            .ok_or("truncated")?
-            .parse::<f64>()
-            .map_err(|e| e.to_string())
-    };
-    let (nv, nf, _) = (num()? as usize, num()? as usize, num()?);
-    let mut pos = Vec::with_capacity(nv);
-    for _ in 0..nv {
-        pos.push([num()?, num()?, num()?]);
-    }
-    let mut tri = vec![];
-    for _ in 0..nf {
-        let k = num()? as usize;
-        let idx: Vec<u32> = (0..k)
-            .map(|_| num().map(|x| x as u32))
-            .collect::<Result<_, _>>()?;
-        for i in 1..k.saturating_sub(1) {
-            tri.push([idx[0], idx[i], idx[i + 1]]);
-        }
-    }
-    TriMesh::new(pos, tri).map_err(|e| e.to_string())
+    pleat::mesh::io::read_mesh(path).map_err(|e| e.to_string())
 }
 
 /// Renders a few evaluated surfaces to `$PLEAT_RENDER_DIR` (default `/tmp`) as PNG, for a look.
