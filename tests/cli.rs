@@ -40,3 +40,44 @@ fn unreadable_input_exits_two_with_message() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("does_not_exist.obj"));
 }
+
+#[cfg(feature = "lod")]
+#[test]
+fn offset_writes_a_verified_watertight_mesh() {
+    let out = std::env::temp_dir().join(format!("pleat-cli-offset-{}.obj", std::process::id()));
+    let o = pleat(&[
+        "offset",
+        "assets/dirty_two_boxes.obj",
+        "--screen-size",
+        "25",
+        "-o",
+        out.to_str().unwrap(),
+        "--stats-json",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stats = String::from_utf8_lossy(&o.stdout);
+    assert!(stats.contains("\"watertight\":true"), "{stats}");
+    let c = pleat(&["check", "--json", out.to_str().unwrap()]);
+    let report = String::from_utf8_lossy(&c.stdout);
+    assert!(report.contains("\"is_watertight\": true"), "{report}");
+    assert!(
+        report.contains("\"self_intersection_free\": true"),
+        "{report}"
+    );
+    let _ = std::fs::remove_file(out);
+}
+
+#[cfg(feature = "lod")]
+#[test]
+fn offset_rejects_bad_screen_size() {
+    let o = pleat(&[
+        "offset",
+        "assets/dirty_two_boxes.obj",
+        "--screen-size",
+        "-1",
+        "-o",
+        "x.obj",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("screen size"));
+}
