@@ -74,7 +74,7 @@ fn offset_rejects_bad_screen_size() {
         "offset",
         "assets/dirty_two_boxes.obj",
         "--screen-size",
-        "-1",
+        "0",
         "-o",
         "x.obj",
     ]);
