@@ -104,9 +104,16 @@ int main(int argc, char **argv) {
     CHECK_STATUS(pleat_mesh_create_f32(pos, nv, 0, idx, ni, &mesh), PLEAT_STATUS_OK);
     CHECK(pleat_mesh_triangle_count(mesh) == ni / 3);
     printf("imported %s: %zu vertices, %zu triangles\n", in, nv, ni / 3);
-#ifdef PLEAT_HAVE_CHECK
-    check_and_print(mesh);
-#endif
+    {
+        PleatMeshReport r;
+        memset(&r, 0, sizeof r);
+        r.struct_size = sizeof r;
+        CHECK_STATUS(pleat_mesh_check(mesh, 0, &r), PLEAT_STATUS_OK);
+        printf("check: components=%llu boundary_edges=%llu watertight=%u self_intersection_free=%u\n",
+               (unsigned long long)r.component_count, (unsigned long long)r.boundary_edge_count,
+               r.is_watertight, r.self_intersection_free);
+        CHECK(r.triangle_count == ni / 3);
+    }
     exp = make_scene(mesh);
     CHECK(aiExportScene(exp, "obj", out, 0) == aiReturn_SUCCESS);
     back = aiImportFile(out, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);

@@ -285,6 +285,7 @@ pub type PleatProgressFn = Option<
 ///
 /// # Safety
 /// `cb` and `user_data` are as the caller of the pleat entry point passed them.
+#[allow(dead_code)] // used by the long operations' entry points
 unsafe fn call_progress(
     cb: PleatProgressFn,
     user_data: *mut std::ffi::c_void,
@@ -300,6 +301,7 @@ unsafe fn call_progress(
     f(user_data, &info) == 0
 }
 
+#[allow(dead_code)] // used by the long operations' entry points
 enum Msg {
     Progress(String, f64),
     Done(std::thread::Result<crate::Result<()>>),
@@ -311,6 +313,7 @@ enum Msg {
 /// invoked on the calling thread: without a custom pool `f` runs on the calling thread; with a
 /// pool set by `pleat_set_thread_count`, `f` runs on a pool worker while the calling thread
 /// relays progress messages to `cb` and signals cancellation back through an atomic flag.
+#[allow(dead_code)] // used by the long operations' entry points
 pub(crate) fn guard_progress(
     cb: PleatProgressFn,
     user_data: *mut std::ffi::c_void,
@@ -329,6 +332,7 @@ pub(crate) fn guard_progress(
     status_of(result)
 }
 
+#[allow(dead_code)] // used by the long operations' entry points
 fn run_on_pool(
     pool: &rayon::ThreadPool,
     cb: PleatProgressFn,

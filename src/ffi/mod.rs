@@ -16,6 +16,8 @@
 
 mod common;
 mod mesh;
+mod report;
 
 pub use common::*;
 pub use mesh::*;
+pub use report::*;

@@ -3,7 +3,11 @@
 
 pub mod halfedge;
 pub mod io;
+mod report;
 mod trimesh;
+mod weld;
 
 pub use halfedge::HalfEdgeMesh;
+pub use report::{MeshReport, ReportOptions};
 pub use trimesh::{Edge, EdgeList, TriMesh};
+pub use weld::ExactWeld;

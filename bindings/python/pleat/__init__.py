@@ -73,6 +73,24 @@ _sig("pleat_mesh_read_file", _st, _c.c_char_p, _c.POINTER(_P))
 _sig("pleat_mesh_write_file", _st, _P, _c.c_char_p)
 
 
+class _Report(_c.Structure):
+    _fields_ = [("struct_size", _c.c_uint32), ("is_closed", _c.c_uint32)] + [
+        (n, _c.c_uint64) for n in (
+            "vertex_count", "referenced_vertex_count", "triangle_count", "edge_count",
+            "component_count", "boundary_edge_count", "nonmanifold_edge_count",
+            "nonmanifold_vertex_count", "degenerate_face_count", "duplicate_face_count",
+            "misoriented_edge_count", "self_intersecting_pair_count")
+    ] + [("total_genus", _c.c_int64), ("euler_characteristic", _c.c_int64)] + [
+        (n, _c.c_uint32) for n in (
+            "is_edge_manifold", "is_manifold", "is_watertight", "consistently_oriented",
+            "self_intersections_checked", "self_intersection_free")
+    ] + [("surface_area", _c.c_double), ("signed_volume", _c.c_double),
+         ("bbox_diagonal", _c.c_double), ("bbox_min", _c.c_double * 3), ("bbox_max", _c.c_double * 3)]
+
+
+_sig("pleat_mesh_check", _st, _P, _c.c_uint32, _c.POINTER(_Report))
+
+
 def _check(status):
     if status != 0:
         raise PleatError(status, _lib.pleat_last_error().decode("utf-8", "replace"))
@@ -148,6 +166,24 @@ class Mesh:
         buf = (_c.c_uint32 * (3 * n))()
         _check(_lib.pleat_mesh_copy_indices(self._h, buf, 3 * n))
         return [tuple(buf[3 * i:3 * i + 3]) for i in range(n)]
+
+    def check(self, self_intersections=True, weld=False):
+        """Validity report as a dict (same fields as PleatMeshReport; yes/no fields as bool)."""
+        r = _Report()
+        r.struct_size = _c.sizeof(_Report)
+        flags = (0 if self_intersections else 1) | (2 if weld else 0)
+        _check(_lib.pleat_mesh_check(self._h, flags, _c.byref(r)))
+        out = {}
+        for name, ctype in _Report._fields_:
+            v = getattr(r, name)
+            if name == "struct_size":
+                continue
+            if ctype is _c.c_uint32:
+                v = bool(v)
+            elif hasattr(v, "__len__"):
+                v = tuple(v)
+            out[name] = v
+        return out
 
     def close(self):
         """Releases the mesh now (also done when garbage-collected)."""

@@ -40,6 +40,9 @@ try:
     check(False, "missing file accepted")
 except pleat.PleatError as e:
     check(e.status == "IO" and "file.obj" in str(e), "missing file status")
+r = m.check()
+check(r["is_watertight"] and r["total_genus"] == 0 and r["component_count"] == 1, "check closed tet")
+check(abs(r["surface_area"] - (1.5 + 3 ** 0.5 / 2)) < 1e-12, "area")
 check(pleat.version().count(".") == 2, "version")
 check(pleat.has_feature("lod") in (True, False), "has_feature")
 m.close()
