@@ -42,7 +42,7 @@ pub(crate) fn aligned_position(g: &Guard<'_>, v: u32, reference: &[P3]) -> Optio
         let c = m.position(m.target(m.next(out)));
         let cf = crate::lowpoly::vec3::norm(tri_normal(&[pv, b, c]));
         let t = reference[f as usize];
-        if !(cf > 0.0) || t == [0.0; 3] {
+        if cf.is_nan() || cf <= 0.0 || t == [0.0; 3] {
             continue;
         }
         any = true;
@@ -72,7 +72,7 @@ pub(crate) fn aligned_position(g: &Guard<'_>, v: u32, reference: &[P3]) -> Optio
 fn solve3(h: [[f64; 3]; 3], r: P3) -> Option<P3> {
     let det3 = |m: [[f64; 3]; 3]| dot(m[0], cross(m[1], m[2]));
     let d = det3(h);
-    if !(d.abs() > 0.0) || !d.is_finite() {
+    if d == 0.0 || !d.is_finite() {
         return None;
     }
     let mut x = [0.0; 3];

@@ -30,10 +30,11 @@
 //!    the operation, `Δw(q) = (Σ_{new M_e} Ω_f(q) − Σ_{old M_e} Ω_f(q)) / 4π` (solid angles) must
 //!    round to 0. Together with "no touching", every input point stays strictly inside.
 
-use super::sp::{self, TriangleBvh};
-use super::vec3::{bbox_of, dot, normalized, solid_angle, tri_normal, P3};
+use super::vec3::{bbox_of, dot, normalized, P3};
 use crate::mesh::halfedge::CollapseRecord;
 use crate::mesh::HalfEdgeMesh;
+use crate::spatial::solid_angle;
+use crate::spatial::{self as sp, TriangleBvh};
 
 /// Half-angle of the normal cone of `M_1` below which pairs of faces sharing a vertex are not
 /// tested exactly (§4.3.3). Volino & Thalmann's surface-normal test asks for a cone of
@@ -207,11 +208,6 @@ impl<'a> Guard<'a> {
     /// The input model.
     pub fn input(&self) -> &'a InputModel {
         self.input
-    }
-
-    /// Gives the mesh back.
-    pub fn into_mesh(self) -> HalfEdgeMesh {
-        self.mesh
     }
 
     /// Corner positions of the live faces around `v`.
@@ -469,8 +465,8 @@ impl<'a> Guard<'a> {
         let (lo, hi) = bbox_of(new_patch.iter().chain(old_patch).flatten().copied());
         for i in pbvh.query_box(lo, hi) {
             let q = self.input.positions[pts[i as usize][0] as usize];
-            let new_w: f64 = new_patch.iter().map(|t| solid_angle(q, t)).sum();
-            let old_w: f64 = old_patch.iter().map(|t| solid_angle(q, t)).sum();
+            let new_w: f64 = new_patch.iter().map(|t| solid_angle(*t, q)).sum();
+            let old_w: f64 = old_patch.iter().map(|t| solid_angle(*t, q)).sum();
             let dw = (new_w - old_w) / (4.0 * std::f64::consts::PI);
             if dw.abs() > 0.25 {
                 return Err(Reject::Uncovers);
@@ -491,9 +487,4 @@ pub(crate) fn touches_input_triangle(tri: &[P3; 3], t: &[P3; 3], degenerate: boo
         return sp::triangles_intersect(tri, t);
     }
     (0..3).any(|i| sp::segment_triangle_intersect([t[i], t[(i + 1) % 3]], tri))
-}
-
-/// Unit normal of a triangle, `None` when degenerate.
-pub(crate) fn unit_normal(t: &[P3; 3]) -> Option<P3> {
-    normalized(tri_normal(t))
 }

@@ -12,9 +12,10 @@
 
 use rayon::prelude::*;
 
-use super::sp::{self, TriangleBvh};
 use super::vec3::{for_each_sample, sample_resolution, P3};
 use crate::mesh::TriMesh;
+use crate::mesh::{MeshReport, ReportOptions};
+use crate::spatial::{FastWindingNumber, TriangleBvh};
 
 /// Samples per bounding-box diagonal of the final Hausdorff measurement (spacing `l / 400`).
 pub const FINAL_SAMPLES_PER_DIAGONAL: f64 = 400.0;
@@ -84,45 +85,39 @@ pub(crate) fn hausdorff(a: &Surface, b: &Surface, spacing: f64, max_k: usize) ->
     ab.max(ba)
 }
 
-/// What the independent verification found.
+/// What the independent verification ([`MeshReport`]) found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Verification {
-    /// Every edge in exactly two faces, consistently oriented, single fans at vertices.
+    /// Edge- and vertex-manifold, no repeated-index faces, consistently oriented.
     pub manifold: bool,
-    /// Closed (no boundary).
+    /// Closed and manifold.
     pub watertight: bool,
-    /// No two faces intersect beyond their shared vertices/edges (CGAL's rules).
+    /// No two faces intersect beyond their shared vertices/edges (CGAL's rules) and no face is
+    /// degenerate.
     pub self_intersection_free: bool,
+    /// Number of connected components.
+    pub components: usize,
+    /// Total Euler characteristic.
+    pub euler: i64,
 }
 
-/// Verifies watertightness, manifoldness and intersection-freeness of `mesh` with code that
-/// does not share the guard's shortcuts (every candidate pair is tested exactly).
+/// Verifies watertightness, manifoldness and intersection-freeness of `mesh` with
+/// [`MeshReport`], which shares none of the guard's shortcuts.
 pub(crate) fn verify(mesh: &TriMesh) -> Verification {
-    let (manifold, watertight) = match crate::mesh::HalfEdgeMesh::from_trimesh(mesh) {
-        Ok(h) => (true, h.boundary_loop_count() == 0),
-        Err(_) => (false, false),
-    };
-    let pos = mesh.positions();
-    let tris = mesh.triangles();
-    let bvh = TriangleBvh::new(pos, tris);
-    let degenerate = tris
-        .par_iter()
-        .any(|t| sp::is_collinear(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]));
-    let hit = (0..tris.len()).into_par_iter().any(|f| {
-        let tri = tris[f].map(|v| pos[v as usize]);
-        bvh.query_triangle(&tri)
-            .any(|g| g as usize > f && sp::faces_intersect(pos, tris[f], tris[g as usize]))
-    });
+    let r = MeshReport::compute_with(mesh, &ReportOptions::default());
     Verification {
-        manifold,
-        watertight,
-        self_intersection_free: !hit && !degenerate,
+        manifold: r.is_manifold && r.consistently_oriented,
+        watertight: r.is_watertight,
+        self_intersection_free: r.self_intersection_free == Some(true),
+        components: r.n_components,
+        euler: r.euler_characteristic_total,
     }
 }
 
-/// Cage checks: the mesh touches no input triangle, and every input vertex has winding number
-/// ≈ 1 with respect to it (brute force over the faces; exact enough far from the surface, which
-/// the no-touch test guarantees). Returns `(untouched, encloses)`.
+/// Cage checks: the mesh touches no input triangle (exact tests on BVH candidates), and every
+/// referenced input vertex has winding number above 1/2 with respect to it (hierarchical
+/// winding numbers, Barill et al. 2018 — accurate away from the surface, which the no-touch
+/// test guarantees). Returns `(untouched, encloses)`.
 pub(crate) fn verify_cage(cage: &TriMesh, input: &super::guard::InputModel) -> (bool, bool) {
     let pos = cage.positions();
     let tris = cage.triangles();
@@ -142,17 +137,11 @@ pub(crate) fn verify_cage(cage: &TriMesh, input: &super::guard::InputModel) -> (
             used[v as usize] = true;
         }
     }
-    let encloses = (0..input.positions.len())
-        .into_par_iter()
+    let points: Vec<P3> = (0..input.positions.len())
         .filter(|&v| used[v])
-        .all(|v| {
-            let q = input.positions[v];
-            let w: f64 = tris
-                .iter()
-                .map(|t| super::vec3::solid_angle(q, &t.map(|i| pos[i as usize])))
-                .sum::<f64>()
-                / (4.0 * std::f64::consts::PI);
-            w > 0.5
-        });
+        .map(|v| input.positions[v])
+        .collect();
+    let fwn = FastWindingNumber::new(cage);
+    let encloses = fwn.winding_numbers(&points).iter().all(|&w| w > 0.5);
     (untouched, encloses)
 }

@@ -13,7 +13,6 @@ pub(crate) mod guard;
 pub(crate) mod measure;
 mod pipeline;
 mod simplify;
-mod sp;
 mod vec3;
 
 pub use guard::CONE_HALF_ANGLE;

@@ -311,6 +311,7 @@ fn bake_level(
         .stages
         .push(("offset".into(), t0.elapsed().as_secs_f64()));
     stats.count("faces_offset", start.triangle_count() as u64);
+    let start_topology = topology_of(&start);
     rep.window(w0 + 0.2 * ws, 0.7 * ws);
     let cfg = LoopConfig {
         d,
@@ -342,7 +343,9 @@ fn bake_level(
     stats.stages.push(("verify".into(), verify_s));
     stats.count("reruns_exact", reruns);
     record_verification(&mut stats, v, mode);
-    let ok = v.0.manifold && v.0.watertight && v.0.self_intersection_free && v.1;
+    let same_topology = (v.0.components, v.0.euler) == start_topology;
+    stats.verify("same_topology_as_offset", same_topology);
+    let ok = v.0.manifold && v.0.watertight && v.0.self_intersection_free && v.1 && same_topology;
     if !ok {
         return Err(Error::Internal(format!(
             "the output failed independent verification ({v:?}); please report the input"
@@ -360,6 +363,18 @@ fn bake_level(
     stats.count("vertices", mesh.vertex_count() as u64);
     rep.check("done", 1.0)?;
     Ok((mesh, stats))
+}
+
+/// `(components, Euler characteristic)` of a mesh (no self-intersection pass).
+fn topology_of(mesh: &TriMesh) -> (usize, i64) {
+    let r = crate::mesh::MeshReport::compute_with(
+        mesh,
+        &crate::mesh::ReportOptions {
+            self_intersections: false,
+            weld: false,
+        },
+    );
+    (r.n_components, r.euler_characteristic_total)
 }
 
 /// `(Pro.III verification, cage checks hold)`.
@@ -454,11 +469,6 @@ impl LoopStats {
         }
         s.metric("flow_motion", self.flow_motion);
         s.metric("align_motion", self.align_motion);
-        for (i, c) in self.change_per_round.iter().enumerate() {
-            s.metric(&format!("change_round_{}", i + 1), *c);
-        }
-        s.metric("flow_motion", self.flow_motion);
-        s.metric("align_motion", self.align_motion);
     }
 }
 
@@ -491,7 +501,7 @@ fn optimize(
         slack: cfg.slack,
         spacing: cfg.d,
     };
-    let rounds = cfg.max_rounds.max(0);
+    let rounds = cfg.max_rounds;
     for i in 0..rounds {
         let frac = |x: f64| (i as f64 + x) / rounds as f64;
         rep.check("simplify", frac(0.0))?;

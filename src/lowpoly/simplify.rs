@@ -131,7 +131,7 @@ impl Quadric {
         let c02 = a01 * a12 - a02 * a11;
         let det = a00 * c00 + a01 * c01 + a02 * c02;
         let tr = (a00 + a11 + a22) / 3.0;
-        if !(det.abs() > 1e-12 * tr * tr * tr) {
+        if det.is_nan() || det.abs() <= 1e-12 * tr * tr * tr {
             return None;
         }
         let c11 = a00 * a22 - a02 * a02;
