@@ -33,6 +33,8 @@
 use super::vec3::{bbox_of, dot, normalized, P3};
 use crate::mesh::halfedge::CollapseRecord;
 use crate::mesh::HalfEdgeMesh;
+#[cfg(test)]
+use super::measure;
 use crate::spatial::solid_angle;
 use crate::spatial::{self as sp, TriangleBvh};
 
@@ -487,4 +489,124 @@ pub(crate) fn touches_input_triangle(tri: &[P3; 3], t: &[P3; 3], degenerate: boo
         return sp::triangles_intersect(tri, t);
     }
     (0..3).any(|i| sp::segment_triangle_intersect([t[i], t[(i + 1) % 3]], tri))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::TriMesh;
+
+    /// Unit cube `[0,1]³` scaled by `s` and shifted by `o`, outward oriented.
+    pub(crate) fn cube(s: f64, o: f64) -> TriMesh {
+        let p = (0..8)
+            .map(|i: u32| {
+                [
+                    o + s * (i & 1) as f64,
+                    o + s * ((i >> 1) & 1) as f64,
+                    o + s * ((i >> 2) & 1) as f64,
+                ]
+            })
+            .collect();
+        let f = vec![
+            [0, 2, 3],
+            [0, 3, 1],
+            [4, 5, 7],
+            [4, 7, 6],
+            [0, 1, 5],
+            [0, 5, 4],
+            [2, 6, 7],
+            [2, 7, 3],
+            [0, 4, 6],
+            [0, 6, 2],
+            [1, 3, 7],
+            [1, 7, 5],
+        ];
+        TriMesh::new(p, f).unwrap()
+    }
+
+    fn guard_for<'a>(m: &TriMesh, input: &'a InputModel, cage: bool) -> Guard<'a> {
+        Guard::new(HalfEdgeMesh::from_trimesh(m).unwrap(), input, cage)
+    }
+
+    /// Two unit cubes, `[0,1]³` (vertices 0–7) and `[2,3]³` (vertices 8–15).
+    fn two_cubes() -> TriMesh {
+        let a = cube(1.0, 0.0);
+        let b = cube(1.0, 2.0);
+        let mut p = a.positions().to_vec();
+        p.extend_from_slice(b.positions());
+        let mut t = a.triangles().to_vec();
+        t.extend(b.triangles().iter().map(|f| f.map(|v| v + 8)));
+        TriMesh::new(p, t).unwrap()
+    }
+
+    #[test]
+    fn moves_that_intersect_are_refused_and_undone() {
+        let m = two_cubes();
+        let input = InputModel::new(&m, false);
+        let mut g = guard_for(&m, &input, false);
+        // Vertex 7 = (1,1,1) pushed below the bottom face: its faces cross it (inside M_1).
+        assert_eq!(g.try_move(7, [0.5, 0.5, -0.5]), Err(Reject::SelfIntersection));
+        assert_eq!(g.mesh().position(7), [1., 1., 1.]);
+        // Into the other cube: found through the BVH (M_r).
+        assert_eq!(g.try_move(7, [2.5, 2.5, 2.5]), Err(Reject::SelfIntersection));
+        assert!(g.try_move(7, [1.2, 1.2, 1.2]).is_ok());
+        assert_eq!(g.mesh().position(7), [1.2, 1.2, 1.2]);
+        // The other cube's corner (2,2,2) comes closer; the BVH follows the move, so a later
+        // check near its new position sees it.
+        assert!(g.try_move(8, [1.5, 1.5, 1.5]).is_ok());
+        assert_eq!(g.try_move(7, [1.6, 1.6, 1.6]), Err(Reject::SelfIntersection));
+        // Onto another vertex: degenerate faces.
+        assert_eq!(g.try_move(7, [1.0, 1.0, 0.0]), Err(Reject::Degenerate));
+        g.mesh().check_invariants().unwrap();
+        assert!(measure::verify(&g.mesh().to_trimesh()).self_intersection_free);
+    }
+
+    #[test]
+    fn exact_only_mode_agrees() {
+        let m = cube(1.0, 0.0);
+        let input = InputModel::new(&m, false);
+        let mut g = guard_for(&m, &input, false);
+        g.set_exact_only(true);
+        assert_eq!(g.try_move(7, [0.5, 0.5, -0.5]), Err(Reject::SelfIntersection));
+        assert!(g.try_move(7, [1.2, 1.2, 1.2]).is_ok());
+        assert_eq!(g.stats.cone_fast_path, 0);
+    }
+
+    #[test]
+    fn collapses_are_checked_and_undone() {
+        let m = cube(1.0, 0.0);
+        let input = InputModel::new(&m, false);
+        let mut g = guard_for(&m, &input, false);
+        let h = g.mesh().find_halfedge(0, 3).unwrap();
+        // Collapsing the bottom diagonal to a point far above the cube folds it through.
+        assert!(g.try_collapse(h, [0.5, 0.5, 5.0]).is_err());
+        assert_eq!(g.mesh().face_count(), 12);
+        g.mesh().check_invariants().unwrap();
+        let rec = g.try_collapse(h, [0.5, 0.5, -0.1]).unwrap();
+        assert_eq!(rec.removed_faces.len(), 2);
+        assert_eq!(g.mesh().face_count(), 10);
+        let out = g.mesh().to_trimesh();
+        assert!(measure::verify(&out).self_intersection_free);
+    }
+
+    #[test]
+    fn cage_refuses_touching_and_uncovering() {
+        let big = cube(1.0, 0.0);
+        // A tiny triangle soup near the (1,1,1) corner, inside the cage.
+        let soup = TriMesh::new(
+            vec![[0.9, 0.9, 0.85], [0.85, 0.9, 0.9], [0.9, 0.85, 0.9]],
+            vec![[0, 1, 2]],
+        )
+        .unwrap();
+        let input = InputModel::new(&soup, true);
+        let mut g = guard_for(&big, &input, true);
+        // Cutting the corner off beyond the triangle: no contact, but the soup ends outside.
+        assert_eq!(g.try_move(7, [0.5, 0.5, 0.5]), Err(Reject::Uncovers));
+        // Moving the corner onto an input vertex.
+        assert_eq!(g.try_move(7, [0.9, 0.9, 0.85]), Err(Reject::TouchesInput));
+        // Moving outward is fine.
+        assert!(g.try_move(7, [1.1, 1.1, 1.1]).is_ok());
+        assert_eq!(g.stats.rejected_uncover, 1);
+        assert_eq!(g.stats.rejected_touch, 1);
+    }
 }
