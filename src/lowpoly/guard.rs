@@ -30,11 +30,11 @@
 //!    the operation, `Δw(q) = (Σ_{new M_e} Ω_f(q) − Σ_{old M_e} Ω_f(q)) / 4π` (solid angles) must
 //!    round to 0. Together with "no touching", every input point stays strictly inside.
 
+#[cfg(test)]
+use super::measure;
 use super::vec3::{bbox_of, dot, normalized, P3};
 use crate::mesh::halfedge::CollapseRecord;
 use crate::mesh::HalfEdgeMesh;
-#[cfg(test)]
-use super::measure;
 use crate::spatial::solid_angle;
 use crate::spatial::{self as sp, TriangleBvh};
 
@@ -545,16 +545,25 @@ mod tests {
         let input = InputModel::new(&m, false);
         let mut g = guard_for(&m, &input, false);
         // Vertex 7 = (1,1,1) pushed below the bottom face: its faces cross it (inside M_1).
-        assert_eq!(g.try_move(7, [0.5, 0.5, -0.5]), Err(Reject::SelfIntersection));
+        assert_eq!(
+            g.try_move(7, [0.5, 0.5, -0.5]),
+            Err(Reject::SelfIntersection)
+        );
         assert_eq!(g.mesh().position(7), [1., 1., 1.]);
         // Into the other cube: found through the BVH (M_r).
-        assert_eq!(g.try_move(7, [2.5, 2.5, 2.5]), Err(Reject::SelfIntersection));
+        assert_eq!(
+            g.try_move(7, [2.5, 2.5, 2.5]),
+            Err(Reject::SelfIntersection)
+        );
         assert!(g.try_move(7, [1.2, 1.2, 1.2]).is_ok());
         assert_eq!(g.mesh().position(7), [1.2, 1.2, 1.2]);
         // The other cube's corner (2,2,2) comes closer; the BVH follows the move, so a later
         // check near its new position sees it.
         assert!(g.try_move(8, [1.5, 1.5, 1.5]).is_ok());
-        assert_eq!(g.try_move(7, [1.6, 1.6, 1.6]), Err(Reject::SelfIntersection));
+        assert_eq!(
+            g.try_move(7, [1.6, 1.6, 1.6]),
+            Err(Reject::SelfIntersection)
+        );
         // Onto another vertex: degenerate faces.
         assert_eq!(g.try_move(7, [1.0, 1.0, 0.0]), Err(Reject::Degenerate));
         g.mesh().check_invariants().unwrap();
@@ -567,7 +576,10 @@ mod tests {
         let input = InputModel::new(&m, false);
         let mut g = guard_for(&m, &input, false);
         g.set_exact_only(true);
-        assert_eq!(g.try_move(7, [0.5, 0.5, -0.5]), Err(Reject::SelfIntersection));
+        assert_eq!(
+            g.try_move(7, [0.5, 0.5, -0.5]),
+            Err(Reject::SelfIntersection)
+        );
         assert!(g.try_move(7, [1.2, 1.2, 1.2]).is_ok());
         assert_eq!(g.stats.cone_fast_path, 0);
     }

@@ -27,7 +27,12 @@ pub struct LodParams {
     /// distance and per-collapse error bound is `d = l / n_p`. Finite, `> 0`.
     pub screen_size: f64,
     /// Optional target face count `n_F` (Pro.I): simplification stops there and the loop ends
-    /// when it is met. `None` minimises the count. At least 4 when given.
+    /// when it is met. When a round makes no collapse (or the loop converges) before the target
+    /// is reached, the per-collapse distance bound `d` of Alg. 5 is doubled and the one-sided
+    /// distance check tolerates patches up to that bound (counted in
+    /// `Stats` as `target_relaxations`), so the target is reached unless topology or the
+    /// guarantees forbid it or the `N` rounds run out. `None` minimises the count at error `d`.
+    /// At least 4 when given.
     pub target_faces: Option<usize>,
     /// Maximum number of rounds `N` of Alg. 3 (0 returns the offset surface).
     pub max_rounds: u32,
@@ -435,6 +440,7 @@ struct LoopStats {
     flow_motion: f64,
     align_motion: f64,
     target_met: bool,
+    relaxations: u64,
 }
 
 impl LoopStats {
@@ -463,6 +469,7 @@ impl LoopStats {
         s.count("guard_cone_fast_path", g.cone_fast_path);
         s.count("guard_exact_tests", g.exact_tests);
         s.count("target_met", self.target_met as u64);
+        s.count("target_relaxations", self.relaxations);
         s.metric("last_round_change", self.last_change);
         for (i, c) in self.change_per_round.iter().enumerate() {
             s.metric(&format!("change_round_{}", i + 1), *c);
@@ -495,7 +502,7 @@ fn optimize(
     let mut g = Guard::new(he, model, cfg.mode == Mode::Cage);
     g.set_exact_only(exact_only);
     let mut ls = LoopStats::default();
-    let sopt = SimplifyOptions {
+    let mut sopt = SimplifyOptions {
         d: cfg.d,
         target_faces: cfg.target_faces,
         slack: cfg.slack,
@@ -536,7 +543,18 @@ fn optimize(
         ls.change_per_round.push(ls.last_change);
         ls.converge_s += t0.elapsed().as_secs_f64();
         ls.target_met = cfg.target_faces.is_some_and(|n| g.mesh().face_count() <= n);
-        if ls.last_change < cfg.epsilon_abs || ls.target_met {
+        if ls.target_met {
+            break;
+        }
+        let converged = ls.last_change < cfg.epsilon_abs;
+        if cfg.target_faces.is_some() && (converged || sr.collapses == 0) {
+            // Pro.I with a face target: relax the per-collapse bound until it is reached.
+            sopt.d *= 2.0;
+            sopt.slack = sopt.slack.max(sopt.d);
+            ls.relaxations += 1;
+            continue;
+        }
+        if converged {
             break;
         }
     }
