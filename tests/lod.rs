@@ -1,5 +1,6 @@
 //! LOD and cage pipeline: guarantees verified independently (MeshReport, and the CGAL
 //! `meshcheck` when present), chains, stability on extreme inputs, determinism, cancellation.
+#![cfg(feature = "lod")]
 
 #[path = "common/shapes.rs"]
 mod shapes;
@@ -18,10 +19,10 @@ fn params(np: f64) -> LodParams {
 fn bake(m: &TriMesh, p: &LodParams, cage: bool) -> pleat::Result<(TriMesh, Stats)> {
     let mut prog = |_: pleat::Progress<'_>| true;
     if cage {
-        pleat::cage::generate(m, p, &mut prog)
-    } else {
-        generate(m, p, &mut prog)
+        #[cfg(feature = "cage")]
+        return pleat::cage::generate(m, p, &mut prog);
     }
+    generate(m, p, &mut prog)
 }
 
 /// Pro.III checked by code independent of the pipeline, plus the pipeline's own record.
@@ -121,6 +122,7 @@ fn face_target_is_met() {
     }
 }
 
+#[cfg(feature = "cage")]
 #[test]
 fn cages_enclose_and_do_not_touch() {
     for (name, m) in [
@@ -175,7 +177,7 @@ fn extreme_scales_and_shapes_give_valid_output_or_a_clear_error() {
         ("np1000", sphere.clone(), 1000.0),
     ];
     for (name, m, np) in cases {
-        for cage in [false, true] {
+        for cage in [false, cfg!(feature = "cage")] {
             let what = format!("{name} cage={cage}");
             match bake(&m, &params(np), cage) {
                 Ok((out, s)) => assert_valid(&out, &s, &what),

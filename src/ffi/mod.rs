@@ -15,9 +15,11 @@
 //!   capability was left out returns `PLEAT_STATUS_UNSUPPORTED`.
 
 mod common;
+mod lod;
 mod mesh;
 mod report;
 
 pub use common::*;
+pub use lod::*;
 pub use mesh::*;
 pub use report::*;

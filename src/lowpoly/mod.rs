@@ -17,4 +17,5 @@ mod vec3;
 
 pub use guard::CONE_HALF_ANGLE;
 pub use pipeline::{generate, generate_chain, LodParams};
+#[cfg(feature = "cage")]
 pub(crate) use pipeline::{run, run_chain, Mode};
