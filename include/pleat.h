@@ -17,6 +17,9 @@
 // `struct_size`) does not change it.
 #define PLEAT_ABI_VERSION 1
 
+// `PleatLodParams::flags` bit: skip the feature-alignment step (Alg. 6).
+#define PLEAT_LOD_NO_ALIGN 1
+
 // `pleat_mesh_check` flag: skip the self-intersection test (the most expensive part);
 // `self_intersections_checked` is then 0.
 #define PLEAT_CHECK_SKIP_SELF_INTERSECTIONS 1
@@ -95,6 +98,99 @@ typedef struct PleatMesh PleatMesh;
 // output of long operations; destroyed with `pleat_stats_destroy`. Immutable.
 typedef struct PleatStats PleatStats;
 
+// Parameters of `pleat_lod_generate`, `pleat_lod_generate_chain` and `pleat_cage_generate`.
+// Get the defaults from `pleat_lod_params_default()` and change what you need; the defaults
+// are the dissertation's (n_p = 200, N = 50, r = 1/8, ε = 1e-4, θ0 = 120°, l0 = 4).
+//
+// `struct_size` must be `sizeof(PleatLodParams)` as the caller knows it (the default sets
+// it): fields beyond it keep their defaults, so older callers keep working when fields are
+// appended.
+typedef struct PleatLodParams {
+  // `sizeof(PleatLodParams)`; at least the offset of `target_faces` (16).
+  uint32_t struct_size;
+  // Maximum number of optimization rounds N (default 50; 0 returns the offset surface).
+  uint32_t max_rounds;
+  // Screen size n_p in pixels covered by the input's bounding-box diagonal l (default 200).
+  // The offset distance and error bound is d = l / n_p. Finite and > 0.
+  double screen_size;
+  // Target triangle count n_F, or 0 for none (minimise the count). At least 4 when set.
+  uint64_t target_faces;
+  // Flow fraction r in (0, 1] (default 0.125).
+  double flow_ratio;
+  // Convergence threshold ε relative to l (default 1e-4), >= 0.
+  double epsilon;
+  // Feature-curve dihedral threshold θ0 in degrees, (0, 180] (default 120).
+  double theta0_deg;
+  // Minimum feature-curve length l0 in edges (default 4).
+  uint32_t l0;
+  // Bitwise OR of `PLEAT_LOD_*` flags (default 0).
+  uint32_t flags;
+  // Upper bound on the bake's memory in bytes (default 2 GiB); exceeding the estimate fails
+  // with `PLEAT_STATUS_LIMIT_EXCEEDED` before the expensive work.
+  uint64_t memory_budget_bytes;
+} PleatLodParams;
+
+// Progress information passed to a [`PleatProgressFn`].
+typedef struct PleatProgress {
+  // Name of the running stage, NUL-terminated, valid during the callback only.
+  const char *stage;
+  // Fraction of the whole operation done, in [0, 1].
+  double fraction;
+} PleatProgress;
+
+// Progress callback of long operations. Called on the calling thread only, with the caller's
+// `user_data`. Return 0 to continue, non-zero to cancel: the operation then returns
+// `PLEAT_STATUS_CANCELLED` promptly and writes no output.
+typedef int32_t (*PleatProgressFn)(void *user_data, const struct PleatProgress *info);
+
+// Statistics of one baked level, filled when a non-NULL pointer is passed. Set `struct_size`
+// to `sizeof(PleatLodStats)`; pleat fills only that many bytes. Yes/no fields are 0 or 1.
+typedef struct PleatLodStats {
+  // In: `sizeof(PleatLodStats)` as the caller knows it. Out: the bytes pleat filled.
+  uint32_t struct_size;
+  // Optimization rounds run.
+  uint32_t rounds;
+  // Triangles of the result.
+  uint64_t face_count;
+  // Vertices of the result.
+  uint64_t vertex_count;
+  // Triangles of the start surface (offset surface, or the finer level in a chain).
+  uint64_t start_face_count;
+  // Edge collapses performed.
+  uint64_t collapse_count;
+  // Wall seconds, total.
+  double seconds_total;
+  // Wall seconds of the offset stage.
+  double seconds_offset;
+  // Wall seconds of simplification (Alg. 5), summed over rounds.
+  double seconds_simplify;
+  // Wall seconds of the flow, summed over rounds.
+  double seconds_flow;
+  // Wall seconds of the feature alignment, summed over rounds.
+  double seconds_align;
+  // Wall seconds of the independent verification.
+  double seconds_verify;
+  // Offset distance d = l / n_p, in model units.
+  double offset_distance;
+  // Two-sided sampled Hausdorff distance between result and input, model units.
+  double hausdorff;
+  // `hausdorff / l` (l = the input's bounding-box diagonal).
+  double hausdorff_relative;
+  // 1: verified closed and manifold.
+  uint32_t watertight;
+  // 1: verified manifold and consistently oriented.
+  uint32_t manifold;
+  // 1: verified free of self-intersections (exact predicates).
+  uint32_t self_intersection_free;
+  // Cages: 1 when verified to enclose every input vertex without touching the input.
+  // LODs: 0.
+  uint32_t encloses_input;
+  // 1 when the result was recomputed with exact checks only (see README).
+  uint32_t exact_rerun;
+  // 1 when a target face count was given and met.
+  uint32_t target_met;
+} PleatLodStats;
+
 // Parameters of `pleat_offset_surface`. Get defaults from `pleat_offset_params_default()` and
 // change what you need; `struct_size` lets newer libraries accept older callers.
 typedef struct PleatOffsetParams {
@@ -126,19 +222,6 @@ typedef struct PleatOffsetParams {
   // Reserved, must be 0.
   uint32_t reserved;
 } PleatOffsetParams;
-
-// Progress information passed to a [`PleatProgressFn`].
-typedef struct PleatProgress {
-  // Name of the running stage, NUL-terminated, valid during the callback only.
-  const char *stage;
-  // Fraction of the whole operation done, in [0, 1].
-  double fraction;
-} PleatProgress;
-
-// Progress callback of long operations. Called on the calling thread only, with the caller's
-// `user_data`. Return 0 to continue, non-zero to cancel: the operation then returns
-// `PLEAT_STATUS_CANCELLED` promptly and writes no output.
-typedef int32_t (*PleatProgressFn)(void *user_data, const struct PleatProgress *info);
 
 // Validity report of a triangle soup, filled by `pleat_mesh_check`. Counts follow the
 // independent checker's definitions (see README). Yes/no fields are 0 or 1.
@@ -243,6 +326,67 @@ uint32_t pleat_abi_version(void);
 // # Safety
 // `name` is NULL or a NUL-terminated string.
 uint32_t pleat_has_feature(const char *name);
+
+// The defaults, with `struct_size = sizeof(PleatLodParams)`.
+struct PleatLodParams pleat_lod_params_default(void);
+
+// Bakes one LOD of `input` (any triangle soup): a watertight, manifold,
+// self-intersection-free mesh within about d = l / n_p of the input, with as few triangles
+// as possible (or `params->target_faces`).
+//
+// - `input`: non-NULL mesh handle.
+// - `params`: NULL for the defaults, else from `pleat_lod_params_default()` (checked:
+//   `struct_size` >= 16, finite screen size > 0, flow ratio in (0, 1], ...).
+// - `progress`: NULL or a callback, called on the calling thread; non-zero cancels
+//   (`PLEAT_STATUS_CANCELLED`). `user_data` is passed to it unchanged (may be NULL).
+// - `out`: non-NULL; receives a new mesh on success (destroy with `pleat_mesh_destroy`).
+// - `stats`: NULL, or a `PleatLodStats` with `struct_size` set, filled on success.
+//
+// Returns `PLEAT_STATUS_UNSUPPORTED` when built without the `lod` feature.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes stated; `input` is a live handle.
+PleatStatus pleat_lod_generate(const struct PleatMesh *input,
+                               const struct PleatLodParams *params,
+                               PleatProgressFn progress,
+                               void *user_data,
+                               struct PleatMesh **out,
+                               struct PleatLodStats *stats);
+
+// Bakes a cage of `input` (any triangle soup): watertight, manifold, self-intersection-free,
+// enclosing every input vertex without touching the input, at offset d = l / n_p.
+// Parameters as `pleat_lod_generate`; `stats->encloses_input` reports the verification.
+// Returns `PLEAT_STATUS_UNSUPPORTED` when built without the `cage` feature.
+//
+// # Safety
+// As `pleat_lod_generate`.
+PleatStatus pleat_cage_generate(const struct PleatMesh *input,
+                                const struct PleatLodParams *params,
+                                PleatProgressFn progress,
+                                void *user_data,
+                                struct PleatMesh **out,
+                                struct PleatLodStats *stats);
+
+// Bakes one LOD per screen size; coarser levels start from the next finer result, so a chain
+// costs little more than its finest level.
+//
+// - `screen_sizes`: `count` screen sizes (any order; each finite and > 0), `count` >= 1.
+// - `params`: as `pleat_lod_generate`; `screen_size` and `target_faces` are ignored.
+// - `out_meshes`: array of `count` pointers; on success `out_meshes[i]` is the level of
+//   `screen_sizes[i]` (destroy each with `pleat_mesh_destroy`). Nothing is written on failure.
+// - `stats`: NULL, or an array of `count` `PleatLodStats` whose first element's `struct_size`
+//   gives the element size used for all.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes stated.
+PleatStatus pleat_lod_generate_chain(const struct PleatMesh *input,
+                                     const double *screen_sizes,
+                                     size_t count,
+                                     const struct PleatLodParams *params,
+                                     PleatProgressFn progress,
+                                     void *user_data,
+                                     struct PleatMesh **out_meshes,
+                                     struct PleatLodStats *stats);
 
 // Creates a mesh from single-precision positions and 32-bit triangle indices.
 //

@@ -4,7 +4,11 @@
 //! an operation fails.
 
 use clap::{Parser, Subcommand};
+#[cfg(feature = "lod")]
+use pleat::lowpoly::LodParams;
 use pleat::mesh::io::read_mesh;
+#[cfg(feature = "lod")]
+use pleat::mesh::io::write_mesh;
 use pleat::mesh::{MeshReport, ReportOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -57,6 +61,47 @@ enum Command {
         #[arg(long)]
         stats_json: bool,
     },
+    #[cfg(feature = "lod")]
+    /// Bake LODs by screen size: watertight, manifold, self-intersection-free meshes that look
+    /// like the input when its bounding-box diagonal covers N pixels.
+    Lod {
+        /// The input mesh (any triangle soup).
+        input: PathBuf,
+        #[command(flatten)]
+        bake: BakeArgs,
+    },
+    #[cfg(feature = "cage")]
+    /// Bake a cage: like `lod`, but enclosing the input without touching it.
+    Cage {
+        /// The input mesh (any triangle soup).
+        input: PathBuf,
+        #[command(flatten)]
+        bake: BakeArgs,
+    },
+}
+
+/// Options shared by `lod` and `cage`.
+#[cfg(feature = "lod")]
+#[derive(clap::Args)]
+struct BakeArgs {
+    /// Screen size(s) n_p in pixels, comma separated (`50,100,200`): one output per size.
+    #[arg(long, value_delimiter = ',', required = true)]
+    screen_size: Vec<f64>,
+    /// Target triangle count (only with a single screen size).
+    #[arg(long)]
+    faces: Option<usize>,
+    /// Output file; `{n}` is replaced by the screen size (required with several sizes).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Maximum optimization rounds N.
+    #[arg(long, default_value_t = 50)]
+    rounds: u32,
+    /// Skip the feature-alignment step.
+    #[arg(long)]
+    no_align: bool,
+    /// No progress bar and no summary.
+    #[arg(short, long)]
+    quiet: bool,
 }
 
 fn main() -> ExitCode {
@@ -87,6 +132,10 @@ fn main() -> ExitCode {
             };
             offset(&input, &output, &params, stats_json)
         }
+        #[cfg(feature = "lod")]
+        Command::Lod { input, bake: b } => bake(&input, &b, false),
+        #[cfg(feature = "cage")]
+        Command::Cage { input, bake: b } => bake(&input, &b, true),
     }
 }
 
@@ -94,72 +143,125 @@ fn main() -> ExitCode {
 #[cfg(feature = "lod")]
 const EXIT_FAILED: u8 = 1;
 
-/// A progress bar on stderr when it is a terminal (hidden otherwise, e.g. in build logs).
+/// The output path of screen size `n_p`.
 #[cfg(feature = "lod")]
-fn progress_bar() -> indicatif::ProgressBar {
-    let bar = indicatif::ProgressBar::with_draw_target(
-        Some(1000),
-        indicatif::ProgressDrawTarget::stderr(),
-    );
-    if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {percent:>3}% {msg}") {
-        bar.set_style(style);
-    }
-    bar
+fn output_path(pattern: &std::path::Path, n_p: f64) -> PathBuf {
+    let s = pattern.to_string_lossy();
+    PathBuf::from(s.replace("{n}", &format!("{n_p}")))
 }
 
+/// `pleat lod` / `pleat cage`.
 #[cfg(feature = "lod")]
-fn offset(
-    input: &std::path::Path,
-    output: &std::path::Path,
-    params: &pleat::lowpoly::OffsetParams,
-    stats_json: bool,
-) -> ExitCode {
+fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
+    let cmd = if cage { "cage" } else { "lod" };
+    let sizes = &args.screen_size;
+    let many = sizes.len() > 1;
+    if many && !args.output.to_string_lossy().contains("{n}") {
+        eprintln!("pleat {cmd}: with several screen sizes the output needs a {{n}} placeholder");
+        return ExitCode::from(EXIT_INPUT);
+    }
+    if many && args.faces.is_some() {
+        eprintln!("pleat {cmd}: --faces needs a single screen size");
+        return ExitCode::from(EXIT_INPUT);
+    }
     let mesh = match read_mesh(input) {
         Ok(m) => m,
         Err(e) => {
-            eprintln!("pleat offset: {e}");
+            eprintln!("pleat {cmd}: {e}");
             return ExitCode::from(EXIT_INPUT);
         }
     };
-    let bar = progress_bar();
-    let result = pleat::lowpoly::offset_surface_with_progress(&mesh, params, &mut |p| {
-        bar.set_position((p.fraction * 1000.0) as u64);
-        bar.set_message(p.stage.to_string());
+    let params = LodParams {
+        screen_size: sizes[0],
+        target_faces: args.faces,
+        max_rounds: args.rounds,
+        align: !args.no_align,
+        ..LodParams::default()
+    };
+    let bar = progress_bar(args.quiet);
+    let mut prog = |p: pleat::Progress<'_>| {
+        if let Some(b) = &bar {
+            b.set_position((p.fraction * 1000.0) as u64);
+            b.set_message(p.stage.to_string());
+        }
         true
-    });
-    bar.finish_and_clear();
-    let (out, stats) = match result {
-        Ok(r) => r,
+    };
+    let result = match (many, cage) {
+        (false, false) => pleat::lowpoly::generate(&mesh, &params, &mut prog).map(|r| vec![r]),
+        (true, false) => pleat::lowpoly::generate_chain(&mesh, sizes, &params, &mut prog),
+        #[cfg(feature = "cage")]
+        (false, true) => pleat::cage::generate(&mesh, &params, &mut prog).map(|r| vec![r]),
+        #[cfg(feature = "cage")]
+        (true, true) => pleat::cage::generate_chain(&mesh, sizes, &params, &mut prog),
+        #[cfg(not(feature = "cage"))]
+        (_, true) => unreachable!("the cage subcommand needs the cage feature"),
+    };
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let levels = match result {
+        Ok(l) => l,
         Err(e) => {
-            eprintln!("pleat offset: {e}");
-            return ExitCode::from(match e {
+            eprintln!("pleat {cmd}: {e}");
+            let code = match e {
                 pleat::Error::InvalidArgument(_) => EXIT_INPUT,
                 _ => EXIT_FAILED,
-            });
+            };
+            return ExitCode::from(code);
         }
     };
-    if let Err(e) = pleat::mesh::io::write_mesh(output, &out) {
-        eprintln!("pleat offset: {e}");
-        return ExitCode::from(EXIT_FAILED);
-    }
-    if stats_json {
-        println!("{}", stats.to_json());
-    } else {
-        eprintln!(
-            "{} -> {}: {} triangles in {:.2} s; verified: {}",
-            input.display(),
-            output.display(),
-            out.triangle_count(),
-            stats.total_seconds(),
-            stats
-                .verified
-                .iter()
-                .map(|(n, ok)| format!("{n}={ok}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
+    for ((out, stats), &n_p) in levels.iter().zip(sizes) {
+        let path = output_path(&args.output, n_p);
+        if let Err(e) = write_mesh(&path, out) {
+            eprintln!("pleat {cmd}: {e}");
+            return ExitCode::from(EXIT_FAILED);
+        }
+        if !args.quiet {
+            print_bake_summary(&path, n_p, out, stats);
+        }
     }
     ExitCode::SUCCESS
+}
+
+/// An indicatif bar on a terminal (stderr), nothing otherwise.
+#[cfg(feature = "lod")]
+fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if quiet || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let b = indicatif::ProgressBar::new(1000);
+    b.set_style(
+        indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent:>3}% {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    Some(b)
+}
+
+#[cfg(feature = "lod")]
+fn print_bake_summary(
+    path: &std::path::Path,
+    n_p: f64,
+    m: &pleat::mesh::TriMesh,
+    s: &pleat::Stats,
+) {
+    let ok = s.verified.iter().all(|v| v.1);
+    println!(
+        "{}: n_p={n_p} {} triangles, Hausdorff/l={:.5} (d/l={:.5}), {} rounds, {:.2} s, \
+         verified: {}",
+        path.display(),
+        m.triangle_count(),
+        s.get_metric("hausdorff_rel").unwrap_or(f64::NAN),
+        1.0 / n_p,
+        s.get_count("rounds").unwrap_or(0),
+        s.total_seconds(),
+        if ok {
+            "watertight, manifold, intersection-free"
+        } else {
+            "NO"
+        }
+    );
 }
 
 /// Exit code for errors reading input or bad arguments.
@@ -227,4 +329,64 @@ fn print_report(path: &std::path::Path, r: &MeshReport) {
     }
     println!("  bbox diagonal       {}", r.bbox_diagonal);
     println!("  surface area        {}", r.surface_area);
+}
+
+/// `pleat offset`.
+#[cfg(feature = "lod")]
+fn offset(
+    input: &std::path::Path,
+    output: &std::path::Path,
+    params: &pleat::lowpoly::OffsetParams,
+    stats_json: bool,
+) -> ExitCode {
+    let mesh = match read_mesh(input) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("pleat offset: {e}");
+            return ExitCode::from(EXIT_INPUT);
+        }
+    };
+    let bar = progress_bar(false);
+    let result = pleat::lowpoly::offset_surface_with_progress(&mesh, params, &mut |p| {
+        if let Some(b) = &bar {
+            b.set_position((p.fraction * 1000.0) as u64);
+            b.set_message(p.stage.to_string());
+        }
+        true
+    });
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let (out, stats) = match result {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("pleat offset: {e}");
+            return ExitCode::from(match e {
+                pleat::Error::InvalidArgument(_) => EXIT_INPUT,
+                _ => EXIT_FAILED,
+            });
+        }
+    };
+    if let Err(e) = pleat::mesh::io::write_mesh(output, &out) {
+        eprintln!("pleat offset: {e}");
+        return ExitCode::from(EXIT_FAILED);
+    }
+    if stats_json {
+        println!("{}", stats.to_json());
+    } else {
+        eprintln!(
+            "{} -> {}: {} triangles in {:.2} s; verified: {}",
+            input.display(),
+            output.display(),
+            out.triangle_count(),
+            stats.total_seconds(),
+            stats
+                .verified
+                .iter()
+                .map(|(n, ok)| format!("{n}={ok}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    ExitCode::SUCCESS
 }

@@ -102,6 +102,16 @@ fn status_of(result: std::thread::Result<crate::Result<()>>) -> PleatStatus {
     }
 }
 
+/// Records that this build lacks the cargo feature `feature` and returns
+/// `PleatStatus::Unsupported` (for entry points whose capability was left out).
+#[allow(dead_code)]
+pub(crate) fn unsupported(feature: &str) -> PleatStatus {
+    set_last_error(&format!(
+        "this build of pleat was compiled without the `{feature}` feature"
+    ));
+    PleatStatus::Unsupported
+}
+
 /// `Err(InvalidArgument)` naming a NULL pointer parameter.
 pub(crate) fn null_arg(name: &str) -> Error {
     Error::InvalidArgument(format!("`{name}` is NULL"))

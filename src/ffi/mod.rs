@@ -15,12 +15,14 @@
 //!   capability was left out returns `PLEAT_STATUS_UNSUPPORTED`.
 
 mod common;
+mod lod;
 mod mesh;
 mod offset;
 mod report;
 mod stats;
 
 pub use common::*;
+pub use lod::*;
 pub use mesh::*;
 pub use offset::*;
 pub use report::*;

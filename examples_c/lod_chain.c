@@ -1,0 +1,148 @@
+/* Bake a chain of LODs (and a cage) from arrays or from a mesh file, verify every level with
+ * pleat_mesh_check, and cancel a bake from the progress callback.
+ *
+ *   lod_chain            a generated torus
+ *   lod_chain FILE       any mesh file pleat reads (obj, ply, off, stl, gltf)
+ */
+#include <math.h>
+#include "test_util.h"
+
+#define RING 24
+#define TUBE 12
+
+/* A torus (radii 1 and 0.35) as caller arrays: RING x TUBE quads, two triangles each. */
+static void make_torus(float *p, uint32_t *t) {
+    int i, j, k = 0;
+    const double two_pi = 6.283185307179586;
+    for (i = 0; i < RING; i++) {
+        for (j = 0; j < TUBE; j++) {
+            double u = two_pi * i / RING, v = two_pi * j / TUBE;
+            double r = 1.0 + 0.35 * cos(v);
+            p[3 * (i * TUBE + j) + 0] = (float)(r * cos(u));
+            p[3 * (i * TUBE + j) + 1] = (float)(r * sin(u));
+            p[3 * (i * TUBE + j) + 2] = (float)(0.35 * sin(v));
+        }
+    }
+    for (i = 0; i < RING; i++) {
+        for (j = 0; j < TUBE; j++) {
+            uint32_t a = (uint32_t)(i * TUBE + j);
+            uint32_t b = (uint32_t)(((i + 1) % RING) * TUBE + j);
+            uint32_t c = (uint32_t)(((i + 1) % RING) * TUBE + (j + 1) % TUBE);
+            uint32_t d = (uint32_t)(i * TUBE + (j + 1) % TUBE);
+            t[k++] = a; t[k++] = b; t[k++] = c;
+            t[k++] = a; t[k++] = c; t[k++] = d;
+        }
+    }
+}
+
+static void verify(const char *what, const PleatMesh *m) {
+    PleatMeshReport r;
+    memset(&r, 0, sizeof r);
+    r.struct_size = sizeof r;
+    CHECK_STATUS(pleat_mesh_check(m, 0, &r), PLEAT_STATUS_OK);
+    printf("%s: %llu triangles, watertight=%u manifold=%u self_intersection_free=%u\n", what,
+           (unsigned long long)r.triangle_count, r.is_watertight, r.is_manifold,
+           r.self_intersection_free);
+    CHECK(r.is_watertight == 1 && r.is_manifold == 1 && r.consistently_oriented == 1);
+    CHECK(r.self_intersections_checked == 1 && r.self_intersection_free == 1);
+}
+
+static int print_progress(void *user_data, const PleatProgress *info) {
+    int *calls = (int *)user_data;
+    (*calls)++;
+    CHECK(info != NULL && info->stage != NULL);
+    CHECK(info->fraction >= 0.0 && info->fraction <= 1.0);
+    return 0;
+}
+
+static void bake_chain(const PleatMesh *input) {
+    const double sizes[3] = {25.0, 50.0, 100.0};
+    PleatMesh *levels[3] = {NULL, NULL, NULL};
+    PleatLodStats stats[3];
+    PleatLodParams params = pleat_lod_params_default();
+    int i, calls = 0;
+    memset(stats, 0, sizeof stats);
+    for (i = 0; i < 3; i++) stats[i].struct_size = sizeof stats[0];
+    params.max_rounds = 8;
+    CHECK_STATUS(pleat_lod_generate_chain(input, sizes, 3, &params, print_progress, &calls,
+                                          levels, stats),
+                 PLEAT_STATUS_OK);
+    CHECK(calls > 0);
+    for (i = 0; i < 3; i++) {
+        char name[64];
+        CHECK(levels[i] != NULL);
+        if (!levels[i]) continue;
+        snprintf(name, sizeof name, "LOD n_p=%g", sizes[i]);
+        verify(name, levels[i]);
+        printf("  stats: %llu faces, %u rounds, %.3f s, Hausdorff/l = %.4f (d/l = %.4f)\n",
+               (unsigned long long)stats[i].face_count, stats[i].rounds,
+               stats[i].seconds_total, stats[i].hausdorff_relative, 1.0 / sizes[i]);
+        CHECK(stats[i].struct_size == sizeof stats[0]);
+        CHECK(stats[i].face_count == pleat_mesh_triangle_count(levels[i]));
+        CHECK(stats[i].watertight == 1 && stats[i].manifold == 1);
+        CHECK(stats[i].self_intersection_free == 1);
+        CHECK(stats[i].hausdorff_relative > 0.0 && stats[i].hausdorff_relative < 4.0 / sizes[i]);
+    }
+    CHECK(pleat_mesh_triangle_count(levels[0]) <= pleat_mesh_triangle_count(levels[2]));
+    for (i = 0; i < 3; i++) pleat_mesh_destroy(levels[i]);
+}
+
+static void bake_cage(const PleatMesh *input) {
+    PleatMesh *cage = NULL;
+    PleatLodStats st;
+    PleatLodParams params = pleat_lod_params_default();
+    memset(&st, 0, sizeof st);
+    st.struct_size = sizeof st;
+    params.screen_size = 25.0;
+    params.max_rounds = 5;
+    CHECK_STATUS(pleat_cage_generate(input, &params, NULL, NULL, &cage, &st), PLEAT_STATUS_OK);
+    if (!cage) return;
+    verify("cage n_p=25", cage);
+    CHECK(st.encloses_input == 1);
+    pleat_mesh_destroy(cage);
+}
+
+static int cancel_after_three(void *user_data, const PleatProgress *info) {
+    int *calls = (int *)user_data;
+    (void)info;
+    return ++(*calls) >= 3;
+}
+
+static void cancel(const PleatMesh *input) {
+    PleatMesh *out = NULL;
+    int calls = 0;
+    CHECK_STATUS(pleat_lod_generate(input, NULL, cancel_after_three, &calls, &out, NULL),
+                 PLEAT_STATUS_CANCELLED);
+    CHECK(calls == 3);
+    CHECK(out == NULL);
+    /* also with a custom thread pool: the callback still runs on this thread */
+    calls = 0;
+    CHECK_STATUS(pleat_set_thread_count(2), PLEAT_STATUS_OK);
+    CHECK_STATUS(pleat_lod_generate(input, NULL, cancel_after_three, &calls, &out, NULL),
+                 PLEAT_STATUS_CANCELLED);
+    CHECK(calls >= 3 && out == NULL);
+    CHECK_STATUS(pleat_set_thread_count(0), PLEAT_STATUS_OK);
+}
+
+int main(int argc, char **argv) {
+    PleatMesh *input = NULL;
+    if (!pleat_has_feature("lod")) {
+        printf("lod_chain: built without the lod feature, skipped\n");
+        return 0;
+    }
+    if (argc > 1) {
+        CHECK_STATUS(pleat_mesh_read_file(argv[1], &input), PLEAT_STATUS_OK);
+    } else {
+        static float p[3 * RING * TUBE];
+        static uint32_t t[6 * RING * TUBE];
+        make_torus(p, t);
+        CHECK_STATUS(pleat_mesh_create_f32(p, RING * TUBE, 0, t, 6 * RING * TUBE, &input),
+                     PLEAT_STATUS_OK);
+    }
+    if (!input) return finish("lod_chain");
+    bake_chain(input);
+    if (pleat_has_feature("cage")) bake_cage(input);
+    cancel(input);
+    pleat_mesh_destroy(input);
+    return finish("lod_chain");
+}

@@ -1,0 +1,432 @@
+//! LODs and cages: `pleat_lod_params_default`, `pleat_lod_generate`,
+//! `pleat_lod_generate_chain`, `pleat_cage_generate`.
+//!
+//! The functions exist in every build; without the cargo feature `lod` (or `cage`) they return
+//! `PLEAT_STATUS_UNSUPPORTED`.
+
+use super::common::{guard_progress, null_arg, unsupported, PleatProgressFn, PleatStatus};
+use super::mesh::{emit_mesh, mesh_ref, PleatMesh};
+use crate::{Error, Result};
+
+/// `PleatLodParams::flags` bit: skip the feature-alignment step (Alg. 6).
+pub const PLEAT_LOD_NO_ALIGN: u32 = 1;
+
+/// Parameters of `pleat_lod_generate`, `pleat_lod_generate_chain` and `pleat_cage_generate`.
+/// Get the defaults from `pleat_lod_params_default()` and change what you need; the defaults
+/// are the dissertation's (n_p = 200, N = 50, r = 1/8, ε = 1e-4, θ0 = 120°, l0 = 4).
+///
+/// `struct_size` must be `sizeof(PleatLodParams)` as the caller knows it (the default sets
+/// it): fields beyond it keep their defaults, so older callers keep working when fields are
+/// appended.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct PleatLodParams {
+    /// `sizeof(PleatLodParams)`; at least the offset of `target_faces` (16).
+    pub struct_size: u32,
+    /// Maximum number of optimization rounds N (default 50; 0 returns the offset surface).
+    pub max_rounds: u32,
+    /// Screen size n_p in pixels covered by the input's bounding-box diagonal l (default 200).
+    /// The offset distance and error bound is d = l / n_p. Finite and > 0.
+    pub screen_size: f64,
+    /// Target triangle count n_F, or 0 for none (minimise the count). At least 4 when set.
+    pub target_faces: u64,
+    /// Flow fraction r in (0, 1] (default 0.125).
+    pub flow_ratio: f64,
+    /// Convergence threshold ε relative to l (default 1e-4), >= 0.
+    pub epsilon: f64,
+    /// Feature-curve dihedral threshold θ0 in degrees, (0, 180] (default 120).
+    pub theta0_deg: f64,
+    /// Minimum feature-curve length l0 in edges (default 4).
+    pub l0: u32,
+    /// Bitwise OR of `PLEAT_LOD_*` flags (default 0).
+    pub flags: u32,
+    /// Upper bound on the bake's memory in bytes (default 2 GiB); exceeding the estimate fails
+    /// with `PLEAT_STATUS_LIMIT_EXCEEDED` before the expensive work.
+    pub memory_budget_bytes: u64,
+}
+
+/// Statistics of one baked level, filled when a non-NULL pointer is passed. Set `struct_size`
+/// to `sizeof(PleatLodStats)`; pleat fills only that many bytes. Yes/no fields are 0 or 1.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PleatLodStats {
+    /// In: `sizeof(PleatLodStats)` as the caller knows it. Out: the bytes pleat filled.
+    pub struct_size: u32,
+    /// Optimization rounds run.
+    pub rounds: u32,
+    /// Triangles of the result.
+    pub face_count: u64,
+    /// Vertices of the result.
+    pub vertex_count: u64,
+    /// Triangles of the start surface (offset surface, or the finer level in a chain).
+    pub start_face_count: u64,
+    /// Edge collapses performed.
+    pub collapse_count: u64,
+    /// Wall seconds, total.
+    pub seconds_total: f64,
+    /// Wall seconds of the offset stage.
+    pub seconds_offset: f64,
+    /// Wall seconds of simplification (Alg. 5), summed over rounds.
+    pub seconds_simplify: f64,
+    /// Wall seconds of the flow, summed over rounds.
+    pub seconds_flow: f64,
+    /// Wall seconds of the feature alignment, summed over rounds.
+    pub seconds_align: f64,
+    /// Wall seconds of the independent verification.
+    pub seconds_verify: f64,
+    /// Offset distance d = l / n_p, in model units.
+    pub offset_distance: f64,
+    /// Two-sided sampled Hausdorff distance between result and input, model units.
+    pub hausdorff: f64,
+    /// `hausdorff / l` (l = the input's bounding-box diagonal).
+    pub hausdorff_relative: f64,
+    /// 1: verified closed and manifold.
+    pub watertight: u32,
+    /// 1: verified manifold and consistently oriented.
+    pub manifold: u32,
+    /// 1: verified free of self-intersections (exact predicates).
+    pub self_intersection_free: u32,
+    /// Cages: 1 when verified to enclose every input vertex without touching the input.
+    /// LODs: 0.
+    pub encloses_input: u32,
+    /// 1 when the result was recomputed with exact checks only (see README).
+    pub exact_rerun: u32,
+    /// 1 when a target face count was given and met.
+    pub target_met: u32,
+}
+
+/// The defaults, with `struct_size = sizeof(PleatLodParams)`.
+#[no_mangle]
+pub extern "C" fn pleat_lod_params_default() -> PleatLodParams {
+    PleatLodParams {
+        struct_size: std::mem::size_of::<PleatLodParams>() as u32,
+        max_rounds: 50,
+        screen_size: 200.0,
+        target_faces: 0,
+        flow_ratio: 0.125,
+        epsilon: 1e-4,
+        theta0_deg: 120.0,
+        l0: 4,
+        flags: 0,
+        memory_budget_bytes: 2 << 30,
+    }
+}
+
+/// Smallest accepted `PleatLodParams::struct_size`: through `screen_size`.
+const MIN_PARAMS_SIZE: u32 = 16;
+/// Smallest accepted `PleatLodStats::struct_size`: through `rounds`.
+const MIN_STATS_SIZE: u32 = 8;
+
+/// Reads the caller's params over the defaults (NULL = defaults).
+///
+/// # Safety
+/// `p` is NULL or points to `p->struct_size` readable bytes.
+unsafe fn read_params(p: *const PleatLodParams) -> Result<PleatLodParams> {
+    let mut out = pleat_lod_params_default();
+    if p.is_null() {
+        return Ok(out);
+    }
+    let size = std::ptr::read_unaligned(p as *const u32);
+    if size < MIN_PARAMS_SIZE {
+        return Err(Error::InvalidArgument(format!(
+            "params->struct_size is {size}; set it with pleat_lod_params_default() or to \
+             sizeof(PleatLodParams)"
+        )));
+    }
+    let n = (size as usize).min(std::mem::size_of::<PleatLodParams>());
+    std::ptr::copy_nonoverlapping(p as *const u8, &mut out as *mut _ as *mut u8, n);
+    out.struct_size = std::mem::size_of::<PleatLodParams>() as u32;
+    Ok(out)
+}
+
+/// Checks a stats output's `struct_size` before any work.
+///
+/// # Safety
+/// `s` is NULL or points to at least 4 readable bytes.
+unsafe fn stats_size(s: *const PleatLodStats) -> Result<Option<u32>> {
+    if s.is_null() {
+        return Ok(None);
+    }
+    let size = std::ptr::read_unaligned(s as *const u32);
+    if size < MIN_STATS_SIZE {
+        return Err(Error::InvalidArgument(format!(
+            "stats->struct_size is {size}; set it to sizeof(PleatLodStats)"
+        )));
+    }
+    Ok(Some(size))
+}
+
+/// Copies `c` into the caller's `dst` (at most `size` bytes).
+///
+/// # Safety
+/// `dst` points to `size` writable bytes.
+unsafe fn write_stats(dst: *mut PleatLodStats, size: u32, mut c: PleatLodStats) {
+    let n = (size as usize).min(std::mem::size_of::<PleatLodStats>());
+    c.struct_size = n as u32;
+    std::ptr::copy_nonoverlapping(&c as *const PleatLodStats as *const u8, dst as *mut u8, n);
+}
+
+#[cfg(feature = "lod")]
+mod imp {
+    use super::*;
+    use crate::lowpoly::LodParams;
+    use crate::mesh::TriMesh;
+    use crate::Stats;
+
+    pub(super) fn to_rust(p: &PleatLodParams) -> Result<LodParams> {
+        let target = match p.target_faces {
+            0 => None,
+            n => Some(usize::try_from(n).map_err(|_| {
+                Error::InvalidArgument(format!("target_faces {n} is out of range"))
+            })?),
+        };
+        let known = PLEAT_LOD_NO_ALIGN;
+        if p.flags & !known != 0 {
+            return Err(Error::InvalidArgument(format!(
+                "unknown flags {:#x}",
+                p.flags
+            )));
+        }
+        Ok(LodParams {
+            screen_size: p.screen_size,
+            target_faces: target,
+            max_rounds: p.max_rounds,
+            flow_ratio: p.flow_ratio,
+            epsilon: p.epsilon,
+            theta0_deg: p.theta0_deg,
+            l0: p.l0,
+            memory_budget_bytes: p.memory_budget_bytes,
+            align: p.flags & PLEAT_LOD_NO_ALIGN == 0,
+        })
+    }
+
+    pub(super) fn bake(
+        m: &TriMesh,
+        p: &PleatLodParams,
+        cage: bool,
+        prog: &mut crate::report::ProgressFn<'_>,
+    ) -> Result<(TriMesh, Stats)> {
+        let rp = to_rust(p)?;
+        if cage {
+            #[cfg(feature = "cage")]
+            return crate::cage::generate(m, &rp, prog);
+        }
+        crate::lowpoly::generate(m, &rp, prog)
+    }
+
+    pub(super) fn bake_chain(
+        m: &TriMesh,
+        sizes: &[f64],
+        p: &PleatLodParams,
+        prog: &mut crate::report::ProgressFn<'_>,
+    ) -> Result<Vec<(TriMesh, Stats)>> {
+        crate::lowpoly::generate_chain(m, sizes, &to_rust(p)?, prog)
+    }
+
+    fn stage(s: &Stats, name: &str) -> f64 {
+        s.stages.iter().filter(|x| x.0 == name).map(|x| x.1).sum()
+    }
+
+    fn verified(s: &Stats, name: &str) -> u32 {
+        s.verified.iter().any(|v| v.0 == name && v.1) as u32
+    }
+
+    pub(super) fn to_c(mesh: &TriMesh, s: &Stats) -> PleatLodStats {
+        let count = |n: &str| s.get_count(n).unwrap_or(0);
+        let metric = |n: &str| s.get_metric(n).unwrap_or(f64::NAN);
+        PleatLodStats {
+            struct_size: std::mem::size_of::<PleatLodStats>() as u32,
+            rounds: count("rounds") as u32,
+            face_count: mesh.triangle_count() as u64,
+            vertex_count: mesh.vertex_count() as u64,
+            start_face_count: count("faces_offset"),
+            collapse_count: count("collapses"),
+            seconds_total: s.total_seconds(),
+            seconds_offset: stage(s, "offset"),
+            seconds_simplify: stage(s, "simplify"),
+            seconds_flow: stage(s, "flow"),
+            seconds_align: stage(s, "align"),
+            seconds_verify: stage(s, "verify"),
+            offset_distance: metric("d"),
+            hausdorff: metric("hausdorff"),
+            hausdorff_relative: metric("hausdorff_rel"),
+            watertight: verified(s, "watertight"),
+            manifold: verified(s, "manifold"),
+            self_intersection_free: verified(s, "self_intersection_free"),
+            encloses_input: verified(s, "cage_encloses_without_touching"),
+            exact_rerun: (count("reruns_exact") > 0) as u32,
+            target_met: count("target_met") as u32,
+        }
+    }
+}
+
+/// Stand-ins when the `lod` feature is off (never called: the entry points return
+/// `PLEAT_STATUS_UNSUPPORTED` first).
+#[cfg(not(feature = "lod"))]
+mod imp {
+    use super::*;
+    use crate::mesh::TriMesh;
+    use crate::Stats;
+
+    fn off() -> Error {
+        Error::Internal("the `lod` feature is not built".into())
+    }
+
+    pub(super) fn bake(
+        _: &TriMesh,
+        _: &PleatLodParams,
+        _: bool,
+        _: &mut crate::report::ProgressFn<'_>,
+    ) -> Result<(TriMesh, Stats)> {
+        Err(off())
+    }
+
+    pub(super) fn bake_chain(
+        _: &TriMesh,
+        _: &[f64],
+        _: &PleatLodParams,
+        _: &mut crate::report::ProgressFn<'_>,
+    ) -> Result<Vec<(TriMesh, Stats)>> {
+        Err(off())
+    }
+
+    pub(super) fn to_c(_: &TriMesh, _: &Stats) -> PleatLodStats {
+        PleatLodStats::default()
+    }
+}
+
+/// The shared body of `pleat_lod_generate` and `pleat_cage_generate`.
+///
+/// # Safety
+/// As those functions.
+unsafe fn generate_one(
+    cage: bool,
+    input: *const PleatMesh,
+    params: *const PleatLodParams,
+    progress: PleatProgressFn,
+    user_data: *mut std::ffi::c_void,
+    out: *mut *mut PleatMesh,
+    stats: *mut PleatLodStats,
+) -> PleatStatus {
+    if !cfg!(feature = "lod") {
+        return unsupported("lod");
+    }
+    if cage && !cfg!(feature = "cage") {
+        return unsupported("cage");
+    }
+    guard_progress(progress, user_data, |prog| {
+        let m = mesh_ref(input, "input")?;
+        if out.is_null() {
+            return Err(null_arg("out"));
+        }
+        let p = read_params(params)?;
+        let ssize = stats_size(stats)?;
+        let (mesh, st) = imp::bake(m, &p, cage, prog)?;
+        if let Some(size) = ssize {
+            write_stats(stats, size, imp::to_c(&mesh, &st));
+        }
+        emit_mesh(out, mesh);
+        Ok(())
+    })
+}
+
+/// Bakes one LOD of `input` (any triangle soup): a watertight, manifold,
+/// self-intersection-free mesh within about d = l / n_p of the input, with as few triangles
+/// as possible (or `params->target_faces`).
+///
+/// - `input`: non-NULL mesh handle.
+/// - `params`: NULL for the defaults, else from `pleat_lod_params_default()` (checked:
+///   `struct_size` >= 16, finite screen size > 0, flow ratio in (0, 1], ...).
+/// - `progress`: NULL or a callback, called on the calling thread; non-zero cancels
+///   (`PLEAT_STATUS_CANCELLED`). `user_data` is passed to it unchanged (may be NULL).
+/// - `out`: non-NULL; receives a new mesh on success (destroy with `pleat_mesh_destroy`).
+/// - `stats`: NULL, or a `PleatLodStats` with `struct_size` set, filled on success.
+///
+/// Returns `PLEAT_STATUS_UNSUPPORTED` when built without the `lod` feature.
+///
+/// # Safety
+/// Pointers are NULL or valid for the sizes stated; `input` is a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_lod_generate(
+    input: *const PleatMesh,
+    params: *const PleatLodParams,
+    progress: PleatProgressFn,
+    user_data: *mut std::ffi::c_void,
+    out: *mut *mut PleatMesh,
+    stats: *mut PleatLodStats,
+) -> PleatStatus {
+    generate_one(false, input, params, progress, user_data, out, stats)
+}
+
+/// Bakes a cage of `input` (any triangle soup): watertight, manifold, self-intersection-free,
+/// enclosing every input vertex without touching the input, at offset d = l / n_p.
+/// Parameters as `pleat_lod_generate`; `stats->encloses_input` reports the verification.
+/// Returns `PLEAT_STATUS_UNSUPPORTED` when built without the `cage` feature.
+///
+/// # Safety
+/// As `pleat_lod_generate`.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_cage_generate(
+    input: *const PleatMesh,
+    params: *const PleatLodParams,
+    progress: PleatProgressFn,
+    user_data: *mut std::ffi::c_void,
+    out: *mut *mut PleatMesh,
+    stats: *mut PleatLodStats,
+) -> PleatStatus {
+    generate_one(true, input, params, progress, user_data, out, stats)
+}
+
+/// Bakes one LOD per screen size; coarser levels start from the next finer result, so a chain
+/// costs little more than its finest level.
+///
+/// - `screen_sizes`: `count` screen sizes (any order; each finite and > 0), `count` >= 1.
+/// - `params`: as `pleat_lod_generate`; `screen_size` and `target_faces` are ignored.
+/// - `out_meshes`: array of `count` pointers; on success `out_meshes[i]` is the level of
+///   `screen_sizes[i]` (destroy each with `pleat_mesh_destroy`). Nothing is written on failure.
+/// - `stats`: NULL, or an array of `count` `PleatLodStats` whose first element's `struct_size`
+///   gives the element size used for all.
+///
+/// # Safety
+/// Pointers are NULL or valid for the sizes stated.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_lod_generate_chain(
+    input: *const PleatMesh,
+    screen_sizes: *const f64,
+    count: usize,
+    params: *const PleatLodParams,
+    progress: PleatProgressFn,
+    user_data: *mut std::ffi::c_void,
+    out_meshes: *mut *mut PleatMesh,
+    stats: *mut PleatLodStats,
+) -> PleatStatus {
+    if !cfg!(feature = "lod") {
+        return unsupported("lod");
+    }
+    guard_progress(progress, user_data, |prog| {
+        let m = mesh_ref(input, "input")?;
+        if screen_sizes.is_null() {
+            return Err(null_arg("screen_sizes"));
+        }
+        if out_meshes.is_null() {
+            return Err(null_arg("out_meshes"));
+        }
+        if count == 0 || count > 64 {
+            return Err(Error::InvalidArgument(format!(
+                "count is {count}; give 1 to 64 screen sizes"
+            )));
+        }
+        let sizes = std::slice::from_raw_parts(screen_sizes, count).to_vec();
+        let p = read_params(params)?;
+        let ssize = stats_size(stats)?;
+        let levels = imp::bake_chain(m, &sizes, &p, prog)?;
+        for (i, (mesh, st)) in levels.into_iter().enumerate() {
+            if let Some(size) = ssize {
+                let dst = (stats as *mut u8).add(i * size as usize) as *mut PleatLodStats;
+                write_stats(dst, size, imp::to_c(&mesh, &st));
+            }
+            emit_mesh(out_meshes.add(i), mesh);
+        }
+        Ok(())
+    })
+}

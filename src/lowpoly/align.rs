@@ -1,0 +1,124 @@
+//! Feature alignment — dissertation Alg. 6 and eq. 4.4–4.5 (§4.3.2 "Feature Alignment").
+//!
+//! After the flow, each vertex `v` is moved to the minimiser of
+//! `E(v) = Σ_{f ∈ N¹(v)} ‖ n_f(v) / c_f − ñ_f / ‖ñ_f‖ ‖²` (eq. 4.5), where `n_f` is the
+//! unnormalised normal of face `f` of the current mesh, `c_f = ‖n_f‖` frozen at its current
+//! value (Alg. 6 line 3), and `ñ_f` the normal of the same face before the flow (`M̃`).
+//!
+//! Derivation of the quadratic (the text only names it): for face `f = (v, b, c)` in
+//! counter-clockwise order, `n_f = (b − v) × (c − v) = b × c + v × (b − c) = b × c − [e]ₓ v`
+//! with `e = b − c`, linear in `v`. With `A_f = −[e]ₓ / c_f` and `y_f = ñ̂_f − (b × c)/c_f`,
+//! `E = Σ ‖A_f v − y_f‖²`, whose normal equations are
+//! `Σ (|e|² I − e eᵀ)/c_f² · v = Σ (e × y_f) / c_f` (using `[e]ₓᵀ = −[e]ₓ`). The 3×3 system is
+//! solved directly (with a tiny Tikhonov term for rings whose edges are all parallel); the
+//! step `v_opt − v` is clamped to `max_step` and applied with the line search of Alg. 4.
+
+use super::flow::{local_update, record, MoveReport};
+use super::guard::Guard;
+use super::vec3::{add, cross, dot, norm, normalized, scale, sub, tri_normal, P3};
+use crate::{Error, Result};
+
+/// Unit normals of the live faces of the guard's mesh, indexed by face id (`[0; 3]` for
+/// deleted or degenerate faces): `ñ_f / ‖ñ_f‖` of `M̃`, taken before the flow.
+pub(crate) fn reference_normals(g: &Guard<'_>) -> Vec<P3> {
+    let m = g.mesh();
+    let mut n = vec![[0.0; 3]; m.face_capacity()];
+    for f in m.faces() {
+        n[f as usize] = normalized(m.face_area_vector(f)).unwrap_or([0.0; 3]);
+    }
+    n
+}
+
+/// The minimiser of eq. 4.5 for vertex `v`, or `None` when the ring is degenerate.
+pub(crate) fn aligned_position(g: &Guard<'_>, v: u32, reference: &[P3]) -> Option<P3> {
+    let m = g.mesh();
+    let pv = m.position(v);
+    let mut h = [[0.0f64; 3]; 3];
+    let mut rhs = [0.0; 3];
+    let mut any = false;
+    for out in m.outgoing(v) {
+        let Some(f) = m.face(out) else { continue };
+        let b = m.position(m.target(out));
+        let c = m.position(m.target(m.next(out)));
+        let cf = crate::lowpoly::vec3::norm(tri_normal(&[pv, b, c]));
+        let t = reference[f as usize];
+        if cf.is_nan() || cf <= 0.0 || t == [0.0; 3] {
+            continue;
+        }
+        any = true;
+        let e = sub(b, c);
+        let ee = dot(e, e);
+        let w = 1.0 / (cf * cf);
+        for (i, row) in h.iter_mut().enumerate() {
+            for (j, x) in row.iter_mut().enumerate() {
+                let id = if i == j { ee } else { 0.0 };
+                *x += w * (id - e[i] * e[j]);
+            }
+        }
+        let y = sub(t, scale(cross(b, c), 1.0 / cf));
+        rhs = add(rhs, scale(cross(e, y), 1.0 / cf));
+    }
+    if !any {
+        return None;
+    }
+    let tr = h[0][0] + h[1][1] + h[2][2];
+    for (i, row) in h.iter_mut().enumerate() {
+        row[i] += 1e-9 * tr;
+    }
+    solve3(h, rhs)
+}
+
+/// Solves the 3×3 system `h x = r` by Cramer's rule; `None` when singular or non-finite.
+fn solve3(h: [[f64; 3]; 3], r: P3) -> Option<P3> {
+    let det3 = |m: [[f64; 3]; 3]| dot(m[0], cross(m[1], m[2]));
+    let d = det3(h);
+    if d == 0.0 || !d.is_finite() {
+        return None;
+    }
+    let mut x = [0.0; 3];
+    for (k, xk) in x.iter_mut().enumerate() {
+        let mut m = h;
+        for (row, rv) in m.iter_mut().zip(r) {
+            row[k] = rv;
+        }
+        *xk = det3(m) / d;
+    }
+    x.iter().all(|c| c.is_finite()).then_some(x)
+}
+
+/// One alignment sweep (Alg. 3 lines 12–16): every vertex in id order towards its eq. 4.5
+/// optimum, step length at most `max_step`, through the guarded line search.
+pub(crate) fn align_sweep(
+    g: &mut Guard<'_>,
+    reference: &[P3],
+    max_step: f64,
+    keep_going: &mut dyn FnMut(f64) -> bool,
+) -> Result<MoveReport> {
+    let verts: Vec<u32> = g
+        .mesh()
+        .vertices()
+        .filter(|&v| g.mesh().vertex_halfedge(v).is_some())
+        .collect();
+    let mut rep = MoveReport::default();
+    for (i, &v) in verts.iter().enumerate() {
+        if i % 1024 == 0 && !keep_going(i as f64 / verts.len() as f64) {
+            return Err(Error::Cancelled);
+        }
+        let Some(opt) = aligned_position(g, v, reference) else {
+            rep.stuck += 1;
+            continue;
+        };
+        let mut d = sub(opt, g.mesh().position(v));
+        let len = norm(d);
+        if len > max_step {
+            d = scale(d, max_step / len);
+        }
+        let moved = if len > 0.0 {
+            local_update(g, v, d)
+        } else {
+            0.0
+        };
+        record(&mut rep, moved);
+    }
+    Ok(rep)
+}

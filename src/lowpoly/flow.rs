@@ -1,0 +1,91 @@
+//! Mesh flow — dissertation Alg. 3 lines 7–11 with the local update of Alg. 4.
+//!
+//! Every vertex `v` is pushed a fraction `r` (default 1/8, §4.4.3) of the way to its closest
+//! input point `v*`: `d_v = r (v* − v)`. The [`local_update`] line search halves the step
+//! until the move passes the [`Guard`], and applies `0.95 α d_v` — the 0.95 safety factor of
+//! Alg. 4. Unlike the pseudo-code, the position actually applied (`v + 0.95 α d_v`) is the one
+//! the guard checks, so no unchecked position is ever written.
+//!
+//! Closest points are computed for all vertices up front in parallel (each depends only on its
+//! own vertex, which does not move before its turn), then vertices are updated sequentially in
+//! id order (Gauss–Seidel, deterministic for any thread count).
+
+use rayon::prelude::*;
+
+use super::guard::Guard;
+use super::vec3::{add, norm, scale, sub, P3};
+use crate::{Error, Result};
+
+/// The safety factor of Alg. 4 line 5.
+pub const SAFETY_FACTOR: f64 = 0.95;
+
+/// Halvings of the line search before a vertex is left in place (α ≥ 2⁻¹⁰).
+pub const MAX_HALVINGS: u32 = 10;
+
+/// What one flow (or alignment) sweep did.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct MoveReport {
+    /// Vertices moved (with some α).
+    pub moved: u64,
+    /// Vertices left in place (every α rejected, or zero step).
+    pub stuck: u64,
+    /// Sum of the lengths of the applied displacements.
+    pub total_motion: f64,
+}
+
+/// Alg. 4: tries `v + 0.95 α d` for `α = 1, 1/2, …` and applies the first the guard accepts.
+/// Returns the applied displacement length (0 when none was accepted).
+pub(crate) fn local_update(g: &mut Guard<'_>, v: u32, d: P3) -> f64 {
+    let p = g.mesh().position(v);
+    let mut alpha = 1.0;
+    for _ in 0..=MAX_HALVINGS {
+        let step = scale(d, SAFETY_FACTOR * alpha);
+        if g.try_move(v, add(p, step)).is_ok() {
+            return norm(step);
+        }
+        alpha *= 0.5;
+    }
+    0.0
+}
+
+/// One flow sweep (Alg. 3 lines 7–11) with ratio `r`. `keep_going` is polled with the
+/// fraction done; `false` cancels.
+pub(crate) fn flow_sweep(
+    g: &mut Guard<'_>,
+    r: f64,
+    keep_going: &mut dyn FnMut(f64) -> bool,
+) -> Result<MoveReport> {
+    let verts: Vec<u32> = g
+        .mesh()
+        .vertices()
+        .filter(|&v| g.mesh().vertex_halfedge(v).is_some())
+        .collect();
+    let input = g.input();
+    let positions: Vec<P3> = verts.iter().map(|&v| g.mesh().position(v)).collect();
+    let targets: Vec<P3> = positions.par_iter().map(|&p| input.closest(p).0).collect();
+    let mut rep = MoveReport::default();
+    for (i, &v) in verts.iter().enumerate() {
+        if i % 1024 == 0 && !keep_going(i as f64 / verts.len() as f64) {
+            return Err(Error::Cancelled);
+        }
+        let d = scale(sub(targets[i], positions[i]), r);
+        record(
+            &mut rep,
+            if norm(d) > 0.0 {
+                local_update(g, v, d)
+            } else {
+                0.0
+            },
+        );
+    }
+    Ok(rep)
+}
+
+pub(crate) fn record(rep: &mut MoveReport, moved: f64) {
+    if moved > 0.0 {
+        rep.moved += 1;
+        rep.total_motion += moved;
+    } else {
+        rep.stuck += 1;
+    }
+}

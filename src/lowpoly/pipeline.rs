@@ -1,0 +1,608 @@
+//! The LOD pipeline — dissertation Alg. 3 (§4.3.2) after the offset stage (§4.3.1):
+//! `M_d ← offset surface at d = l / n_p`, then up to `N` rounds of
+//! {simplify (Alg. 5) → flow (Alg. 3–4) → align (Alg. 6)}, stopping early when the sampled
+//! Hausdorff distance between consecutive rounds falls below `ε·l` (line 17) or the face target
+//! `n_F` is met; finally an independent verification of Pro.III (watertight, manifold,
+//! intersection-free), with a rerun using exact checks only if the normal-cone shortcut ever
+//! let an intersection through (§4.3.3, last paragraph).
+
+use std::time::Instant;
+
+use super::align::{align_sweep, reference_normals};
+use super::flow::flow_sweep;
+use super::guard::{Guard, GuardStats, InputModel};
+use super::measure::{self, Surface, Verification, FINAL_SAMPLES_PER_DIAGONAL};
+use super::simplify::{simplify_pass, SimplifyOptions, SimplifyReport};
+use super::vec3::{add, normalized, scale, P3};
+use crate::mesh::{HalfEdgeMesh, TriMesh};
+use crate::report::{Progress, ProgressFn};
+use crate::{Error, Result, Stats};
+
+/// Parameters of [`generate`] and [`generate_chain`] (and of cages, `crate::cage`). Start from
+/// [`LodParams::default`]; defaults are the dissertation's (§4.4: `n_p = 200`, `N = 50`,
+/// `r = 1/8`, `ε = 1e-4`, `θ0 = 120°`, `l0 = 4`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LodParams {
+    /// Screen size `n_p`: pixels covered by the input's bounding-box diagonal `l`. The offset
+    /// distance and per-collapse error bound is `d = l / n_p`. Finite, `> 0`.
+    pub screen_size: f64,
+    /// Optional target face count `n_F` (Pro.I): simplification stops there and the loop ends
+    /// when it is met. When a round makes no collapse (or the loop converges) before the target
+    /// is reached, the per-collapse distance bound `d` of Alg. 5 is doubled and the one-sided
+    /// distance check tolerates patches up to that bound (counted in
+    /// `Stats` as `target_relaxations`), so the target is reached unless topology or the
+    /// guarantees forbid it or the `N` rounds run out. `None` minimises the count at error `d`.
+    /// At least 4 when given.
+    pub target_faces: Option<usize>,
+    /// Maximum number of rounds `N` of Alg. 3 (0 returns the offset surface).
+    pub max_rounds: u32,
+    /// Flow fraction `r` in `(0, 1]` (Alg. 3 line 9).
+    pub flow_ratio: f64,
+    /// Convergence threshold `ε` relative to `l` (Alg. 3 line 17), `≥ 0`.
+    pub epsilon: f64,
+    /// Feature-curve dihedral threshold `θ0` in degrees, `(0, 180]` (offset stage).
+    pub theta0_deg: f64,
+    /// Minimum feature-curve length `l0` in edges (offset stage).
+    pub l0: u32,
+    /// Upper bound on the memory of the bake in bytes; estimated before the expensive work
+    /// starts, exceeding it fails with `Error::LimitExceeded`.
+    pub memory_budget_bytes: u64,
+    /// Run the feature-alignment step (Alg. 6). Default true.
+    pub align: bool,
+}
+
+impl Default for LodParams {
+    fn default() -> Self {
+        LodParams {
+            screen_size: 200.0,
+            target_faces: None,
+            max_rounds: 50,
+            flow_ratio: 0.125,
+            epsilon: 1e-4,
+            theta0_deg: 120.0,
+            l0: 4,
+            memory_budget_bytes: 2 << 30,
+            align: true,
+        }
+    }
+}
+
+/// Approximate bytes per working-mesh face (half-edge records, BVH node, caches).
+const BYTES_PER_WORK_FACE: f64 = 400.0;
+/// Approximate bytes per input face (copy, BVH, flags).
+const BYTES_PER_INPUT_FACE: f64 = 200.0;
+
+impl LodParams {
+    /// Checks every parameter (and the memory estimate for `input`) before any work.
+    pub fn validate(&self, input: &TriMesh) -> Result<()> {
+        let bad = |m: String| Err(Error::InvalidArgument(m));
+        if !(self.screen_size.is_finite() && self.screen_size > 0.0) {
+            return bad(format!(
+                "screen size n_p must be finite and > 0, got {}",
+                self.screen_size
+            ));
+        }
+        if let Some(n) = self.target_faces {
+            if n < 4 {
+                return bad(format!("target face count must be at least 4, got {n}"));
+            }
+        }
+        if !(self.flow_ratio > 0.0 && self.flow_ratio <= 1.0) {
+            return bad(format!(
+                "flow ratio r must be in (0, 1], got {}",
+                self.flow_ratio
+            ));
+        }
+        if !(self.epsilon.is_finite() && self.epsilon >= 0.0) {
+            return bad(format!(
+                "epsilon must be finite and >= 0, got {}",
+                self.epsilon
+            ));
+        }
+        if !(self.theta0_deg > 0.0 && self.theta0_deg <= 180.0) {
+            return bad(format!(
+                "theta0 must be in (0, 180] degrees, got {}",
+                self.theta0_deg
+            ));
+        }
+        if self.memory_budget_bytes == 0 {
+            return bad("memory budget must be > 0".into());
+        }
+        let l = input.bbox_diagonal();
+        if !(l > 0.0 && l.is_finite()) {
+            return Err(Error::InvalidMesh(format!(
+                "the input's bounding-box diagonal is {l}; nothing to approximate"
+            )));
+        }
+        let est = self.memory_estimate(input);
+        if est > self.memory_budget_bytes as f64 {
+            return Err(Error::LimitExceeded(format!(
+                "the bake needs about {:.0} MiB at screen size {} but the memory budget is \
+                 {:.0} MiB",
+                est / (1u64 << 20) as f64,
+                self.screen_size,
+                self.memory_budget_bytes as f64 / (1u64 << 20) as f64
+            )));
+        }
+        Ok(())
+    }
+
+    /// Estimated peak bytes: the input structures plus the offset surface, whose face count is
+    /// about `2 · area / h²` with voxel edge `h = d/√3` (area of a thin part's offset ≤ twice
+    /// the input's, plus a sphere of radius `d` per component, bounded by the box).
+    fn memory_estimate(&self, input: &TriMesh) -> f64 {
+        let l = input.bbox_diagonal();
+        let d = l / self.screen_size;
+        let h = d / 3f64.sqrt();
+        let area = 2.0 * input.surface_area() + 4.0 * std::f64::consts::PI * d * d;
+        let (lo, hi) = input.bbox();
+        let ext: Vec<f64> = (0..3).map(|k| hi[k] - lo[k] + 2.0 * d).collect();
+        let box_area = 2.0 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[0] * ext[2]);
+        let faces = 2.0 * area.min(8.0 * box_area) / (h * h);
+        faces * BYTES_PER_WORK_FACE + input.triangle_count() as f64 * BYTES_PER_INPUT_FACE
+    }
+}
+
+/// Whether the loop builds a LOD or a cage.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Mode {
+    Lod,
+    Cage,
+}
+
+/// Maps stage progress into a window of the caller's progress and turns `false` into
+/// `Error::Cancelled`.
+pub(crate) struct Reporter<'p, 'f> {
+    f: &'p mut ProgressFn<'f>,
+    base: f64,
+    span: f64,
+}
+
+impl<'p, 'f> Reporter<'p, 'f> {
+    pub fn new(f: &'p mut ProgressFn<'f>) -> Self {
+        Reporter {
+            f,
+            base: 0.0,
+            span: 1.0,
+        }
+    }
+
+    /// Sets the window `[base, base + span]` of the whole operation.
+    pub fn window(&mut self, base: f64, span: f64) {
+        self.base = base;
+        self.span = span;
+    }
+
+    /// Reports `stage` at `fraction` of the current window.
+    pub fn report(&mut self, stage: &str, fraction: f64) -> bool {
+        (self.f)(Progress {
+            stage,
+            fraction: (self.base + self.span * fraction.clamp(0.0, 1.0)).clamp(0.0, 1.0),
+        })
+    }
+
+    /// As [`report`](Self::report), with `Err(Cancelled)` on `false`.
+    pub fn check(&mut self, stage: &str, fraction: f64) -> Result<()> {
+        if self.report(stage, fraction) {
+            Ok(())
+        } else {
+            Err(Error::Cancelled)
+        }
+    }
+}
+
+/// Bakes one LOD of `input` (any triangle soup) at `params.screen_size`: a watertight,
+/// manifold, self-intersection-free mesh within about `d = l / n_p` of the input (Pro.I–III).
+/// `progress` is called on this thread; returning `false` cancels with `Error::Cancelled`.
+///
+/// `Stats`: stage seconds (`offset`, `simplify`, `flow`, `align`, `verify`, `measure`), counts
+/// (`faces_offset`, `faces_round_<i>`, `rounds`, `collapses`, guard counters, `reruns_exact`,
+/// `faces`, `vertices`), metrics (`d`, `hausdorff`, `hausdorff_rel` = two-sided sampled
+/// Hausdorff / `l`, see `measure` for the sampling density), verified guarantees
+/// (`watertight`, `manifold`, `self_intersection_free`).
+///
+/// Errors: `InvalidArgument` for a bad parameter (NaN or `≤ 0` screen size, …),
+/// `LimitExceeded` over the memory budget, `InvalidMesh` for an input with nothing to
+/// approximate, `Cancelled`, and `Internal` if a guarantee cannot be established.
+pub fn generate(
+    input: &TriMesh,
+    params: &LodParams,
+    progress: &mut ProgressFn<'_>,
+) -> Result<(TriMesh, Stats)> {
+    run(input, params, Mode::Lod, progress)
+}
+
+/// Bakes one LOD per screen size (in the given order of `screen_sizes`). The finest level is
+/// baked from the input; each coarser level starts from the next finer result (which already
+/// has every Pro.III guarantee, so the guard keeps them), with the one-sided distance check of
+/// Alg. 5 relaxed to `d` of the coarser level — the distance its own offset surface would start
+/// from. `params.screen_size` and `params.target_faces` are ignored (a face target is per
+/// level: call [`generate`]). Each level's `Stats` has a `chain_level` count (0 = finest).
+pub fn generate_chain(
+    input: &TriMesh,
+    screen_sizes: &[f64],
+    params: &LodParams,
+    progress: &mut ProgressFn<'_>,
+) -> Result<Vec<(TriMesh, Stats)>> {
+    run_chain(input, screen_sizes, params, Mode::Lod, progress)
+}
+
+/// [`generate`] for either mode.
+pub(crate) fn run(
+    input: &TriMesh,
+    params: &LodParams,
+    mode: Mode,
+    progress: &mut ProgressFn<'_>,
+) -> Result<(TriMesh, Stats)> {
+    params.validate(input)?;
+    let mut rep = Reporter::new(progress);
+    let model = InputModel::new(input, mode == Mode::Cage);
+    bake_level(&model, input, params, mode, None, &mut rep, (0.0, 1.0))
+}
+
+/// [`generate_chain`] for either mode.
+pub(crate) fn run_chain(
+    input: &TriMesh,
+    screen_sizes: &[f64],
+    params: &LodParams,
+    mode: Mode,
+    progress: &mut ProgressFn<'_>,
+) -> Result<Vec<(TriMesh, Stats)>> {
+    if screen_sizes.is_empty() {
+        return Err(Error::InvalidArgument("no screen size given".into()));
+    }
+    let mut level_params = Vec::with_capacity(screen_sizes.len());
+    for &s in screen_sizes {
+        let p = LodParams {
+            screen_size: s,
+            target_faces: None,
+            ..params.clone()
+        };
+        p.validate(input)?;
+        level_params.push(p);
+    }
+    let mut order: Vec<usize> = (0..screen_sizes.len()).collect();
+    order.sort_by(|&a, &b| screen_sizes[b].total_cmp(&screen_sizes[a]).then(a.cmp(&b)));
+    let mut rep = Reporter::new(progress);
+    let model = InputModel::new(input, mode == Mode::Cage);
+    let mut out: Vec<Option<(TriMesh, Stats)>> = vec![None; screen_sizes.len()];
+    let mut prev: Option<TriMesh> = None;
+    let n = order.len() as f64;
+    for (rank, &i) in order.iter().enumerate() {
+        let window = (rank as f64 / n, 1.0 / n);
+        let (mesh, mut stats) = bake_level(
+            &model,
+            input,
+            &level_params[i],
+            mode,
+            prev.as_ref(),
+            &mut rep,
+            window,
+        )?;
+        stats.count("chain_level", rank as u64);
+        prev = Some(mesh.clone());
+        out[i] = Some((mesh, stats));
+    }
+    Ok(out
+        .into_iter()
+        .map(|x| x.expect("every level baked"))
+        .collect())
+}
+
+/// Bakes one level: start surface (offset of the input, or `finer` in a chain), the loop,
+/// verification, measurement.
+fn bake_level(
+    model: &InputModel,
+    input: &TriMesh,
+    params: &LodParams,
+    mode: Mode,
+    finer: Option<&TriMesh>,
+    rep: &mut Reporter<'_, '_>,
+    window: (f64, f64),
+) -> Result<(TriMesh, Stats)> {
+    let mut stats = Stats::default();
+    let l = model.diag;
+    let d = l / params.screen_size;
+    stats.metric("d", d);
+    let (w0, ws) = window;
+    rep.window(w0, 0.2 * ws);
+    rep.check("offset", 0.0)?;
+    let t0 = Instant::now();
+    let (start, slack) = match finer {
+        Some(m) => (m.clone(), d),
+        None => (initial_surface(input, model, d, mode)?, 0.0),
+    };
+    stats
+        .stages
+        .push(("offset".into(), t0.elapsed().as_secs_f64()));
+    stats.count("faces_offset", start.triangle_count() as u64);
+    let start_topology = topology_of(&start);
+    rep.window(w0 + 0.2 * ws, 0.7 * ws);
+    let cfg = LoopConfig {
+        d,
+        slack,
+        target_faces: params.target_faces,
+        max_rounds: params.max_rounds,
+        r: params.flow_ratio,
+        epsilon_abs: params.epsilon * l,
+        align: params.align,
+        mode,
+    };
+    let (mut mesh, mut ls) = optimize(&start, model, &cfg, false, rep)?;
+    rep.window(w0 + 0.9 * ws, 0.1 * ws);
+    rep.check("verify", 0.0)?;
+    let t0 = Instant::now();
+    let mut v = verify_level(&mesh, model, mode);
+    let mut reruns = 0;
+    if !v.0.self_intersection_free || !v.1 {
+        // §4.3.3: the normal-cone shortcut let an intersection through: rerun exactly.
+        reruns = 1;
+        rep.window(w0 + 0.2 * ws, 0.7 * ws);
+        let (m2, ls2) = optimize(&start, model, &cfg, true, rep)?;
+        mesh = m2;
+        ls = ls2;
+        v = verify_level(&mesh, model, mode);
+    }
+    let verify_s = t0.elapsed().as_secs_f64();
+    ls.write(&mut stats);
+    stats.stages.push(("verify".into(), verify_s));
+    stats.count("reruns_exact", reruns);
+    record_verification(&mut stats, v, mode);
+    let same_topology = (v.0.components, v.0.euler) == start_topology;
+    stats.verify("same_topology_as_offset", same_topology);
+    let ok = v.0.manifold && v.0.watertight && v.0.self_intersection_free && v.1 && same_topology;
+    if !ok {
+        return Err(Error::Internal(format!(
+            "the output failed independent verification ({v:?}); please report the input"
+        )));
+    }
+    rep.check("measure", 0.5)?;
+    let t0 = Instant::now();
+    let h = final_hausdorff(&mesh, input, l);
+    stats
+        .stages
+        .push(("measure".into(), t0.elapsed().as_secs_f64()));
+    stats.metric("hausdorff", h);
+    stats.metric("hausdorff_rel", h / l);
+    stats.count("faces", mesh.triangle_count() as u64);
+    stats.count("vertices", mesh.vertex_count() as u64);
+    rep.check("done", 1.0)?;
+    Ok((mesh, stats))
+}
+
+/// `(components, Euler characteristic)` of a mesh (no self-intersection pass).
+fn topology_of(mesh: &TriMesh) -> (usize, i64) {
+    let r = crate::mesh::MeshReport::compute_with(
+        mesh,
+        &crate::mesh::ReportOptions {
+            self_intersections: false,
+            weld: false,
+        },
+    );
+    (r.n_components, r.euler_characteristic_total)
+}
+
+/// `(Pro.III verification, cage checks hold)`.
+fn verify_level(mesh: &TriMesh, model: &InputModel, mode: Mode) -> (Verification, bool) {
+    let v = measure::verify(mesh);
+    let cage_ok = match mode {
+        Mode::Lod => true,
+        Mode::Cage => {
+            let (untouched, encloses) = measure::verify_cage(mesh, model);
+            untouched && encloses
+        }
+    };
+    (v, cage_ok)
+}
+
+fn record_verification(stats: &mut Stats, v: (Verification, bool), mode: Mode) {
+    stats.verify("watertight", v.0.watertight);
+    stats.verify("manifold", v.0.manifold);
+    stats.verify("self_intersection_free", v.0.self_intersection_free);
+    if mode == Mode::Cage {
+        stats.verify("cage_encloses_without_touching", v.1);
+    }
+}
+
+/// Two-sided Hausdorff between the result and the input (sampling in `measure`).
+fn final_hausdorff(mesh: &TriMesh, input: &TriMesh, l: f64) -> f64 {
+    let a = Surface::new(mesh);
+    let b = Surface::new(input);
+    measure::hausdorff(&a, &b, l / FINAL_SAMPLES_PER_DIAGONAL, 32)
+}
+
+/// Settings of the loop for one level.
+#[derive(Debug, Clone, Copy)]
+struct LoopConfig {
+    d: f64,
+    slack: f64,
+    target_faces: Option<usize>,
+    max_rounds: u32,
+    r: f64,
+    epsilon_abs: f64,
+    align: bool,
+    mode: Mode,
+}
+
+/// Totals of one run of the loop.
+#[derive(Debug, Default)]
+struct LoopStats {
+    simplify_s: f64,
+    flow_s: f64,
+    align_s: f64,
+    converge_s: f64,
+    rounds: u64,
+    faces_per_round: Vec<u64>,
+    simplify: SimplifyReport,
+    guard: GuardStats,
+    last_change: f64,
+    change_per_round: Vec<f64>,
+    flow_motion: f64,
+    align_motion: f64,
+    target_met: bool,
+    relaxations: u64,
+}
+
+impl LoopStats {
+    fn write(&self, s: &mut Stats) {
+        s.stages.push(("simplify".into(), self.simplify_s));
+        s.stages.push(("flow".into(), self.flow_s));
+        s.stages.push(("align".into(), self.align_s));
+        s.stages.push(("convergence".into(), self.converge_s));
+        s.count("rounds", self.rounds);
+        for (i, f) in self.faces_per_round.iter().enumerate() {
+            s.count(&format!("faces_round_{}", i + 1), *f);
+        }
+        s.count("collapses", self.simplify.collapses);
+        s.count("collapse_candidates", self.simplify.candidates);
+        s.count("rejected_fold", self.simplify.rejected_fold);
+        s.count("rejected_hausdorff", self.simplify.rejected_hausdorff);
+        s.count("rejected_distance", self.simplify.rejected_distance);
+        s.count("rejected_guard", self.simplify.rejected_guard);
+        let g = &self.guard;
+        s.count("guard_checks", g.checks);
+        s.count("guard_rejected_topology", g.rejected_topology);
+        s.count("guard_rejected_degenerate", g.rejected_degenerate);
+        s.count("guard_rejected_intersection", g.rejected_intersection);
+        s.count("guard_rejected_touch", g.rejected_touch);
+        s.count("guard_rejected_uncover", g.rejected_uncover);
+        s.count("guard_cone_fast_path", g.cone_fast_path);
+        s.count("guard_exact_tests", g.exact_tests);
+        s.count("target_met", self.target_met as u64);
+        s.count("target_relaxations", self.relaxations);
+        s.metric("last_round_change", self.last_change);
+        for (i, c) in self.change_per_round.iter().enumerate() {
+            s.metric(&format!("change_round_{}", i + 1), *c);
+        }
+        s.metric("flow_motion", self.flow_motion);
+        s.metric("align_motion", self.align_motion);
+    }
+}
+
+fn add_simplify(acc: &mut SimplifyReport, r: &SimplifyReport) {
+    acc.collapses += r.collapses;
+    acc.candidates += r.candidates;
+    acc.rejected_fold += r.rejected_fold;
+    acc.rejected_hausdorff += r.rejected_hausdorff;
+    acc.rejected_distance += r.rejected_distance;
+    acc.rejected_guard += r.rejected_guard;
+}
+
+/// Alg. 3 from `start` (watertight, manifold, intersection-free; in cage mode enclosing the
+/// input without touching it).
+fn optimize(
+    start: &TriMesh,
+    model: &InputModel,
+    cfg: &LoopConfig,
+    exact_only: bool,
+    rep: &mut Reporter<'_, '_>,
+) -> Result<(TriMesh, LoopStats)> {
+    let he = HalfEdgeMesh::from_trimesh(start)
+        .map_err(|e| Error::Internal(format!("the start surface is not manifold: {e}")))?;
+    let mut g = Guard::new(he, model, cfg.mode == Mode::Cage);
+    g.set_exact_only(exact_only);
+    let mut ls = LoopStats::default();
+    let mut sopt = SimplifyOptions {
+        d: cfg.d,
+        target_faces: cfg.target_faces,
+        slack: cfg.slack,
+        spacing: cfg.d,
+    };
+    let rounds = cfg.max_rounds;
+    for i in 0..rounds {
+        let frac = |x: f64| (i as f64 + x) / rounds as f64;
+        rep.check("simplify", frac(0.0))?;
+        let before = Surface::new(&g.mesh().to_trimesh());
+        let t0 = Instant::now();
+        let sr = {
+            let mut kg = |x: f64| rep.report("simplify", frac(0.5 * x));
+            simplify_pass(&mut g, &sopt, &mut kg)?
+        };
+        add_simplify(&mut ls.simplify, &sr);
+        ls.simplify_s += t0.elapsed().as_secs_f64();
+        let reference = reference_normals(&g);
+        let t0 = Instant::now();
+        {
+            let mut kg = |x: f64| rep.report("flow", frac(0.5 + 0.25 * x));
+            let fr = flow_sweep(&mut g, cfg.r, &mut kg)?;
+            ls.flow_motion += fr.total_motion;
+        }
+        ls.flow_s += t0.elapsed().as_secs_f64();
+        if cfg.align {
+            let t0 = Instant::now();
+            let mut kg = |x: f64| rep.report("align", frac(0.75 + 0.25 * x));
+            let ar = align_sweep(&mut g, &reference, cfg.d, &mut kg)?;
+            ls.align_motion += ar.total_motion;
+            ls.align_s += t0.elapsed().as_secs_f64();
+        }
+        ls.rounds += 1;
+        ls.faces_per_round.push(g.mesh().face_count() as u64);
+        let t0 = Instant::now();
+        let after = Surface::new(&g.mesh().to_trimesh());
+        ls.last_change = measure::hausdorff(&after, &before, cfg.d, 8);
+        ls.change_per_round.push(ls.last_change);
+        ls.converge_s += t0.elapsed().as_secs_f64();
+        ls.target_met = cfg.target_faces.is_some_and(|n| g.mesh().face_count() <= n);
+        if ls.target_met {
+            break;
+        }
+        let converged = ls.last_change < cfg.epsilon_abs;
+        if cfg.target_faces.is_some() && (converged || sr.collapses == 0) {
+            // Pro.I with a face target: relax the per-collapse bound until it is reached.
+            sopt.d *= 2.0;
+            sopt.slack = sopt.slack.max(sopt.d);
+            ls.relaxations += 1;
+            continue;
+        }
+        if converged {
+            break;
+        }
+    }
+    ls.guard = g.stats.clone();
+    Ok((g.mesh().to_trimesh(), ls))
+}
+
+/// The start surface `M_d`.
+///
+/// TEMPORARY stand-in until `offset_surface` (branch `offset`) lands on `main`: the input must
+/// be a closed manifold; each vertex is pushed `d` along its area-weighted normal, and the
+/// result is used when it passes the independent verification (and, for cages, encloses the
+/// input without touching it). LODs fall back to the input itself when it is intersection-free.
+fn initial_surface(input: &TriMesh, model: &InputModel, d: f64, mode: Mode) -> Result<TriMesh> {
+    let he = HalfEdgeMesh::from_trimesh(input).map_err(|e| {
+        Error::InvalidMesh(format!(
+            "until the offset stage is available the input must be a closed manifold: {e}"
+        ))
+    })?;
+    if he.boundary_loop_count() != 0 {
+        return Err(Error::InvalidMesh(
+            "until the offset stage is available the input must be closed".into(),
+        ));
+    }
+    let mut normals = vec![[0.0; 3]; input.vertex_count()];
+    for f in he.faces() {
+        let n = he.face_area_vector(f);
+        for v in he.face_vertices(f) {
+            normals[v as usize] = add(normals[v as usize], n);
+        }
+    }
+    let pos: Vec<P3> = input
+        .positions()
+        .iter()
+        .zip(&normals)
+        .map(|(&p, &n)| add(p, scale(normalized(n).unwrap_or([0.0; 3]), d)))
+        .collect();
+    let pushed = TriMesh::new(pos, input.triangles().to_vec())?;
+    let (v, cage_ok) = verify_level(&pushed, model, mode);
+    if v.manifold && v.watertight && v.self_intersection_free && cage_ok {
+        return Ok(pushed);
+    }
+    if mode == Mode::Lod && measure::verify(input).self_intersection_free {
+        return Ok(input.clone());
+    }
+    Err(Error::InvalidMesh(
+        "until the offset stage is available the input must be a closed, intersection-free \
+         manifold"
+            .into(),
+    ))
+}

@@ -1,0 +1,602 @@
+//! One pass of guarded quadric edge collapses — dissertation Alg. 5 (§4.3.2 "Mesh
+//! Simplification").
+//!
+//! Vertex quadrics are Garland & Heckbert's (1997) area-weighted face-plane quadrics plus one
+//! *virtual plane* per edge: the plane through the edge perpendicular to its faces (normal
+//! `n̄ × ê`, `n̄` the mean of the two face normals), weighted by [`VIRTUAL_PLANE_WEIGHT`]`·|e|²`.
+//! In flat regions the face planes alone give a rank-1 quadric whose minimiser is a whole
+//! plane; the virtual planes make it full rank and keep the optimum near the collapsed edge.
+//!
+//! Edges are popped by increasing cost. A collapse is **skipped** (Alg. 5 lines 9–22) when
+//! - the half-edge preconditions refuse it (topology), or a new face's normal turns by more
+//!   than 90° (a fold-over, cheap to detect before the exact tests);
+//! - it would move the surface by more than `d`: the two-sided Hausdorff distance between the
+//!   patch before (`M_e`, the faces around both endpoints) and after (`M'_e`) exceeds `d`
+//!   (line 20; sampled as in Metro, see [`sample_resolution`]);
+//! - it increases the one-sided distance from the local patch to the input (line 17):
+//!   `D(M'_e) > max(D(M_e), slack)`, where `D` is the area-weighted mean over the patch of the
+//!   sampled point-to-input distances (`slack` is 0 for Alg. 5 as written and `d` when a chain
+//!   level starts from a finer result). The text does not say which one-sided distance; the
+//!   maximum does not work: on an offset surface every vertex sits at distance `≈ d`, and the
+//!   quadric optimum of a convex patch lies just outside it, so every convex collapse would
+//!   "increase" the maximum by a rounding-level amount and nothing would ever simplify. The
+//!   mean rejects what the check is for — collapses that push the surface away from the input
+//!   (concave regions) — and accepts chords that bring it closer;
+//! - the [`Guard`] refuses it (self-intersections; cage mode: touching or uncovering the input).
+//!
+//! Candidate positions are tried in order — the quadric optimum, the edge midpoint, the two
+//! endpoints — and the first that passes every check is used: on convex parts of an offset
+//! surface the quadric optimum lies slightly *outside* (farther from the input) while the
+//! midpoint lies on the chord, closer to it.
+//!
+//! The pass stops when the queue is empty or the face count reaches the target `n_F`.
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use super::guard::Guard;
+use super::vec3::{
+    add, cross, dist, dot, for_each_sample, norm, normalized, point_triangle_distance,
+    sample_resolution, scale, sub, tri_normal, P3,
+};
+use crate::mesh::halfedge::INVALID;
+use crate::{Error, Result};
+
+/// Weight of an edge's virtual plane relative to `|e|²` (face planes weigh their area).
+pub const VIRTUAL_PLANE_WEIGHT: f64 = 0.01;
+
+/// Largest sampling grid per triangle edge in the distance checks.
+const MAX_SAMPLE_RES: usize = 4;
+
+/// Options of one simplification pass.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SimplifyOptions {
+    /// Largest allowed local two-sided Hausdorff change per collapse (`d = l / n_p`).
+    pub d: f64,
+    /// Stop when the face count is at most this.
+    pub target_faces: Option<usize>,
+    /// One-sided distance allowance (0 = Alg. 5 exactly).
+    pub slack: f64,
+    /// Sample spacing of the distance checks.
+    pub spacing: f64,
+}
+
+/// What one pass did.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SimplifyReport {
+    pub collapses: u64,
+    pub candidates: u64,
+    pub rejected_fold: u64,
+    pub rejected_hausdorff: u64,
+    pub rejected_distance: u64,
+    pub rejected_guard: u64,
+}
+
+/// A symmetric quadric `Q(x) = xᵀAx + 2bᵀx + c`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Quadric {
+    /// Upper triangle of `A`: `a00 a01 a02 a11 a12 a22`.
+    a: [f64; 6],
+    b: [f64; 3],
+    c: f64,
+}
+
+impl Quadric {
+    /// `w · (n · (x − p))²` for a unit normal `n`.
+    pub fn plane(n: P3, p: P3, w: f64) -> Quadric {
+        let d = -dot(n, p);
+        Quadric {
+            a: [
+                w * n[0] * n[0],
+                w * n[0] * n[1],
+                w * n[0] * n[2],
+                w * n[1] * n[1],
+                w * n[1] * n[2],
+                w * n[2] * n[2],
+            ],
+            b: scale(n, w * d),
+            c: w * d * d,
+        }
+    }
+
+    /// Sum of two quadrics.
+    pub fn add(&self, o: &Quadric) -> Quadric {
+        let mut a = self.a;
+        for (x, y) in a.iter_mut().zip(o.a) {
+            *x += y;
+        }
+        Quadric {
+            a,
+            b: add(self.b, o.b),
+            c: self.c + o.c,
+        }
+    }
+
+    /// `Q(x)`.
+    pub fn eval(&self, x: P3) -> f64 {
+        let [a00, a01, a02, a11, a12, a22] = self.a;
+        let ax = [
+            a00 * x[0] + a01 * x[1] + a02 * x[2],
+            a01 * x[0] + a11 * x[1] + a12 * x[2],
+            a02 * x[0] + a12 * x[1] + a22 * x[2],
+        ];
+        dot(x, ax) + 2.0 * dot(self.b, x) + self.c
+    }
+
+    /// The minimiser `−A⁻¹b`, or `None` when `A` is (nearly) singular.
+    pub fn minimize(&self) -> Option<P3> {
+        let [a00, a01, a02, a11, a12, a22] = self.a;
+        let c00 = a11 * a22 - a12 * a12;
+        let c01 = a02 * a12 - a01 * a22;
+        let c02 = a01 * a12 - a02 * a11;
+        let det = a00 * c00 + a01 * c01 + a02 * c02;
+        let tr = (a00 + a11 + a22) / 3.0;
+        if det.is_nan() || det.abs() <= 1e-12 * tr * tr * tr {
+            return None;
+        }
+        let c11 = a00 * a22 - a02 * a02;
+        let c12 = a01 * a02 - a00 * a12;
+        let c22 = a00 * a11 - a01 * a01;
+        let b = self.b;
+        let x = [
+            -(c00 * b[0] + c01 * b[1] + c02 * b[2]) / det,
+            -(c01 * b[0] + c11 * b[1] + c12 * b[2]) / det,
+            -(c02 * b[0] + c12 * b[1] + c22 * b[2]) / det,
+        ];
+        x.iter().all(|c| c.is_finite()).then_some(x)
+    }
+}
+
+/// Vertex quadrics of the current mesh (indexed by vertex id): face planes weighted by area
+/// plus the virtual edge planes.
+fn vertex_quadrics(g: &Guard<'_>) -> Vec<Quadric> {
+    let m = g.mesh();
+    let mut q = vec![Quadric::default(); m.vertex_capacity()];
+    for f in m.faces() {
+        let t = m.face_positions(f);
+        let nv = tri_normal(&t);
+        let Some(n) = normalized(nv) else { continue };
+        let fq = Quadric::plane(n, t[0], 0.5 * norm(nv));
+        for v in m.face_vertices(f) {
+            q[v as usize] = q[v as usize].add(&fq);
+        }
+    }
+    for e in m.edges() {
+        let h = m.edge_halfedge(e);
+        let (a, b) = (m.origin(h), m.target(h));
+        let (pa, pb) = (m.position(a), m.position(b));
+        let nsum = [m.face(h), m.face(h ^ 1)]
+            .into_iter()
+            .flatten()
+            .fold([0.0; 3], |s, f| add(s, m.face_normal(f)));
+        let Some(pn) = normalized(cross(nsum, sub(pb, pa))) else {
+            continue;
+        };
+        let l2 = super::vec3::norm2(sub(pb, pa));
+        let vq = Quadric::plane(pn, pa, VIRTUAL_PLANE_WEIGHT * l2);
+        q[a as usize] = q[a as usize].add(&vq);
+        q[b as usize] = q[b as usize].add(&vq);
+    }
+    q
+}
+
+/// Optimal position and cost of collapsing edge `a–b` with combined quadric `q`.
+fn collapse_target(q: &Quadric, pa: P3, pb: P3) -> (P3, f64) {
+    let mid = scale(add(pa, pb), 0.5);
+    let len = dist(pa, pb);
+    let x = q
+        .minimize()
+        .filter(|x| dist(*x, mid) <= 2.0 * len)
+        .unwrap_or_else(|| {
+            [pa, pb, mid]
+                .into_iter()
+                .min_by(|x, y| q.eval(*x).total_cmp(&q.eval(*y)))
+                .expect("three candidates")
+        });
+    (x, q.eval(x).max(0.0))
+}
+
+/// A queue entry: cost, edge id, edge version at push time.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    cost: f64,
+    edge: u32,
+    version: u32,
+    target: P3,
+}
+
+impl PartialEq for Entry {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+impl Eq for Entry {}
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Entry {
+    /// Reversed, so that `BinaryHeap` pops the cheapest edge (ties: smallest edge id).
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.cost
+            .total_cmp(&self.cost)
+            .then_with(|| o.edge.cmp(&self.edge))
+    }
+}
+
+/// The state of one pass.
+struct Pass<'g, 'a> {
+    g: &'g mut Guard<'a>,
+    opt: SimplifyOptions,
+    quadrics: Vec<Quadric>,
+    version: Vec<u32>,
+    heap: BinaryHeap<Entry>,
+    /// Sampled max distance to the input per face (NaN = not computed yet).
+    face_dist: Vec<f64>,
+    /// Distance to the input per vertex (NaN = not computed yet).
+    vert_dist: Vec<f64>,
+    report: SimplifyReport,
+}
+
+/// Runs one pass of Alg. 5 on the guard's mesh. `keep_going` is polled now and then with the
+/// fraction of the queue processed; returning `false` cancels with `Error::Cancelled`.
+pub(crate) fn simplify_pass(
+    g: &mut Guard<'_>,
+    opt: &SimplifyOptions,
+    keep_going: &mut dyn FnMut(f64) -> bool,
+) -> Result<SimplifyReport> {
+    let mut pass = Pass::new(g, *opt);
+    pass.run(keep_going)?;
+    Ok(pass.report)
+}
+
+impl<'g, 'a> Pass<'g, 'a> {
+    fn new(g: &'g mut Guard<'a>, opt: SimplifyOptions) -> Self {
+        let quadrics = vertex_quadrics(g);
+        let m = g.mesh();
+        let mut pass = Pass {
+            version: vec![0; m.edge_capacity()],
+            face_dist: vec![f64::NAN; m.face_capacity()],
+            vert_dist: vec![f64::NAN; m.vertex_capacity()],
+            heap: BinaryHeap::with_capacity(m.edge_count()),
+            quadrics,
+            opt,
+            report: SimplifyReport::default(),
+            g,
+        };
+        let edges: Vec<u32> = pass.g.mesh().edges().collect();
+        for e in edges {
+            pass.push(e);
+        }
+        pass
+    }
+
+    fn target_reached(&self) -> bool {
+        self.opt
+            .target_faces
+            .is_some_and(|n| self.g.mesh().face_count() <= n)
+    }
+
+    fn push(&mut self, e: u32) {
+        let m = self.g.mesh();
+        let h = m.edge_halfedge(e);
+        let (a, b) = (m.origin(h), m.target(h));
+        let q = self.quadrics[a as usize].add(&self.quadrics[b as usize]);
+        let (target, cost) = collapse_target(&q, m.position(a), m.position(b));
+        self.heap.push(Entry {
+            cost,
+            edge: e,
+            version: self.version[e as usize],
+            target,
+        });
+    }
+
+    fn run(&mut self, keep_going: &mut dyn FnMut(f64) -> bool) -> Result<()> {
+        let total = self.heap.len().max(1) as f64;
+        let mut pops = 0u64;
+        while !self.target_reached() {
+            let Some(entry) = self.heap.pop() else { break };
+            pops += 1;
+            if pops % 512 == 0 && !keep_going((pops as f64 / total).min(1.0)) {
+                return Err(Error::Cancelled);
+            }
+            let e = entry.edge;
+            if entry.version != self.version[e as usize] || !self.g.mesh().is_edge_live(e) {
+                continue;
+            }
+            self.report.candidates += 1;
+            self.try_edge(e, entry.target);
+        }
+        Ok(())
+    }
+
+    /// Checks and performs the collapse of edge `e`, trying the quadric optimum `x` first and
+    /// then the edge midpoint and the two endpoints (see the module docs).
+    fn try_edge(&mut self, e: u32, x: P3) {
+        let m = self.g.mesh();
+        let h0 = m.edge_halfedge(e);
+        let Some(h) = [h0, h0 ^ 1]
+            .into_iter()
+            .find(|&h| m.can_collapse(h).is_ok())
+        else {
+            self.report.rejected_guard += 1;
+            return;
+        };
+        let (a, b) = (m.origin(h), m.target(h));
+        let (pa, pb) = (m.position(a), m.position(b));
+        let mut candidates = vec![x];
+        for c in [scale(add(pa, pb), 0.5), pa, pb] {
+            if !candidates.contains(&c) {
+                candidates.push(c);
+            }
+        }
+        let mut last = Rejection::Guard;
+        for c in candidates {
+            match self.try_position(h, a, b, c) {
+                Ok(()) => return,
+                Err(r) => last = r,
+            }
+        }
+        match last {
+            Rejection::Fold => self.report.rejected_fold += 1,
+            Rejection::Hausdorff => self.report.rejected_hausdorff += 1,
+            Rejection::Distance => self.report.rejected_distance += 1,
+            Rejection::Guard => self.report.rejected_guard += 1,
+        }
+    }
+
+    /// All checks for collapsing `h = a→b` to `x`, and the collapse when they pass.
+    fn try_position(
+        &mut self,
+        h: u32,
+        a: u32,
+        b: u32,
+        x: P3,
+    ) -> std::result::Result<(), Rejection> {
+        let (old, new) = self.patches(h, x);
+        if folds_over(&old, &new) {
+            return Err(Rejection::Fold);
+        }
+        if !self.within_hausdorff(a, b, x, &old, &new) {
+            return Err(Rejection::Hausdorff);
+        }
+        let Some(new_face_dist) = self.distance_not_increased(a, x, &old, &new) else {
+            return Err(Rejection::Distance);
+        };
+        match self.g.try_collapse(h, x) {
+            Ok(rec) => {
+                self.commit(a, b, x, &rec.modified_faces, &new, &new_face_dist);
+                Ok(())
+            }
+            Err(_) => Err(Rejection::Guard),
+        }
+    }
+
+    /// The patch before (faces around `a` and `b`) and after the collapse of `h = a→b` to `x`
+    /// (the surviving faces with `a`, `b` replaced by `x`), each with its face ids.
+    fn patches(&self, h: u32, x: P3) -> (Patch, Patch) {
+        let m = self.g.mesh();
+        let (a, b) = (m.origin(h), m.target(h));
+        let dying = [m.face(h), m.face(h ^ 1)];
+        let mut old = Patch::default();
+        let mut new = Patch::default();
+        let faces_b = m
+            .vertex_faces(b)
+            .filter(|f| !m.vertex_faces(a).any(|g| g == *f));
+        let all: Vec<u32> = m.vertex_faces(a).chain(faces_b).collect();
+        for f in all {
+            let vs = m.face_vertices(f);
+            let t = vs.map(|v| m.position(v));
+            old.push(f, vs, t);
+            if dying.contains(&Some(f)) {
+                continue;
+            }
+            let nvs = vs.map(|v| if v == b { a } else { v });
+            let nt = nvs.map(|v| if v == a { x } else { m.position(v) });
+            new.push(f, nvs, nt);
+        }
+        (old, new)
+    }
+
+    /// Alg. 5 line 20: sampled two-sided Hausdorff distance between the old and new patch is
+    /// at most `d`. Samples skip the shared ring vertices (distance 0 on both sides).
+    fn within_hausdorff(&self, a: u32, b: u32, x: P3, old: &Patch, new: &Patch) -> bool {
+        let d = self.opt.d;
+        let s = self.opt.spacing;
+        let near = |p: P3, other: &Patch| -> bool {
+            other
+                .tris
+                .iter()
+                .any(|t| point_triangle_distance(p, t) <= d)
+        };
+        let one_side = |from: &Patch, to: &Patch, moved: &[(u32, P3)]| -> bool {
+            for &(_, p) in moved {
+                if !near(p, to) {
+                    return false;
+                }
+            }
+            for t in &from.tris {
+                let k = sample_resolution(t, s, MAX_SAMPLE_RES);
+                let mut ok = true;
+                for_each_sample(t, k, true, |p| ok = ok && near(p, to));
+                if !ok {
+                    return false;
+                }
+            }
+            true
+        };
+        let m = self.g.mesh();
+        one_side(new, old, &[(a, x)])
+            && one_side(old, new, &[(a, m.position(a)), (b, m.position(b))])
+    }
+
+    fn vertex_distance(&mut self, v: u32) -> f64 {
+        let d = self.vert_dist[v as usize];
+        if !d.is_nan() {
+            return d;
+        }
+        let d = self.g.input().distance(self.g.mesh().position(v));
+        self.vert_dist[v as usize] = d;
+        d
+    }
+
+    /// Mean of the sampled distances of a triangle to the input, given its corner distances
+    /// (corners count once each, like every other grid sample).
+    fn triangle_distance(&self, t: &[P3; 3], corner: [f64; 3]) -> f64 {
+        let k = sample_resolution(t, self.opt.spacing, MAX_SAMPLE_RES);
+        let input = self.g.input();
+        let mut sum = corner[0] + corner[1] + corner[2];
+        let mut n = 3usize;
+        for_each_sample(t, k, true, |p| {
+            sum += input.distance(p);
+            n += 1;
+        });
+        sum / n as f64
+    }
+
+    fn face_distance(&mut self, f: u32, vs: [u32; 3], t: &[P3; 3]) -> f64 {
+        let d = self.face_dist[f as usize];
+        if !d.is_nan() {
+            return d;
+        }
+        let corner = vs.map(|v| self.vertex_distance(v));
+        let d = self.triangle_distance(t, corner);
+        self.face_dist[f as usize] = d;
+        d
+    }
+
+    /// Alg. 5 line 17: the one-sided distance from the new patch to the input does not exceed
+    /// the old patch's (or the slack). The patch distance is the area-weighted mean of the
+    /// faces' sampled mean distances (see the module docs for why not the maximum). Returns
+    /// the new faces' distances when it holds.
+    fn distance_not_increased(
+        &mut self,
+        a: u32,
+        x: P3,
+        old: &Patch,
+        new: &Patch,
+    ) -> Option<Vec<f64>> {
+        let (mut old_sum, mut old_area) = (0.0, 0.0);
+        for i in 0..old.ids.len() {
+            let w = norm(tri_normal(&old.tris[i]));
+            old_sum += w * self.face_distance(old.ids[i], old.verts[i], &old.tris[i]);
+            old_area += w;
+        }
+        let old_mean = if old_area > 0.0 {
+            old_sum / old_area
+        } else {
+            0.0
+        };
+        let limit = old_mean.max(self.opt.slack) * (1.0 + 1e-9);
+        let dx = self.g.input().distance(x);
+        let (mut new_sum, mut new_area) = (0.0, 0.0);
+        let mut out = Vec::with_capacity(new.ids.len());
+        for i in 0..new.ids.len() {
+            let vs = new.verts[i];
+            let mut corner = [0.0; 3];
+            for k in 0..3 {
+                corner[k] = if vs[k] == a {
+                    dx
+                } else {
+                    self.vertex_distance(vs[k])
+                };
+            }
+            let fd = self.triangle_distance(&new.tris[i], corner);
+            let w = norm(tri_normal(&new.tris[i]));
+            new_sum += w * fd;
+            new_area += w;
+            out.push(fd);
+        }
+        let new_mean = if new_area > 0.0 {
+            new_sum / new_area
+        } else {
+            0.0
+        };
+        (new_mean <= limit).then_some(out)
+    }
+
+    /// Book-keeping after an accepted collapse of `b` into `a` at `x`.
+    fn commit(&mut self, a: u32, b: u32, x: P3, modified: &[u32], new: &Patch, fd: &[f64]) {
+        self.report.collapses += 1;
+        let _ = x;
+        self.quadrics[a as usize] = self.quadrics[a as usize].add(&self.quadrics[b as usize]);
+        self.vert_dist[a as usize] = f64::NAN;
+        for (i, &f) in new.ids.iter().enumerate() {
+            self.face_dist[f as usize] = fd[i];
+        }
+        debug_assert!(modified.iter().all(|f| new.ids.contains(f)));
+        let m = self.g.mesh();
+        let edges: Vec<u32> = m.outgoing(a).map(|h| m.edge(h)).collect();
+        for e in edges {
+            if e != INVALID {
+                self.version[e as usize] = self.version[e as usize].wrapping_add(1);
+                self.push(e);
+            }
+        }
+    }
+}
+
+/// Which check refused a candidate position.
+#[derive(Debug, Clone, Copy)]
+enum Rejection {
+    Fold,
+    Hausdorff,
+    Distance,
+    Guard,
+}
+
+/// Faces of a patch: ids, vertex ids and corner positions.
+#[derive(Debug, Default)]
+struct Patch {
+    ids: Vec<u32>,
+    verts: Vec<[u32; 3]>,
+    tris: Vec<[P3; 3]>,
+}
+
+impl Patch {
+    fn push(&mut self, f: u32, vs: [u32; 3], t: [P3; 3]) {
+        self.ids.push(f);
+        self.verts.push(vs);
+        self.tris.push(t);
+    }
+}
+
+/// True when a surviving face's normal turns by 90° or more (or degenerates).
+fn folds_over(old: &Patch, new: &Patch) -> bool {
+    new.ids.iter().enumerate().any(|(i, f)| {
+        let j = old
+            .ids
+            .iter()
+            .position(|g| g == f)
+            .expect("new faces are old faces");
+        let n0 = tri_normal(&old.tris[j]);
+        let n1 = tri_normal(&new.tris[i]);
+        dot(n0, n1) <= 0.0
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quadric_of_three_planes_has_their_corner_as_minimiser() {
+        let q = Quadric::plane([1., 0., 0.], [1., 0., 0.], 1.0)
+            .add(&Quadric::plane([0., 1., 0.], [0., 2., 0.], 2.0))
+            .add(&Quadric::plane([0., 0., 1.], [0., 0., 3.], 0.5));
+        let x = q.minimize().unwrap();
+        assert!(dist(x, [1., 2., 3.]) < 1e-12);
+        assert!(q.eval(x).abs() < 1e-12);
+        assert!((q.eval([0., 2., 3.]) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn rank_one_quadric_is_singular() {
+        let q = Quadric::plane([0., 0., 1.], [0., 0., 0.], 1.0);
+        assert!(q.minimize().is_none());
+        let (x, c) = collapse_target(&q, [0., 0., 0.], [1., 0., 0.]);
+        assert_eq!(c, 0.0);
+        assert_eq!(x[2], 0.0);
+    }
+}
