@@ -1,1 +1,23 @@
-//! The C ABI: the only place with `extern "C"`.
+//! The C ABI: the only place with `extern "C"`. Thin wrappers over the safe Rust API.
+//!
+//! Conventions (see README "C API"):
+//! - Every fallible function returns [`PleatStatus`]; outputs are written only on success; the
+//!   reason of the last failure on the calling thread is available from
+//!   [`pleat_last_error`] / [`pleat_last_error_message`].
+//! - Every entry point runs inside `catch_unwind`: a panic becomes
+//!   `PLEAT_STATUS_INTERNAL`, never an abort of the host.
+//! - Every pointer is checked for NULL, every count against overflow and the data it describes,
+//!   every coordinate for NaN/Inf. Pointers that are non-NULL but invalid cannot be detected:
+//!   they are the caller's responsibility, as in any C API.
+//! - Work runs on pleat's own thread pool ([`pleat_set_thread_count`]); callbacks run on the
+//!   calling thread only.
+//! - The ABI is the same whatever cargo features the library was built with: a function whose
+//!   capability was left out returns `PLEAT_STATUS_UNSUPPORTED`.
+
+mod common;
+mod mesh;
+mod report;
+
+pub use common::*;
+pub use mesh::*;
+pub use report::*;

@@ -1,1 +1,20 @@
-//! Spatial queries: BVH, closest points, exact triangle–triangle tests, winding numbers.
+//! Spatial queries: BVH, closest points, exact triangle–triangle tests, self-intersections,
+//! winding numbers.
+
+pub mod bvh;
+pub mod self_intersect;
+pub mod tritri;
+pub mod winding;
+
+pub use bvh::{ClosestPoint, TriangleBvh};
+pub use self_intersect::{
+    degenerate_faces, find_self_intersections, find_self_intersections_in, has_self_intersection,
+    has_self_intersection_in, self_intersections, SelfIntersections,
+};
+pub use tritri::{
+    are_coplanar, coplanar_same_side, faces_intersect, is_collinear, orient2d, orient3d,
+    segment_triangle_intersect, sharing, triangles_intersect, Point3, Sharing,
+};
+pub use winding::{
+    solid_angle, winding_number, winding_number_in, winding_numbers, FastWindingNumber,
+};

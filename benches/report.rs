@@ -1,0 +1,189 @@
+//! Benchmark of `MeshReport` (plain `std::time`, no harness): a generated closed bumpy sphere of
+//! 1,310,720 triangles (the same surface as `../shared/tools/tests/make_big.py`, which the
+//! tools README times meshcheck on), then the large corpus meshes when `../shared/meshes` exists.
+//! Prints seconds per phase.
+//!
+//! `cargo bench --bench report` (release). Options after `--`: `--subdivisions N` (default 8),
+//! `--threads N` (default: rayon's), `--repeat N` (default 1).
+
+use std::collections::HashMap;
+use std::time::Instant;
+
+use pleat::mesh::{MeshReport, ReportOptions, TriMesh};
+use pleat::Stats;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let opt = |name: &str, default: usize| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1))
+            .map_or(default, |v| v.parse().expect("a number"))
+    };
+    let (subdivisions, threads, repeat) = (
+        opt("--subdivisions", 8),
+        opt("--threads", 0),
+        opt("--repeat", 1),
+    );
+    if threads > 0 {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build_global()
+            .unwrap();
+    }
+    println!("threads: {}", rayon::current_num_threads());
+
+    let t0 = Instant::now();
+    let mesh = bumpy_sphere(subdivisions as u32);
+    println!(
+        "generated bumpy sphere: {} vertices, {} triangles in {:.2} s",
+        mesh.vertex_count(),
+        mesh.triangle_count(),
+        t0.elapsed().as_secs_f64()
+    );
+    for _ in 0..repeat {
+        let r = run("bumpy_sphere", &mesh);
+        assert!(
+            r.is_watertight && r.self_intersection_free == Some(true) && r.total_genus == Some(0)
+        );
+    }
+    corpus(repeat);
+}
+
+/// Times one full report and prints its phases.
+fn run(name: &str, mesh: &TriMesh) -> MeshReport {
+    let mut stats = Stats::default();
+    let t0 = Instant::now();
+    let r = MeshReport::compute_timed(mesh, &ReportOptions::default(), &mut stats);
+    let total = t0.elapsed().as_secs_f64();
+    let phases: Vec<String> = stats
+        .stages
+        .iter()
+        .map(|(n, s)| format!("{n} {s:.3}"))
+        .collect();
+    println!(
+        "{name}: {} triangles, total {total:.3} s [{}]; watertight {}, self-intersecting pairs {:?}",
+        mesh.triangle_count(),
+        phases.join(", "),
+        r.is_watertight,
+        r.n_self_intersecting_pairs
+    );
+    r
+}
+
+/// The `large_*` meshes of the shared corpus, when present (`$PLEAT_MESHES`, else
+/// `../shared/meshes`, else `../../shared/meshes` from the crate root).
+fn corpus(repeat: usize) {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let candidates = [
+        std::env::var_os("PLEAT_MESHES").map(std::path::PathBuf::from),
+        Some(root.join("../shared/meshes")),
+        Some(root.join("../../shared/meshes")),
+    ];
+    let Some(dir) = candidates.into_iter().flatten().find(|d| d.is_dir()) else {
+        println!("corpus: ../shared/meshes not found (set PLEAT_MESHES), skipped");
+        return;
+    };
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        return;
+    };
+    let mut files: Vec<_> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .is_some_and(|n| n.to_string_lossy().starts_with("large_"))
+        })
+        .collect();
+    files.sort();
+    for f in files {
+        let t0 = Instant::now();
+        let mesh = match pleat::mesh::io::read_mesh(&f) {
+            Ok(m) => m,
+            Err(e) => {
+                println!("{}: cannot read: {e}", f.display());
+                continue;
+            }
+        };
+        let read = t0.elapsed().as_secs_f64();
+        let name = f.file_name().unwrap().to_string_lossy().to_string();
+        println!("{name}: read in {read:.3} s");
+        for _ in 0..repeat {
+            run(&name, &mesh);
+        }
+    }
+}
+
+/// An icosphere subdivided `n` times (20·4ⁿ triangles), displaced radially by
+/// `1 + 0.08 sin(7x) cos(5y) + 0.03 sin(23z)` (make_big.py's bumps).
+fn bumpy_sphere(n: u32) -> TriMesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut p: Vec<[f64; 3]> = vec![
+        [-1., t, 0.],
+        [1., t, 0.],
+        [-1., -t, 0.],
+        [1., -t, 0.],
+        [0., -1., t],
+        [0., 1., t],
+        [0., -1., -t],
+        [0., 1., -t],
+        [t, 0., -1.],
+        [t, 0., 1.],
+        [-t, 0., -1.],
+        [-t, 0., 1.],
+    ];
+    let mut f: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for v in &mut p {
+        *v = normalize(*v);
+    }
+    for _ in 0..n {
+        let mut mid: HashMap<(u32, u32), u32> = HashMap::with_capacity(f.len() * 3 / 2);
+        let mut next = Vec::with_capacity(f.len() * 4);
+        for tri in &f {
+            let mut m = [0u32; 3];
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                m[k] = *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                    let (pa, pb) = (p[a as usize], p[b as usize]);
+                    p.push(normalize([pa[0] + pb[0], pa[1] + pb[1], pa[2] + pb[2]]));
+                    p.len() as u32 - 1
+                });
+            }
+            next.push([tri[0], m[0], m[2]]);
+            next.push([tri[1], m[1], m[0]]);
+            next.push([tri[2], m[2], m[1]]);
+            next.push(m);
+        }
+        f = next;
+    }
+    for v in &mut p {
+        let r = 1.0 + 0.08 * (7.0 * v[0]).sin() * (5.0 * v[1]).cos() + 0.03 * (23.0 * v[2]).sin();
+        *v = v.map(|c| c * r);
+    }
+    TriMesh::new(p, f).unwrap()
+}
+
+fn normalize(v: [f64; 3]) -> [f64; 3] {
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    v.map(|c| c / n)
+}

@@ -1,0 +1,383 @@
+//! Self-intersections of a triangle soup, with the semantics of CGAL's
+//! `Polygon_mesh_processing::self_intersections` / `does_self_intersect` as `meshcheck` applies
+//! them to any soup:
+//!
+//! 1. exactly coincident points are welded first ([`ExactWeld`]), so unwelded seams are not
+//!    intersections;
+//! 2. degenerate faces (exactly collinear corners, including repeated indices after welding) are
+//!    reported separately and take part in no pair;
+//! 3. every other pair of faces whose closed bounding boxes meet is tested with
+//!    [`faces_intersect`](super::faces_intersect): shared vertex or edge is allowed, anything
+//!    more (folded-over neighbours, duplicate faces, touching, crossing, coplanar overlap) is an
+//!    intersection (dissertation §4.3.3: "a mesh has intersections when any of its two triangles
+//!    overlaps, or any of its two non-adjacent triangles touch or intersect").
+//!
+//! Broad phase: the non-degenerate faces are cut into spatially coherent chunks (runs of the
+//! Morton order of their box centres), one [`TriangleBvh`] per chunk is built in parallel, and
+//! every chunk tree is traversed against itself and against every later chunk whose bounds it
+//! touches, in parallel: each pair of faces with touching boxes is found exactly once; the pairs
+//! are sorted. Narrow phase: exact predicates, in parallel
+//! over the sorted candidates with rayon (an order-preserving filter), so the result does not
+//! depend on the number of threads. [`has_self_intersection`] instead queries the tree face by
+//! face in parallel and stops at the first hit.
+
+use rayon::prelude::*;
+
+use super::bvh::{corners_box, TriangleBvh};
+use super::tritri::{faces_intersect, is_collinear, Point3};
+use crate::mesh::{ExactWeld, TriMesh};
+use crate::Stats;
+
+/// All self-intersections of a soup: intersecting face pairs and degenerate faces.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SelfIntersections {
+    /// Intersecting pairs `(f, g)` with `f < g` (face indices of the input), sorted.
+    pub pairs: Vec<(u32, u32)>,
+    /// Faces whose corners are exactly collinear (zero area), sorted. They are excluded from
+    /// `pairs`; CGAL's `does_self_intersect` counts each as a self-intersection.
+    pub degenerate: Vec<u32>,
+}
+
+impl SelfIntersections {
+    /// True when there is no intersecting pair and no degenerate face (meshcheck's
+    /// `self_intersection_free`, CGAL's `!does_self_intersect`).
+    pub fn is_free(&self) -> bool {
+        self.pairs.is_empty() && self.degenerate.is_empty()
+    }
+}
+
+/// The intersecting face pairs `(f, g)`, `f < g`, of `mesh`, sorted (degenerate faces excluded;
+/// see [`find_self_intersections`] for those).
+pub fn self_intersections(mesh: &TriMesh) -> Vec<(u32, u32)> {
+    find_self_intersections(mesh).pairs
+}
+
+/// Intersecting pairs and degenerate faces of `mesh`. See the [module docs](self).
+pub fn find_self_intersections(mesh: &TriMesh) -> SelfIntersections {
+    find_self_intersections_in(mesh.positions(), mesh.triangles())
+}
+
+/// As [`find_self_intersections`], on raw buffers (indices must be in range).
+pub fn find_self_intersections_in(
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+) -> SelfIntersections {
+    let weld = ExactWeld::compute(positions);
+    find_self_intersections_welded(positions, triangles, &weld, &mut Stats::default())
+}
+
+/// As [`find_self_intersections_in`] with the exact weld of `positions` already computed;
+/// records the stages `si_prepare` (welded faces, degenerate faces), `si_bvh` (chunk trees) and
+/// `si_pairs_and_tests` (traversal with the exact test of each candidate pair) in `stats`.
+pub(crate) fn find_self_intersections_welded(
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+    weld: &ExactWeld,
+    stats: &mut Stats,
+) -> SelfIntersections {
+    let (welded, faces, degenerate) = stats.time("si_prepare", || {
+        split_degenerate(positions, triangles, weld)
+    });
+    let chunks = stats.time("si_bvh", || {
+        ChunkedBvh::new(positions, &welded, &faces, CHUNK_FACES)
+    });
+    let narrow = Narrow {
+        positions,
+        welded: &welded,
+    };
+    let pairs = stats.time("si_pairs_and_tests", || {
+        chunks.pairs_where(|f, g| narrow.intersect(f, g))
+    });
+    SelfIntersections { pairs, degenerate }
+}
+
+/// True when `mesh` has a degenerate face or an intersecting face pair (CGAL's
+/// `does_self_intersect`). Stops at the first hit found.
+pub fn has_self_intersection(mesh: &TriMesh) -> bool {
+    has_self_intersection_in(mesh.positions(), mesh.triangles())
+}
+
+/// As [`has_self_intersection`], on raw buffers (indices must be in range).
+pub fn has_self_intersection_in(positions: &[Point3], triangles: &[[u32; 3]]) -> bool {
+    let prep = Prepared::new(positions, triangles, &ExactWeld::compute(positions));
+    !prep.degenerate.is_empty()
+        || prep
+            .faces
+            .par_iter()
+            .with_min_len(256)
+            .any(|&f| prep.any_partner(f))
+}
+
+/// Indices of the faces of `triangles` whose corners are exactly collinear, sorted.
+pub fn degenerate_faces(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<u32> {
+    (0..triangles.len() as u32)
+        .into_par_iter()
+        .filter(|&f| is_degenerate(positions, triangles[f as usize]))
+        .collect()
+}
+
+#[inline]
+fn is_degenerate(positions: &[Point3], t: [u32; 3]) -> bool {
+    let [a, b, c] = t.map(|v| positions[v as usize]);
+    is_collinear(a, b, c)
+}
+
+/// Exact narrow phase on welded faces.
+struct Narrow<'a> {
+    positions: &'a [Point3],
+    welded: &'a [[u32; 3]],
+}
+
+impl Narrow<'_> {
+    /// Whether faces `f` and `g` (both non-degenerate) intersect.
+    fn intersect(&self, f: u32, g: u32) -> bool {
+        faces_intersect(
+            self.positions,
+            self.welded[f as usize],
+            self.welded[g as usize],
+        )
+    }
+}
+
+/// The welded faces, the non-degenerate ones and the degenerate ones (both sorted).
+fn split_degenerate(
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+    weld: &ExactWeld,
+) -> (Vec<[u32; 3]>, Vec<u32>, Vec<u32>) {
+    let welded = if weld.is_identity() {
+        triangles.to_vec()
+    } else {
+        weld.apply(triangles)
+    };
+    let flags: Vec<bool> = welded
+        .par_iter()
+        .map(|&t| is_degenerate(positions, t))
+        .collect();
+    let (degenerate, faces): (Vec<u32>, Vec<u32>) =
+        (0..welded.len() as u32).partition(|&f| flags[f as usize]);
+    (welded, faces, degenerate)
+}
+
+/// Welded faces, degenerate/non-degenerate split and the BVH of the non-degenerate faces.
+struct Prepared<'a> {
+    positions: &'a [Point3],
+    welded: Vec<[u32; 3]>,
+    faces: Vec<u32>,
+    degenerate: Vec<u32>,
+    bvh: TriangleBvh,
+}
+
+impl<'a> Prepared<'a> {
+    fn new(positions: &'a [Point3], triangles: &[[u32; 3]], weld: &ExactWeld) -> Self {
+        let (welded, faces, degenerate) = split_degenerate(positions, triangles, weld);
+        let bvh = TriangleBvh::from_subset(positions, &welded, &faces);
+        Prepared {
+            positions,
+            welded,
+            faces,
+            degenerate,
+            bvh,
+        }
+    }
+
+    fn corners(&self, f: u32) -> [Point3; 3] {
+        self.welded[f as usize].map(|v| self.positions[v as usize])
+    }
+
+    fn any_partner(&self, f: u32) -> bool {
+        let tf = self.welded[f as usize];
+        self.bvh
+            .query_triangle(&self.corners(f))
+            .any(|g| g > f && faces_intersect(self.positions, tf, self.welded[g as usize]))
+    }
+}
+
+/// Faces per broad-phase chunk (below this, one tree).
+const CHUNK_FACES: usize = 1 << 15;
+
+/// Spatially coherent chunks of faces with one BVH each (parallel build and traversal).
+struct ChunkedBvh {
+    trees: Vec<TriangleBvh>,
+}
+
+impl ChunkedBvh {
+    /// About `faces.len() / chunk_faces` chunks (at least 1, at most 64).
+    fn new(positions: &[Point3], welded: &[[u32; 3]], faces: &[u32], chunk_faces: usize) -> Self {
+        let chunks = (faces.len() / chunk_faces.max(1)).clamp(1, 64);
+        let order = morton_order(positions, welded, faces);
+        let size = order.len().div_ceil(chunks).max(1);
+        let trees = order
+            .par_chunks(size)
+            .map(|ids| TriangleBvh::from_subset(positions, welded, ids))
+            .collect();
+        ChunkedBvh { trees }
+    }
+
+    /// The pairs `(f, g)`, `f < g`, of faces with touching boxes that pass `test`, sorted. Each
+    /// touching pair is visited exactly once; chunk pairs are processed in parallel.
+    fn pairs_where(&self, test: impl Fn(u32, u32) -> bool + Sync) -> Vec<(u32, u32)> {
+        let n = self.trees.len();
+        let tasks: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
+        let mut pairs: Vec<(u32, u32)> = tasks
+            .into_par_iter()
+            .flat_map_iter(|(i, j)| {
+                let mut hits = Vec::new();
+                self.for_each_pair(i, j, |f, g| {
+                    if test(f, g) {
+                        hits.push((f, g));
+                    }
+                });
+                hits
+            })
+            .collect();
+        pairs.par_sort_unstable();
+        pairs
+    }
+
+    /// Calls `f(a, b)`, `a < b`, for the touching pairs between chunks `i` and `j` (`i ≤ j`).
+    fn for_each_pair(&self, i: usize, j: usize, mut f: impl FnMut(u32, u32)) {
+        let (a, b) = (&self.trees[i], &self.trees[j]);
+        if i == j {
+            return a.for_each_self_pair(f);
+        }
+        if let (Some((alo, ahi)), Some((blo, bhi))) = (a.bounds(), b.bounds()) {
+            if (0..3).all(|k| alo[k] <= bhi[k] && blo[k] <= ahi[k]) {
+                a.for_each_pair_with(b, |x, y| f(x.min(y), x.max(y)));
+            }
+        }
+    }
+}
+
+/// `faces` sorted by the Morton code (21 bits per axis) of their box centres, ties by index.
+fn morton_order(positions: &[Point3], welded: &[[u32; 3]], faces: &[u32]) -> Vec<u32> {
+    let centre = |f: u32| {
+        let (lo, hi) = corners_box(&welded[f as usize].map(|v| positions[v as usize]));
+        [0, 1, 2].map(|k| 0.5 * lo[k] + 0.5 * hi[k])
+    };
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for &f in faces {
+        let c = centre(f);
+        for k in 0..3 {
+            lo[k] = lo[k].min(c[k]);
+            hi[k] = hi[k].max(c[k]);
+        }
+    }
+    let scale = [0, 1, 2].map(|k| {
+        if hi[k] > lo[k] {
+            2_097_151.0 / (hi[k] - lo[k])
+        } else {
+            0.0
+        }
+    });
+    let mut keyed: Vec<(u64, u32)> = faces
+        .par_iter()
+        .map(|&f| {
+            let c = centre(f);
+            let q = [0, 1, 2].map(|k| ((c[k] - lo[k]) * scale[k]) as u64);
+            (spread(q[0]) | spread(q[1]) << 1 | spread(q[2]) << 2, f)
+        })
+        .collect();
+    keyed.par_sort_unstable();
+    keyed.into_iter().map(|(_, f)| f).collect()
+}
+
+/// Spreads the low 21 bits of `x` to every third bit.
+fn spread(x: u64) -> u64 {
+    let mut x = x & 0x1f_ffff;
+    x = (x | x << 32) & 0x001f_0000_0000_ffff;
+    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
+    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+    x = (x | x << 2) & 0x1249_2492_4924_9249;
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mesh(p: Vec<Point3>, t: Vec<[u32; 3]>) -> TriMesh {
+        TriMesh::new(p, t).unwrap()
+    }
+
+    #[test]
+    fn tetrahedron_is_free_and_crossing_pair_is_found() {
+        let tet = mesh(
+            vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
+            vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+        );
+        assert!(find_self_intersections(&tet).is_free());
+        assert!(!has_self_intersection(&tet));
+        // Two separate triangles crossing each other, plus a degenerate one.
+        let m = mesh(
+            vec![
+                [0., 0., 0.],
+                [4., 0., 0.],
+                [0., 4., 0.],
+                [1., 1., -1.],
+                [1., 1., 1.],
+                [2., 1., 0.],
+                [9., 9., 9.],
+            ],
+            vec![[0, 1, 2], [3, 4, 5], [6, 6, 0]],
+        );
+        let si = find_self_intersections(&m);
+        assert_eq!(si.pairs, vec![(0, 1)]);
+        assert_eq!(si.degenerate, vec![2]);
+        assert!(has_self_intersection(&m));
+    }
+
+    #[test]
+    fn chunked_broad_phase_finds_every_touching_pair_once() {
+        // A 40 × 40 grid of unit squares (3200 triangles), slightly wavy, plus a crossing sheet.
+        let n = 40u32;
+        let mut p = Vec::new();
+        for i in 0..=n {
+            for j in 0..=n {
+                p.push([i as f64, j as f64, 0.1 * ((i * j) % 3) as f64]);
+            }
+        }
+        let id = |i: u32, j: u32| i * (n + 1) + j;
+        let mut t = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let faces: Vec<u32> = (0..t.len() as u32).collect();
+        let single = TriangleBvh::new(&p, &t).self_pairs();
+        assert!(single.len() > 10_000);
+        for chunk_faces in [1, 50, 333, 5000] {
+            let chunked = ChunkedBvh::new(&p, &t, &faces, chunk_faces);
+            assert_eq!(
+                chunked.trees.len(),
+                (faces.len() / chunk_faces).clamp(1, 64)
+            );
+            assert_eq!(
+                chunked.pairs_where(|_, _| true),
+                single,
+                "chunk size {chunk_faces}"
+            );
+        }
+    }
+
+    #[test]
+    fn unwelded_seams_do_not_count() {
+        // Two triangles of a square, each with its own copy of the diagonal's vertices.
+        let m = mesh(
+            vec![
+                [0., 0., 0.],
+                [1., 0., 0.],
+                [1., 1., 0.],
+                [0., 0., 0.],
+                [1., 1., 0.],
+                [0., 1., 0.],
+            ],
+            vec![[0, 1, 2], [3, 4, 5]],
+        );
+        assert!(find_self_intersections(&m).is_free());
+    }
+}

@@ -1,0 +1,255 @@
+//! Builds every C program in `examples_c/` against the freshly built shared library and runs it,
+//! so `cargo test` alone covers the C ABI. Also compiles the header in strict C99 and C++17.
+//!
+//! - Programs whose name starts with `assimp_` are built only when `pkg-config` finds assimp
+//!   (Debian: `apt-get install libassimp-dev`); otherwise they are skipped with a loud message.
+//! - When `valgrind` is on PATH (and `PLEAT_NO_VALGRIND` is unset) every program also runs under
+//!   memcheck: any invalid access or definite leak fails the test.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The features this test binary was built with, so the library matches.
+fn features() -> Vec<&'static str> {
+    let mut f = Vec::new();
+    if cfg!(feature = "lod") {
+        f.push("lod");
+    }
+    if cfg!(feature = "cage") {
+        f.push("cage");
+    }
+    if cfg!(feature = "wrinkle") {
+        f.push("wrinkle");
+    }
+    if cfg!(feature = "tfw") {
+        f.push("tfw");
+    }
+    if cfg!(feature = "io-gltf") {
+        f.push("io-gltf");
+    }
+    f
+}
+
+/// Builds the cdylib (a nested cargo call; `--tests` keeps the dependency features identical to
+/// this test build, so nothing but pleat itself is compiled) and returns its directory.
+fn build_library() -> PathBuf {
+    let feats = features().join(",");
+    let mut cmd = Command::new(env!("CARGO"));
+    cmd.args(["build", "--lib", "--tests", "--no-default-features"])
+        .current_dir(root());
+    if !feats.is_empty() {
+        cmd.args(["--features", &feats]);
+    }
+    let st = cmd.status().expect("run cargo");
+    assert!(st.success(), "cargo build of the shared library failed");
+    // This test binary lives in <target>/<profile>/deps/.
+    let exe = std::env::current_exe().expect("current_exe");
+    let dir = exe.parent().and_then(Path::parent).expect("profile dir");
+    assert!(
+        dir.join("libpleat.so").exists() || dir.join("libpleat.dylib").exists(),
+        "no shared library in {}",
+        dir.display()
+    );
+    link_soname(dir);
+    dir.to_path_buf()
+}
+
+/// The library's SONAME is `libpleat.so.0` (see build.rs); an install provides that name as a
+/// symlink, and so does this test, next to cargo's output.
+fn link_soname(dir: &Path) {
+    #[cfg(target_os = "linux")]
+    {
+        let link = dir.join("libpleat.so.0");
+        let _ = std::fs::remove_file(&link);
+        std::os::unix::fs::symlink("libpleat.so", &link).expect("symlink libpleat.so.0");
+    }
+    #[cfg(not(target_os = "linux"))]
+    let _ = dir;
+}
+
+fn have(tool: &str) -> bool {
+    Command::new(tool)
+        .arg("--version")
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false)
+}
+
+fn pkg_config(lib: &str) -> Option<Vec<String>> {
+    let out = Command::new("pkg-config")
+        .args(["--cflags", "--libs", lib])
+        .output()
+        .ok()?;
+    out.status.success().then(|| {
+        String::from_utf8_lossy(&out.stdout)
+            .split_whitespace()
+            .map(String::from)
+            .collect()
+    })
+}
+
+fn compile(src: &Path, out: &Path, libdir: &Path, cxx: bool, extra: &[String]) {
+    let cc = if cxx { "c++" } else { "cc" };
+    let std = if cxx { "-std=c++17" } else { "-std=c99" };
+    let mut cmd = Command::new(
+        std::env::var("CC")
+            .ok()
+            .filter(|_| !cxx)
+            .unwrap_or(cc.into()),
+    );
+    cmd.args([std, "-Wall", "-Wextra", "-Werror", "-pedantic", "-g"])
+        .arg(format!("-I{}", root().join("include").display()))
+        .arg(format!("-I{}", root().join("bindings/cpp").display()))
+        .arg(src)
+        .arg("-o")
+        .arg(out)
+        .arg(format!("-L{}", libdir.display()))
+        .arg(format!("-Wl,-rpath,{}", libdir.display()))
+        .arg("-lpleat")
+        .arg("-lm")
+        .args(extra);
+    let o = cmd.output().expect("run the C compiler");
+    assert!(
+        o.status.success(),
+        "compiling {} failed:\n{}",
+        src.display(),
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn run(exe: &Path, valgrind: bool) {
+    let mut cmd = if valgrind {
+        let mut c = Command::new("valgrind");
+        c.args([
+            "--quiet",
+            "--error-exitcode=99",
+            "--leak-check=full",
+            "--errors-for-leak-kinds=definite",
+            "--show-leak-kinds=definite",
+        ])
+        .arg(exe);
+        c
+    } else {
+        Command::new(exe)
+    };
+    let o = cmd.current_dir(root()).output().expect("run C program");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    print!("{stdout}");
+    eprint!("{stderr}");
+    assert!(
+        o.status.success(),
+        "{} failed (valgrind: {valgrind}, status {:?})",
+        exe.display(),
+        o.status
+    );
+}
+
+#[test]
+fn c_programs_pass() {
+    if !have("cc") {
+        println!("SKIPPED: no C compiler `cc` on PATH; the C harness did not run");
+        return;
+    }
+    let libdir = build_library();
+    let out_dir = libdir.join("c-harness");
+    std::fs::create_dir_all(&out_dir).unwrap();
+    let valgrind = std::env::var_os("PLEAT_NO_VALGRIND").is_none() && have("valgrind");
+    if !valgrind {
+        println!(
+            "NOTE: valgrind not found (apt-get install valgrind): C programs run without memcheck"
+        );
+    }
+    let assimp = pkg_config("assimp");
+    let mut srcs: Vec<PathBuf> = std::fs::read_dir(root().join("examples_c"))
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "c" || x == "cpp"))
+        .collect();
+    srcs.sort();
+    let mut ran = 0;
+    for src in &srcs {
+        let stem = src.file_stem().unwrap().to_string_lossy().to_string();
+        let cxx = src.extension().is_some_and(|x| x == "cpp");
+        let mut extra = Vec::new();
+        if stem.starts_with("assimp_") {
+            match &assimp {
+                Some(flags) => extra.extend(flags.iter().cloned()),
+                None => {
+                    println!("SKIPPED: {stem} (assimp not found by pkg-config; apt-get install libassimp-dev)");
+                    continue;
+                }
+            }
+        }
+        let exe = out_dir.join(&stem);
+        compile(src, &exe, &libdir, cxx, &extra);
+        run(&exe, valgrind);
+        ran += 1;
+    }
+    assert!(ran > 0, "no C program ran");
+    run_python_bindings(&libdir);
+}
+
+/// Runs the ctypes package's tests against the same library.
+fn run_python_bindings(libdir: &Path) {
+    if !have("python3") {
+        println!("SKIPPED: python3 not found; the Python bindings were not tested");
+        return;
+    }
+    let o = Command::new("python3")
+        .arg(root().join("bindings/python/tests/test_pleat.py"))
+        .env("PLEAT_LIBRARY", libdir.join("libpleat.so"))
+        .output()
+        .expect("run python3");
+    print!("{}", String::from_utf8_lossy(&o.stdout));
+    eprint!("{}", String::from_utf8_lossy(&o.stderr));
+    assert!(o.status.success(), "Python binding tests failed");
+}
+
+#[test]
+fn header_compiles_strict_c99_and_cxx17() {
+    if !have("cc") {
+        println!("SKIPPED: no C compiler");
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("pleat-hdr-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let c = dir.join("h.c");
+    std::fs::write(
+        &c,
+        "#include \"pleat.h\"\nint main(void){return PLEAT_STATUS_OK;}\n",
+    )
+    .unwrap();
+    for (cc, std, src) in [("cc", "-std=c99", &c), ("c++", "-std=c++17", &c)] {
+        if !have(cc) {
+            println!("SKIPPED: {cc} not found");
+            continue;
+        }
+        let mut cmd = Command::new(cc);
+        if cc == "c++" {
+            cmd.args(["-x", "c++"]);
+        }
+        let o = cmd
+            .args([
+                std,
+                "-Wall",
+                "-Wextra",
+                "-Werror",
+                "-pedantic",
+                "-fsyntax-only",
+            ])
+            .arg(format!("-I{}", root().join("include").display()))
+            .arg(src)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{cc} {std}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}
