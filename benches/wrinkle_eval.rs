@@ -53,8 +53,8 @@ fn corpus(dir: &Path) {
     }
     println!("[corpus] evaluation time per level (best of {REPEATS}), 1 and 2 threads");
     println!(
-        "{:28} {:>5} {:>9} {:>9} {:>10} {:>10} {:>7}",
-        "mesh", "level", "vertices", "faces", "1 thread s", "2 threads s", "speedup"
+        "{:28} {:>5} {:>9} {:>9} {:>11} {:>10} {:>11} {:>7}",
+        "mesh", "level", "vertices", "faces", "1 thr CPU s", "1 thread s", "2 threads s", "speedup"
     );
     for path in files {
         let name = path.file_name().unwrap().to_string_lossy().to_string();

@@ -3,15 +3,15 @@
 
 #![cfg(feature = "wrinkle")]
 
-mod common;
+mod wrinkle_common;
 
-use common::*;
 use pleat::mesh::TriMesh;
 use pleat::wrinkle::{
     cwf_to_string, parse_cwf, read_cwf, write_cwf, Complex, Cwf, FrequencyField, KnoppelOptions,
     PhaseWeights,
 };
 use pleat::Error;
+use wrinkle_common::*;
 
 fn plane_wave(m: &TriMesh, k: [f64; 3]) -> (Vec<f64>, Vec<Complex>) {
     let th: Vec<f64> = m

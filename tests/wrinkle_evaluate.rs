@@ -3,11 +3,11 @@
 
 #![cfg(feature = "wrinkle")]
 
-mod common;
+mod wrinkle_common;
 
-use common::*;
 use pleat::mesh::TriMesh;
 use pleat::wrinkle::{Complex, Cwf, EvalOptions, Evaluated};
+use wrinkle_common::*;
 
 fn with_z() -> EvalOptions {
     EvalOptions {

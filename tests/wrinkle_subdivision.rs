@@ -3,11 +3,11 @@
 
 #![cfg(feature = "wrinkle")]
 
-mod common;
+mod wrinkle_common;
 
-use common::*;
 use pleat::mesh::TriMesh;
 use pleat::wrinkle::{BoundaryRule, Complex, LoopHierarchy, SubdivisionOptions};
+use wrinkle_common::*;
 
 fn opts(boundary: BoundaryRule) -> SubdivisionOptions {
     SubdivisionOptions {
