@@ -15,9 +15,13 @@
 //!   capability was left out returns `PLEAT_STATUS_UNSUPPORTED`.
 
 mod common;
+mod edges;
 mod mesh;
 mod report;
+mod wrinkle;
 
 pub use common::*;
+pub use edges::*;
 pub use mesh::*;
 pub use report::*;
+pub use wrinkle::*;
