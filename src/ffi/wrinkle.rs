@@ -505,7 +505,7 @@ pub unsafe extern "C" fn pleat_cwf_copy_omega(
 ) -> PleatStatus {
     wrinkle_only!([cwf, dst, edge_capacity] guard(|| {
         let c = imp::cwf_ref(cwf)?;
-        copy_doubles(c.cwf.omega(), dst, edge_capacity, "edge")
+        copy_doubles(c.cwf.omega(), dst, edge_capacity, "one per edge")
     }))
 }
 
@@ -528,7 +528,7 @@ pub unsafe extern "C" fn pleat_cwf_copy_corner_omega(
     wrinkle_only!([cwf, dst, corner_capacity] guard(|| {
         let c = imp::cwf_ref(cwf)?;
         let corners = imp::corner_omega(&c.cwf);
-        copy_doubles(&corners, dst, corner_capacity, "corner")
+        copy_doubles(&corners, dst, corner_capacity, "three per triangle")
     }))
 }
 
@@ -548,7 +548,7 @@ pub unsafe extern "C" fn pleat_cwf_copy_amplitude(
 ) -> PleatStatus {
     wrinkle_only!([cwf, dst, vertex_capacity] guard(|| {
         let c = imp::cwf_ref(cwf)?;
-        copy_doubles(c.cwf.amplitude(), dst, vertex_capacity, "vertex")
+        copy_doubles(c.cwf.amplitude(), dst, vertex_capacity, "one per vertex")
     }))
 }
 
@@ -572,7 +572,7 @@ pub unsafe extern "C" fn pleat_cwf_copy_zeta(
         let cap = vertex_capacity.checked_mul(2).ok_or_else(|| {
             Error::InvalidArgument("vertex_capacity * 2 overflows".into())
         })?;
-        copy_doubles(&flat, dst, cap, "double")
+        copy_doubles(&flat, dst, cap, "two per vertex")
     }))
 }
 
@@ -623,7 +623,7 @@ unsafe fn copy_doubles(src: &[f64], dst: *mut f64, capacity: usize, unit: &str) 
     }
     if capacity < src.len() {
         return Err(Error::LimitExceeded(format!(
-            "dst holds {capacity} values ({unit}s), {} are needed",
+            "dst holds {capacity} values, {} are needed ({unit})",
             src.len()
         )));
     }
