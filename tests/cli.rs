@@ -217,3 +217,31 @@ fn wrinkle_eval_refuses_bad_input_with_exit_two() {
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[cfg(feature = "wrinkle")]
+#[test]
+fn wrinkle_demo_script_runs() {
+    let dir = scratch_with_octahedron("demo");
+    let out = dir.join("demo.ply");
+    let o = Command::new("sh")
+        .arg("examples_c/wrinkle_demo.sh")
+        .arg("")
+        .arg(&out)
+        .env("PLEAT", env!("CARGO_BIN_EXE_pleat"))
+        .env("LEVELS", "2")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output();
+    let Ok(o) = o else {
+        println!("SKIPPED: no `sh` to run examples_c/wrinkle_demo.sh");
+        return;
+    };
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{s}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(s.contains("triangles           320"), "{s}");
+    assert!(s.matches("watertight          yes").count() == 2, "{s}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
