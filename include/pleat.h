@@ -27,6 +27,51 @@
 // `pleat_mesh_check` flag: analyse topology after merging exactly coincident vertices.
 #define PLEAT_CHECK_WELD 2
 
+// Per-vertex field of an evaluation: the Loop-subdivided amplitude `a` (1 double per vertex).
+#define PLEAT_WRINKLE_FIELD_AMPLITUDE 1
+
+// Per-vertex field: the phase `arg z` in (−π, π] radians, 0 where `z = 0` (1 double).
+#define PLEAT_WRINKLE_FIELD_PHASE 2
+
+// Per-vertex field: unit area-weighted normal of the undisplaced refined mesh, the direction of
+// the displacement; zero where undefined (3 doubles).
+#define PLEAT_WRINKLE_FIELD_NORMALS 4
+
+// Per-vertex field: the upsampled complex field `z` (amplitude included) as `re, im`
+// (2 doubles). The displacement is `displacement_scale · re · normal`.
+#define PLEAT_WRINKLE_FIELD_Z 8
+
+// Per-vertex field: the undisplaced (Loop-smoothed) positions (3 doubles).
+#define PLEAT_WRINKLE_FIELD_SMOOTH_POSITIONS 16
+
+// Per-edge field: the one-form ω of the refined mesh on the output mesh's edges in pleat's
+// edge numbering (`pleat_mesh_copy_edges` of the output mesh), 1 double per edge. Costs one
+// more one-form subdivision.
+#define PLEAT_WRINKLE_FIELD_OMEGA 32
+
+// Loop boundary rule: boundary vertices stay fixed, boundary edges split at their midpoints.
+#define PLEAT_WRINKLE_BOUNDARY_FIXED 0
+
+// Loop boundary rule: cubic B-spline boundary curve; corners (see `corner_angle`) stay fixed.
+#define PLEAT_WRINKLE_BOUNDARY_SMOOTH 1
+
+// Knöppel edge weights: cotangent weights (clamped positive).
+#define PLEAT_PHASE_WEIGHTS_COTAN 0
+
+// Knöppel edge weights: barycentric edge areas.
+#define PLEAT_PHASE_WEIGHTS_EDGE_AREA 1
+
+// `pleat_cwf_create_from_frequency`: one wave vector per vertex.
+#define PLEAT_FREQUENCY_PER_VERTEX 0
+
+// `pleat_cwf_create_from_frequency`: one wave vector per triangle.
+#define PLEAT_FREQUENCY_PER_FACE 1
+
+// Relative tolerance of the antisymmetry check of `pleat_cwf_create_from_corner_omega`: the two
+// corner values `w_ab` (triangle traversing edge a→b) and `w_ba` (its neighbour, b→a) must
+// satisfy `|w_ab + w_ba| ≤ PLEAT_CORNER_OMEGA_TOLERANCE · max(1, |w_ab|, |w_ba|)`.
+#define PLEAT_CORNER_OMEGA_TOLERANCE 1e-6
+
 // Result of every fallible pleat function. `PLEAT_STATUS_OK` (0) is success; on any other
 // value no output was written and `pleat_last_error()` says why.
 enum PleatStatus
@@ -88,6 +133,13 @@ typedef int32_t PleatStatsKind;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
+// A complex wrinkle field on a base mesh (opaque): ω per edge (pleat's edge numbering),
+// amplitude and unit phase z̃ per vertex, and a private copy of the base mesh (the `PleatMesh`
+// passed at creation may be destroyed afterwards). Created by `pleat_cwf_create*` or
+// `pleat_cwf_read_file`, destroyed by `pleat_cwf_destroy`. Immutable: may be read (evaluated,
+// copied out) from several threads at once; destroying it while in use is undefined.
+typedef struct PleatCwf PleatCwf;
+
 // An indexed triangle mesh owned by pleat (opaque). Created by `pleat_mesh_create_*`,
 // `pleat_mesh_read_file` or an operation that returns a mesh; destroyed by
 // `pleat_mesh_destroy`. Immutable after creation, so it may be read from several threads at
@@ -97,6 +149,12 @@ typedef struct PleatMesh PleatMesh;
 // Statistics of one long operation (opaque). Returned through the optional `PleatStats **`
 // output of long operations; destroyed with `pleat_stats_destroy`. Immutable.
 typedef struct PleatStats PleatStats;
+
+// Optional per-vertex (and per-edge) fields of one evaluation (opaque), requested with
+// `PLEAT_WRINKLE_FIELD_*` bits in `PleatWrinkleEvalParams::flags` and returned by
+// `pleat_cwf_evaluate`. Vertex order is that of the output mesh. Destroyed by
+// `pleat_wrinkle_fields_destroy`. Immutable; thread rules as `PleatCwf`.
+typedef struct PleatWrinkleFields PleatWrinkleFields;
 
 // Parameters of `pleat_lod_generate`, `pleat_lod_generate_chain` and `pleat_cage_generate`.
 // Get the defaults from `pleat_lod_params_default()` and change what you need; the defaults
@@ -286,6 +344,86 @@ typedef struct PleatMeshReport {
   double bbox_max[3];
 } PleatMeshReport;
 
+// Parameters of `pleat_cwf_evaluate`. Get the defaults from
+// `pleat_wrinkle_eval_params_default()` and change what you need; `struct_size` must stay
+// `sizeof(PleatWrinkleEvalParams)` (an older, shorter struct is accepted: missing fields take
+// their defaults).
+typedef struct PleatWrinkleEvalParams {
+  // `sizeof(PleatWrinkleEvalParams)`; at least 8.
+  uint32_t struct_size;
+  // Loop refinements; default 3. Each multiplies the triangle count by 4: levels whose output
+  // would exceed `max_output_triangles` fail with `PLEAT_STATUS_LIMIT_EXCEEDED` before any
+  // allocation.
+  uint32_t levels;
+  // Bitwise OR of `PLEAT_WRINKLE_FIELD_*`: the fields to compute into `*out_fields`; ignored
+  // when `out_fields` is NULL; default 0.
+  uint32_t flags;
+  // `PLEAT_WRINKLE_BOUNDARY_FIXED` (default) or `PLEAT_WRINKLE_BOUNDARY_SMOOTH`.
+  uint32_t boundary;
+  // With the smooth boundary rule: a boundary vertex whose triangle angles sum to a value
+  // differing from π by more than this is a corner and stays fixed. Radians in [0, π];
+  // default π/6.
+  double corner_angle;
+  // Multiplies the displacement `Re(z) n̂` (so it is in the base mesh's length unit per unit
+  // amplitude); finite; default 1.
+  double displacement_scale;
+  // Upper bound on the output triangle count, ≥ 1; default 2^26 (67,108,864). The output is
+  // also limited to the u32 index range.
+  uint64_t max_output_triangles;
+} PleatWrinkleEvalParams;
+
+// Parameters of Knöppel et al.'s phase solve (used when pleat computes z̃ from ω). Get the
+// defaults from `pleat_knoppel_params_default()`; `struct_size` versioned as
+// `PleatWrinkleEvalParams`.
+typedef struct PleatKnoppelParams {
+  // `sizeof(PleatKnoppelParams)`; at least 8.
+  uint32_t struct_size;
+  // `PLEAT_PHASE_WEIGHTS_COTAN` (default) or `PLEAT_PHASE_WEIGHTS_EDGE_AREA`.
+  uint32_t weights;
+  // Maximum inverse-iteration steps, 1 to 1,000,000; default 200.
+  uint32_t max_iterations;
+  // Reserved, set to 0.
+  uint32_t reserved;
+  // Convergence tolerance on the relative residual, finite, ≥ 0; default 1e-12.
+  double tolerance;
+  // Relative shift of the inverse iteration, finite, in [0, 1); default 1e-9.
+  double shift;
+} PleatKnoppelParams;
+
+// Outcome of the Knöppel phase solve of a `PleatCwf` (`pleat_cwf_get_knoppel_report`).
+typedef struct PleatKnoppelReport {
+  // In: `sizeof(PleatKnoppelReport)` (≥ 8). Out: bytes filled.
+  uint32_t struct_size;
+  // Inverse-iteration steps taken.
+  uint32_t iterations;
+  // Smallest generalized eigenvalue found (largest over connected components); 0 for a
+  // perfectly compatible ω.
+  double eigenvalue;
+  // Final relative residual.
+  double residual;
+  // Absolute shift σ used.
+  double shift;
+} PleatKnoppelReport;
+
+// What `pleat_cwf_evaluate` did. Set `struct_size = sizeof(PleatWrinkleEvalStats)` before the
+// call; pleat fills at most that many bytes.
+typedef struct PleatWrinkleEvalStats {
+  // In: `sizeof(PleatWrinkleEvalStats)` as the caller knows it (≥ 8). Out: bytes filled.
+  uint32_t struct_size;
+  // Loop refinements done.
+  uint32_t levels;
+  // Vertices of the output mesh.
+  uint64_t vertex_count;
+  // Triangles of the output mesh.
+  uint64_t triangle_count;
+  // Wall seconds of the whole evaluation.
+  double total_seconds;
+  // Wall seconds of the Loop refinements (all levels).
+  double subdivision_seconds;
+  // Wall seconds of the normals and the displacement.
+  double displacement_seconds;
+} PleatWrinkleEvalStats;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -326,6 +464,32 @@ uint32_t pleat_abi_version(void);
 // # Safety
 // `name` is NULL or a NUL-terminated string.
 uint32_t pleat_has_feature(const char *name);
+
+// Number of unique undirected edges of `mesh` (0 when `mesh` is NULL). Degenerate corners
+// (a triangle repeating a vertex) contribute no edge.
+//
+// This is the length of every per-edge array of the C API (e.g. wrinkle one-forms). The edge
+// list is rebuilt on each call (O(T log T) for T triangles): query it once.
+//
+// # Safety
+// `mesh` is NULL or a live handle.
+size_t pleat_mesh_edge_count(const struct PleatMesh *mesh);
+
+// Copies the edges of `mesh` in pleat's edge numbering: edge `e` is written as the two vertex
+// indices `dst[2e] < dst[2e + 1]`; edges are sorted by `(dst[2e], dst[2e + 1])`. A value on
+// edge `e` (such as a one-form ω) is integrated from `dst[2e]` to `dst[2e + 1]`; on the
+// opposite direction it is negated.
+//
+// - `mesh`: non-NULL.
+// - `dst`: room for `edge_capacity` edges, i.e. `2 * edge_capacity` `uint32_t`; non-NULL.
+// - `edge_capacity`: number of edges `dst` holds; must be ≥ `pleat_mesh_edge_count(mesh)`,
+//   else `PLEAT_STATUS_LIMIT_EXCEEDED` and nothing is written.
+//
+// # Safety
+// `mesh` is NULL or live; `dst` is NULL or valid for `2 * edge_capacity` u32 writes.
+PleatStatus pleat_mesh_copy_edges(const struct PleatMesh *mesh,
+                                  uint32_t *dst,
+                                  size_t edge_capacity);
 
 // The defaults, with `struct_size = sizeof(PleatLodParams)`.
 struct PleatLodParams pleat_lod_params_default(void);
@@ -583,6 +747,291 @@ PleatStatus pleat_stats_to_json(const struct PleatStats *stats,
 // # Safety
 // `stats` is NULL or a live handle not yet destroyed.
 void pleat_stats_destroy(struct PleatStats *stats);
+
+// The default evaluation parameters (levels 3, no fields, fixed boundary, corner angle π/6,
+// displacement scale 1, at most 2^26 output triangles), with `struct_size` set. Available in
+// every build.
+struct PleatWrinkleEvalParams pleat_wrinkle_eval_params_default(void);
+
+// The default Knöppel parameters (cotangent weights, 200 iterations, tolerance 1e-12, shift
+// 1e-9), with `struct_size` set. Available in every build.
+struct PleatKnoppelParams pleat_knoppel_params_default(void);
+
+// Creates a wrinkle field from ω on the base mesh's edges, amplitudes and (optionally) phases.
+//
+// - `base`: the base mesh; non-NULL. Must be a consistently oriented manifold (each edge in one
+//   or two triangles, one fan per vertex), boundary allowed, no degenerate or duplicate
+//   triangles, else `PLEAT_STATUS_INVALID_MESH`. pleat keeps its own copy.
+// - `omega`: `edge_count` doubles; non-NULL. `omega[e]` is the frequency one-form on edge `e`
+//   of `pleat_mesh_copy_edges(base)`, integrated from its smaller to its larger vertex
+//   index: the phase advance in radians (`ω_ij ≈ k·(x_j − x_i)` for a plane wave of wave
+//   vector `k`, in radians per length unit). Finite.
+// - `edge_count`: must equal `pleat_mesh_edge_count(base)`.
+// - `amplitude`: `vertex_count` doubles, finite, ≥ 0, in the mesh's length unit; non-NULL.
+// - `zeta_re_im`: 2 doubles per vertex (`re, im`), the unit phase z̃ (need not be exactly unit;
+//   the field is `z = amplitude · z̃`), finite. NULL: z̃ is computed from ω by Knöppel et al.'s
+//   method with default parameters (`pleat_cwf_create_from_frequency` takes parameters).
+// - `vertex_count`: must equal `pleat_mesh_vertex_count(base)`.
+// - `out`: receives the new field (destroy with `pleat_cwf_destroy`); non-NULL.
+//
+// Returns `PLEAT_STATUS_INVALID_ARGUMENT` for NULL pointers, mismatched counts, NaN/Inf or
+// negative amplitudes; `PLEAT_STATUS_NUMERICAL` if the phase solve fails;
+// `PLEAT_STATUS_UNSUPPORTED` without the `wrinkle` capability.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes described above.
+PleatStatus pleat_cwf_create(const struct PleatMesh *base,
+                             const double *omega,
+                             size_t edge_count,
+                             const double *amplitude,
+                             const double *zeta_re_im,
+                             size_t vertex_count,
+                             struct PleatCwf **out);
+
+// Creates a wrinkle field from ω given per triangle corner, so callers need not know pleat's
+// edge numbering.
+//
+// - `base`: as `pleat_cwf_create`; non-NULL.
+// - `corner_omega`: `corner_count` doubles, 3 per triangle: `corner_omega[3t + i]` is ω
+//   integrated along triangle `t`'s edge from its corner `i` to corner `(i + 1) % 3`, in
+//   radians. Finite. An interior edge is seen by its two triangles in opposite directions;
+//   their values must be opposite: `|w_ab + w_ba| ≤ PLEAT_CORNER_OMEGA_TOLERANCE ·
+//   max(1, |w_ab|, |w_ba|)`, else `PLEAT_STATUS_INVALID_ARGUMENT` naming the edge. The field
+//   stores their mean `(w_ab − w_ba) / 2` (per edge, oriented min → max).
+// - `corner_count`: must equal `3 * pleat_mesh_triangle_count(base)`.
+// - `amplitude`, `zeta_re_im` (NULL = Knöppel phase), `vertex_count`, `out`: as
+//   `pleat_cwf_create`.
+//
+// Base-mesh problems (`PLEAT_STATUS_INVALID_MESH`) are reported before antisymmetry
+// violations.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes described above.
+PleatStatus pleat_cwf_create_from_corner_omega(const struct PleatMesh *base,
+                                               const double *corner_omega,
+                                               size_t corner_count,
+                                               const double *amplitude,
+                                               const double *zeta_re_im,
+                                               size_t vertex_count,
+                                               struct PleatCwf **out);
+
+// Creates a wrinkle field from wave vectors (the gradient of the phase, radians per length
+// unit) and amplitudes; the phase z̃ is Knöppel et al.'s (2015) smoothest unit field whose
+// gradient best matches the wave vectors.
+//
+// - `base`: as `pleat_cwf_create`; non-NULL.
+// - `frequency`: `3 * frequency_count` doubles, xyz wave vectors (tangent to the surface; a
+//   normal component is harmless: only its projection on the edges counts). Finite; non-NULL.
+//   Per vertex: `ω_ij = ½ (k_i + k_j)·(x_j − x_i)`; per face: the mean over the edge's triangles
+//   of `k_f·(x_j − x_i)`.
+// - `frequency_count`: the number of vectors: `pleat_mesh_vertex_count(base)` for
+//   `PLEAT_FREQUENCY_PER_VERTEX`, `pleat_mesh_triangle_count(base)` for
+//   `PLEAT_FREQUENCY_PER_FACE`.
+// - `location`: `PLEAT_FREQUENCY_PER_VERTEX` or `PLEAT_FREQUENCY_PER_FACE`.
+// - `amplitude`: `vertex_count` doubles, finite, ≥ 0; non-NULL.
+// - `vertex_count`: must equal `pleat_mesh_vertex_count(base)`.
+// - `params`: Knöppel parameters; NULL = `pleat_knoppel_params_default()`.
+// - `out`: receives the new field; non-NULL.
+//
+// A singularity (vortex) of the wave field becomes a vertex with z̃ = 0. Roughly linear in the
+// vertex count after one sparse Cholesky factorization (~0.2 s for 100k vertices).
+//
+// # Safety
+// Pointers are NULL or valid for the sizes described above.
+PleatStatus pleat_cwf_create_from_frequency(const struct PleatMesh *base,
+                                            const double *frequency,
+                                            size_t frequency_count,
+                                            uint32_t location,
+                                            const double *amplitude,
+                                            size_t vertex_count,
+                                            const struct PleatKnoppelParams *params,
+                                            struct PleatCwf **out);
+
+// Reads a `.cwf` file (format: README "Wrinkle fields", `src/wrinkle/io.rs`) written for
+// `base`, whose connectivity (vertex, edge and triangle counts and a hash of the triangles)
+// must match what the file records; positions may differ (a deformed base mesh).
+//
+// - `base`: non-NULL; pleat keeps its own copy.
+// - `path`: NUL-terminated UTF-8 path; non-NULL.
+// - `out`: receives the new field; non-NULL.
+//
+// Returns `PLEAT_STATUS_IO` when the file cannot be read, `PLEAT_STATUS_PARSE` when its content
+// is malformed (message with the line), `PLEAT_STATUS_INVALID_ARGUMENT` when it was written
+// for other connectivity or holds invalid values.
+//
+// # Safety
+// `base` is NULL or live; `path` is NULL or NUL-terminated; `out` is NULL or writable.
+PleatStatus pleat_cwf_read_file(const struct PleatMesh *base,
+                                const char *path,
+                                struct PleatCwf **out);
+
+// Writes `cwf` as a `.cwf` text file (lossless: every double round-trips bit for bit). The
+// base mesh is not written; store it separately (e.g. `pleat_mesh_write_file` to `.ply`/`.obj`,
+// which keep the vertex order).
+//
+// - `cwf`: non-NULL.
+// - `path`: NUL-terminated UTF-8 path; non-NULL. An existing file is replaced.
+//
+// # Safety
+// `cwf` is NULL or live; `path` is NULL or NUL-terminated.
+PleatStatus pleat_cwf_write_file(const struct PleatCwf *cwf, const char *path);
+
+// Destroys a wrinkle field. NULL is accepted and ignored. Destroying twice is undefined.
+//
+// # Safety
+// `cwf` is NULL or a handle from pleat not yet destroyed.
+void pleat_cwf_destroy(struct PleatCwf *cwf);
+
+// Number of vertices of the field's base mesh (the length of its per-vertex arrays); 0 when
+// `cwf` is NULL or the build lacks `wrinkle`.
+//
+// # Safety
+// `cwf` is NULL or live.
+size_t pleat_cwf_vertex_count(const struct PleatCwf *cwf);
+
+// Number of edges of the field's base mesh (the length of ω); 0 when `cwf` is NULL or the
+// build lacks `wrinkle`.
+//
+// # Safety
+// `cwf` is NULL or live.
+size_t pleat_cwf_edge_count(const struct PleatCwf *cwf);
+
+// Copies ω, one double per edge in pleat's edge numbering (`pleat_mesh_copy_edges` of the base
+// mesh), integrated from the smaller to the larger vertex index, in radians.
+//
+// - `cwf`, `dst`: non-NULL.
+// - `edge_capacity`: doubles `dst` holds; ≥ `pleat_cwf_edge_count(cwf)`, else
+//   `PLEAT_STATUS_LIMIT_EXCEEDED` and nothing is written.
+//
+// # Safety
+// `cwf` is NULL or live; `dst` is NULL or valid for `edge_capacity` doubles.
+PleatStatus pleat_cwf_copy_omega(const struct PleatCwf *cwf, double *dst, size_t edge_capacity);
+
+// Copies ω per triangle corner, 3 doubles per triangle: `dst[3t + i]` is ω integrated along
+// triangle `t` from its corner `i` to corner `(i + 1) % 3` (the layout accepted by
+// `pleat_cwf_create_from_corner_omega`).
+//
+// - `cwf`, `dst`: non-NULL.
+// - `corner_capacity`: doubles `dst` holds; ≥ 3 × the base mesh's triangle count, else
+//   `PLEAT_STATUS_LIMIT_EXCEEDED` and nothing is written.
+//
+// # Safety
+// `cwf` is NULL or live; `dst` is NULL or valid for `corner_capacity` doubles.
+PleatStatus pleat_cwf_copy_corner_omega(const struct PleatCwf *cwf,
+                                        double *dst,
+                                        size_t corner_capacity);
+
+// Copies the amplitude, one double per base vertex (length unit, ≥ 0).
+//
+// - `cwf`, `dst`: non-NULL.
+// - `vertex_capacity`: doubles `dst` holds; ≥ `pleat_cwf_vertex_count(cwf)`, else
+//   `PLEAT_STATUS_LIMIT_EXCEEDED` and nothing is written.
+//
+// # Safety
+// `cwf` is NULL or live; `dst` is NULL or valid for `vertex_capacity` doubles.
+PleatStatus pleat_cwf_copy_amplitude(const struct PleatCwf *cwf,
+                                     double *dst,
+                                     size_t vertex_capacity);
+
+// Copies the unit phase z̃, two doubles (`re, im`) per base vertex (0, 0 at a singularity).
+//
+// - `cwf`, `dst`: non-NULL.
+// - `vertex_capacity`: vertices `dst` holds (it holds `2 * vertex_capacity` doubles);
+//   ≥ `pleat_cwf_vertex_count(cwf)`, else `PLEAT_STATUS_LIMIT_EXCEEDED`.
+//
+// # Safety
+// `cwf` is NULL or live; `dst` is NULL or valid for `2 * vertex_capacity` doubles.
+PleatStatus pleat_cwf_copy_zeta(const struct PleatCwf *cwf, double *dst, size_t vertex_capacity);
+
+// Fills `*out` with the report of the Knöppel phase solve that produced the field's z̃.
+//
+// - `cwf`: non-NULL. Fields whose z̃ was given by the caller or read from a file have no
+//   report: `PLEAT_STATUS_INVALID_ARGUMENT`.
+// - `out`: non-NULL, `out->struct_size = sizeof(PleatKnoppelReport)` (≥ 8).
+//
+// # Safety
+// `cwf` is NULL or live; `out` is NULL or valid for `out->struct_size` bytes.
+PleatStatus pleat_cwf_get_knoppel_report(const struct PleatCwf *cwf,
+                                         struct PleatKnoppelReport *out);
+
+// Evaluates the wrinkled surface (dissertation §3.5): `params->levels` Loop refinements of the
+// base mesh, ω and z, then every vertex moves by `displacement_scale · Re(z) · n̂` along the
+// unit normal of the undisplaced refined mesh. The output is watertight (closed and manifold)
+// when the base mesh is, with the base vertices first, then one new vertex per edge of each
+// level; triangles are oriented like the base.
+//
+// - `cwf`: non-NULL.
+// - `params`: NULL = `pleat_wrinkle_eval_params_default()`; see `PleatWrinkleEvalParams` for
+//   each field's range. `PLEAT_STATUS_LIMIT_EXCEEDED` (before allocating) when
+//   `triangles · 4^levels` exceeds `max_output_triangles` or the u32 index range.
+// - `progress`: NULL or a callback, called on the calling thread after each level and after
+//   the displacement; returning non-zero cancels (`PLEAT_STATUS_CANCELLED`, no output).
+// - `user_data`: passed to `progress` unchanged; may be NULL.
+// - `out_mesh`: receives the wrinkled mesh (destroy with `pleat_mesh_destroy`); non-NULL.
+// - `out_fields`: NULL, or receives the fields requested by `params->flags` (destroy with
+//   `pleat_wrinkle_fields_destroy`; a handle is returned even when no field was requested).
+// - `stats`: NULL, or a `PleatWrinkleEvalStats` with `struct_size` set (≥ 8), filled on
+//   success.
+//
+// Runs in parallel on pleat's thread pool; output bytes do not depend on the thread count.
+// About 4 M output triangles per second per core.
+//
+// # Safety
+// Pointers are NULL or valid as described; `progress` is a valid function or NULL.
+PleatStatus pleat_cwf_evaluate(const struct PleatCwf *cwf,
+                               const struct PleatWrinkleEvalParams *params,
+                               PleatProgressFn progress,
+                               void *user_data,
+                               struct PleatMesh **out_mesh,
+                               struct PleatWrinkleFields **out_fields,
+                               struct PleatWrinkleEvalStats *stats);
+
+// Number of elements of one evaluated field: vertices of the output mesh for per-vertex
+// fields, its edges for `PLEAT_WRINKLE_FIELD_OMEGA`. 0 when `fields` is NULL, `field` is not a
+// single `PLEAT_WRINKLE_FIELD_*` value, or the field was not requested.
+//
+// Elements have 1 (amplitude, phase, omega), 2 (z) or 3 (normals, smooth positions) doubles.
+//
+// # Safety
+// `fields` is NULL or live.
+size_t pleat_wrinkle_fields_count(const struct PleatWrinkleFields *fields, uint32_t field);
+
+// Copies one evaluated field into a caller buffer, element by element.
+//
+// - `fields`: non-NULL.
+// - `field`: one `PLEAT_WRINKLE_FIELD_*` value that was set in `params->flags`, else
+//   `PLEAT_STATUS_INVALID_ARGUMENT`.
+// - `dst`: room for `element_capacity` elements `stride_bytes` apart; non-NULL.
+// - `element_capacity`: ≥ `pleat_wrinkle_fields_count(fields, field)`, else
+//   `PLEAT_STATUS_LIMIT_EXCEEDED` and nothing is written.
+// - `stride_bytes`: bytes between consecutive elements; 0 = packed (8 × components); otherwise
+//   ≥ 8 × components (bytes in between are left untouched, so interleaved vertex buffers work).
+//
+// # Safety
+// `fields` is NULL or live; `dst` is NULL or valid for
+// `(element_capacity - 1) * stride + 8 * components` bytes.
+PleatStatus pleat_wrinkle_fields_copy(const struct PleatWrinkleFields *fields,
+                                      uint32_t field,
+                                      double *dst,
+                                      size_t element_capacity,
+                                      size_t stride_bytes);
+
+// As `pleat_wrinkle_fields_copy`, converting to float (rounded to nearest; packed element size
+// 4 × components bytes).
+//
+// # Safety
+// As `pleat_wrinkle_fields_copy` with 4-byte components.
+PleatStatus pleat_wrinkle_fields_copy_f32(const struct PleatWrinkleFields *fields,
+                                          uint32_t field,
+                                          float *dst,
+                                          size_t element_capacity,
+                                          size_t stride_bytes);
+
+// Destroys evaluated fields. NULL is accepted and ignored.
+//
+// # Safety
+// `fields` is NULL or a handle from pleat not yet destroyed.
+void pleat_wrinkle_fields_destroy(struct PleatWrinkleFields *fields);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -168,3 +168,208 @@ fn offset_rejects_bad_screen_size() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("screen size"));
 }
+
+/// A fresh scratch directory holding the regular octahedron as `oct.obj`.
+#[cfg(feature = "wrinkle")]
+fn scratch_with_octahedron(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("pleat-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("oct.obj"),
+        "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
+         f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n",
+    )
+    .unwrap();
+    dir
+}
+
+#[cfg(feature = "wrinkle")]
+fn path_str(p: &std::path::Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[cfg(feature = "wrinkle")]
+#[test]
+fn wrinkle_plane_wave_then_eval_gives_watertight_mesh() {
+    let dir = scratch_with_octahedron("plane-wave");
+    let (base, cwf, out) = (dir.join("oct.obj"), dir.join("w.cwf"), dir.join("w.ply"));
+    let o = pleat(&[
+        "wrinkle",
+        "plane-wave",
+        path_str(&base),
+        "--k",
+        "-4,2,1",
+        "--amplitude",
+        "0.02",
+        "-o",
+        path_str(&cwf),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&cwf).unwrap();
+    assert!(
+        text.starts_with("pleat-cwf 1\nvertices 6\nedges 12\n"),
+        "{text}"
+    );
+    let o = pleat(&[
+        "wrinkle",
+        "eval",
+        path_str(&base),
+        "--cwf",
+        path_str(&cwf),
+        "--levels",
+        "2",
+        "-o",
+        path_str(&out),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("128 triangles"));
+    let o = pleat(&["check", path_str(&out)]);
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert!(s.contains("triangles           128"), "{s}");
+    assert!(s.contains("watertight          yes"), "{s}");
+    assert!(s.contains("self-intersections  none"), "{s}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[cfg(feature = "wrinkle")]
+#[test]
+fn wrinkle_from_field_reads_the_documented_format() {
+    let dir = scratch_with_octahedron("from-field");
+    let (base, field, cwf) = (dir.join("oct.obj"), dir.join("f.txt"), dir.join("f.cwf"));
+    // one `fx fy fz [amplitude]` line per vertex; comments and blank lines ignored
+    std::fs::write(
+        &field,
+        "# wave vectors\n3 0 0\n3 0 0 0.05\n\n0 3 0\n0 3 0   # trailing text is not allowed\n",
+    )
+    .unwrap();
+    let args = |f: &std::path::Path| {
+        vec![
+            "wrinkle".to_string(),
+            "from-field".into(),
+            path_str(&base).into(),
+            "--field".into(),
+            path_str(f).into(),
+            "--amplitude".into(),
+            "0.01".into(),
+            "-o".into(),
+            path_str(&cwf).into(),
+        ]
+    };
+    let run = |f: &std::path::Path| {
+        let a = args(f);
+        pleat(&a.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let o = run(&field);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("f.txt:6"), "{err}");
+    std::fs::write(
+        &field,
+        "# wave vectors\n3 0 0\n3 0 0 0.05\n\n0 3 0\n0 3 0\n0 0 3\n0 0 3 0\n",
+    )
+    .unwrap();
+    let o = run(&field);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&cwf).unwrap();
+    let vertex: Vec<&str> = text
+        .lines()
+        .skip_while(|l| *l != "vertex")
+        .skip(1)
+        .take(6)
+        .collect();
+    let amp: Vec<f64> = vertex
+        .iter()
+        .map(|l| l.split_whitespace().next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(amp, [0.01, 0.05, 0.01, 0.01, 0.01, 0.0]);
+    // too few lines
+    std::fs::write(&field, "1 0 0\n").unwrap();
+    let o = run(&field);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("one line per vertex"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[cfg(feature = "wrinkle")]
+#[test]
+fn wrinkle_eval_refuses_bad_input_with_exit_two() {
+    let dir = scratch_with_octahedron("eval-errors");
+    let (base, cwf, out) = (dir.join("oct.obj"), dir.join("w.cwf"), dir.join("w.obj"));
+    let o = pleat(&[
+        "wrinkle",
+        "plane-wave",
+        path_str(&base),
+        "--k=1,2,3",
+        "-o",
+        path_str(&cwf),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // too many levels: refused before any allocation
+    let o = pleat(&[
+        "wrinkle",
+        "eval",
+        path_str(&base),
+        "--cwf",
+        path_str(&cwf),
+        "--levels",
+        "40",
+        "-o",
+        path_str(&out),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("limit exceeded"));
+    // a field written for another base mesh
+    let o = pleat(&[
+        "wrinkle",
+        "eval",
+        "assets/dirty_two_boxes.obj",
+        "--cwf",
+        path_str(&cwf),
+        "-o",
+        path_str(&out),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("was written for a base mesh"));
+    // a wave vector with two components
+    let o = pleat(&[
+        "wrinkle",
+        "plane-wave",
+        path_str(&base),
+        "--k",
+        "1,2",
+        "-o",
+        path_str(&cwf),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[cfg(feature = "wrinkle")]
+#[test]
+fn wrinkle_demo_script_runs() {
+    let dir = scratch_with_octahedron("demo");
+    let out = dir.join("demo.ply");
+    let o = Command::new("sh")
+        .arg("examples_c/wrinkle_demo.sh")
+        .arg("")
+        .arg(&out)
+        .env("PLEAT", env!("CARGO_BIN_EXE_pleat"))
+        .env("LEVELS", "2")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output();
+    let Ok(o) = o else {
+        println!("SKIPPED: no `sh` to run examples_c/wrinkle_demo.sh");
+        return;
+    };
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{s}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(s.contains("triangles           320"), "{s}");
+    assert!(s.matches("watertight          yes").count() == 2, "{s}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -78,6 +78,9 @@ enum Command {
         #[command(flatten)]
         bake: BakeArgs,
     },
+    /// Complex wrinkle fields: build (.cwf files) and evaluate wrinkled meshes.
+    #[command(subcommand)]
+    Wrinkle(WrinkleCommand),
 }
 
 /// Options shared by `lod` and `cage`.
@@ -102,6 +105,75 @@ struct BakeArgs {
     /// No progress bar and no summary.
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// `pleat wrinkle ...` (needs the `wrinkle` feature; otherwise exits 2 with a message).
+#[derive(Subcommand)]
+enum WrinkleCommand {
+    /// Evaluate a wrinkle field: Loop-refine BASE `--levels` times and displace along the
+    /// normals; writes the wrinkled mesh (format by extension of OUT).
+    Eval {
+        /// The base mesh the field was made for (obj, ply, off, stl, glb, gltf).
+        base: PathBuf,
+        /// The wrinkle field (.cwf).
+        #[arg(long)]
+        cwf: PathBuf,
+        /// Loop refinements (each multiplies the triangle count by 4).
+        #[arg(long, default_value_t = 3)]
+        levels: u32,
+        /// Multiplies the displacement.
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+        /// Smooth (B-spline) boundary instead of a fixed one.
+        #[arg(long)]
+        smooth_boundary: bool,
+        /// Refuse outputs with more triangles than this.
+        #[arg(long, default_value_t = 1 << 26)]
+        max_triangles: usize,
+        /// Output mesh file.
+        #[arg(short = 'o', long = "output")]
+        out: PathBuf,
+    },
+    /// Build a .cwf from a per-vertex wave-vector field (phase by Knöppel et al. 2015).
+    ///
+    /// FIELD format: one line per base vertex, in vertex order: `fx fy fz [amplitude]` — the
+    /// wave vector (the phase gradient, radians per length unit) and optionally that vertex's
+    /// amplitude (length unit, ≥ 0). Blank lines and lines starting with `#` are ignored.
+    FromField {
+        /// The base mesh.
+        base: PathBuf,
+        /// The per-vertex field text file.
+        #[arg(long)]
+        field: PathBuf,
+        /// Amplitude of vertices whose line has none [default: 0.005 × bbox diagonal].
+        #[arg(long)]
+        amplitude: Option<f64>,
+        /// Knöppel edge weights: cotangent or barycentric edge areas.
+        #[arg(long, value_parser = ["cotan", "edge-area"], default_value = "cotan")]
+        weights: String,
+        /// Output .cwf file.
+        #[arg(short = 'o', long = "output")]
+        out: PathBuf,
+    },
+    /// Build a .cwf holding the global plane wave exp(i k·x) (exactly compatible, no solve).
+    PlaneWave {
+        /// The base mesh.
+        base: PathBuf,
+        /// Wave vector in radians per length unit: KX,KY,KZ (wavelength 2π/|k|).
+        #[arg(
+            long,
+            value_delimiter = ',',
+            allow_hyphen_values = true,
+            required = true
+        )]
+        k: Vec<f64>,
+        /// Amplitude (length unit) [default: 0.005 × bbox diagonal].
+        #[arg(long)]
+        amplitude: Option<f64>,
+        /// Output .cwf file.
+        #[arg(short = 'o', long = "output")]
+        out: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -136,6 +208,7 @@ fn main() -> ExitCode {
         Command::Lod { input, bake: b } => bake(&input, &b, false),
         #[cfg(feature = "cage")]
         Command::Cage { input, bake: b } => bake(&input, &b, true),
+        Command::Wrinkle(cmd) => wrinkle_cmd::run(cmd),
     }
 }
 
@@ -389,4 +462,263 @@ fn offset(
         );
     }
     ExitCode::SUCCESS
+}
+
+/// `pleat wrinkle ...`.
+#[cfg(feature = "wrinkle")]
+mod wrinkle_cmd {
+    use super::{WrinkleCommand, EXIT_INPUT};
+    use pleat::mesh::io::{read_mesh, write_mesh};
+    use pleat::mesh::TriMesh;
+    use pleat::wrinkle::{
+        read_cwf, write_cwf, BoundaryRule, Complex, Cwf, EvalOptions, FrequencyField,
+        KnoppelOptions, PhaseWeights, SubdivisionOptions,
+    };
+    use pleat::Error;
+    use std::path::Path;
+    use std::process::ExitCode;
+
+    /// A failure and its exit code: 2 for unreadable input or bad arguments, 1 otherwise.
+    struct Fail(u8, String);
+
+    fn input(e: Error) -> Fail {
+        Fail(EXIT_INPUT, e.to_string())
+    }
+
+    fn op(e: Error) -> Fail {
+        let code = match e {
+            Error::InvalidArgument(_) | Error::InvalidMesh(_) | Error::LimitExceeded(_) => {
+                EXIT_INPUT
+            }
+            _ => 1,
+        };
+        Fail(code, e.to_string())
+    }
+
+    pub fn run(cmd: WrinkleCommand) -> ExitCode {
+        let (name, r) = match cmd {
+            WrinkleCommand::Eval {
+                base,
+                cwf,
+                levels,
+                scale,
+                smooth_boundary,
+                max_triangles,
+                out,
+            } => {
+                let boundary = if smooth_boundary {
+                    BoundaryRule::Smooth
+                } else {
+                    BoundaryRule::Fixed
+                };
+                let opts = EvalOptions {
+                    subdivision: SubdivisionOptions {
+                        boundary,
+                        ..Default::default()
+                    },
+                    displacement_scale: scale,
+                    max_output_faces: max_triangles,
+                    ..Default::default()
+                };
+                ("eval", eval(&base, &cwf, levels as usize, &opts, &out))
+            }
+            WrinkleCommand::FromField {
+                base,
+                field,
+                amplitude,
+                weights,
+                out,
+            } => {
+                let weights = if weights == "edge-area" {
+                    PhaseWeights::EdgeArea
+                } else {
+                    PhaseWeights::Cotan
+                };
+                (
+                    "from-field",
+                    from_field(&base, &field, amplitude, weights, &out),
+                )
+            }
+            WrinkleCommand::PlaneWave {
+                base,
+                k,
+                amplitude,
+                out,
+            } => ("plane-wave", plane_wave(&base, &k, amplitude, &out)),
+        };
+        match r {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(Fail(code, msg)) => {
+                eprintln!("pleat wrinkle {name}: {msg}");
+                ExitCode::from(code)
+            }
+        }
+    }
+
+    fn eval(
+        base: &Path,
+        cwf: &Path,
+        levels: usize,
+        opts: &EvalOptions,
+        out: &Path,
+    ) -> Result<(), Fail> {
+        let mesh = read_mesh(base).map_err(input)?;
+        let field = read_cwf(cwf, mesh).map_err(input)?;
+        let bar = indicatif::ProgressBar::new(1000);
+        let (ev, stats) = field
+            .evaluate_with_progress(levels, opts, &mut |p| {
+                bar.set_message(p.stage.to_string());
+                bar.set_position((p.fraction * 1000.0) as u64);
+                true
+            })
+            .map_err(op)?;
+        bar.finish_and_clear();
+        write_mesh(out, &ev.mesh).map_err(op)?;
+        println!(
+            "{}: {} levels, {} vertices, {} triangles in {:.3} s",
+            out.display(),
+            levels,
+            ev.mesh.vertex_count(),
+            ev.mesh.triangle_count(),
+            stats.total_seconds()
+        );
+        Ok(())
+    }
+
+    fn default_amplitude(mesh: &TriMesh, amplitude: Option<f64>) -> Result<f64, Fail> {
+        let a = amplitude.unwrap_or(0.005 * mesh.bbox_diagonal());
+        if !(a.is_finite() && a >= 0.0) {
+            return Err(Fail(
+                EXIT_INPUT,
+                format!("--amplitude {a} must be finite and ≥ 0"),
+            ));
+        }
+        Ok(a)
+    }
+
+    /// Parses the per-vertex field file: `fx fy fz [amplitude]` per line, `#` comments.
+    fn parse_field(
+        text: &str,
+        name: &str,
+        n: usize,
+        default_amplitude: f64,
+    ) -> Result<(Vec<[f64; 3]>, Vec<f64>), Fail> {
+        let mut k = Vec::with_capacity(n);
+        let mut a = Vec::with_capacity(n);
+        for (i, line) in text.lines().enumerate() {
+            let line = line.trim();
+            if line.is_empty() || line.starts_with('#') {
+                continue;
+            }
+            let bad = |what: &str| Fail(EXIT_INPUT, format!("{name}:{}: {what}", i + 1));
+            let v: Vec<f64> = line
+                .split_whitespace()
+                .map(|t| t.parse::<f64>())
+                .collect::<Result<_, _>>()
+                .map_err(|_| bad(&format!("'{line}' is not 3 or 4 numbers")))?;
+            if !(v.len() == 3 || v.len() == 4) || v.iter().any(|x| !x.is_finite()) {
+                return Err(bad(&format!(
+                    "'{line}': expected 'fx fy fz [amplitude]' (finite numbers)"
+                )));
+            }
+            if k.len() == n {
+                return Err(bad(&format!(
+                    "more lines than the base mesh's {n} vertices"
+                )));
+            }
+            k.push([v[0], v[1], v[2]]);
+            a.push(v.get(3).copied().unwrap_or(default_amplitude));
+        }
+        if k.len() != n {
+            return Err(Fail(
+                EXIT_INPUT,
+                format!(
+                    "{name} has {} vectors but the base mesh has {n} vertices (one line per \
+                     vertex)",
+                    k.len()
+                ),
+            ));
+        }
+        Ok((k, a))
+    }
+
+    fn from_field(
+        base: &Path,
+        field: &Path,
+        amplitude: Option<f64>,
+        weights: PhaseWeights,
+        out: &Path,
+    ) -> Result<(), Fail> {
+        let mesh = read_mesh(base).map_err(input)?;
+        let a0 = default_amplitude(&mesh, amplitude)?;
+        let text = std::fs::read_to_string(field).map_err(|e| {
+            Fail(
+                EXIT_INPUT,
+                format!("cannot read '{}': {e}", field.display()),
+            )
+        })?;
+        let (k, a) = parse_field(&text, &field.display().to_string(), mesh.vertex_count(), a0)?;
+        let opts = KnoppelOptions {
+            weights,
+            ..Default::default()
+        };
+        let (cwf, report, _) =
+            Cwf::from_frequency_field(mesh, FrequencyField::PerVertex(&k), a, &opts).map_err(op)?;
+        write_cwf(out, &cwf).map_err(op)?;
+        println!(
+            "{}: {} vertices, {} edges; Knöppel eigenvalue {:.3e} after {} iterations",
+            out.display(),
+            cwf.amplitude().len(),
+            cwf.omega().len(),
+            report.eigenvalue,
+            report.iterations
+        );
+        Ok(())
+    }
+
+    fn plane_wave(base: &Path, k: &[f64], amplitude: Option<f64>, out: &Path) -> Result<(), Fail> {
+        let mesh = read_mesh(base).map_err(input)?;
+        if k.len() != 3 || k.iter().any(|c| !c.is_finite()) {
+            return Err(Fail(
+                EXIT_INPUT,
+                "--k needs three finite numbers KX,KY,KZ".into(),
+            ));
+        }
+        let k = [k[0], k[1], k[2]];
+        let a = default_amplitude(&mesh, amplitude)?;
+        let dot = |p: &[f64; 3]| k[0] * p[0] + k[1] * p[1] + k[2] * p[2];
+        let x = mesh.positions();
+        let omega = mesh
+            .edges()
+            .edges
+            .iter()
+            .map(|e| dot(&x[e.0[1] as usize]) - dot(&x[e.0[0] as usize]))
+            .collect();
+        let zeta = x.iter().map(|p| Complex::cis(dot(p))).collect();
+        let n = mesh.vertex_count();
+        let cwf = Cwf::new(mesh, omega, vec![a; n], zeta).map_err(op)?;
+        write_cwf(out, &cwf).map_err(op)?;
+        println!(
+            "{}: plane wave k = ({}, {}, {}), amplitude {a}, {} vertices, {} edges",
+            out.display(),
+            k[0],
+            k[1],
+            k[2],
+            n,
+            cwf.omega().len()
+        );
+        Ok(())
+    }
+}
+
+/// Stand-in when the binary was built without the `wrinkle` feature.
+#[cfg(not(feature = "wrinkle"))]
+mod wrinkle_cmd {
+    use super::{WrinkleCommand, EXIT_INPUT};
+    use std::process::ExitCode;
+
+    pub fn run(_cmd: WrinkleCommand) -> ExitCode {
+        eprintln!("pleat wrinkle: this pleat was built without the `wrinkle` feature");
+        ExitCode::from(EXIT_INPUT)
+    }
 }

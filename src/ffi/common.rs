@@ -102,12 +102,13 @@ fn status_of(result: std::thread::Result<crate::Result<()>>) -> PleatStatus {
     }
 }
 
-/// Records that this build lacks the cargo feature `feature` and returns
-/// `PleatStatus::Unsupported` (for entry points whose capability was left out).
-#[allow(dead_code)]
+/// Records that this build was compiled without the cargo feature `feature` and returns
+/// `PLEAT_STATUS_UNSUPPORTED` (for entry points whose capability was left out).
+#[allow(dead_code)] // used only by builds that leave a capability out
 pub(crate) fn unsupported(feature: &str) -> PleatStatus {
     set_last_error(&format!(
-        "this build of pleat was compiled without the `{feature}` feature"
+        "this build of pleat was compiled without the `{feature}` capability \
+         (see pleat_has_feature)"
     ));
     PleatStatus::Unsupported
 }

@@ -15,15 +15,19 @@
 //!   capability was left out returns `PLEAT_STATUS_UNSUPPORTED`.
 
 mod common;
+mod edges;
 mod lod;
 mod mesh;
 mod offset;
 mod report;
 mod stats;
+mod wrinkle;
 
 pub use common::*;
+pub use edges::*;
 pub use lod::*;
 pub use mesh::*;
 pub use offset::*;
 pub use report::*;
 pub use stats::*;
+pub use wrinkle::*;
