@@ -88,7 +88,9 @@ static void free_scene(struct aiScene *sc) {
 
 int main(int argc, char **argv) {
     const char *in = argc > 1 ? argv[1] : "assets/dirty_two_boxes.obj";
-    const char *out = argc > 2 ? argv[2] : "target/assimp_roundtrip_out.obj";
+    const char *tmp = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    char out_default[1024];
+    const char *out;
     const struct aiScene *sc = aiImportFile(in, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
     const struct aiScene *back;
     float *pos = NULL;
@@ -96,6 +98,8 @@ int main(int argc, char **argv) {
     size_t nv = 0, ni = 0;
     PleatMesh *mesh = NULL;
     struct aiScene *exp;
+    snprintf(out_default, sizeof out_default, "%s/pleat_assimp_roundtrip_out.obj", tmp);
+    out = argc > 2 ? argv[2] : out_default;
     if (!sc) {
         fprintf(stderr, "assimp cannot import %s: %s\n", in, aiGetErrorString());
         return 1;
