@@ -322,7 +322,7 @@ enum Msg {
 /// `f` receives a Rust progress closure (return `false` = cancel). The C callback `cb` is always
 /// invoked on the calling thread: without a custom pool `f` runs on the calling thread; with a
 /// pool set by `pleat_set_thread_count`, `f` runs on a pool worker while the calling thread
-/// relays progress messages to `cb` and signals cancellation back through an atomic flag.
+/// relays each progress report to `cb` and sends its answer back; the worker waits for it.
 pub(crate) fn guard_progress(
     cb: PleatProgressFn,
     user_data: *mut std::ffi::c_void,
@@ -347,19 +347,25 @@ fn run_on_pool(
     user_data: *mut std::ffi::c_void,
     f: impl FnOnce(&mut dyn FnMut(crate::Progress<'_>) -> bool) -> crate::Result<()>,
 ) -> std::thread::Result<crate::Result<()>> {
-    use std::sync::atomic::{AtomicBool, Ordering};
+    // The worker waits for the callback's answer at every report, so a
+    // cancellation takes effect at exactly the report that asked for it,
+    // whatever the thread count (reports are coarse: the round trip is cheap).
     let (tx, rx) = std::sync::mpsc::channel::<Msg>();
-    let cancel = AtomicBool::new(false);
+    let (answer_tx, answer_rx) = std::sync::mpsc::channel::<bool>();
     let job = AssertSend(f);
     pool.in_place_scope(|s| {
-        let cancel = &cancel;
         s.spawn(move |_| {
             let job = job;
             let progress_tx = tx.clone();
             let r = catch_unwind(AssertUnwindSafe(|| {
                 let mut relay = |p: crate::Progress<'_>| {
-                    let _ = progress_tx.send(Msg::Progress(p.stage.to_string(), p.fraction));
-                    !cancel.load(Ordering::Relaxed)
+                    if progress_tx
+                        .send(Msg::Progress(p.stage.to_string(), p.fraction))
+                        .is_err()
+                    {
+                        return false;
+                    }
+                    answer_rx.recv().unwrap_or(false)
                 };
                 (job.0)(&mut relay)
             }));
@@ -369,9 +375,8 @@ fn run_on_pool(
             match rx.recv() {
                 Ok(Msg::Progress(stage, fraction)) => {
                     // SAFETY: on the calling thread, with the caller's callback.
-                    if !unsafe { call_progress(cb, user_data, &stage, fraction) } {
-                        cancel.store(true, Ordering::Relaxed);
-                    }
+                    let go_on = unsafe { call_progress(cb, user_data, &stage, fraction) };
+                    let _ = answer_tx.send(go_on);
                 }
                 Ok(Msg::Done(r)) => return r,
                 Err(_) => return Ok(Err(Error::Internal("worker vanished".into()))),
