@@ -630,6 +630,13 @@ size_t pleat_cwf_vertex_count(const struct PleatCwf *cwf);
 // `cwf` is NULL or live.
 size_t pleat_cwf_edge_count(const struct PleatCwf *cwf);
 
+// Number of triangles of the field's base mesh (a third of the length of per-corner ω); 0
+// when `cwf` is NULL or the build lacks `wrinkle`.
+//
+// # Safety
+// `cwf` is NULL or live.
+size_t pleat_cwf_triangle_count(const struct PleatCwf *cwf);
+
 // Copies ω, one double per edge in pleat's edge numbering (`pleat_mesh_copy_edges` of the base
 // mesh), integrated from the smaller to the larger vertex index, in radians.
 //
@@ -646,7 +653,7 @@ PleatStatus pleat_cwf_copy_omega(const struct PleatCwf *cwf, double *dst, size_t
 // `pleat_cwf_create_from_corner_omega`).
 //
 // - `cwf`, `dst`: non-NULL.
-// - `corner_capacity`: doubles `dst` holds; ≥ 3 × the base mesh's triangle count, else
+// - `corner_capacity`: doubles `dst` holds; ≥ `3 * pleat_cwf_triangle_count(cwf)`, else
 //   `PLEAT_STATUS_LIMIT_EXCEEDED` and nothing is written.
 //
 // # Safety

@@ -488,6 +488,24 @@ pub unsafe extern "C" fn pleat_cwf_edge_count(cwf: *const PleatCwf) -> usize {
     }
 }
 
+/// Number of triangles of the field's base mesh (a third of the length of per-corner ω); 0
+/// when `cwf` is NULL or the build lacks `wrinkle`.
+///
+/// # Safety
+/// `cwf` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_cwf_triangle_count(cwf: *const PleatCwf) -> usize {
+    #[cfg(feature = "wrinkle")]
+    {
+        cwf.as_ref().map_or(0, |c| c.cwf.base().triangle_count())
+    }
+    #[cfg(not(feature = "wrinkle"))]
+    {
+        let _ = cwf;
+        0
+    }
+}
+
 /// Copies ω, one double per edge in pleat's edge numbering (`pleat_mesh_copy_edges` of the base
 /// mesh), integrated from the smaller to the larger vertex index, in radians.
 ///
@@ -514,7 +532,7 @@ pub unsafe extern "C" fn pleat_cwf_copy_omega(
 /// `pleat_cwf_create_from_corner_omega`).
 ///
 /// - `cwf`, `dst`: non-NULL.
-/// - `corner_capacity`: doubles `dst` holds; ≥ 3 × the base mesh's triangle count, else
+/// - `corner_capacity`: doubles `dst` holds; ≥ `3 * pleat_cwf_triangle_count(cwf)`, else
 ///   `PLEAT_STATUS_LIMIT_EXCEEDED` and nothing is written.
 ///
 /// # Safety
