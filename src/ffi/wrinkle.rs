@@ -370,8 +370,8 @@ pub unsafe extern "C" fn pleat_cwf_create_from_corner_omega(
 /// - `params`: Knöppel parameters; NULL = `pleat_knoppel_params_default()`.
 /// - `out`: receives the new field; non-NULL.
 ///
-/// A singularity (vortex) of the wave field becomes a vertex with z̃ = 0. Roughly linear in the
-/// vertex count after one sparse Cholesky factorization (~0.2 s for 100k vertices).
+/// A singularity (vortex) of the wave field becomes a vertex with z̃ = 0 when it falls on one.
+/// Cost: one sparse Cholesky factorization of a 2V × 2V matrix and a few solves.
 ///
 /// # Safety
 /// Pointers are NULL or valid for the sizes described above.
@@ -672,7 +672,8 @@ unsafe fn copy_doubles(src: &[f64], dst: *mut f64, capacity: usize, unit: &str) 
 ///   success.
 ///
 /// Runs in parallel on pleat's thread pool; output bytes do not depend on the thread count.
-/// About 4 M output triangles per second per core.
+/// Time and memory grow with the output size, `triangles · 4^levels` (see
+/// `benches/wrinkle_eval.rs` for measurements).
 ///
 /// # Safety
 /// Pointers are NULL or valid as described; `progress` is a valid function or NULL.
