@@ -809,6 +809,11 @@ unsafe fn copy_field<T: Copy>(
             "dst holds {element_capacity} elements, the field has {n}"
         )));
     }
+    if n.saturating_sub(1).checked_mul(stride).is_none() {
+        return Err(Error::InvalidArgument(format!(
+            "stride_bytes {stride_bytes} times {n} elements overflows"
+        )));
+    }
     for (i, e) in values.chunks_exact(comps).enumerate() {
         let q = (dst as *mut u8).add(i * stride) as *mut T;
         for (k, &c) in e.iter().enumerate() {
