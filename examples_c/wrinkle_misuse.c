@@ -295,6 +295,8 @@ static void misuse_evaluate(Input *in) {
                      PLEAT_STATUS_LIMIT_EXCEEDED);
         CHECK_STATUS(pleat_wrinkle_fields_copy(f, PLEAT_WRINKLE_FIELD_PHASE, buf, n, 4),
                      PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(pleat_wrinkle_fields_copy(f, PLEAT_WRINKLE_FIELD_PHASE, buf, n, (size_t)-1 / 2),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
         CHECK_STATUS(pleat_wrinkle_fields_copy(f, PLEAT_WRINKLE_FIELD_PHASE, NULL, n, 0),
                      PLEAT_STATUS_INVALID_ARGUMENT);
         CHECK_STATUS(pleat_wrinkle_fields_copy(NULL, PLEAT_WRINKLE_FIELD_PHASE, buf, n, 0),

@@ -833,8 +833,8 @@ PleatStatus pleat_cwf_create_from_corner_omega(const struct PleatMesh *base,
 // - `params`: Knöppel parameters; NULL = `pleat_knoppel_params_default()`.
 // - `out`: receives the new field; non-NULL.
 //
-// A singularity (vortex) of the wave field becomes a vertex with z̃ = 0. Roughly linear in the
-// vertex count after one sparse Cholesky factorization (~0.2 s for 100k vertices).
+// A singularity (vortex) of the wave field becomes a vertex with z̃ = 0 when it falls on one.
+// Cost: one sparse Cholesky factorization of a 2V × 2V matrix and a few solves.
 //
 // # Safety
 // Pointers are NULL or valid for the sizes described above.
@@ -896,6 +896,13 @@ size_t pleat_cwf_vertex_count(const struct PleatCwf *cwf);
 // `cwf` is NULL or live.
 size_t pleat_cwf_edge_count(const struct PleatCwf *cwf);
 
+// Number of triangles of the field's base mesh (a third of the length of per-corner ω); 0
+// when `cwf` is NULL or the build lacks `wrinkle`.
+//
+// # Safety
+// `cwf` is NULL or live.
+size_t pleat_cwf_triangle_count(const struct PleatCwf *cwf);
+
 // Copies ω, one double per edge in pleat's edge numbering (`pleat_mesh_copy_edges` of the base
 // mesh), integrated from the smaller to the larger vertex index, in radians.
 //
@@ -912,7 +919,7 @@ PleatStatus pleat_cwf_copy_omega(const struct PleatCwf *cwf, double *dst, size_t
 // `pleat_cwf_create_from_corner_omega`).
 //
 // - `cwf`, `dst`: non-NULL.
-// - `corner_capacity`: doubles `dst` holds; ≥ 3 × the base mesh's triangle count, else
+// - `corner_capacity`: doubles `dst` holds; ≥ `3 * pleat_cwf_triangle_count(cwf)`, else
 //   `PLEAT_STATUS_LIMIT_EXCEEDED` and nothing is written.
 //
 // # Safety
@@ -974,7 +981,8 @@ PleatStatus pleat_cwf_get_knoppel_report(const struct PleatCwf *cwf,
 //   success.
 //
 // Runs in parallel on pleat's thread pool; output bytes do not depend on the thread count.
-// About 4 M output triangles per second per core.
+// Time and memory grow with the output size, `triangles · 4^levels` (see
+// `benches/wrinkle_eval.rs` for measurements).
 //
 // # Safety
 // Pointers are NULL or valid as described; `progress` is a valid function or NULL.

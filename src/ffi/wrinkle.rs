@@ -370,8 +370,8 @@ pub unsafe extern "C" fn pleat_cwf_create_from_corner_omega(
 /// - `params`: Knöppel parameters; NULL = `pleat_knoppel_params_default()`.
 /// - `out`: receives the new field; non-NULL.
 ///
-/// A singularity (vortex) of the wave field becomes a vertex with z̃ = 0. Roughly linear in the
-/// vertex count after one sparse Cholesky factorization (~0.2 s for 100k vertices).
+/// A singularity (vortex) of the wave field becomes a vertex with z̃ = 0 when it falls on one.
+/// Cost: one sparse Cholesky factorization of a 2V × 2V matrix and a few solves.
 ///
 /// # Safety
 /// Pointers are NULL or valid for the sizes described above.
@@ -488,6 +488,24 @@ pub unsafe extern "C" fn pleat_cwf_edge_count(cwf: *const PleatCwf) -> usize {
     }
 }
 
+/// Number of triangles of the field's base mesh (a third of the length of per-corner ω); 0
+/// when `cwf` is NULL or the build lacks `wrinkle`.
+///
+/// # Safety
+/// `cwf` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_cwf_triangle_count(cwf: *const PleatCwf) -> usize {
+    #[cfg(feature = "wrinkle")]
+    {
+        cwf.as_ref().map_or(0, |c| c.cwf.base().triangle_count())
+    }
+    #[cfg(not(feature = "wrinkle"))]
+    {
+        let _ = cwf;
+        0
+    }
+}
+
 /// Copies ω, one double per edge in pleat's edge numbering (`pleat_mesh_copy_edges` of the base
 /// mesh), integrated from the smaller to the larger vertex index, in radians.
 ///
@@ -514,7 +532,7 @@ pub unsafe extern "C" fn pleat_cwf_copy_omega(
 /// `pleat_cwf_create_from_corner_omega`).
 ///
 /// - `cwf`, `dst`: non-NULL.
-/// - `corner_capacity`: doubles `dst` holds; ≥ 3 × the base mesh's triangle count, else
+/// - `corner_capacity`: doubles `dst` holds; ≥ `3 * pleat_cwf_triangle_count(cwf)`, else
 ///   `PLEAT_STATUS_LIMIT_EXCEEDED` and nothing is written.
 ///
 /// # Safety
@@ -654,7 +672,8 @@ unsafe fn copy_doubles(src: &[f64], dst: *mut f64, capacity: usize, unit: &str) 
 ///   success.
 ///
 /// Runs in parallel on pleat's thread pool; output bytes do not depend on the thread count.
-/// About 4 M output triangles per second per core.
+/// Time and memory grow with the output size, `triangles · 4^levels` (see
+/// `benches/wrinkle_eval.rs` for measurements).
 ///
 /// # Safety
 /// Pointers are NULL or valid as described; `progress` is a valid function or NULL.
@@ -788,6 +807,11 @@ unsafe fn copy_field<T: Copy>(
     if element_capacity < n {
         return Err(Error::LimitExceeded(format!(
             "dst holds {element_capacity} elements, the field has {n}"
+        )));
+    }
+    if n.saturating_sub(1).checked_mul(stride).is_none() {
+        return Err(Error::InvalidArgument(format!(
+            "stride_bytes {stride_bytes} times {n} elements overflows"
         )));
     }
     for (i, e) in values.chunks_exact(comps).enumerate() {
