@@ -1,7 +1,9 @@
 //! Interior removal (Algorithm 1, line 13): the unsigned offset has invisible components —
 //! the inner sheet of a closed input, bubbles inside thick parts. Each component of the
-//! (closed, oriented, intersection-free) offset mesh is dropped when a point of it has a
-//! non-zero winding number with respect to another component.
+//! (closed, oriented, intersection-free) offset surface is dropped when a point of it has a
+//! non-zero winding number with respect to another component. The pipeline decides this on the
+//! MC33 template surface right after extraction (see `offset::visible_patches`), so invisible
+//! components never reach the feature phase.
 //!
 //! Since the mesh is intersection-free, a component lies entirely inside or entirely outside
 //! another, so one sample vertex decides; the winding number of a closed surface at a point not
@@ -20,6 +22,7 @@ use super::geom::V3;
 use crate::mesh::TriMesh;
 use crate::spatial::FastWindingNumber;
 
+#[cfg(test)]
 /// Connected components of a triangle mesh through shared vertices: `comp[t]` per triangle and
 /// the component count. Components are numbered by their smallest triangle index.
 pub(crate) fn components(n_vertices: usize, tris: &[[u32; 3]]) -> (Vec<u32>, usize) {
