@@ -391,11 +391,9 @@ fn visible_patches(set: &PatchSet, stats: &mut Stats) -> Vec<bool> {
     // Template triangles with their patch's component.
     let mut tris = Vec::new();
     let mut tri_comp = Vec::new();
-    for p in 0..set.len() {
-        let before = tris.len();
+    for (p, &c) in pcomp.iter().enumerate() {
         set.patch_triangles(p, false, &mut tris);
-        tri_comp.resize(tris.len(), pcomp[p]);
-        debug_assert!(tris.len() > before);
+        tri_comp.resize(tris.len(), c);
     }
     let keep = visible_components(&set.positions, &tris, &tri_comp, n);
     stats.count(
