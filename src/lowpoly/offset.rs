@@ -14,7 +14,7 @@ use super::extract::{deviation, extract, ExtractParams, Mode, PatchSet};
 use super::filter::vertices_on_real_curves;
 use super::flips::{flip_to_features, FlipCounts};
 use super::geom::V3;
-use super::interior::visible_components;
+use super::interior::{visible_components, ComponentBox};
 use crate::mesh::{HalfEdgeMesh, MeshReport, ReportOptions, TriMesh};
 use crate::report::{Progress, ProgressFn, Stats};
 use crate::{Error, Result};
@@ -388,14 +388,26 @@ fn visible_patches(set: &PatchSet, stats: &mut Stats) -> Vec<bool> {
         stats.count("components_removed", 0);
         return vec![true; set.len()];
     }
-    // Template triangles with their patch's component.
-    let mut tris = Vec::new();
-    let mut tri_comp = Vec::new();
+    let mut boxes = vec![ComponentBox::empty([0.0; 3]); n];
+    let mut patches_of: Vec<Vec<u32>> = vec![Vec::new(); n];
     for (p, &c) in pcomp.iter().enumerate() {
-        set.patch_triangles(p, false, &mut tris);
-        tri_comp.resize(tris.len(), c);
+        let b = &mut boxes[c as usize];
+        if patches_of[c as usize].is_empty() {
+            b.sample = set.positions[set.ids(p)[0] as usize];
+        }
+        patches_of[c as usize].push(p as u32);
+        for &v in set.ids(p) {
+            b.grow(set.positions[v as usize]);
+        }
     }
-    let keep = visible_components(&set.positions, &tris, &tri_comp, n);
+    let triangles = |c: usize| {
+        let mut t = Vec::new();
+        for &p in &patches_of[c] {
+            set.patch_triangles(p as usize, false, &mut t);
+        }
+        t
+    };
+    let keep = visible_components(&set.positions, &boxes, &triangles);
     stats.count(
         "components_removed",
         keep.iter().filter(|&&k| !k).count() as u64,
