@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use pleat::lowpoly::{offset_surface, OffsetDistance, OffsetParams};
+use pleat::lowpoly::{offset_surface_with_progress, OffsetDistance, OffsetParams};
 use pleat::mesh::TriMesh;
 
 fn corpus_dir() -> Option<PathBuf> {
@@ -59,7 +59,21 @@ fn child(path: &Path, np: f64) {
     };
     let t = Instant::now();
     let cpu0 = cpu_seconds();
-    match offset_surface(&mesh, &params) {
+    let trace = std::env::var("PLEAT_BENCH_MEMTRACE").is_ok();
+    let mut last = String::new();
+    let mut progress = |p: pleat::Progress<'_>| {
+        if trace && p.stage != last {
+            eprintln!(
+                "  [{:>8.3} s] {:<10} VmHWM {:7.1} MiB",
+                t.elapsed().as_secs_f64(),
+                p.stage,
+                peak_rss_bytes() as f64 / 1048576.0
+            );
+            last = p.stage.to_string();
+        }
+        true
+    };
+    match offset_surface_with_progress(&mesh, &params, &mut progress) {
         Ok((out, stats)) => {
             let total = t.elapsed().as_secs_f64();
             let cpu = cpu_seconds() - cpu0;

@@ -75,8 +75,10 @@ pub(crate) struct PatchSet {
     pub center: Vec<u32>,
     /// Feature vertex, or [`NONE`].
     pub feature: Vec<u32>,
-    /// Patch of each feature vertex id.
-    pub feature_patch: std::collections::HashMap<u32, u32>,
+    /// Largest angle between two iso-point normals of the patch, in degrees.
+    pub normal_spread_deg: Vec<f32>,
+    /// Patch of each extra vertex (id `n_iso + i`), [`NONE`] for centers.
+    pub feature_patch: Vec<u32>,
     /// Counters.
     pub counts: ExtractCounts,
 }
@@ -122,6 +124,50 @@ impl ExtractCounts {
 }
 
 impl PatchSet {
+    /// Components of the surface, per patch (patches are connected through shared
+    /// iso-points), numbered from 0 by their first patch; and the count.
+    pub(crate) fn patch_components(&self) -> (Vec<u32>, usize) {
+        let mut parent: Vec<u32> = (0..self.n_iso as u32).collect();
+        fn find(p: &mut [u32], mut x: u32) -> u32 {
+            while p[x as usize] != x {
+                p[x as usize] = p[p[x as usize] as usize];
+                x = p[x as usize];
+            }
+            x
+        }
+        for p in 0..self.len() {
+            let ids = self.ids(p);
+            for &v in &ids[1..] {
+                let (a, b) = (find(&mut parent, ids[0]), find(&mut parent, v));
+                if a != b {
+                    parent[a.max(b) as usize] = a.min(b);
+                }
+            }
+        }
+        let mut label = vec![NONE; self.n_iso];
+        let mut n = 0usize;
+        let comp = (0..self.len())
+            .map(|p| {
+                let r = find(&mut parent, self.ids(p)[0]) as usize;
+                if label[r] == NONE {
+                    label[r] = n as u32;
+                    n += 1;
+                }
+                label[r]
+            })
+            .collect();
+        (comp, n)
+    }
+
+    /// The patch whose feature vertex is `id`, if `id` is one.
+    pub(crate) fn patch_of_feature(&self, id: u32) -> Option<usize> {
+        let i = (id as usize).checked_sub(self.n_iso)?;
+        self.feature_patch
+            .get(i)
+            .filter(|&&p| p != NONE)
+            .map(|&p| p as usize)
+    }
+
     /// Number of patches.
     pub(crate) fn len(&self) -> usize {
         self.first_len.len()
@@ -158,15 +204,19 @@ impl PatchSet {
         }
     }
 
-    /// The mesh with feature vertices where `use_feature(p)`: compacted positions, triangles,
-    /// and for each output vertex its id in [`PatchSet::positions`].
+    /// The mesh of the patches as `mode` says: compacted positions, triangles, and for each
+    /// output vertex its id in [`PatchSet::positions`].
     pub(crate) fn assemble(
         &self,
-        use_feature: &dyn Fn(usize) -> bool,
+        mode: &dyn Fn(usize) -> Mode,
     ) -> (Vec<V3>, Vec<[u32; 3]>, Vec<u32>) {
         let mut tris = Vec::new();
         for p in 0..self.len() {
-            self.patch_triangles(p, use_feature(p), &mut tris);
+            match mode(p) {
+                Mode::Skip => {}
+                Mode::Template => self.patch_triangles(p, false, &mut tris),
+                Mode::Feature => self.patch_triangles(p, true, &mut tris),
+            }
         }
         let mut remap = vec![NONE; self.positions.len()];
         let mut back = Vec::new();
@@ -182,6 +232,17 @@ impl PatchSet {
         let pos = back.iter().map(|&v| self.positions[v as usize]).collect();
         (pos, tris, back)
     }
+}
+
+/// How a patch enters an assembled mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Mode {
+    /// Left out (an invisible component).
+    Skip,
+    /// MC33 template triangulation.
+    Template,
+    /// Fan around the feature vertex (the template when it has none).
+    Feature,
 }
 
 /// Eight corner values of the cube at `p` through a brick's neighbourhood.
@@ -289,9 +350,11 @@ pub(crate) fn extract(
                 let mut mixed = 0;
                 let cells = for_mixed_cubes(grid, k, p.d, |g, v| {
                     mixed += 1;
-                    let dec = decide(v);
-                    for (e, ec) in EDGE_CORNERS.iter().enumerate() {
-                        if (dec.inside >> ec[0] & 1) != (dec.inside >> ec[1] & 1) {
+                    // Each grid edge is edge 0, 4 or 8 (leaving corner 0) of exactly one cube:
+                    // emit it from there only, so every key appears once.
+                    for e in [0usize, 4, 8] {
+                        let ec = EDGE_CORNERS[e];
+                        if (v[ec[0] as usize] < 0.0) != (v[ec[1] as usize] < 0.0) {
                             out.push(cube_edge_key(g, e));
                         }
                     }
@@ -309,7 +372,6 @@ pub(crate) fn extract(
         }
     }
     keys.par_sort_unstable();
-    keys.dedup();
     // Iso-points and their normals (eq. 4.3).
     let iso: Vec<IsoPoint> = keys
         .par_iter()
@@ -344,13 +406,12 @@ pub(crate) fn extract(
         }
     }
     set.counts.add(&counts);
-    set.feature_patch = set
-        .feature
-        .iter()
-        .enumerate()
-        .filter(|(_, &f)| f != NONE)
-        .map(|(p, &f)| (f, p as u32))
-        .collect();
+    set.feature_patch = vec![NONE; set.positions.len() - set.n_iso];
+    for (p, &f) in set.feature.iter().enumerate() {
+        if f != NONE {
+            set.feature_patch[f as usize - set.n_iso] = p as u32;
+        }
+    }
     Ok(set)
 }
 
@@ -485,6 +546,7 @@ struct BrickPatches {
     extra: Vec<V3>,
     center: Vec<u32>,
     feature: Vec<u32>,
+    spread: Vec<f32>,
     counts: ExtractCounts,
 }
 
@@ -578,6 +640,7 @@ fn cube_patches(
         let f = push_extra(pg.feature);
         out.center.push(c);
         out.feature.push(f);
+        out.spread.push(pg.normal_spread_deg);
     }
 }
 
@@ -599,6 +662,7 @@ fn append(set: &mut PatchSet, bp: BrickPatches) {
     let shift = |x: u32| if x == NONE { NONE } else { base + x };
     set.center.extend(bp.center.into_iter().map(shift));
     set.feature.extend(bp.feature.into_iter().map(shift));
+    set.normal_spread_deg.extend(bp.spread);
     set.loop_ids.extend(bp.loop_ids);
     for l in bp.loop_len {
         let last = *set.loop_off.last().unwrap_or(&0);

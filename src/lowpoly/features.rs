@@ -265,6 +265,8 @@ pub(crate) struct PatchGeom {
     pub center: Option<V3>,
     /// Template triangulation (local indices; `edges.len()` is the center).
     pub plain: Vec<LocalTri>,
+    /// Largest angle (degrees) between two iso-point normals of the patch (0 without normals).
+    pub normal_spread_deg: f32,
 }
 
 impl PatchGeom {
@@ -333,6 +335,7 @@ pub(crate) fn cube_geometry(
             feature: None,
             center: None,
             plain: Vec::new(),
+            normal_spread_deg: 0.0,
         };
         if g.is_annulus() {
             let (a, b) = pts[k].split_at(first_len);
@@ -421,6 +424,7 @@ fn disk_geometry(
     };
     if let (Some(nrm), true) = (normals, separated) {
         g.feature = feature_vertex(pts, &g.edges, nrm, c, cons).map(onto_surface);
+        g.normal_spread_deg = normal_spread(&g.edges, nrm);
     }
     if !plain_disk(pts, &g.edges, &mut g.plain) {
         // Template needs a center: the centroid projected into the polyhedron.
@@ -434,6 +438,17 @@ fn disk_geometry(
 
 fn clamp_into_cube(p: V3) -> V3 {
     p.map(|x| x.clamp(0.25, 0.75))
+}
+
+/// Largest angle between two of the normals of `edges`, in degrees.
+fn normal_spread(edges: &[u8], nrm: &[V3; 12]) -> f32 {
+    let mut min_cos = 1.0f64;
+    for (i, &a) in edges.iter().enumerate() {
+        for &b in &edges[i + 1..] {
+            min_cos = min_cos.min(dot(nrm[a as usize], nrm[b as usize]));
+        }
+    }
+    min_cos.clamp(-1.0, 1.0).acos().to_degrees() as f32
 }
 
 /// Eq. 4.3 with Tikhonov regularisation toward the centroid `c`.

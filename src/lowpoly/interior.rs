@@ -1,7 +1,9 @@
 //! Interior removal (Algorithm 1, line 13): the unsigned offset has invisible components —
 //! the inner sheet of a closed input, bubbles inside thick parts. Each component of the
-//! (closed, oriented, intersection-free) offset mesh is dropped when a point of it has a
-//! non-zero winding number with respect to another component.
+//! (closed, oriented, intersection-free) offset surface is dropped when a point of it has a
+//! non-zero winding number with respect to another component. The pipeline decides this on the
+//! MC33 template surface right after extraction (see `offset::visible_patches`), so invisible
+//! components never reach the feature phase.
 //!
 //! Since the mesh is intersection-free, a component lies entirely inside or entirely outside
 //! another, so one sample vertex decides; the winding number of a closed surface at a point not
@@ -20,6 +22,7 @@ use super::geom::V3;
 use crate::mesh::TriMesh;
 use crate::spatial::FastWindingNumber;
 
+#[cfg(test)]
 /// Connected components of a triangle mesh through shared vertices: `comp[t]` per triangle and
 /// the component count. Components are numbered by their smallest triangle index.
 pub(crate) fn components(n_vertices: usize, tris: &[[u32; 3]]) -> (Vec<u32>, usize) {
@@ -55,25 +58,51 @@ pub(crate) fn components(n_vertices: usize, tris: &[[u32; 3]]) -> (Vec<u32>, usi
     (comp, n)
 }
 
-/// Which components to keep: those not inside any other component.
+/// A component as the containment test sees it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ComponentBox {
+    /// Bounding box.
+    pub lo: V3,
+    /// Bounding box.
+    pub hi: V3,
+    /// A point on the component.
+    pub sample: V3,
+}
+
+impl ComponentBox {
+    /// An empty box with sample point `sample`.
+    pub(crate) fn empty(sample: V3) -> ComponentBox {
+        ComponentBox {
+            lo: [f64::INFINITY; 3],
+            hi: [f64::NEG_INFINITY; 3],
+            sample,
+        }
+    }
+
+    /// Extends the box to contain `x`.
+    pub(crate) fn grow(&mut self, x: V3) {
+        for ((lo, hi), v) in self.lo.iter_mut().zip(self.hi.iter_mut()).zip(x) {
+            *lo = lo.min(v);
+            *hi = hi.max(v);
+        }
+    }
+}
+
+/// Which of `n` components to keep: those not inside any other. `boxes[c]` describes
+/// component `c`; `triangles(c)` yields its closed triangle set (asked only for components
+/// that contain another's box, the only possible containers).
 pub(crate) fn visible_components(
     pos: &[V3],
-    tris: &[[u32; 3]],
-    comp: &[u32],
-    n: usize,
+    boxes: &[ComponentBox],
+    triangles: &(dyn Fn(usize) -> Vec<[u32; 3]> + Sync),
 ) -> Vec<bool> {
+    let n = boxes.len();
     if n <= 1 {
         return vec![true; n];
     }
-    let mut members: Vec<Vec<[u32; 3]>> = vec![Vec::new(); n];
-    for (t, &c) in tris.iter().zip(comp) {
-        members[c as usize].push(*t);
-    }
-    let boxes: Vec<(V3, V3)> = members.iter().map(|m| bbox(pos, m)).collect();
-    // Candidate containers of each component: components whose box contains its box.
     let aabbs: Vec<Aabb> = boxes
         .iter()
-        .map(|b| Aabb::new(Vector::from(b.0), Vector::from(b.1)))
+        .map(|b| Aabb::new(Vector::from(b.lo), Vector::from(b.hi)))
         .collect();
     let tree = Bvh::from_leaves(BvhBuildStrategy::Binned, &aabbs);
     let mut inside_of: Vec<Vec<u32>> = vec![Vec::new(); n];
@@ -84,22 +113,21 @@ pub(crate) fn visible_components(
             }
         }
     }
-    // One winding-number hierarchy per actual container (Barill et al. 2018).
+    // One winding-number hierarchy per actual container (Barill et al. 2018), built one at a
+    // time so only one container's hierarchy is alive per thread.
     let hidden: Vec<Vec<u32>> = (0..n)
         .into_par_iter()
         .filter(|&b| !inside_of[b].is_empty())
         .map(|b| {
-            let Some(mesh) = component_mesh(pos, &members[b]) else {
+            let Some(mesh) = component_mesh(pos, &triangles(b)) else {
                 return Vec::new();
             };
             let fwn = FastWindingNumber::new(&mesh);
+            drop(mesh);
             inside_of[b]
                 .iter()
                 .copied()
-                .filter(|&a| {
-                    let q = pos[members[a as usize][0][0] as usize];
-                    fwn.winding_number(q).abs() > 0.5
-                })
+                .filter(|&a| fwn.winding_number(boxes[a as usize].sample).abs() > 0.5)
                 .collect()
         })
         .collect();
@@ -128,23 +156,8 @@ fn component_mesh(pos: &[V3], tris: &[[u32; 3]]) -> Option<TriMesh> {
     TriMesh::new(p, t).ok()
 }
 
-fn bbox(pos: &[V3], tris: &[[u32; 3]]) -> (V3, V3) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for t in tris {
-        for &v in t {
-            let p = pos[v as usize];
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
-    }
-    (lo, hi)
-}
-
-fn contains(outer: &(V3, V3), inner: &(V3, V3)) -> bool {
-    (0..3).all(|k| outer.0[k] <= inner.0[k] && inner.1[k] <= outer.1[k])
+fn contains(outer: &ComponentBox, inner: &ComponentBox) -> bool {
+    (0..3).all(|k| outer.lo[k] <= inner.lo[k] && inner.hi[k] <= outer.hi[k])
 }
 
 #[cfg(test)]
@@ -194,8 +207,27 @@ mod tests {
         }
         let (comp, n) = components(pos.len(), &tris);
         assert_eq!(n, 3);
+        let members: Vec<Vec<[u32; 3]>> = (0..n as u32)
+            .map(|c| {
+                tris.iter()
+                    .zip(&comp)
+                    .filter(|x| *x.1 == c)
+                    .map(|x| *x.0)
+                    .collect()
+            })
+            .collect();
+        let boxes: Vec<ComponentBox> = members
+            .iter()
+            .map(|m| {
+                let mut b = ComponentBox::empty(pos[m[0][0] as usize]);
+                for &v in m.iter().flatten() {
+                    b.grow(pos[v as usize]);
+                }
+                b
+            })
+            .collect();
         assert_eq!(
-            visible_components(&pos, &tris, &comp, n),
+            visible_components(&pos, &boxes, &|c| members[c].clone()),
             vec![true, false, true]
         );
     }
