@@ -12,21 +12,6 @@
 #include <stddef.h>
 #include <stdint.h>
 
-// The id meaning "no element" (a boundary half-edge's face, a deleted element's links, ...).
-#define INVALID UINT32_MAX
-
-// The safety factor of Alg. 4 line 5.
-#define SAFETY_FACTOR 0.95
-
-// Halvings of the line search before a vertex is left in place (α ≥ 2⁻¹⁰).
-#define MAX_HALVINGS 10
-
-// Samples per bounding-box diagonal of the final Hausdorff measurement (spacing `l / 400`).
-#define FINAL_SAMPLES_PER_DIAGONAL 400.0
-
-// Weight of an edge's virtual plane relative to `|e|²` (face planes weigh their area).
-#define VIRTUAL_PLANE_WEIGHT 0.01
-
 // Version of the C ABI. Incremented on any incompatible change to a function signature or to
 // the layout of an existing struct field. Adding functions or appending struct fields (behind
 // `struct_size`) does not change it.
@@ -80,11 +65,38 @@ typedef int32_t PleatStatus;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
+// Kind of entry in a `PleatStats`, for `pleat_stats_entry`.
+enum PleatStatsKind
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : int32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  // Wall-clock seconds of a stage, in execution order.
+  PLEAT_STATS_KIND_STAGE = 0,
+  // A count (cells visited, faces out, flips, ...); the value is an integer.
+  PLEAT_STATS_KIND_COUNT = 1,
+  // A real metric (e.g. `hausdorff_rel`: two-sided Hausdorff distance / bbox diagonal).
+  PLEAT_STATS_KIND_METRIC = 2,
+  // A guarantee checked by independent code after the operation: value 1 (holds) or 0.
+  PLEAT_STATS_KIND_VERIFIED = 3,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum PleatStatsKind PleatStatsKind;
+#else
+typedef int32_t PleatStatsKind;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
 // An indexed triangle mesh owned by pleat (opaque). Created by `pleat_mesh_create_*`,
 // `pleat_mesh_read_file` or an operation that returns a mesh; destroyed by
 // `pleat_mesh_destroy`. Immutable after creation, so it may be read from several threads at
 // once; destroying it while another thread uses it is undefined.
 typedef struct PleatMesh PleatMesh;
+
+// Statistics of one long operation (opaque). Returned through the optional `PleatStats **`
+// output of long operations; destroyed with `pleat_stats_destroy`. Immutable.
+typedef struct PleatStats PleatStats;
 
 // Parameters of `pleat_lod_generate`, `pleat_lod_generate_chain` and `pleat_cage_generate`.
 // Get the defaults from `pleat_lod_params_default()` and change what you need; the defaults
@@ -107,7 +119,7 @@ typedef struct PleatLodParams {
   double flow_ratio;
   // Convergence threshold ε relative to l (default 1e-4), >= 0.
   double epsilon;
-  // Feature-curve dihedral threshold θ0 in degrees, (0, 180] (default 120).
+  // Feature-curve dihedral threshold θ0 in degrees, (0, 180) (default 120).
   double theta0_deg;
   // Minimum feature-curve length l0 in edges (default 4).
   uint32_t l0;
@@ -178,6 +190,38 @@ typedef struct PleatLodStats {
   // 1 when a target face count was given and met.
   uint32_t target_met;
 } PleatLodStats;
+
+// Parameters of `pleat_offset_surface`. Get defaults from `pleat_offset_params_default()` and
+// change what you need; `struct_size` lets newer libraries accept older callers.
+typedef struct PleatOffsetParams {
+  // `sizeof(PleatOffsetParams)` as the caller knows it (set by the default function).
+  uint32_t struct_size;
+  // 0: `d = bbox diagonal / screen_size` (default); 1: `d = distance` in model units.
+  uint32_t use_absolute_distance;
+  // Screen size n_p in pixels covered by the bounding-box diagonal; > 0. Default 200.
+  double screen_size;
+  // Offset distance d in model units when `use_absolute_distance` is 1; > 0. Default 0.
+  double distance;
+  // Voxel edge as a multiple of d/√3; > 0, at most 2 is sensible. Default 1.
+  double voxel_scale;
+  // Feature-curve dihedral threshold θ0 in degrees, in (0, 180). Default 120.
+  double theta0_deg;
+  // Minimum edges of a real feature curve l0. Default 4.
+  uint32_t l0;
+  // 1: insert feature vertices to recover sharp creases (default); 0: plain MC33.
+  uint32_t features;
+  // 1: drop components inside other components (default); 0: keep them.
+  uint32_t remove_interior;
+  // Secant steps refining each iso-point against the exact distance, 0–64. Default 0.
+  uint32_t iso_refinement_steps;
+  // Memory budget of the distance band and extraction in bytes; exceeding it fails with
+  // `PLEAT_STATUS_LIMIT_EXCEEDED` before the expensive work. Default 2 GiB.
+  uint64_t memory_budget_bytes;
+  // 1: verify the output with independent checks, recorded in the stats (default); 0: skip.
+  uint32_t verify;
+  // Reserved, must be 0.
+  uint32_t reserved;
+} PleatOffsetParams;
 
 // Validity report of a triangle soup, filled by `pleat_mesh_check`. Counts follow the
 // independent checker's definitions (see README). Yes/no fields are 0 or 1.
@@ -456,6 +500,32 @@ PleatStatus pleat_mesh_read_file(const char *path, struct PleatMesh **out);
 // `mesh` is NULL or live; `path` is NULL or NUL-terminated.
 PleatStatus pleat_mesh_write_file(const struct PleatMesh *mesh, const char *path);
 
+// The default offset parameters (screen size 200, features on, θ0 = 120°, l0 = 4).
+struct PleatOffsetParams pleat_offset_params_default(void);
+
+// Computes the watertight, manifold, self-intersection-free, feature-preserving d-offset
+// surface of any triangle soup (stage 1 of the LOD pipeline, dissertation §4.3.1).
+//
+// - `mesh`: the input, any soup; non-NULL.
+// - `params`: NULL for defaults, else initialised by `pleat_offset_params_default()`.
+// - `progress`, `user_data`: optional callback (NULL for none), called on this thread; a
+//   non-zero return cancels with `PLEAT_STATUS_CANCELLED`.
+// - `out`: receives the new mesh on success; non-NULL.
+// - `out_stats`: receives a `PleatStats` (destroy with `pleat_stats_destroy`); NULL to skip.
+//
+// Errors: `PLEAT_STATUS_INVALID_ARGUMENT` for NULL/NaN/out-of-range parameters,
+// `PLEAT_STATUS_LIMIT_EXCEEDED` when the grid would exceed `memory_budget_bytes`,
+// `PLEAT_STATUS_CANCELLED`, and `PLEAT_STATUS_UNSUPPORTED` in a build without feature `lod`.
+//
+// # Safety
+// Pointers are NULL or valid as described.
+PleatStatus pleat_offset_surface(const struct PleatMesh *mesh,
+                                 const struct PleatOffsetParams *params,
+                                 PleatProgressFn progress,
+                                 void *user_data,
+                                 struct PleatMesh **out,
+                                 struct PleatStats **out_stats);
+
 // Computes the validity report of `mesh` (any soup) into `*out`.
 //
 // - `mesh`: non-NULL.
@@ -470,6 +540,49 @@ PleatStatus pleat_mesh_write_file(const struct PleatMesh *mesh, const char *path
 PleatStatus pleat_mesh_check(const struct PleatMesh *mesh,
                              uint32_t flags,
                              struct PleatMeshReport *out);
+
+// Number of entries of `kind` (0 when `stats` is NULL).
+//
+// # Safety
+// `stats` is NULL or live.
+size_t pleat_stats_count(const struct PleatStats *stats, PleatStatsKind kind);
+
+// Entry `index` of `kind`: its name (NUL-terminated, valid until the stats are destroyed) and
+// value (seconds for stages, the count as a double for counts, 1/0 for verified guarantees).
+//
+// - `name`, `value`: outputs; either may be NULL to skip it.
+// - Returns `PLEAT_STATUS_INVALID_ARGUMENT` for a NULL `stats` or an index out of range.
+//
+// # Safety
+// `stats` is NULL or live; `name`/`value` are NULL or valid for a write.
+PleatStatus pleat_stats_entry(const struct PleatStats *stats,
+                              PleatStatsKind kind,
+                              size_t index,
+                              const char **name,
+                              double *value);
+
+// Total wall-clock seconds over all stages (0 when `stats` is NULL).
+//
+// # Safety
+// `stats` is NULL or live.
+double pleat_stats_total_seconds(const struct PleatStats *stats);
+
+// Copies the stats as one JSON object (`{"stages":{..},"counts":{..},"metrics":{..},
+// "verified":{..}}`) into `buf` (capacity `len`, NUL-terminated, truncated if needed); the
+// full length without the NUL goes to `needed` (may be NULL). `buf` may be NULL with `len` 0.
+//
+// # Safety
+// `stats` is NULL or live; `buf` valid for `len` bytes; `needed` NULL or valid.
+PleatStatus pleat_stats_to_json(const struct PleatStats *stats,
+                                char *buf,
+                                size_t len,
+                                size_t *needed);
+
+// Destroys stats; NULL is ignored.
+//
+// # Safety
+// `stats` is NULL or a live handle not yet destroyed.
+void pleat_stats_destroy(struct PleatStats *stats);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -36,6 +36,8 @@ pub enum Error {
     OutOfMemory,
     /// A bug in pleat: please report it with the input that triggered it.
     Internal(String),
+    /// This build was compiled without the capability (cargo feature) the call needs.
+    Unsupported(String),
 }
 
 impl fmt::Display for Error {
@@ -50,6 +52,7 @@ impl fmt::Display for Error {
             Error::LimitExceeded(m) => write!(f, "limit exceeded: {m}"),
             Error::OutOfMemory => write!(f, "out of memory"),
             Error::Internal(m) => write!(f, "internal error (a bug in pleat): {m}"),
+            Error::Unsupported(m) => write!(f, "not supported by this build: {m}"),
         }
     }
 }

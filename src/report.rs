@@ -57,6 +57,65 @@ impl Stats {
     }
 }
 
+impl Stats {
+    /// The stats as one JSON object with four maps in insertion order:
+    /// `{"stages":{name:seconds},"counts":{..},"metrics":{..},"verified":{name:bool}}`.
+    /// Non-finite metrics are written as `null`.
+    pub fn to_json(&self) -> String {
+        fn esc(s: &str) -> String {
+            let mut o = String::with_capacity(s.len() + 2);
+            o.push('"');
+            for c in s.chars() {
+                match c {
+                    '"' => o.push_str("\\\""),
+                    '\\' => o.push_str("\\\\"),
+                    c if (c as u32) < 0x20 => o.push_str(&format!("\\u{:04x}", c as u32)),
+                    c => o.push(c),
+                }
+            }
+            o.push('"');
+            o
+        }
+        fn num(v: f64) -> String {
+            if v.is_finite() {
+                format!("{v:?}")
+            } else {
+                "null".into()
+            }
+        }
+        let map = |items: Vec<(String, String)>| {
+            let body: Vec<String> = items
+                .iter()
+                .map(|(k, v)| format!("{}:{v}", esc(k)))
+                .collect();
+            format!("{{{}}}", body.join(","))
+        };
+        format!(
+            "{{\"stages\":{},\"counts\":{},\"metrics\":{},\"verified\":{}}}",
+            map(self
+                .stages
+                .iter()
+                .map(|(k, v)| (k.clone(), num(*v)))
+                .collect()),
+            map(self
+                .counts
+                .iter()
+                .map(|(k, v)| (k.clone(), v.to_string()))
+                .collect()),
+            map(self
+                .metrics
+                .iter()
+                .map(|(k, v)| (k.clone(), num(*v)))
+                .collect()),
+            map(self
+                .verified
+                .iter()
+                .map(|(k, v)| (k.clone(), v.to_string()))
+                .collect()),
+        )
+    }
+}
+
 /// Progress information passed to a progress callback.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Progress<'a> {

@@ -7,8 +7,10 @@ fn generate() -> String {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let config = cbindgen::Config::from_file(root.join("cbindgen.toml")).expect("cbindgen.toml");
     let mut out = Vec::new();
+    // Only src/ffi/ is the C ABI: parse it alone, so public Rust constants elsewhere in the
+    // crate never leak into the header.
     cbindgen::Builder::new()
-        .with_crate(&root)
+        .with_src(root.join("src/ffi/mod.rs"))
         .with_config(config)
         .generate()
         .expect("cbindgen failed")

@@ -52,6 +52,7 @@ impl PleatStatus {
             Error::LimitExceeded(_) => PleatStatus::LimitExceeded,
             Error::OutOfMemory => PleatStatus::OutOfMemory,
             Error::Internal(_) => PleatStatus::Internal,
+            Error::Unsupported(_) => PleatStatus::Unsupported,
         }
     }
 }
@@ -99,16 +100,6 @@ fn status_of(result: std::thread::Result<crate::Result<()>>) -> PleatStatus {
         Ok(Err(e)) => fail(e),
         Err(p) => fail(Error::Internal(format!("panic: {}", panic_message(&*p)))),
     }
-}
-
-/// Records that this build lacks the cargo feature `feature` and returns
-/// `PleatStatus::Unsupported` (for entry points whose capability was left out).
-#[allow(dead_code)]
-pub(crate) fn unsupported(feature: &str) -> PleatStatus {
-    set_last_error(&format!(
-        "this build of pleat was compiled without the `{feature}` feature"
-    ));
-    PleatStatus::Unsupported
 }
 
 /// `Err(InvalidArgument)` naming a NULL pointer parameter.
@@ -295,7 +286,6 @@ pub type PleatProgressFn = Option<
 ///
 /// # Safety
 /// `cb` and `user_data` are as the caller of the pleat entry point passed them.
-#[allow(dead_code)] // used by the long operations' entry points
 unsafe fn call_progress(
     cb: PleatProgressFn,
     user_data: *mut std::ffi::c_void,
@@ -311,7 +301,6 @@ unsafe fn call_progress(
     f(user_data, &info) == 0
 }
 
-#[allow(dead_code)] // used by the long operations' entry points
 enum Msg {
     Progress(String, f64),
     Done(std::thread::Result<crate::Result<()>>),
@@ -323,7 +312,6 @@ enum Msg {
 /// invoked on the calling thread: without a custom pool `f` runs on the calling thread; with a
 /// pool set by `pleat_set_thread_count`, `f` runs on a pool worker while the calling thread
 /// relays progress messages to `cb` and signals cancellation back through an atomic flag.
-#[allow(dead_code)] // used by the long operations' entry points
 pub(crate) fn guard_progress(
     cb: PleatProgressFn,
     user_data: *mut std::ffi::c_void,
@@ -342,7 +330,6 @@ pub(crate) fn guard_progress(
     status_of(result)
 }
 
-#[allow(dead_code)] // used by the long operations' entry points
 fn run_on_pool(
     pool: &rayon::ThreadPool,
     cb: PleatProgressFn,

@@ -17,9 +17,13 @@
 mod common;
 mod lod;
 mod mesh;
+mod offset;
 mod report;
+mod stats;
 
 pub use common::*;
 pub use lod::*;
 pub use mesh::*;
+pub use offset::*;
 pub use report::*;
+pub use stats::*;

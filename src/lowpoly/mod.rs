@@ -1,21 +1,35 @@
 //! Low-poly meshes by screen size (dissertation ch. 4).
 //!
+//! Stage 1, [`offset_surface`]: the robust, feature-preserving `d`-offset surface of any
+//! triangle soup (§4.3.1): narrow-band unsigned distance (`distance`), Marching Cubes 33
+//! topology (`mc33`), feature vertices (`features`), interior removal (`interior`).
+//!
 //! Stage 2, the mesh-optimization loop (§4.3.2–4.3.3, Alg. 3–7): [`generate`] bakes one LOD,
 //! [`generate_chain`] several. Every local operation of the loop — edge collapses
-//! ([`simplify`](self) , Alg. 5), the flow (Alg. 3–4) and the feature alignment (Alg. 6, eq.
-//! 4.5) — goes through one guard (`guard.rs`) that keeps the mesh watertight, manifold, of the
-//! same topology and free of self-intersections, and in cage mode (`crate::cage`) disjoint
-//! from the input and enclosing it.
+//! (`simplify.rs`, Alg. 5), the flow (Alg. 3–4) and the feature alignment (Alg. 6, eq. 4.5) —
+//! goes through one guard (`guard.rs`) that keeps the mesh watertight, manifold, of the same
+//! topology and free of self-intersections, and in cage mode (`crate::cage`) disjoint from the
+//! input and enclosing it.
 
 mod align;
+pub(crate) mod distance;
+mod extract;
+pub(crate) mod features;
+mod filter;
+mod flips;
 mod flow;
+mod geom;
 pub(crate) mod guard;
+mod interior;
+pub(crate) mod mc33;
 pub(crate) mod measure;
+mod offset;
 mod pipeline;
 mod simplify;
 mod vec3;
 
 pub use guard::CONE_HALF_ANGLE;
+pub use offset::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};
 pub use pipeline::{generate, generate_chain, LodParams};
 #[cfg(feature = "cage")]
 pub(crate) use pipeline::{run, run_chain, Mode};

@@ -7,19 +7,21 @@
 //! 2. degenerate faces (exactly collinear corners, including repeated indices after welding) are
 //!    reported separately and take part in no pair;
 //! 3. every other pair of faces whose closed bounding boxes meet is tested with
-//!    [`faces_intersect`](super::faces_intersect): shared vertex or edge is allowed, anything
+//!    [`faces_intersect`](super::faces_intersect()): shared vertex or edge is allowed, anything
 //!    more (folded-over neighbours, duplicate faces, touching, crossing, coplanar overlap) is an
 //!    intersection (dissertation §4.3.3: "a mesh has intersections when any of its two triangles
 //!    overlaps, or any of its two non-adjacent triangles touch or intersect").
 //!
 //! Broad phase: the non-degenerate faces are cut into spatially coherent chunks (runs of the
-//! Morton order of their box centres), one [`TriangleBvh`] per chunk is built in parallel, and
-//! every chunk tree is traversed against itself and against every later chunk whose bounds it
-//! touches, in parallel: each pair of faces with touching boxes is found exactly once; the pairs
-//! are sorted. Narrow phase: exact predicates, in parallel
-//! over the sorted candidates with rayon (an order-preserving filter), so the result does not
-//! depend on the number of threads. [`has_self_intersection`] instead queries the tree face by
-//! face in parallel and stops at the first hit.
+//! Morton order of their box centres, about 32k faces each), one [`TriangleBvh`] per chunk is
+//! built in parallel, and every chunk tree is traversed against itself and against every later
+//! chunk whose bounds it touches, in parallel: each pair of faces with touching boxes is visited
+//! exactly once. Narrow phase: each visited pair is tested with exact predicates right away (no
+//! candidate list is stored). The hits are sorted, so the result does not depend on the number
+//! of threads. [`has_self_intersection`] runs the same traversal but stops testing at the first
+//! hit.
+
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
@@ -99,13 +101,17 @@ pub fn has_self_intersection(mesh: &TriMesh) -> bool {
 
 /// As [`has_self_intersection`], on raw buffers (indices must be in range).
 pub fn has_self_intersection_in(positions: &[Point3], triangles: &[[u32; 3]]) -> bool {
-    let prep = Prepared::new(positions, triangles, &ExactWeld::compute(positions));
-    !prep.degenerate.is_empty()
-        || prep
-            .faces
-            .par_iter()
-            .with_min_len(256)
-            .any(|&f| prep.any_partner(f))
+    let weld = ExactWeld::compute(positions);
+    let (welded, faces, degenerate) = split_degenerate(positions, triangles, &weld);
+    if !degenerate.is_empty() {
+        return true;
+    }
+    let chunks = ChunkedBvh::new(positions, &welded, &faces, CHUNK_FACES);
+    let narrow = Narrow {
+        positions,
+        welded: &welded,
+    };
+    chunks.any_pair(|f, g| narrow.intersect(f, g))
 }
 
 /// Indices of the faces of `triangles` whose corners are exactly collinear, sorted.
@@ -159,40 +165,6 @@ fn split_degenerate(
     (welded, faces, degenerate)
 }
 
-/// Welded faces, degenerate/non-degenerate split and the BVH of the non-degenerate faces.
-struct Prepared<'a> {
-    positions: &'a [Point3],
-    welded: Vec<[u32; 3]>,
-    faces: Vec<u32>,
-    degenerate: Vec<u32>,
-    bvh: TriangleBvh,
-}
-
-impl<'a> Prepared<'a> {
-    fn new(positions: &'a [Point3], triangles: &[[u32; 3]], weld: &ExactWeld) -> Self {
-        let (welded, faces, degenerate) = split_degenerate(positions, triangles, weld);
-        let bvh = TriangleBvh::from_subset(positions, &welded, &faces);
-        Prepared {
-            positions,
-            welded,
-            faces,
-            degenerate,
-            bvh,
-        }
-    }
-
-    fn corners(&self, f: u32) -> [Point3; 3] {
-        self.welded[f as usize].map(|v| self.positions[v as usize])
-    }
-
-    fn any_partner(&self, f: u32) -> bool {
-        let tf = self.welded[f as usize];
-        self.bvh
-            .query_triangle(&self.corners(f))
-            .any(|g| g > f && faces_intersect(self.positions, tf, self.welded[g as usize]))
-    }
-}
-
 /// Faces per broad-phase chunk (below this, one tree).
 const CHUNK_FACES: usize = 1 << 15;
 
@@ -233,6 +205,22 @@ impl ChunkedBvh {
             .collect();
         pairs.par_sort_unstable();
         pairs
+    }
+
+    /// Whether some pair of faces with touching boxes passes `test`. Chunk pairs are processed
+    /// in parallel; once a hit is found no further test runs and no new chunk pair starts.
+    fn any_pair(&self, test: impl Fn(u32, u32) -> bool + Sync) -> bool {
+        let found = AtomicBool::new(false);
+        let n = self.trees.len();
+        let tasks: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
+        tasks.into_par_iter().any(|(i, j)| {
+            self.for_each_pair(i, j, |f, g| {
+                if !found.load(Ordering::Relaxed) && test(f, g) {
+                    found.store(true, Ordering::Relaxed);
+                }
+            });
+            found.load(Ordering::Relaxed)
+        })
     }
 
     /// Calls `f(a, b)`, `a < b`, for the touching pairs between chunks `i` and `j` (`i ≤ j`).

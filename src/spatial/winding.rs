@@ -76,6 +76,12 @@ struct Node {
     center: Point3,
     /// Distance from `center` to the farthest corner of the node's bounding box.
     radius: f64,
+    /// Total area of the node's triangles.
+    area: f64,
+    /// The node's bounding box.
+    lo: Point3,
+    /// The node's bounding box.
+    hi: Point3,
     /// `Σ A_t n_t` (half the sum of the triangles' cross products).
     normal: Point3,
     /// `M[j][i] = Σ A_t (x_t − center)_j n_t,i` with `x_t` the triangle centroid (exact first
@@ -87,6 +93,20 @@ struct Node {
     /// Triangle range `[start, end)` in `triangles` (a leaf) or, for an inner node, its two
     /// children's node indices.
     kind: NodeKind,
+}
+
+impl Node {
+    const EMPTY: Node = Node {
+        center: [0.0; 3],
+        radius: 0.0,
+        area: 0.0,
+        lo: [f64::INFINITY; 3],
+        hi: [f64::NEG_INFINITY; 3],
+        normal: [0.0; 3],
+        moment: [[0.0; 3]; 3],
+        second: [[[0.0; 3]; 3]; 3],
+        kind: NodeKind::Leaf { start: 0, end: 0 },
+    };
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -105,14 +125,20 @@ impl FastWindingNumber {
     /// node radius from its center (larger is more accurate and slower; Barill et al. use 2).
     pub fn with_accuracy(mesh: &TriMesh, beta: f64) -> Self {
         let positions = mesh.positions().to_vec();
-        let mut triangles = mesh.triangles().to_vec();
-        let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
-        let centroids: Vec<Point3> = triangles.iter().map(|t| centroid(&positions, *t)).collect();
+        let triangles = mesh.triangles();
+        let centroids: Vec<Point3> = triangles
+            .par_iter()
+            .map(|t| centroid(&positions, *t))
+            .collect();
         let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
-        build(
-            &positions, &triangles, &centroids, &mut order, 0, &mut nodes,
-        );
-        triangles = order.iter().map(|&t| triangles[t as usize]).collect();
+        let mut nodes = vec![Node::EMPTY; subtree_nodes(order.len())];
+        let input = BuildInput {
+            positions: &positions,
+            triangles,
+            centroids: &centroids,
+        };
+        input.build(&mut order, 0, 0, &mut nodes);
+        let triangles = order.iter().map(|&t| triangles[t as usize]).collect();
         FastWindingNumber {
             positions,
             triangles,
@@ -185,114 +211,168 @@ fn far_field(node: &Node, y: Point3, d: f64) -> f64 {
     zeroth + first + second
 }
 
-/// Builds the subtree over `order` (a slice of triangle ids) and returns its node index.
-fn build(
-    positions: &[Point3],
-    triangles: &[[u32; 3]],
-    centroids: &[Point3],
-    order: &mut [u32],
-    offset: u32,
-    nodes: &mut Vec<Node>,
-) -> u32 {
-    let id = nodes.len() as u32;
-    nodes.push(summarize(positions, triangles, centroids, order, offset));
-    if order.len() > LEAF_SIZE {
-        let axis = longest_axis(centroids, order);
+/// Subtrees with more triangles than this are built in parallel (`rayon::join`).
+const PARALLEL_BUILD: usize = 1 << 14;
+
+/// Number of nodes of the subtree over `len` triangles: the split is always at `len / 2`, so the
+/// tree shape, and the preorder position of every node, depend on `len` only.
+fn subtree_nodes(len: usize) -> usize {
+    if len <= LEAF_SIZE {
+        1
+    } else {
+        1 + subtree_nodes(len / 2) + subtree_nodes(len - len / 2)
+    }
+}
+
+/// The mesh data the tree is built from.
+struct BuildInput<'a> {
+    positions: &'a [Point3],
+    triangles: &'a [[u32; 3]],
+    centroids: &'a [Point3],
+}
+
+impl BuildInput<'_> {
+    /// Builds the subtree over `order` (triangle ids; reordered so each node's triangles are
+    /// contiguous) into `nodes` in preorder; `nodes[0]` gets absolute index `id`, its triangles
+    /// start at `offset` in the final triangle order. Median splits along the longest axis of
+    /// the centroids; moments are merged bottom-up.
+    fn build(&self, order: &mut [u32], offset: u32, id: u32, nodes: &mut [Node]) {
+        if order.len() <= LEAF_SIZE {
+            nodes[0] = self.leaf(order, offset);
+            return;
+        }
+        let axis = longest_axis(self.centroids, order);
         let mid = order.len() / 2;
+        let c = self.centroids;
         order.select_nth_unstable_by(mid, |&a, &b| {
-            centroids[a as usize][axis]
-                .total_cmp(&centroids[b as usize][axis])
+            c[a as usize][axis]
+                .total_cmp(&c[b as usize][axis])
                 .then(a.cmp(&b))
         });
         let (lo, hi) = order.split_at_mut(mid);
-        let left = build(positions, triangles, centroids, lo, offset, nodes);
-        let right = build(
-            positions,
-            triangles,
-            centroids,
-            hi,
-            offset + mid as u32,
-            nodes,
+        let (head, rest) = nodes.split_at_mut(1);
+        let (left, right) = rest.split_at_mut(subtree_nodes(mid));
+        let (lid, rid) = (id + 1, id + 1 + left.len() as u32);
+        let roff = offset + mid as u32;
+        if lo.len() + hi.len() > PARALLEL_BUILD {
+            rayon::join(
+                || self.build(lo, offset, lid, left),
+                || self.build(hi, roff, rid, right),
+            );
+        } else {
+            self.build(lo, offset, lid, left);
+            self.build(hi, roff, rid, right);
+        }
+        head[0] = merge(
+            &left[0],
+            &right[0],
+            NodeKind::Inner {
+                left: lid,
+                right: rid,
+            },
         );
-        nodes[id as usize].kind = NodeKind::Inner { left, right };
     }
-    id
+
+    /// Expansion data of a leaf, summed over its triangles.
+    fn leaf(&self, ids: &[u32], offset: u32) -> Node {
+        let mut node = Node::EMPTY;
+        let mut weighted = [0.0; 3];
+        for &t in ids {
+            let an = area_normal(self.positions, self.triangles[t as usize]);
+            let area = norm(an);
+            let c = self.centroids[t as usize];
+            for k in 0..3 {
+                node.normal[k] += an[k];
+                weighted[k] += area * c[k];
+            }
+            node.area += area;
+            for &v in &self.triangles[t as usize] {
+                let q = self.positions[v as usize];
+                node.lo = [0, 1, 2].map(|k| node.lo[k].min(q[k]));
+                node.hi = [0, 1, 2].map(|k| node.hi[k].max(q[k]));
+            }
+        }
+        node.center = if node.area > 0.0 {
+            weighted.map(|w| w / node.area)
+        } else {
+            box_centre(&node)
+        };
+        for &t in ids {
+            let tri = self.triangles[t as usize];
+            let an = area_normal(self.positions, tri);
+            let r = sub(self.centroids[t as usize], node.center);
+            let corners = tri.map(|v| sub(self.positions[v as usize], node.center));
+            for j in 0..3 {
+                for (m, a) in node.moment[j].iter_mut().zip(an) {
+                    *m += r[j] * a;
+                }
+                for k in 0..3 {
+                    let rr = corners.iter().map(|q| q[j] * q[k]).sum::<f64>() + 9.0 * r[j] * r[k];
+                    for (s, a) in node.second[j][k].iter_mut().zip(an) {
+                        *s += a * rr / 12.0;
+                    }
+                }
+            }
+        }
+        node.radius = box_radius(&node);
+        node.kind = NodeKind::Leaf {
+            start: offset,
+            end: offset + ids.len() as u32,
+        };
+        node
+    }
 }
 
-/// Expansion data of a set of triangles (a leaf until `build` makes it inner).
-fn summarize(
-    positions: &[Point3],
-    triangles: &[[u32; 3]],
-    centroids: &[Point3],
-    ids: &[u32],
-    offset: u32,
-) -> Node {
-    let mut normal = [0.0; 3];
-    let mut weighted = [0.0; 3];
-    let mut area_sum = 0.0;
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for &t in ids {
-        let an = area_normal(positions, triangles[t as usize]);
-        let area = norm(an);
-        let c = centroids[t as usize];
-        for k in 0..3 {
-            normal[k] += an[k];
-            weighted[k] += area * c[k];
-        }
-        area_sum += area;
-        for &v in &triangles[t as usize] {
-            let q = positions[v as usize];
-            for k in 0..3 {
-                lo[k] = lo[k].min(q[k]);
-                hi[k] = hi[k].max(q[k]);
-            }
-        }
+/// The parent of `l` and `r`: sums of their moments moved to the parent's centre. With
+/// `d = c_child − c`: `M'_ji = M_ji + d_j N_i` and
+/// `S'_jki = S_jki + d_j M_ki + d_k M_ji + d_j d_k N_i` (expanding `(x − c) = (x − c_child) + d`).
+fn merge(l: &Node, r: &Node, kind: NodeKind) -> Node {
+    let mut node = Node::EMPTY;
+    node.area = l.area + r.area;
+    for k in 0..3 {
+        node.lo[k] = l.lo[k].min(r.lo[k]);
+        node.hi[k] = l.hi[k].max(r.hi[k]);
+        node.normal[k] = l.normal[k] + r.normal[k];
     }
-    let center = if area_sum > 0.0 {
-        weighted.map(|w| w / area_sum)
+    node.center = if node.area > 0.0 {
+        [0, 1, 2].map(|k| (l.area * l.center[k] + r.area * r.center[k]) / node.area)
     } else {
-        [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]))
+        box_centre(&node)
     };
-    let mut moment = [[0.0; 3]; 3];
-    let mut second = [[[0.0; 3]; 3]; 3];
-    for &t in ids {
-        let tri = triangles[t as usize];
-        let an = area_normal(positions, tri);
-        let r = sub(centroids[t as usize], center);
-        let corners = tri.map(|v| sub(positions[v as usize], center));
+    for child in [l, r] {
+        let d = sub(child.center, node.center);
         for j in 0..3 {
             for i in 0..3 {
-                moment[j][i] += r[j] * an[i];
-            }
-            for k in 0..3 {
-                let rr = corners.iter().map(|q| q[j] * q[k]).sum::<f64>() + 9.0 * r[j] * r[k];
-                for i in 0..3 {
-                    second[j][k][i] += an[i] * rr / 12.0;
+                node.moment[j][i] += child.moment[j][i] + d[j] * child.normal[i];
+                for k in 0..3 {
+                    node.second[j][k][i] += child.second[j][k][i]
+                        + d[j] * child.moment[k][i]
+                        + d[k] * child.moment[j][i]
+                        + d[j] * d[k] * child.normal[i];
                 }
             }
         }
     }
-    let radius = (0..3)
+    node.radius = box_radius(&node);
+    node.kind = kind;
+    node
+}
+
+fn box_centre(node: &Node) -> Point3 {
+    [0, 1, 2].map(|k| 0.5 * (node.lo[k] + node.hi[k]))
+}
+
+/// Distance from the node's centre to the farthest corner of its box.
+fn box_radius(node: &Node) -> f64 {
+    (0..3)
         .map(|k| {
-            (center[k] - lo[k])
+            (node.center[k] - node.lo[k])
                 .abs()
-                .max((hi[k] - center[k]).abs())
+                .max((node.hi[k] - node.center[k]).abs())
                 .powi(2)
         })
         .sum::<f64>()
-        .sqrt();
-    Node {
-        center,
-        radius,
-        normal,
-        moment,
-        second,
-        kind: NodeKind::Leaf {
-            start: offset,
-            end: offset + ids.len() as u32,
-        },
-    }
+        .sqrt()
 }
 
 fn longest_axis(centroids: &[Point3], ids: &[u32]) -> usize {
@@ -447,5 +527,24 @@ mod tests {
         // Small meshes are a single exact leaf.
         let m = tetra();
         assert!((FastWindingNumber::new(&m).winding_number([0.1, 0.1, 0.1]) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn parallel_build_is_deterministic_and_accurate() {
+        let t = torus(256, 128); // 65536 triangles: built with rayon::join
+        let points: Vec<Point3> = (0..50).map(|i| [-2.6 + 0.1 * i as f64, 0.3, 0.1]).collect();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| FastWindingNumber::new(&t).winding_numbers(&points))
+        };
+        let one = run(1);
+        assert_eq!(run(4), one);
+        let exact = winding_numbers(&t, &points);
+        for (e, a) in exact.iter().zip(&one) {
+            assert!((e - a).abs() < 5e-3, "{e} vs {a}");
+        }
     }
 }

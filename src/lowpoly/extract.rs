@@ -1,0 +1,619 @@
+//! Extraction of the `d`-iso-surface from the narrow band: MC33 patches per cube, iso-points
+//! shared through global edge keys, feature vertices per disk patch (Algorithm 1, lines 3–10).
+//!
+//! Iso-points: on a crossed grid edge with values `f_in < d ≤ f_out`, the point sits at the
+//! linear-interpolation parameter clamped into `[ε, 1 − ε]` (`ε = 10⁻³`), so it is strictly
+//! inside the edge even when a grid value equals `d` exactly (which counts as outside). It is a
+//! function of the edge's two values only, computed once per edge, so every cube sharing the
+//! edge uses the bit-identical point. Optionally it is refined against the true distance by a
+//! few regula-falsi (Illinois) steps inside the same bracket.
+//!
+//! Determinism: bricks are visited in sorted key order, cubes in a fixed order inside a brick,
+//! edge keys are sorted before vertex ids are assigned, and parallel results are concatenated
+//! in brick order.
+
+use rayon::prelude::*;
+
+use super::distance::{brick_coords, brick_key, DistanceGrid, InputDistance, BRICK};
+use super::features::{cube_geometry, CubeFlags};
+use super::geom::{add, lerp, normalized, scale, sub, V3};
+use super::mc33::tables::{CORNER_POS, EDGE_AXIS, EDGE_CORNERS};
+use super::mc33::triangulate::{fan, LocalTri};
+use super::mc33::{decide, topology, trilinear, CubeTopology};
+use crate::{Error, Result};
+
+/// Clamp of the iso-point parameter away from grid points.
+pub(crate) const ISO_EPS: f64 = 1e-3;
+/// "No vertex".
+pub(crate) const NONE: u32 = u32::MAX;
+
+/// Global key of the grid edge from point `p` along `axis` (points `< 2^20` per axis).
+#[inline]
+pub(crate) fn edge_key(p: [u32; 3], axis: u8) -> u64 {
+    ((((p[0] as u64) << 42) | ((p[1] as u64) << 21) | p[2] as u64) << 2) | axis as u64
+}
+
+#[inline]
+fn edge_from_key(k: u64) -> ([u32; 3], u8) {
+    let m = (1u64 << 21) - 1;
+    let p = k >> 2;
+    (
+        [(p >> 42) as u32, ((p >> 21) & m) as u32, (p & m) as u32],
+        (k & 3) as u8,
+    )
+}
+
+/// Settings of one extraction.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ExtractParams {
+    /// Iso-value.
+    pub d: f64,
+    /// Compute feature vertices (eq. 4.3).
+    pub features: bool,
+    /// Regula-falsi steps refining each iso-point against the exact distance (0 = off).
+    pub refine_steps: u32,
+}
+
+/// All patches of the iso-surface, before choosing feature or template triangulations.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct PatchSet {
+    /// Iso-points (ids `0..n_iso`), then feature and center vertices.
+    pub positions: Vec<V3>,
+    /// Number of iso-points.
+    pub n_iso: usize,
+    /// Per patch `p`, its loop vertex ids are `loop_ids[loop_off[p]..loop_off[p + 1]]`.
+    pub loop_off: Vec<u32>,
+    /// Loop vertex ids of all patches.
+    pub loop_ids: Vec<u32>,
+    /// Length of the first loop (less than the patch's id count for an annulus).
+    pub first_len: Vec<u8>,
+    /// Per patch, its template triangles are `plain[plain_off[p]..plain_off[p + 1]]`.
+    pub plain_off: Vec<u32>,
+    /// Template triangles (local indices; the patch's id count means its center).
+    pub plain: Vec<LocalTri>,
+    /// Center vertex of the template, or [`NONE`].
+    pub center: Vec<u32>,
+    /// Feature vertex, or [`NONE`].
+    pub feature: Vec<u32>,
+    /// Patch of each feature vertex id.
+    pub feature_patch: std::collections::HashMap<u32, u32>,
+    /// Counters.
+    pub counts: ExtractCounts,
+}
+
+/// Counters of an extraction.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct ExtractCounts {
+    /// Cubes examined.
+    pub cells: u64,
+    /// Cubes with corners on both sides.
+    pub mixed: u64,
+    /// Disk patches.
+    pub disks: u64,
+    /// Annulus (tunnel) patches.
+    pub annuli: u64,
+    /// Tunnels replaced by two disks.
+    pub tunnels_split: u64,
+    /// Cubes whose patches had no separating plane.
+    pub unseparated: u64,
+    /// Cubes that failed their exact check.
+    pub unresolved: u64,
+    /// Iso-points whose normal came from the trilinear gradient.
+    pub gradient_normals: u64,
+}
+
+impl ExtractCounts {
+    fn add(&mut self, o: &ExtractCounts) {
+        self.cells += o.cells;
+        self.mixed += o.mixed;
+        self.disks += o.disks;
+        self.annuli += o.annuli;
+        self.tunnels_split += o.tunnels_split;
+        self.unseparated += o.unseparated;
+        self.unresolved += o.unresolved;
+        self.gradient_normals += o.gradient_normals;
+    }
+
+    fn add_flags(&mut self, f: &CubeFlags) {
+        self.tunnels_split += f.tunnel_split as u64;
+        self.unseparated += f.unseparated as u64;
+        self.unresolved += f.unresolved as u64;
+    }
+}
+
+impl PatchSet {
+    /// Number of patches.
+    pub(crate) fn len(&self) -> usize {
+        self.first_len.len()
+    }
+
+    /// Vertex ids of patch `p` (both loops for an annulus).
+    pub(crate) fn ids(&self, p: usize) -> &[u32] {
+        &self.loop_ids[self.loop_off[p] as usize..self.loop_off[p + 1] as usize]
+    }
+
+    /// Template triangles of patch `p`.
+    fn plain_tris(&self, p: usize) -> &[LocalTri] {
+        &self.plain[self.plain_off[p] as usize..self.plain_off[p + 1] as usize]
+    }
+
+    /// Triangles of patch `p`, with its feature vertex when `use_feature` and it has one.
+    pub(crate) fn patch_triangles(&self, p: usize, use_feature: bool, out: &mut Vec<[u32; 3]>) {
+        let ids = self.ids(p);
+        let n = ids.len();
+        let map = |i: u8, extra: u32| {
+            if (i as usize) < n {
+                ids[i as usize]
+            } else {
+                extra
+            }
+        };
+        if use_feature && self.feature[p] != NONE {
+            let mut buf = Vec::with_capacity(n);
+            fan(n, &mut buf);
+            out.extend(buf.iter().map(|t| t.map(|i| map(i, self.feature[p]))));
+        } else {
+            let c = self.center[p];
+            out.extend(self.plain_tris(p).iter().map(|t| t.map(|i| map(i, c))));
+        }
+    }
+
+    /// The mesh with feature vertices where `use_feature(p)`: compacted positions, triangles,
+    /// and for each output vertex its id in [`PatchSet::positions`].
+    pub(crate) fn assemble(
+        &self,
+        use_feature: &dyn Fn(usize) -> bool,
+    ) -> (Vec<V3>, Vec<[u32; 3]>, Vec<u32>) {
+        let mut tris = Vec::new();
+        for p in 0..self.len() {
+            self.patch_triangles(p, use_feature(p), &mut tris);
+        }
+        let mut remap = vec![NONE; self.positions.len()];
+        let mut back = Vec::new();
+        for t in &mut tris {
+            for v in t.iter_mut() {
+                if remap[*v as usize] == NONE {
+                    remap[*v as usize] = back.len() as u32;
+                    back.push(*v);
+                }
+                *v = remap[*v as usize];
+            }
+        }
+        let pos = back.iter().map(|&v| self.positions[v as usize]).collect();
+        (pos, tris, back)
+    }
+}
+
+/// Eight corner values of the cube at `p` through a brick's neighbourhood.
+struct BrickView<'a> {
+    base: [u32; 3],
+    nb: [Option<&'a [f64]>; 8],
+    cap: f64,
+}
+
+impl<'a> BrickView<'a> {
+    fn new(grid: &'a DistanceGrid, key: u64) -> BrickView<'a> {
+        let b = brick_coords(key);
+        let nb = std::array::from_fn(|i| {
+            let c = CORNER_POS[i];
+            let k = brick_key([b[0] + c[0] as u32, b[1] + c[1] as u32, b[2] + c[2] as u32]);
+            grid.brick_index(k).map(|bi| grid.brick_values(bi))
+        });
+        BrickView {
+            base: b.map(|x| x * BRICK),
+            nb,
+            cap: grid.cap,
+        }
+    }
+
+    /// Value at local point `q ∈ [0, 8]³` of this brick.
+    #[inline]
+    fn value(&self, q: [u32; 3]) -> f64 {
+        let s = (q[0] / BRICK) as usize
+            | ((q[1] / BRICK) as usize) << 1
+            | ((q[2] / BRICK) as usize) << 2;
+        match self.nb[s] {
+            Some(v) => {
+                v[((q[2] % BRICK) * BRICK * BRICK + (q[1] % BRICK) * BRICK + q[0] % BRICK) as usize]
+            }
+            None => self.cap,
+        }
+    }
+
+    /// Corner values `f − d` of the cube with local min corner `q`.
+    fn cube(&self, q: [u32; 3], d: f64) -> [f64; 8] {
+        std::array::from_fn(|c| {
+            let o = CORNER_POS[c];
+            self.value([q[0] + o[0] as u32, q[1] + o[1] as u32, q[2] + o[2] as u32]) - d
+        })
+    }
+}
+
+/// Calls `f(global min corner, values)` for every mixed cube of brick `key`; returns the
+/// number of cubes examined.
+fn for_mixed_cubes(
+    grid: &DistanceGrid,
+    key: u64,
+    d: f64,
+    mut f: impl FnMut([u32; 3], &[f64; 8]),
+) -> u64 {
+    let view = BrickView::new(grid, key);
+    let dims = grid.spec.dims;
+    let mut cells = 0;
+    for z in 0..BRICK {
+        for y in 0..BRICK {
+            for x in 0..BRICK {
+                let g = [view.base[0] + x, view.base[1] + y, view.base[2] + z];
+                if g[0] + 1 >= dims[0] || g[1] + 1 >= dims[1] || g[2] + 1 >= dims[2] {
+                    continue;
+                }
+                cells += 1;
+                let v = view.cube([x, y, z], d);
+                let inside = v.iter().filter(|&&x| x < 0.0).count();
+                if inside != 0 && inside != 8 {
+                    f(g, &v);
+                }
+            }
+        }
+    }
+    cells
+}
+
+/// Global key of cube edge `e` of the cube at `g`.
+#[inline]
+fn cube_edge_key(g: [u32; 3], e: usize) -> u64 {
+    let c = CORNER_POS[EDGE_CORNERS[e][0] as usize];
+    edge_key(
+        [g[0] + c[0] as u32, g[1] + c[1] as u32, g[2] + c[2] as u32],
+        EDGE_AXIS[e],
+    )
+}
+
+/// Runs the extraction. `keep_going(fraction)` is called on this thread between chunks.
+pub(crate) fn extract(
+    grid: &DistanceGrid,
+    input: &InputDistance,
+    p: &ExtractParams,
+    keep_going: &mut dyn FnMut(f64) -> bool,
+) -> Result<PatchSet> {
+    // Pass 1: crossed edges.
+    let mut keys: Vec<u64> = Vec::new();
+    let mut counts = ExtractCounts::default();
+    let chunk = 512;
+    let n_chunks = grid.keys.len().div_ceil(chunk).max(1);
+    for (ci, ks) in grid.keys.chunks(chunk).enumerate() {
+        let part: Vec<(Vec<u64>, u64, u64)> = ks
+            .par_iter()
+            .map(|&k| {
+                let mut out = Vec::new();
+                let mut mixed = 0;
+                let cells = for_mixed_cubes(grid, k, p.d, |g, v| {
+                    mixed += 1;
+                    let dec = decide(v);
+                    for (e, ec) in EDGE_CORNERS.iter().enumerate() {
+                        if (dec.inside >> ec[0] & 1) != (dec.inside >> ec[1] & 1) {
+                            out.push(cube_edge_key(g, e));
+                        }
+                    }
+                });
+                (out, cells, mixed)
+            })
+            .collect();
+        for (o, c, m) in part {
+            keys.extend(o);
+            counts.cells += c;
+            counts.mixed += m;
+        }
+        if !keep_going(0.3 * (ci + 1) as f64 / n_chunks as f64) {
+            return Err(Error::Cancelled);
+        }
+    }
+    keys.par_sort_unstable();
+    keys.dedup();
+    // Iso-points and their normals (eq. 4.3).
+    let iso: Vec<IsoPoint> = keys
+        .par_iter()
+        .map(|&k| iso_point(grid, input, k, p))
+        .collect();
+    counts.gradient_normals = iso.iter().filter(|x| x.gradient).count() as u64;
+    if !keep_going(0.5) {
+        return Err(Error::Cancelled);
+    }
+    // Pass 2: patches.
+    let mut set = PatchSet {
+        positions: iso.iter().map(|x| x.pos).collect(),
+        n_iso: keys.len(),
+        loop_off: vec![0],
+        plain_off: vec![0],
+        ..PatchSet::default()
+    };
+    let ctx = CubeCtx {
+        grid,
+        input,
+        keys: &keys,
+        iso: &iso,
+        p,
+    };
+    for (ci, ks) in grid.keys.chunks(chunk).enumerate() {
+        let part: Vec<BrickPatches> = ks.par_iter().map(|&k| brick_patches(&ctx, k)).collect();
+        for bp in part {
+            append(&mut set, bp);
+        }
+        if !keep_going(0.5 + 0.5 * (ci + 1) as f64 / n_chunks as f64) {
+            return Err(Error::Cancelled);
+        }
+    }
+    set.counts.add(&counts);
+    set.feature_patch = set
+        .feature
+        .iter()
+        .enumerate()
+        .filter(|(_, &f)| f != NONE)
+        .map(|(p, &f)| (f, p as u32))
+        .collect();
+    Ok(set)
+}
+
+/// An iso-point with its normal (eq. 4.3).
+#[derive(Debug, Clone, Copy)]
+struct IsoPoint {
+    pos: V3,
+    /// Unit normal `(p − p*)/‖p − p*‖`, or the edge direction when `gradient`.
+    normal: V3,
+    /// The normal must come from the trilinear gradient (no usable closest point).
+    gradient: bool,
+    /// Input primitive of the closest point (`u32::MAX` when unknown).
+    prim: u32,
+}
+
+/// The iso-point of edge `k` with its normal.
+fn iso_point(grid: &DistanceGrid, input: &InputDistance, k: u64, p: &ExtractParams) -> IsoPoint {
+    let (g, a) = edge_from_key(k);
+    let mut g1 = g;
+    g1[a as usize] += 1;
+    let (f0, f1) = (grid.value(g), grid.value(g1));
+    let (x0, x1) = (grid.spec.point(g), grid.spec.point(g1));
+    let mut t = iso_parameter(f0, f1, p.d);
+    if p.refine_steps > 0 {
+        t = refine(input, x0, x1, f0, f1, t, p, grid.cap);
+    }
+    let t = t.clamp(ISO_EPS, 1.0 - ISO_EPS);
+    let x = lerp(x0, x1, t);
+    let mut prim = u32::MAX;
+    if p.features {
+        if let Some(c) = input.closest(x, grid.cap * 2.0) {
+            prim = c.prim;
+            if let Some(n) = normalized(sub(x, c.point)) {
+                return IsoPoint {
+                    pos: x,
+                    normal: n,
+                    gradient: false,
+                    prim,
+                };
+            }
+        }
+    }
+    // The direction of increasing f along the edge is a usable fallback normal.
+    let mut nv = [0.0; 3];
+    nv[a as usize] = if f1 > f0 { 1.0 } else { -1.0 };
+    IsoPoint {
+        pos: x,
+        normal: nv,
+        gradient: p.features,
+        prim,
+    }
+}
+
+/// Linear-interpolation parameter of `d` between `f0` and `f1` (which straddle `d`).
+#[inline]
+pub(crate) fn iso_parameter(f0: f64, f1: f64, d: f64) -> f64 {
+    let den = f1 - f0;
+    if den == 0.0 {
+        return 0.5;
+    }
+    ((d - f0) / den).clamp(0.0, 1.0)
+}
+
+/// Illinois regula falsi on `g(t) = f(x0 + t(x1 − x0)) − d` inside `[0, 1]`.
+#[allow(clippy::too_many_arguments)]
+fn refine(
+    input: &InputDistance,
+    x0: V3,
+    x1: V3,
+    f0: f64,
+    f1: f64,
+    t0: f64,
+    p: &ExtractParams,
+    cap: f64,
+) -> f64 {
+    let (mut a, mut b) = (0.0, 1.0);
+    let (mut ga, mut gb) = (f0 - p.d, f1 - p.d);
+    if ga * gb > 0.0 {
+        return t0;
+    }
+    let mut t = t0;
+    let mut side = 0i8;
+    for _ in 0..p.refine_steps {
+        let gt = input.distance_capped(lerp(x0, x1, t), cap) - p.d;
+        if gt == 0.0 {
+            return t;
+        }
+        if (gt < 0.0) == (ga < 0.0) {
+            a = t;
+            ga = gt;
+            if side == -1 {
+                gb *= 0.5;
+            }
+            side = -1;
+        } else {
+            b = t;
+            gb = gt;
+            if side == 1 {
+                ga *= 0.5;
+            }
+            side = 1;
+        }
+        let den = gb - ga;
+        t = if den != 0.0 {
+            (a * gb - b * ga) / den
+        } else {
+            0.5 * (a + b)
+        };
+        if !(t > a && t < b) {
+            t = 0.5 * (a + b);
+        }
+    }
+    t
+}
+
+struct CubeCtx<'a> {
+    grid: &'a DistanceGrid,
+    input: &'a InputDistance,
+    keys: &'a [u64],
+    iso: &'a [IsoPoint],
+    p: &'a ExtractParams,
+}
+
+/// Patches of one brick, with brick-local extra vertices.
+#[derive(Default)]
+struct BrickPatches {
+    loop_ids: Vec<u32>,
+    loop_len: Vec<u32>,
+    first_len: Vec<u8>,
+    plain: Vec<LocalTri>,
+    plain_len: Vec<u32>,
+    extra: Vec<V3>,
+    center: Vec<u32>,
+    feature: Vec<u32>,
+    counts: ExtractCounts,
+}
+
+fn brick_patches(ctx: &CubeCtx, key: u64) -> BrickPatches {
+    let mut out = BrickPatches::default();
+    let d = ctx.p.d;
+    let mut cubes: Vec<([u32; 3], [f64; 8])> = Vec::new();
+    for_mixed_cubes(ctx.grid, key, d, |g, v| cubes.push((g, *v)));
+    for (g, v) in cubes {
+        let topo = topology(&decide(&v));
+        cube_patches(ctx, g, &v, &topo, &mut out);
+    }
+    out
+}
+
+fn cube_patches(
+    ctx: &CubeCtx,
+    g: [u32; 3],
+    v: &[f64; 8],
+    topo: &CubeTopology,
+    out: &mut BrickPatches,
+) {
+    let h = ctx.grid.spec.h;
+    let d = ctx.p.d;
+    let origin = ctx.grid.spec.point(g);
+    let mut ids = [NONE; 12];
+    let mut local = [[0.0; 3]; 12];
+    let mut normals = [[0.0; 3]; 12];
+    let mut hint = None;
+    for e in 0..12 {
+        let ec = EDGE_CORNERS[e];
+        if (v[ec[0] as usize] < 0.0) == (v[ec[1] as usize] < 0.0) {
+            continue;
+        }
+        let Ok(i) = ctx.keys.binary_search(&cube_edge_key(g, e)) else {
+            continue;
+        };
+        ids[e] = i as u32;
+        let ip = ctx.iso[i];
+        local[e] = scale(sub(ip.pos, origin), 1.0 / h);
+        normals[e] = if ip.gradient {
+            trilinear_gradient(v, local[e]).unwrap_or(ip.normal)
+        } else {
+            ip.normal
+        };
+        if ip.prim != u32::MAX {
+            hint = Some(ip.prim);
+        }
+    }
+    let normals = ctx.p.features.then_some(&normals);
+    let project = |x: V3| -> Option<V3> {
+        let w = [
+            origin[0] + h * x[0],
+            origin[1] + h * x[1],
+            origin[2] + h * x[2],
+        ];
+        let c = ctx.input.closest_hinted(w, 2.0 * ctx.grid.cap, hint)?;
+        let n = normalized(sub(w, c.point))?;
+        let y = lerp(c.point, add(c.point, n), d);
+        Some(scale(sub(y, origin), 1.0 / h))
+    };
+    let (patches, flags) = cube_geometry(topo, &local, normals, Some(&project));
+    out.counts.add_flags(&flags);
+    let world = |x: V3| {
+        [
+            origin[0] + h * x[0],
+            origin[1] + h * x[1],
+            origin[2] + h * x[2],
+        ]
+    };
+    for pg in patches {
+        if pg.is_annulus() {
+            out.counts.annuli += 1;
+        } else {
+            out.counts.disks += 1;
+        }
+        out.loop_ids
+            .extend(pg.edges.iter().map(|&e| ids[e as usize]));
+        out.loop_len.push(pg.edges.len() as u32);
+        out.first_len.push(pg.first_len as u8);
+        out.plain.extend_from_slice(&pg.plain);
+        out.plain_len.push(pg.plain.len() as u32);
+        let mut push_extra = |x: Option<V3>| match x {
+            Some(x) => {
+                out.extra.push(world(x));
+                (out.extra.len() - 1) as u32
+            }
+            None => NONE,
+        };
+        let c = push_extra(pg.center);
+        let f = push_extra(pg.feature);
+        out.center.push(c);
+        out.feature.push(f);
+    }
+}
+
+/// Unit gradient of the trilinear interpolant at local point `x`.
+fn trilinear_gradient(v: &[f64; 8], x: V3) -> Option<V3> {
+    let e = 1e-4;
+    let g: V3 = std::array::from_fn(|k| {
+        let (mut a, mut b) = (x, x);
+        a[k] = (a[k] - e).max(0.0);
+        b[k] = (b[k] + e).min(1.0);
+        (trilinear(v, b) - trilinear(v, a)) / (b[k] - a[k])
+    });
+    normalized(g)
+}
+
+fn append(set: &mut PatchSet, bp: BrickPatches) {
+    let base = set.positions.len() as u32;
+    set.positions.extend(bp.extra);
+    let shift = |x: u32| if x == NONE { NONE } else { base + x };
+    set.center.extend(bp.center.into_iter().map(shift));
+    set.feature.extend(bp.feature.into_iter().map(shift));
+    set.loop_ids.extend(bp.loop_ids);
+    for l in bp.loop_len {
+        let last = *set.loop_off.last().unwrap_or(&0);
+        set.loop_off.push(last + l);
+    }
+    set.first_len.extend(bp.first_len);
+    set.plain.extend(bp.plain);
+    for l in bp.plain_len {
+        let last = *set.plain_off.last().unwrap_or(&0);
+        set.plain_off.push(last + l);
+    }
+    set.counts.add(&bp.counts);
+}
+
+/// Distance from `x` to the input, for reporting (`max |f(x) − d|`).
+pub(crate) fn deviation(input: &InputDistance, x: V3, d: f64, cap: f64) -> f64 {
+    (input.distance_capped(x, cap) - d).abs()
+}
