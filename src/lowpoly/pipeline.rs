@@ -440,8 +440,7 @@ struct LoopStats {
     faces_per_round: Vec<u64>,
     simplify: SimplifyReport,
     guard: GuardStats,
-    last_change: f64,
-    change_per_round: Vec<f64>,
+    converged: bool,
     flow_motion: f64,
     align_motion: f64,
     target_met: bool,
@@ -475,10 +474,7 @@ impl LoopStats {
         s.count("guard_exact_tests", g.exact_tests);
         s.count("target_met", self.target_met as u64);
         s.count("target_relaxations", self.relaxations);
-        s.metric("last_round_change", self.last_change);
-        for (i, c) in self.change_per_round.iter().enumerate() {
-            s.metric(&format!("change_round_{}", i + 1), *c);
-        }
+        s.count("converged", self.converged as u64);
         s.metric("flow_motion", self.flow_motion);
         s.metric("align_motion", self.align_motion);
     }
@@ -491,6 +487,18 @@ fn add_simplify(acc: &mut SimplifyReport, r: &SimplifyReport) {
     acc.rejected_hausdorff += r.rejected_hausdorff;
     acc.rejected_distance += r.rejected_distance;
     acc.rejected_guard += r.rejected_guard;
+}
+
+/// Alg. 3 line 17: the sampled two-sided Hausdorff distance between the meshes before and
+/// after a round is below `ε·l`. Decided with early exits (the first far sample settles it).
+fn has_converged(before: &TriMesh, after: &TriMesh, cfg: &LoopConfig) -> bool {
+    let eps = cfg.epsilon_abs;
+    let a = Surface::new(after);
+    if measure::one_sided_exceeds(before.positions(), before.triangles(), &a, cfg.d, 8, eps) {
+        return false;
+    }
+    let b = Surface::new(before);
+    !measure::one_sided_exceeds(after.positions(), after.triangles(), &b, cfg.d, 8, eps)
 }
 
 /// Alg. 3 from `start` (watertight, manifold, intersection-free; in cage mode enclosing the
@@ -517,7 +525,7 @@ fn optimize(
     for i in 0..rounds {
         let frac = |x: f64| (i as f64 + x) / rounds as f64;
         rep.check("simplify", frac(0.0))?;
-        let before = Surface::new(&g.mesh().to_trimesh());
+        let before = g.mesh().to_trimesh();
         let t0 = Instant::now();
         let sr = {
             let mut kg = |x: f64| rep.report("simplify", frac(0.5 * x));
@@ -543,15 +551,13 @@ fn optimize(
         ls.rounds += 1;
         ls.faces_per_round.push(g.mesh().face_count() as u64);
         let t0 = Instant::now();
-        let after = Surface::new(&g.mesh().to_trimesh());
-        ls.last_change = measure::hausdorff(&after, &before, cfg.d, 8);
-        ls.change_per_round.push(ls.last_change);
+        let converged = has_converged(&before, &g.mesh().to_trimesh(), cfg);
+        ls.converged = converged;
         ls.converge_s += t0.elapsed().as_secs_f64();
         ls.target_met = cfg.target_faces.is_some_and(|n| g.mesh().face_count() <= n);
         if ls.target_met {
             break;
         }
-        let converged = ls.last_change < cfg.epsilon_abs;
         if cfg.target_faces.is_some() && (converged || sr.collapses == 0) {
             // Pro.I with a face target: relax the per-collapse bound until it is reached.
             sopt.d *= 2.0;
