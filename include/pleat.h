@@ -177,7 +177,7 @@ typedef struct PleatLodParams {
   double flow_ratio;
   // Convergence threshold ε relative to l (default 1e-4), >= 0.
   double epsilon;
-  // Feature-curve dihedral threshold θ0 in degrees, (0, 180] (default 120).
+  // Feature-curve dihedral threshold θ0 in degrees, (0, 180) (default 120).
   double theta0_deg;
   // Minimum feature-curve length l0 in edges (default 4).
   uint32_t l0;

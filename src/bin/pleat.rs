@@ -105,6 +105,9 @@ struct BakeArgs {
     /// No progress bar and no summary.
     #[arg(short, long)]
     quiet: bool,
+    /// Also print every statistic (stage seconds, counts, metrics) of each level.
+    #[arg(short, long)]
+    verbose: bool,
 }
 
 /// `pleat wrinkle ...` (needs the `wrinkle` feature; otherwise exits 2 with a message).
@@ -292,6 +295,9 @@ fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
         if !args.quiet {
             print_bake_summary(&path, n_p, out, stats);
         }
+        if args.verbose {
+            print_stats(stats);
+        }
     }
     ExitCode::SUCCESS
 }
@@ -310,6 +316,22 @@ fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
             .progress_chars("=> "),
     );
     Some(b)
+}
+
+#[cfg(feature = "lod")]
+fn print_stats(s: &pleat::Stats) {
+    for (n, t) in &s.stages {
+        println!("  {n:<28} {t:>10.3} s");
+    }
+    for (n, c) in &s.counts {
+        println!("  {n:<28} {c:>10}");
+    }
+    for (n, m) in &s.metrics {
+        println!("  {n:<28} {m:>10.6}");
+    }
+    for (n, v) in &s.verified {
+        println!("  {n:<28} {v:>10}");
+    }
 }
 
 #[cfg(feature = "lod")]

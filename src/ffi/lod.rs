@@ -4,7 +4,7 @@
 //! The functions exist in every build; without the cargo feature `lod` (or `cage`) they return
 //! `PLEAT_STATUS_UNSUPPORTED`.
 
-use super::common::{guard_progress, null_arg, unsupported, PleatProgressFn, PleatStatus};
+use super::common::{fail, guard_progress, null_arg, PleatProgressFn, PleatStatus};
 use super::mesh::{emit_mesh, mesh_ref, PleatMesh};
 use crate::{Error, Result};
 
@@ -34,7 +34,7 @@ pub struct PleatLodParams {
     pub flow_ratio: f64,
     /// Convergence threshold ε relative to l (default 1e-4), >= 0.
     pub epsilon: f64,
-    /// Feature-curve dihedral threshold θ0 in degrees, (0, 180] (default 120).
+    /// Feature-curve dihedral threshold θ0 in degrees, (0, 180) (default 120).
     pub theta0_deg: f64,
     /// Minimum feature-curve length l0 in edges (default 4).
     pub l0: u32,
@@ -258,6 +258,13 @@ mod imp {
             target_met: count("target_met") as u32,
         }
     }
+}
+
+/// Records that this build lacks the cargo feature `feature`: `PLEAT_STATUS_UNSUPPORTED`.
+fn unsupported(feature: &str) -> PleatStatus {
+    fail(Error::Unsupported(format!(
+        "pleat was compiled without the `{feature}` feature"
+    )))
 }
 
 /// Stand-ins when the `lod` feature is off (never called: the entry points return

@@ -112,6 +112,16 @@ impl InputModel {
         self.closest(p).1
     }
 
+    /// Distance from `p` to the input, given an upper bound `ub` on it (from the triangle
+    /// inequality), which lets the BVH prune everything farther.
+    pub fn distance_bounded(&self, p: P3, ub: f64) -> f64 {
+        let max = ub * (1.0 + 1e-9) + f64::MIN_POSITIVE;
+        match self.bvh.closest_point(&self.positions, &self.tris, p, max) {
+            Some(c) => c.distance,
+            None => self.distance(p),
+        }
+    }
+
     /// Input triangle `t`'s corners.
     pub fn triangle(&self, t: u32) -> [P3; 3] {
         self.tris[t as usize].map(|v| self.positions[v as usize])
@@ -166,6 +176,10 @@ pub(crate) struct Guard<'a> {
     /// Scratch lists.
     m_e: Vec<u32>,
     m_1: Vec<u32>,
+    cand: Vec<u32>,
+    /// Leaf updates since the BVH was last built (it is rebuilt when they exceed the face
+    /// count: incremental edits degrade the tree).
+    edits: usize,
     pub stats: GuardStats,
 }
 
@@ -193,6 +207,8 @@ impl<'a> Guard<'a> {
             epoch: 0,
             m_e: Vec::new(),
             m_1: Vec::new(),
+            cand: Vec::new(),
+            edits: 0,
             stats: GuardStats::default(),
         }
     }
@@ -285,6 +301,7 @@ impl<'a> Guard<'a> {
                 }
                 self.bvh
                     .update(self.mesh.positions(), &self.tris, &rec.modified_faces);
+                self.note_edits(rec.modified_faces.len() + rec.removed_faces.len());
                 Ok(rec)
             }
             Err(r) => {
@@ -293,6 +310,16 @@ impl<'a> Guard<'a> {
                     .expect("undo of the operation just applied");
                 Err(r)
             }
+        }
+    }
+
+    /// Counts leaf edits and rebuilds the BVH when they exceed the live face count.
+    fn note_edits(&mut self, n: usize) {
+        self.edits += n;
+        if self.edits > self.mesh.face_count().max(64) {
+            let live: Vec<u32> = self.mesh.faces().collect();
+            self.bvh = TriangleBvh::from_subset(self.mesh.positions(), &self.tris, &live);
+            self.edits = 0;
         }
     }
 
@@ -415,28 +442,45 @@ impl<'a> Guard<'a> {
         Ok(())
     }
 
-    /// `M_e` does not meet `M_r` (Alg. 7 with exact tests on all BVH candidates).
+    /// `M_e` does not meet `M_r` (Alg. 7 with exact tests on all BVH candidates): one BVH
+    /// query with the box of `M_e`, then per-face box filtering.
     fn check_against_rest(&mut self) -> Result<(), Reject> {
         let ep = self.epoch;
-        let mut cand = Vec::new();
-        for i in 0..self.m_e.len() {
-            let f = self.m_e[i];
-            let tri = self.mesh.face_positions(f);
-            cand.clear();
-            cand.extend(
-                self.bvh
-                    .query_triangle(&tri)
-                    .filter(|&g| self.in_1[g as usize] != ep && self.mesh.is_face_live(g)),
-            );
-            for &g in &cand {
+        let tris: Vec<[P3; 3]> = self
+            .m_e
+            .iter()
+            .map(|&f| self.mesh.face_positions(f))
+            .collect();
+        let boxes: Vec<(P3, P3)> = tris.iter().map(|t| bbox_of(*t)).collect();
+        let (lo, hi) = bbox_of(boxes.iter().flat_map(|b| [b.0, b.1]));
+        let mut cand = std::mem::take(&mut self.cand);
+        cand.clear();
+        cand.extend(
+            self.bvh
+                .query_box(lo, hi)
+                .filter(|&g| self.in_1[g as usize] != ep && self.mesh.is_face_live(g)),
+        );
+        let mut hit = false;
+        'outer: for &g in &cand {
+            let gt = self.tris[g as usize].map(|v| self.mesh.position(v));
+            let gbox = bbox_of(gt);
+            for (tri, fbox) in tris.iter().zip(&boxes) {
+                if !boxes_overlap(*fbox, gbox) {
+                    continue;
+                }
                 self.stats.exact_tests += 1;
-                let gt = self.tris[g as usize].map(|v| self.mesh.position(v));
-                if sp::triangles_intersect(&tri, &gt) {
-                    return Err(Reject::SelfIntersection);
+                if sp::triangles_intersect(tri, &gt) {
+                    hit = true;
+                    break 'outer;
                 }
             }
         }
-        Ok(())
+        self.cand = cand;
+        if hit {
+            Err(Reject::SelfIntersection)
+        } else {
+            Ok(())
+        }
     }
 
     /// Cage mode: `M_e` does not touch the input.

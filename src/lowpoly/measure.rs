@@ -78,6 +78,30 @@ pub(crate) fn one_sided(
     vmax.max(fmax)
 }
 
+/// True when some sample of `from` (see the module docs) lies farther than `threshold` from
+/// `to`. Stops at the first such sample, so a clearly changed surface costs little.
+pub(crate) fn one_sided_exceeds(
+    from_pos: &[P3],
+    from_tris: &[[u32; 3]],
+    to: &Surface,
+    spacing: f64,
+    max_k: usize,
+    threshold: f64,
+) -> bool {
+    from_tris.par_iter().any(|t| {
+        let tri = t.map(|v| from_pos[v as usize]);
+        if tri.iter().any(|&p| to.distance(p) > threshold) {
+            return true;
+        }
+        let k = sample_resolution(&tri, spacing, max_k);
+        let mut over = false;
+        for_each_sample(&tri, k, true, |p| {
+            over = over || to.distance(p) > threshold;
+        });
+        over
+    })
+}
+
 /// Two-sided sampled Hausdorff distance between `a` and `b`.
 pub(crate) fn hausdorff(a: &Surface, b: &Surface, spacing: f64, max_k: usize) -> f64 {
     let ab = one_sided(&a.positions, &a.tris, b, spacing, max_k);

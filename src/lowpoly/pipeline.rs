@@ -12,8 +12,8 @@ use super::align::{align_sweep, reference_normals};
 use super::flow::flow_sweep;
 use super::guard::{Guard, GuardStats, InputModel};
 use super::measure::{self, Surface, Verification, FINAL_SAMPLES_PER_DIAGONAL};
+use super::offset::{offset_surface_with_progress, OffsetDistance, OffsetParams};
 use super::simplify::{simplify_pass, SimplifyOptions, SimplifyReport};
-use super::vec3::{add, normalized, scale, P3};
 use crate::mesh::{HalfEdgeMesh, TriMesh};
 use crate::report::{Progress, ProgressFn};
 use crate::{Error, Result, Stats};
@@ -40,7 +40,7 @@ pub struct LodParams {
     pub flow_ratio: f64,
     /// Convergence threshold `ε` relative to `l` (Alg. 3 line 17), `≥ 0`.
     pub epsilon: f64,
-    /// Feature-curve dihedral threshold `θ0` in degrees, `(0, 180]` (offset stage).
+    /// Feature-curve dihedral threshold `θ0` in degrees, `(0, 180)` (offset stage).
     pub theta0_deg: f64,
     /// Minimum feature-curve length `l0` in edges (offset stage).
     pub l0: u32,
@@ -308,13 +308,18 @@ fn bake_level(
     rep.window(w0, 0.2 * ws);
     rep.check("offset", 0.0)?;
     let t0 = Instant::now();
+    let mut offset_stats = Stats::default();
     let (start, slack) = match finer {
         Some(m) => (m.clone(), d),
-        None => (initial_surface(input, model, d, mode)?, 0.0),
+        None => (
+            initial_surface(input, model, params, d, mode, rep, &mut offset_stats)?,
+            0.0,
+        ),
     };
     stats
         .stages
         .push(("offset".into(), t0.elapsed().as_secs_f64()));
+    stats.metrics.extend(offset_stats.metrics);
     stats.count("faces_offset", start.triangle_count() as u64);
     let start_topology = topology_of(&start);
     rep.window(w0 + 0.2 * ws, 0.7 * ws);
@@ -435,8 +440,7 @@ struct LoopStats {
     faces_per_round: Vec<u64>,
     simplify: SimplifyReport,
     guard: GuardStats,
-    last_change: f64,
-    change_per_round: Vec<f64>,
+    converged: bool,
     flow_motion: f64,
     align_motion: f64,
     target_met: bool,
@@ -470,10 +474,7 @@ impl LoopStats {
         s.count("guard_exact_tests", g.exact_tests);
         s.count("target_met", self.target_met as u64);
         s.count("target_relaxations", self.relaxations);
-        s.metric("last_round_change", self.last_change);
-        for (i, c) in self.change_per_round.iter().enumerate() {
-            s.metric(&format!("change_round_{}", i + 1), *c);
-        }
+        s.count("converged", self.converged as u64);
         s.metric("flow_motion", self.flow_motion);
         s.metric("align_motion", self.align_motion);
     }
@@ -486,6 +487,18 @@ fn add_simplify(acc: &mut SimplifyReport, r: &SimplifyReport) {
     acc.rejected_hausdorff += r.rejected_hausdorff;
     acc.rejected_distance += r.rejected_distance;
     acc.rejected_guard += r.rejected_guard;
+}
+
+/// Alg. 3 line 17: the sampled two-sided Hausdorff distance between the meshes before and
+/// after a round is below `ε·l`. Decided with early exits (the first far sample settles it).
+fn has_converged(before: &TriMesh, after: &TriMesh, cfg: &LoopConfig) -> bool {
+    let eps = cfg.epsilon_abs;
+    let a = Surface::new(after);
+    if measure::one_sided_exceeds(before.positions(), before.triangles(), &a, cfg.d, 8, eps) {
+        return false;
+    }
+    let b = Surface::new(before);
+    !measure::one_sided_exceeds(after.positions(), after.triangles(), &b, cfg.d, 8, eps)
 }
 
 /// Alg. 3 from `start` (watertight, manifold, intersection-free; in cage mode enclosing the
@@ -512,7 +525,7 @@ fn optimize(
     for i in 0..rounds {
         let frac = |x: f64| (i as f64 + x) / rounds as f64;
         rep.check("simplify", frac(0.0))?;
-        let before = Surface::new(&g.mesh().to_trimesh());
+        let before = g.mesh().to_trimesh();
         let t0 = Instant::now();
         let sr = {
             let mut kg = |x: f64| rep.report("simplify", frac(0.5 * x));
@@ -538,15 +551,13 @@ fn optimize(
         ls.rounds += 1;
         ls.faces_per_round.push(g.mesh().face_count() as u64);
         let t0 = Instant::now();
-        let after = Surface::new(&g.mesh().to_trimesh());
-        ls.last_change = measure::hausdorff(&after, &before, cfg.d, 8);
-        ls.change_per_round.push(ls.last_change);
+        let converged = has_converged(&before, &g.mesh().to_trimesh(), cfg);
+        ls.converged = converged;
         ls.converge_s += t0.elapsed().as_secs_f64();
         ls.target_met = cfg.target_faces.is_some_and(|n| g.mesh().face_count() <= n);
         if ls.target_met {
             break;
         }
-        let converged = ls.last_change < cfg.epsilon_abs;
         if cfg.target_faces.is_some() && (converged || sr.collapses == 0) {
             // Pro.I with a face target: relax the per-collapse bound until it is reached.
             sopt.d *= 2.0;
@@ -562,47 +573,49 @@ fn optimize(
     Ok((g.mesh().to_trimesh(), ls))
 }
 
-/// The start surface `M_d`.
-///
-/// TEMPORARY stand-in until `offset_surface` (branch `offset`) lands on `main`: the input must
-/// be a closed manifold; each vertex is pushed `d` along its area-weighted normal, and the
-/// result is used when it passes the independent verification (and, for cages, encloses the
-/// input without touching it). LODs fall back to the input itself when it is intersection-free.
-fn initial_surface(input: &TriMesh, model: &InputModel, d: f64, mode: Mode) -> Result<TriMesh> {
-    let he = HalfEdgeMesh::from_trimesh(input).map_err(|e| {
-        Error::InvalidMesh(format!(
-            "until the offset stage is available the input must be a closed manifold: {e}"
-        ))
-    })?;
-    if he.boundary_loop_count() != 0 {
-        return Err(Error::InvalidMesh(
-            "until the offset stage is available the input must be closed".into(),
-        ));
-    }
-    let mut normals = vec![[0.0; 3]; input.vertex_count()];
-    for f in he.faces() {
-        let n = he.face_area_vector(f);
-        for v in he.face_vertices(f) {
-            normals[v as usize] = add(normals[v as usize], n);
+/// The start surface `M_d`: the offset surface of stage 1 (§4.3.1) at distance `d`, which is
+/// watertight, manifold and intersection-free, and encloses the input at distance about `d`.
+/// In cage mode the enclosure and the absence of contact are checked here, since the guard
+/// only keeps them.
+fn initial_surface(
+    input: &TriMesh,
+    model: &InputModel,
+    params: &LodParams,
+    d: f64,
+    mode: Mode,
+    rep: &mut Reporter<'_, '_>,
+    stats_out: &mut Stats,
+) -> Result<TriMesh> {
+    let op = OffsetParams {
+        distance: OffsetDistance::Absolute(d),
+        theta0_deg: params.theta0_deg,
+        l0: params.l0,
+        memory_budget_bytes: params.memory_budget_bytes,
+        ..OffsetParams::default()
+    };
+    let (mesh, ostats) = {
+        let mut prog = |p: Progress<'_>| rep.report(p.stage, p.fraction);
+        offset_surface_with_progress(input, &op, &mut prog)?
+    };
+    for (name, holds) in &ostats.verified {
+        let essential = ["watertight", "manifold", "self_intersection_free"];
+        if essential.contains(&name.as_str()) && !holds {
+            return Err(Error::Internal(format!(
+                "the offset surface failed its verification ({name}); please report the input"
+            )));
         }
     }
-    let pos: Vec<P3> = input
-        .positions()
-        .iter()
-        .zip(&normals)
-        .map(|(&p, &n)| add(p, scale(normalized(n).unwrap_or([0.0; 3]), d)))
-        .collect();
-    let pushed = TriMesh::new(pos, input.triangles().to_vec())?;
-    let (v, cage_ok) = verify_level(&pushed, model, mode);
-    if v.manifold && v.watertight && v.self_intersection_free && cage_ok {
-        return Ok(pushed);
+    if let Some(dev) = ostats.get_metric("max_deviation_over_d") {
+        stats_out.metric("offset_max_deviation_over_d", dev);
     }
-    if mode == Mode::Lod && measure::verify(input).self_intersection_free {
-        return Ok(input.clone());
+    if mode == Mode::Cage {
+        let (untouched, encloses) = measure::verify_cage(&mesh, model);
+        if !(untouched && encloses) {
+            return Err(Error::Internal(format!(
+                "the offset surface does not enclose the input without contact \
+                 (untouched: {untouched}, encloses: {encloses})"
+            )));
+        }
     }
-    Err(Error::InvalidMesh(
-        "until the offset stage is available the input must be a closed, intersection-free \
-         manifold"
-            .into(),
-    ))
+    Ok(mesh)
 }

@@ -45,7 +45,7 @@ use crate::{Error, Result};
 /// Weight of an edge's virtual plane relative to `|e|²` (face planes weigh their area).
 pub const VIRTUAL_PLANE_WEIGHT: f64 = 0.01;
 
-/// Largest sampling grid per triangle edge in the distance checks.
+/// Largest sampling grid per triangle edge in the local Hausdorff check.
 const MAX_SAMPLE_RES: usize = 4;
 
 /// Options of one simplification pass.
@@ -196,13 +196,13 @@ fn collapse_target(q: &Quadric, pa: P3, pb: P3) -> (P3, f64) {
     (x, q.eval(x).max(0.0))
 }
 
-/// A queue entry: cost, edge id, edge version at push time.
+/// A queue entry: cost, edge id, edge version at push time (the target position of the
+/// current version is in `Pass::targets`).
 #[derive(Debug, Clone, Copy)]
 struct Entry {
     cost: f64,
     edge: u32,
     version: u32,
-    target: P3,
 }
 
 impl PartialEq for Entry {
@@ -231,6 +231,7 @@ struct Pass<'g, 'a> {
     opt: SimplifyOptions,
     quadrics: Vec<Quadric>,
     version: Vec<u32>,
+    targets: Vec<P3>,
     heap: BinaryHeap<Entry>,
     /// Sampled max distance to the input per face (NaN = not computed yet).
     face_dist: Vec<f64>,
@@ -257,6 +258,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         let m = g.mesh();
         let mut pass = Pass {
             version: vec![0; m.edge_capacity()],
+            targets: vec![[0.0; 3]; m.edge_capacity()],
             face_dist: vec![f64::NAN; m.face_capacity()],
             vert_dist: vec![f64::NAN; m.vertex_capacity()],
             heap: BinaryHeap::with_capacity(m.edge_count()),
@@ -284,11 +286,11 @@ impl<'g, 'a> Pass<'g, 'a> {
         let (a, b) = (m.origin(h), m.target(h));
         let q = self.quadrics[a as usize].add(&self.quadrics[b as usize]);
         let (target, cost) = collapse_target(&q, m.position(a), m.position(b));
+        self.targets[e as usize] = target;
         self.heap.push(Entry {
             cost,
             edge: e,
             version: self.version[e as usize],
-            target,
         });
     }
 
@@ -306,7 +308,7 @@ impl<'g, 'a> Pass<'g, 'a> {
                 continue;
             }
             self.report.candidates += 1;
-            self.try_edge(e, entry.target);
+            self.try_edge(e, self.targets[e as usize]);
         }
         Ok(())
     }
@@ -335,7 +337,14 @@ impl<'g, 'a> Pass<'g, 'a> {
         for c in candidates {
             match self.try_position(h, a, b, c) {
                 Ok(()) => return,
-                Err(r) => last = r,
+                // Another position can cure a fold-over or a patch farther from the input;
+                // a too large change or a guard refusal is rarely cured by moving along the
+                // edge, and retrying would double the cost of those rejections.
+                Err(r @ (Rejection::Fold | Rejection::Distance)) => last = r,
+                Err(r) => {
+                    last = r;
+                    break;
+                }
             }
         }
         match last {
@@ -361,7 +370,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         if !self.within_hausdorff(a, b, x, &old, &new) {
             return Err(Rejection::Hausdorff);
         }
-        let Some(new_face_dist) = self.distance_not_increased(a, x, &old, &new) else {
+        let Some(new_face_dist) = self.distance_not_increased(a, b, x, &old, &new) else {
             return Err(Rejection::Distance);
         };
         match self.g.try_collapse(h, x) {
@@ -399,11 +408,22 @@ impl<'g, 'a> Pass<'g, 'a> {
         (old, new)
     }
 
-    /// Alg. 5 line 20: sampled two-sided Hausdorff distance between the old and new patch is
-    /// at most `d`. Samples skip the shared ring vertices (distance 0 on both sides).
+    /// Alg. 5 line 20: the two-sided Hausdorff distance between the old and new patch is at
+    /// most `d`.
+    ///
+    /// Exact shortcut first: `H(M_e, M'_e) ≤ max(|x − a|, |x − b|)`. (A point
+    /// `αx + βr_i + γr_j` of a new face lies within `α|x − a|` (or `α|x − b|`) of the point
+    /// `αa + βr_i + γr_j` of the old face it came from; a point `αa + βb + γc` of a deleted
+    /// face lies within `(α + β) max(|x − a|, |x − b|)` of `(α + β)x + γc` on the new edge
+    /// `x–c`.) Only when that bound exceeds `d` are both patches sampled (skipping the shared
+    /// ring vertices, at distance 0 on both sides).
     fn within_hausdorff(&self, a: u32, b: u32, x: P3, old: &Patch, new: &Patch) -> bool {
         let d = self.opt.d;
         let s = self.opt.spacing;
+        let m = self.g.mesh();
+        if dist(x, m.position(a)).max(dist(x, m.position(b))) <= d {
+            return true;
+        }
         let near = |p: P3, other: &Patch| -> bool {
             other
                 .tris
@@ -426,7 +446,6 @@ impl<'g, 'a> Pass<'g, 'a> {
             }
             true
         };
-        let m = self.g.mesh();
         one_side(new, old, &[(a, x)])
             && one_side(old, new, &[(a, m.position(a)), (b, m.position(b))])
     }
@@ -441,18 +460,20 @@ impl<'g, 'a> Pass<'g, 'a> {
         d
     }
 
-    /// Mean of the sampled distances of a triangle to the input, given its corner distances
-    /// (corners count once each, like every other grid sample).
+    /// Mean distance of a triangle to the input, sampled at its corners (given) and, when it
+    /// is longer than the sample spacing, at its centroid. Smaller triangles use their corners
+    /// only: the distance field is 1-Lipschitz and, at the offset distance, smooth at that
+    /// scale, so an interior sample adds little there.
     fn triangle_distance(&self, t: &[P3; 3], corner: [f64; 3]) -> f64 {
-        let k = sample_resolution(t, self.opt.spacing, MAX_SAMPLE_RES);
-        let input = self.g.input();
-        let mut sum = corner[0] + corner[1] + corner[2];
-        let mut n = 3usize;
-        for_each_sample(t, k, true, |p| {
-            sum += input.distance(p);
-            n += 1;
-        });
-        sum / n as f64
+        let sum = corner[0] + corner[1] + corner[2];
+        if sample_resolution(t, self.opt.spacing, 2) == 1 {
+            return sum / 3.0;
+        }
+        let c = scale(add(add(t[0], t[1]), t[2]), 1.0 / 3.0);
+        let ub = (0..3)
+            .map(|i| corner[i] + dist(c, t[i]))
+            .fold(f64::INFINITY, f64::min);
+        (sum + self.g.input().distance_bounded(c, ub)) / 4.0
     }
 
     fn face_distance(&mut self, f: u32, vs: [u32; 3], t: &[P3; 3]) -> f64 {
@@ -473,6 +494,7 @@ impl<'g, 'a> Pass<'g, 'a> {
     fn distance_not_increased(
         &mut self,
         a: u32,
+        b: u32,
         x: P3,
         old: &Patch,
         new: &Patch,
@@ -489,7 +511,10 @@ impl<'g, 'a> Pass<'g, 'a> {
             0.0
         };
         let limit = old_mean.max(self.opt.slack) * (1.0 + 1e-9);
-        let dx = self.g.input().distance(x);
+        let m = self.g.mesh();
+        let (pa, pb) = (m.position(a), m.position(b));
+        let ub = (self.vertex_distance(a) + dist(x, pa)).min(self.vertex_distance(b) + dist(x, pb));
+        let dx = self.g.input().distance_bounded(x, ub);
         let (mut new_sum, mut new_area) = (0.0, 0.0);
         let mut out = Vec::with_capacity(new.ids.len());
         for i in 0..new.ids.len() {
