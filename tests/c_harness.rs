@@ -34,14 +34,14 @@ fn features() -> Vec<&'static str> {
     f
 }
 
-/// Builds the cdylib (a nested cargo call; `--test c_harness` keeps the dependency features
-/// identical to this test build and `--profile test` its profile, so `cargo test` has already
-/// compiled every unit and the call only copies the library out) and returns its directory.
+/// Builds the cdylib (a nested cargo call; `--tests` keeps the dependency features identical to
+/// those of `cargo test` — every test target, the CLI's included, takes part in feature
+/// unification — and `--profile test` its profile, so after `cargo test` has compiled every unit
+/// the call only copies the library out) and returns its directory.
 fn build_library() -> PathBuf {
     let feats = features().join(",");
     let mut cmd = Command::new(env!("CARGO"));
-    cmd.args(["build", "--lib", "--test", "c_harness", "--profile", "test"])
-        .arg("--no-default-features")
+    cmd.args(["build", "--lib", "--tests", "--profile", "test", "--no-default-features"])
         .current_dir(root());
     if !feats.is_empty() {
         cmd.args(["--features", &feats]);
