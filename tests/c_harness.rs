@@ -41,8 +41,15 @@ fn features() -> Vec<&'static str> {
 fn build_library() -> PathBuf {
     let feats = features().join(",");
     let mut cmd = Command::new(env!("CARGO"));
-    cmd.args(["build", "--lib", "--tests", "--profile", "test", "--no-default-features"])
-        .current_dir(root());
+    cmd.args([
+        "build",
+        "--lib",
+        "--tests",
+        "--profile",
+        "test",
+        "--no-default-features",
+    ])
+    .current_dir(root());
     if !feats.is_empty() {
         cmd.args(["--features", &feats]);
     }
