@@ -40,6 +40,7 @@ pub mod animation;
 mod complex;
 pub mod cwf;
 pub mod evaluate;
+pub mod interp_bench;
 pub mod interpolate;
 pub mod io;
 pub mod knoppel;
