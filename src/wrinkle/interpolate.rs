@@ -775,6 +775,8 @@ struct Hessian {
     diag_mean: f64,
     symbolic: SymbolicLlt<usize>,
     factorizations: usize,
+    /// The last successful factorization, reused as a preconditioner (see `lagged_solve`).
+    last: Option<Llt<usize, f64>>,
 }
 
 impl Hessian {
@@ -842,11 +844,34 @@ impl Hessian {
             diag_mean: if diag_mean > 0.0 { diag_mean } else { 1.0 },
             symbolic,
             factorizations: 0,
+            last: None,
         })
     }
 
-    /// Solves `(K + D(x) + μ·mean(diag K)·I) d = −g`, raising `μ` until the factorization
-    /// succeeds.
+    /// `K + D(x) + μ·mean(diag K)·I` (lower triangle).
+    fn assemble(
+        &self,
+        p: &Problem,
+        x: &[Complex],
+        mu: f64,
+        model: HessianModel,
+    ) -> SparseColMat<usize, f64> {
+        let mut h = self.k.clone();
+        let vals = h.val_mut();
+        for (u, s) in self.diag_slots.iter().enumerate() {
+            let w = p.w_unit[u % p.n_v];
+            let b = unit_block(x[u], w, model);
+            vals[s[0]] += b[0] + mu * self.diag_mean;
+            vals[s[1]] += b[1];
+            vals[s[2]] += b[2] + mu * self.diag_mean;
+        }
+        h
+    }
+
+    /// Solves `(K + D(x) + μ·mean(diag K)·I) d = −g`. First by conjugate gradients
+    /// preconditioned with the previous iteration's factorization (the Hessian changes only in
+    /// its 2×2 diagonal blocks between iterations, so a few steps suffice), else by a fresh
+    /// factorization, raising `μ` until it succeeds.
     fn newton_direction(
         &mut self,
         p: &Problem,
@@ -855,32 +880,25 @@ impl Hessian {
         mu: &mut f64,
         model: HessianModel,
     ) -> Result<Vec<Complex>> {
-        for _ in 0..40 {
-            let mut h = self.k.clone();
-            let vals = h.val_mut();
-            for (u, s) in self.diag_slots.iter().enumerate() {
-                let w = p.w_unit[u % p.n_v];
-                let b = unit_block(x[u], w, model);
-                vals[s[0]] += b[0] + *mu * self.diag_mean;
-                vals[s[1]] += b[1];
-                vals[s[2]] += b[2] + *mu * self.diag_mean;
+        let rhs: Vec<f64> = g.iter().flat_map(|c| [-c.re, -c.im]).collect();
+        if let Some(llt) = &self.last {
+            let h = self.assemble(p, x, *mu, model);
+            if let Some(d) = lagged_solve(&h, llt, &rhs) {
+                return Ok(to_complex(&d));
             }
+        }
+        for _ in 0..40 {
+            let h = self.assemble(p, x, *mu, model);
             self.factorizations += 1;
             if let Ok(llt) =
                 Llt::try_new_with_symbolic(self.symbolic.clone(), h.as_ref(), Side::Lower)
             {
-                {
-                    let mut rhs = Mat::<f64>::from_fn(2 * x.len(), 1, |i, _| {
-                        let c = g[i / 2];
-                        -(if i % 2 == 0 { c.re } else { c.im })
-                    });
-                    llt.solve_in_place(&mut rhs);
-                    let d: Vec<Complex> = (0..x.len())
-                        .map(|u| Complex::new(rhs[(2 * u, 0)], rhs[(2 * u + 1, 0)]))
-                        .collect();
-                    if d.iter().all(|z| z.is_finite()) {
-                        return Ok(d);
-                    }
+                let mut b = Mat::<f64>::from_fn(rhs.len(), 1, |i, _| rhs[i]);
+                llt.solve_in_place(&mut b);
+                let d: Vec<f64> = (0..rhs.len()).map(|i| b[(i, 0)]).collect();
+                if d.iter().all(|v| v.is_finite()) {
+                    self.last = Some(llt);
+                    return Ok(to_complex(&d));
                 }
             }
             *mu = (*mu * 100.0).max(1e-10);
@@ -889,6 +907,79 @@ impl Hessian {
             "the interpolation Hessian could not be factorized even with heavy damping".into(),
         ))
     }
+}
+
+fn to_complex(d: &[f64]) -> Vec<Complex> {
+    d.chunks_exact(2)
+        .map(|c| Complex::new(c[0], c[1]))
+        .collect()
+}
+
+/// `y = H v` for `H` stored as its lower triangle (CSC).
+fn sym_matvec(h: &SparseColMat<usize, f64>, v: &[f64]) -> Vec<f64> {
+    let cp = h.symbolic().col_ptr();
+    let ri = h.symbolic().row_idx();
+    let val = h.val();
+    let mut y = vec![0.0; v.len()];
+    for j in 0..v.len() {
+        for k in cp[j]..cp[j + 1] {
+            let (i, a) = (ri[k], val[k]);
+            y[i] += a * v[j];
+            if i != j {
+                y[j] += a * v[i];
+            }
+        }
+    }
+    y
+}
+
+/// Preconditioned CG on `H d = b` with a stale factorization as preconditioner. `None` when it
+/// does not reach a relative residual of 1e-8 within 12 steps or meets non-positive curvature
+/// (`H` indefinite): the caller then factorizes.
+fn lagged_solve(
+    h: &SparseColMat<usize, f64>,
+    pre: &Llt<usize, f64>,
+    b: &[f64],
+) -> Option<Vec<f64>> {
+    let apply_pre = |r: &[f64]| -> Vec<f64> {
+        let mut m = Mat::<f64>::from_fn(r.len(), 1, |i, _| r[i]);
+        pre.solve_in_place(&mut m);
+        (0..r.len()).map(|i| m[(i, 0)]).collect()
+    };
+    let dotv = |a: &[f64], c: &[f64]| a.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
+    let bnorm = dotv(b, b).sqrt();
+    if bnorm == 0.0 {
+        return Some(vec![0.0; b.len()]);
+    }
+    let mut x = apply_pre(b);
+    let hx = sym_matvec(h, &x);
+    let mut r: Vec<f64> = b.iter().zip(&hx).map(|(bi, hi)| bi - hi).collect();
+    let mut z = apply_pre(&r);
+    let mut pdir = z.clone();
+    let mut rz = dotv(&r, &z);
+    for _ in 0..12 {
+        if dotv(&r, &r).sqrt() <= 1e-8 * bnorm {
+            return Some(x);
+        }
+        let hp = sym_matvec(h, &pdir);
+        let php = dotv(&pdir, &hp);
+        if php.is_nan() || php <= 0.0 {
+            return None;
+        }
+        let alpha = rz / php;
+        for i in 0..x.len() {
+            x[i] += alpha * pdir[i];
+            r[i] -= alpha * hp[i];
+        }
+        z = apply_pre(&r);
+        let rz_new = dotv(&r, &z);
+        let beta = rz_new / rz;
+        rz = rz_new;
+        for i in 0..x.len() {
+            pdir[i] = z[i] + beta * pdir[i];
+        }
+    }
+    (dotv(&r, &r).sqrt() <= 1e-8 * bnorm && x.iter().all(|v| v.is_finite())).then_some(x)
 }
 
 /// The PSD 2×2 Hessian block `(h00, h10, h11)` of `w (|z|² − 1)²` at `z`.
