@@ -17,6 +17,32 @@
 // `struct_size`) does not change it.
 #define PLEAT_ABI_VERSION 1
 
+// `PleatWrinkleInterpStats::stop_reason`: the gradient norm reached the tolerance.
+#define PLEAT_INTERP_STOP_CONVERGED 0
+
+// `PleatWrinkleInterpStats::stop_reason`: the iteration cap was reached first.
+#define PLEAT_INTERP_STOP_ITERATION_CAP 1
+
+// `PleatWrinkleInterpStats::stop_reason`: no step decreased the objective any more (round-off
+// bound; the result is usable, see `final_gradient_norm`).
+#define PLEAT_INTERP_STOP_STALLED 2
+
+// `PleatWrinkleInterpStats::stop_reason`: identical keyframes, the constant path (0 iterations).
+#define PLEAT_INTERP_STOP_IDENTICAL_KEYFRAMES 3
+
+// `PleatWrinkleInterpStats::stop_reason`: `guide_frames == 1`, linear interpolation, no solve.
+#define PLEAT_INTERP_STOP_NO_UNKNOWNS 4
+
+// `PleatWrinkleInterpParams::hessian`: projected Newton (PSD per-vertex blocks).
+#define PLEAT_INTERP_HESSIAN_PROJECTED 0
+
+// `PleatWrinkleInterpParams::hessian`: Gauss–Newton.
+#define PLEAT_INTERP_HESSIAN_GAUSS_NEWTON 1
+
+// `PleatWrinkleInterpParams::hessian`: exact Hessian with Levenberg–Marquardt damping
+// (default; fastest measured).
+#define PLEAT_INTERP_HESSIAN_EXACT 2
+
 // `PleatLodParams::flags` bit: skip the feature-alignment step (Alg. 6).
 #define PLEAT_LOD_NO_ALIGN 1
 
@@ -140,6 +166,12 @@ typedef int32_t PleatStatsKind;
 // copied out) from several threads at once; destroying it while in use is undefined.
 typedef struct PleatCwf PleatCwf;
 
+// A wrinkle animation (opaque): guide frames between two keyframes on one base mesh (a private
+// copy). Created by `pleat_cwf_interpolate` or `pleat_cwf_animation_read_file`, destroyed by
+// `pleat_cwf_animation_destroy`. Immutable: frames may be extracted from several threads at
+// once; destroying it while in use is undefined.
+typedef struct PleatCwfAnimation PleatCwfAnimation;
+
 // An indexed triangle mesh owned by pleat (opaque). Created by `pleat_mesh_create_*`,
 // `pleat_mesh_read_file` or an operation that returns a mesh; destroyed by
 // `pleat_mesh_destroy`. Immutable after creation, so it may be read from several threads at
@@ -155,6 +187,70 @@ typedef struct PleatStats PleatStats;
 // `pleat_cwf_evaluate`. Vertex order is that of the output mesh. Destroyed by
 // `pleat_wrinkle_fields_destroy`. Immutable; thread rules as `PleatCwf`.
 typedef struct PleatWrinkleFields PleatWrinkleFields;
+
+// Parameters of `pleat_cwf_interpolate`. Get the defaults from
+// `pleat_wrinkle_interp_params_default()`; `struct_size` versioned as
+// `PleatWrinkleEvalParams`.
+typedef struct PleatWrinkleInterpParams {
+  // `sizeof(PleatWrinkleInterpParams)`; at least 8.
+  uint32_t struct_size;
+  // `N'`, guide intervals (guide frames at t = n/N', n = 0..N'), 1 to 100000; default 50.
+  // 1 means plain linear interpolation. Cost grows about linearly with it.
+  uint32_t guide_frames;
+  // `k`, linear sub-steps per guide interval, 1 to 100000; default 4. The animation has
+  // `N'·k + 1` playback frames.
+  uint32_t substeps;
+  // Newton iteration cap, 0 to 1000000; default 200 (0 returns the initial guess).
+  uint32_t max_iterations;
+  // `c = c_scale · g_ave` (penalty of E_compat + E_unit, eq. 3.12); finite, > 0; default 1000.
+  double c_scale;
+  // Stop when the normalized gradient norm is ≤ this; finite, ≥ 0; default 1e-6.
+  double gradient_tolerance;
+  // `PLEAT_INTERP_HESSIAN_*`; default `PLEAT_INTERP_HESSIAN_EXACT`.
+  uint32_t hessian;
+  // Reserved, set to 0.
+  uint32_t reserved;
+} PleatWrinkleInterpParams;
+
+// Progress information passed to a [`PleatProgressFn`].
+typedef struct PleatProgress {
+  // Name of the running stage, NUL-terminated, valid during the callback only.
+  const char *stage;
+  // Fraction of the whole operation done, in [0, 1].
+  double fraction;
+} PleatProgress;
+
+// Progress callback of long operations. Called on the calling thread only, with the caller's
+// `user_data`. Return 0 to continue, non-zero to cancel: the operation then returns
+// `PLEAT_STATUS_CANCELLED` promptly and writes no output.
+typedef int32_t (*PleatProgressFn)(void *user_data, const struct PleatProgress *info);
+
+// What `pleat_cwf_interpolate` did. Set `struct_size = sizeof(PleatWrinkleInterpStats)`
+// before the call; pleat fills at most that many bytes.
+typedef struct PleatWrinkleInterpStats {
+  // In: `sizeof(PleatWrinkleInterpStats)` as the caller knows it (≥ 8). Out: bytes filled.
+  uint32_t struct_size;
+  // Newton iterations done.
+  uint32_t iterations;
+  // `PLEAT_INTERP_STOP_*`.
+  uint32_t stop_reason;
+  // Sparse Cholesky factorizations done (including failed, damped ones).
+  uint32_t factorizations;
+  // Wall seconds of the whole call.
+  double total_seconds;
+  // Normalized gradient norm at the end (the stopping residual).
+  double final_gradient_norm;
+  // Final E_smooth (eq. 3.13).
+  double smooth_energy;
+  // Final time integral of E_compat over the guide frames.
+  double compat_energy;
+  // Final time integral of E_unit over the guide frames.
+  double unit_energy;
+  // g_ave (eq. 3.16, area-weighted mean of a²|ω|⁴; 0 when every amplitude is zero).
+  double g_ave;
+  // The penalty c used.
+  double c;
+} PleatWrinkleInterpStats;
 
 // Parameters of `pleat_lod_generate`, `pleat_lod_generate_chain` and `pleat_cage_generate`.
 // Get the defaults from `pleat_lod_params_default()` and change what you need; the defaults
@@ -187,19 +283,6 @@ typedef struct PleatLodParams {
   // with `PLEAT_STATUS_LIMIT_EXCEEDED` before the expensive work.
   uint64_t memory_budget_bytes;
 } PleatLodParams;
-
-// Progress information passed to a [`PleatProgressFn`].
-typedef struct PleatProgress {
-  // Name of the running stage, NUL-terminated, valid during the callback only.
-  const char *stage;
-  // Fraction of the whole operation done, in [0, 1].
-  double fraction;
-} PleatProgress;
-
-// Progress callback of long operations. Called on the calling thread only, with the caller's
-// `user_data`. Return 0 to continue, non-zero to cancel: the operation then returns
-// `PLEAT_STATUS_CANCELLED` promptly and writes no output.
-typedef int32_t (*PleatProgressFn)(void *user_data, const struct PleatProgress *info);
 
 // Statistics of one baked level, filled when a non-NULL pointer is passed. Set `struct_size`
 // to `sizeof(PleatLodStats)`; pleat fills only that many bytes. Yes/no fields are 0 or 1.
@@ -490,6 +573,119 @@ size_t pleat_mesh_edge_count(const struct PleatMesh *mesh);
 PleatStatus pleat_mesh_copy_edges(const struct PleatMesh *mesh,
                                   uint32_t *dst,
                                   size_t edge_capacity);
+
+// The default interpolation parameters (50 guide frames, 4 sub-steps, 200 iterations,
+// c_scale 1000, tolerance 1e-6, exact Hessian), with `struct_size` set. Available in every
+// build.
+struct PleatWrinkleInterpParams pleat_wrinkle_interp_params_default(void);
+
+// Interpolates between keyframe `a` (t = 0) and keyframe `b` (t = 1) (dissertation §3.4):
+// linear amplitude, the explicit magnitude/angle path of ω, and the phase z̃ on the guide frames
+// from a spacetime Newton solve; keyframes whose ω and z̃ disagree are split per eq. 3.17.
+//
+// - `a`, `b`: non-NULL, on the same base mesh (same triangles, positions equal to 1e-9 of the
+//   bounding-box diagonal), else `PLEAT_STATUS_INVALID_ARGUMENT` naming the difference.
+// - `params`: NULL = `pleat_wrinkle_interp_params_default()`; ranges in
+//   `PleatWrinkleInterpParams`.
+// - `progress`: NULL or a callback, called on the calling thread after every Newton iteration;
+//   non-zero cancels (`PLEAT_STATUS_CANCELLED`, no output).
+// - `user_data`: passed to `progress`; may be NULL.
+// - `out`: receives the animation (destroy with `pleat_cwf_animation_destroy`); non-NULL.
+// - `stats`: NULL or a `PleatWrinkleInterpStats` with `struct_size` set; filled on success.
+//
+// Reaching the iteration cap or stalling is not an error (`stats->stop_reason` says so).
+// `PLEAT_STATUS_NUMERICAL` when the factorization fails even with heavy damping. Memory and
+// time grow with `vertices × guide_frames`. Output bytes do not depend on the thread count.
+//
+// # Safety
+// Pointers are NULL or valid as described; `progress` is a valid function or NULL.
+PleatStatus pleat_cwf_interpolate(const struct PleatCwf *a,
+                                  const struct PleatCwf *b,
+                                  const struct PleatWrinkleInterpParams *params,
+                                  PleatProgressFn progress,
+                                  void *user_data,
+                                  struct PleatCwfAnimation **out,
+                                  struct PleatWrinkleInterpStats *stats);
+
+// The wrinkle field at time `t`: amplitude linear between the keyframes, ω and z̃ linear between
+// the two guide frames around `t`. `t = 0` and `t = 1` reproduce the keyframes exactly.
+//
+// - `anim`: non-NULL.
+// - `t`: in [0, 1], not NaN, else `PLEAT_STATUS_INVALID_ARGUMENT`. Playback frame `i` is at
+//   `t = i / (pleat_cwf_animation_frame_count(anim) - 1)`.
+// - `out`: receives a new `PleatCwf` (destroy with `pleat_cwf_destroy`); non-NULL.
+//
+// Cost: O(vertices + edges) plus a copy of the base mesh.
+//
+// # Safety
+// `anim` is NULL or live; `out` is NULL or writable.
+PleatStatus pleat_cwf_animation_frame(const struct PleatCwfAnimation *anim,
+                                      double t,
+                                      struct PleatCwf **out);
+
+// Number of playback frames, `N'·k + 1`; 0 when `anim` is NULL or the build lacks `wrinkle`.
+//
+// # Safety
+// `anim` is NULL or live.
+size_t pleat_cwf_animation_frame_count(const struct PleatCwfAnimation *anim);
+
+// Number of guide intervals `N'` (there are `N' + 1` guide frames); 0 when `anim` is NULL or
+// the build lacks `wrinkle`.
+//
+// # Safety
+// `anim` is NULL or live.
+size_t pleat_cwf_animation_guide_count(const struct PleatCwfAnimation *anim);
+
+// Number of convergence-history records (the initial guess and each Newton iteration); 0 for
+// an animation read from a file, a NULL `anim` or a build without `wrinkle`.
+//
+// # Safety
+// `anim` is NULL or live.
+size_t pleat_cwf_animation_history_count(const struct PleatCwfAnimation *anim);
+
+// Copies the convergence history: 2 doubles per record, `(wall seconds since the start of
+// the call, normalized gradient norm)` — error against run time.
+//
+// - `anim`, `dst`: non-NULL.
+// - `record_capacity`: records `dst` holds (`2 * record_capacity` doubles);
+//   ≥ `pleat_cwf_animation_history_count(anim)`, else `PLEAT_STATUS_LIMIT_EXCEEDED`.
+//
+// # Safety
+// `anim` is NULL or live; `dst` is NULL or valid for `2 * record_capacity` doubles.
+PleatStatus pleat_cwf_animation_copy_history(const struct PleatCwfAnimation *anim,
+                                             double *dst,
+                                             size_t record_capacity);
+
+// Writes the animation as a `.cwfa` text file (lossless; format in README "Wrinkle
+// animation"). The base mesh is not written; store it separately.
+//
+// - `anim`: non-NULL.
+// - `path`: NUL-terminated UTF-8 path; non-NULL. An existing file is replaced.
+//
+// # Safety
+// `anim` is NULL or live; `path` is NULL or NUL-terminated.
+PleatStatus pleat_cwf_animation_write_file(const struct PleatCwfAnimation *anim, const char *path);
+
+// Reads a `.cwfa` file written for `base` (connectivity checked as for `.cwf` files).
+//
+// - `base`: non-NULL; pleat keeps its own copy.
+// - `path`: NUL-terminated UTF-8 path; non-NULL.
+// - `out`: receives the animation; non-NULL.
+//
+// `PLEAT_STATUS_IO` when unreadable, `PLEAT_STATUS_PARSE` when malformed (message with the
+// line), `PLEAT_STATUS_INVALID_ARGUMENT` for other connectivity or invalid values.
+//
+// # Safety
+// `base` is NULL or live; `path` is NULL or NUL-terminated; `out` is NULL or writable.
+PleatStatus pleat_cwf_animation_read_file(const struct PleatMesh *base,
+                                          const char *path,
+                                          struct PleatCwfAnimation **out);
+
+// Destroys an animation. NULL is accepted and ignored. Destroying twice is undefined.
+//
+// # Safety
+// `anim` is NULL or a handle from pleat not yet destroyed.
+void pleat_cwf_animation_destroy(struct PleatCwfAnimation *anim);
 
 // The defaults, with `struct_size = sizeof(PleatLodParams)`.
 struct PleatLodParams pleat_lod_params_default(void);

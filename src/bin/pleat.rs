@@ -81,6 +81,31 @@ enum Command {
     /// Complex wrinkle fields: build (.cwf files) and evaluate wrinkled meshes.
     #[command(subcommand)]
     Wrinkle(WrinkleCommand),
+    /// Benchmarks that write CSV tables and SVG plots.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+/// `pleat bench ...`.
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Wrinkle interpolation: residual vs seconds per keyframe pair (rotation, frequency ×3,
+    /// local rotation) and quality vs number of guide frames (ablation B.7.1). Writes
+    /// interp_convergence.csv/.svg and interp_guide_frames.csv/.svg into OUT_DIR.
+    Wrinkle {
+        /// Base meshes [default: ../shared/meshes/coarse_decimated-knight.off].
+        #[arg(long)]
+        mesh: Vec<PathBuf>,
+        /// Output directory (created).
+        #[arg(long, default_value = "bench-wrinkle")]
+        out_dir: PathBuf,
+        /// Guide frames N' of the convergence runs.
+        #[arg(long, default_value_t = 50)]
+        frames: usize,
+        /// Wave periods per bounding-box diagonal.
+        #[arg(long, default_value_t = 8.0)]
+        wavelengths: f64,
+    },
 }
 
 /// Options shared by `lod` and `cage`.
@@ -158,6 +183,52 @@ enum WrinkleCommand {
         #[arg(short = 'o', long = "output")]
         out: PathBuf,
     },
+    /// Interpolate between two keyframes (dissertation §3.4): writes a .cwfa animation of
+    /// `--frames` guide frames and `--substeps` linear sub-steps each.
+    Interp {
+        /// Keyframe at t = 0 (.cwf).
+        a: PathBuf,
+        /// Keyframe at t = 1 (.cwf), on the same base mesh.
+        b: PathBuf,
+        /// The base mesh both keyframes were made for.
+        #[arg(long)]
+        base: PathBuf,
+        /// Guide frames N'.
+        #[arg(long, default_value_t = 50)]
+        frames: usize,
+        /// Linear sub-steps k per guide interval (N'·k + 1 playback frames).
+        #[arg(long, default_value_t = 4)]
+        substeps: usize,
+        /// c = C_SCALE · g_ave.
+        #[arg(long, default_value_t = 1e3)]
+        c_scale: f64,
+        /// Gradient-norm tolerance.
+        #[arg(long, default_value_t = 1e-6)]
+        tolerance: f64,
+        /// Newton iteration cap.
+        #[arg(long, default_value_t = 200)]
+        max_iterations: usize,
+        /// Output animation (.cwfa).
+        #[arg(short = 'o', long = "output")]
+        out: PathBuf,
+    },
+    /// Evaluate every playback frame of an animation to a mesh file; `{i}` in OUT is replaced
+    /// by the frame number.
+    EvalAnim {
+        /// The base mesh.
+        base: PathBuf,
+        /// The animation (.cwfa).
+        anim: PathBuf,
+        /// Loop refinements.
+        #[arg(long, default_value_t = 3)]
+        levels: u32,
+        /// Multiplies the displacement.
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+        /// Output pattern, e.g. frame_{i}.obj.
+        #[arg(short = 'o', long = "output")]
+        out: PathBuf,
+    },
     /// Build a .cwf holding the global plane wave exp(i k·x) (exactly compatible, no solve).
     PlaneWave {
         /// The base mesh.
@@ -212,6 +283,7 @@ fn main() -> ExitCode {
         #[cfg(feature = "cage")]
         Command::Cage { input, bake: b } => bake(&input, &b, true),
         Command::Wrinkle(cmd) => wrinkle_cmd::run(cmd),
+        Command::Bench(cmd) => wrinkle_cmd::bench(cmd),
     }
 }
 
@@ -489,14 +561,17 @@ fn offset(
 /// `pleat wrinkle ...`.
 #[cfg(feature = "wrinkle")]
 mod wrinkle_cmd {
-    use super::{WrinkleCommand, EXIT_INPUT};
+    use super::{BenchCommand, WrinkleCommand, EXIT_INPUT};
     use pleat::mesh::io::{read_mesh, write_mesh};
     use pleat::mesh::TriMesh;
+    use pleat::wrinkle::interp_bench::{keyframe_pair, svg_plot, PairKind, Series};
     use pleat::wrinkle::{
-        read_cwf, write_cwf, BoundaryRule, Complex, Cwf, EvalOptions, FrequencyField,
-        KnoppelOptions, PhaseWeights, SubdivisionOptions,
+        interpolate_with_progress, read_animation, read_cwf, write_animation, write_cwf,
+        BoundaryRule, Complex, Cwf, EvalOptions, FrequencyField, InterpOptions, KnoppelOptions,
+        PhaseWeights, SubdivisionOptions,
     };
     use pleat::Error;
+    use std::fmt::Write as _;
     use std::path::Path;
     use std::process::ExitCode;
 
@@ -567,6 +642,37 @@ mod wrinkle_cmd {
                 amplitude,
                 out,
             } => ("plane-wave", plane_wave(&base, &k, amplitude, &out)),
+            WrinkleCommand::Interp {
+                a,
+                b,
+                base,
+                frames,
+                substeps,
+                c_scale,
+                tolerance,
+                max_iterations,
+                out,
+            } => {
+                let opts = InterpOptions {
+                    guide_frames: frames,
+                    substeps,
+                    c_scale,
+                    gradient_tolerance: tolerance,
+                    max_iterations,
+                    ..Default::default()
+                };
+                ("interp", interp(&a, &b, &base, &opts, &out))
+            }
+            WrinkleCommand::EvalAnim {
+                base,
+                anim,
+                levels,
+                scale,
+                out,
+            } => (
+                "eval-anim",
+                eval_anim(&base, &anim, levels as usize, scale, &out),
+            ),
         };
         match r {
             Ok(()) => ExitCode::SUCCESS,
@@ -698,6 +804,220 @@ mod wrinkle_cmd {
         Ok(())
     }
 
+    fn interp(
+        a: &Path,
+        b: &Path,
+        base: &Path,
+        opts: &InterpOptions,
+        out: &Path,
+    ) -> Result<(), Fail> {
+        let mesh = read_mesh(base).map_err(input)?;
+        let ka = read_cwf(a, mesh.clone()).map_err(input)?;
+        let kb = read_cwf(b, mesh).map_err(input)?;
+        let bar = indicatif::ProgressBar::new(1000);
+        let (anim, report, _) = interpolate_with_progress(&ka, &kb, opts, &mut |p| {
+            bar.set_position((p.fraction * 1000.0) as u64);
+            true
+        })
+        .map_err(op)?;
+        bar.finish_and_clear();
+        write_animation(out, &anim).map_err(op)?;
+        let secs = report.history.last().map_or(0.0, |h| h.seconds);
+        println!(
+            "{}: {} guide frames × {} sub-steps = {} frames; {} after {} iterations (gradient \
+             {:.2e}) in {secs:.2} s; E_smooth {:.4e}, E_compat {:.4e}, E_unit {:.4e}",
+            out.display(),
+            anim.guide_intervals(),
+            anim.substeps(),
+            anim.frame_count(),
+            report.stop.name(),
+            report.iterations,
+            report.final_gradient_norm(),
+            report.smooth_energy,
+            report.compat_energy,
+            report.unit_energy
+        );
+        Ok(())
+    }
+
+    fn eval_anim(
+        base: &Path,
+        anim: &Path,
+        levels: usize,
+        scale: f64,
+        out: &Path,
+    ) -> Result<(), Fail> {
+        let mesh = read_mesh(base).map_err(input)?;
+        let anim = read_animation(anim, mesh).map_err(input)?;
+        let pattern = out.to_string_lossy().to_string();
+        if !pattern.contains("{i}") && anim.frame_count() > 1 {
+            return Err(Fail(
+                EXIT_INPUT,
+                format!("output '{pattern}' needs a {{i}} placeholder for the frame number"),
+            ));
+        }
+        let opts = EvalOptions {
+            displacement_scale: scale,
+            ..Default::default()
+        };
+        let width = (anim.frame_count() - 1).to_string().len();
+        for i in 0..anim.frame_count() {
+            let frame = anim.frame(i).map_err(op)?;
+            let (ev, _) = frame.evaluate(levels, &opts).map_err(op)?;
+            let path = pattern.replace("{i}", &format!("{i:0width$}"));
+            write_mesh(Path::new(&path), &ev.mesh).map_err(op)?;
+        }
+        println!(
+            "{} frames of {} triangles written to {pattern}",
+            anim.frame_count(),
+            anim.base().triangle_count() << (2 * levels)
+        );
+        Ok(())
+    }
+
+    /// `pleat bench ...`.
+    pub fn bench(cmd: BenchCommand) -> ExitCode {
+        let BenchCommand::Wrinkle {
+            mesh,
+            out_dir,
+            frames,
+            wavelengths,
+        } = cmd;
+        match bench_wrinkle(&mesh, &out_dir, frames, wavelengths) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(Fail(code, msg)) => {
+                eprintln!("pleat bench wrinkle: {msg}");
+                ExitCode::from(code)
+            }
+        }
+    }
+
+    fn bench_wrinkle(
+        meshes: &[std::path::PathBuf],
+        out_dir: &Path,
+        frames: usize,
+        wavelengths: f64,
+    ) -> Result<(), Fail> {
+        let default = vec![std::path::PathBuf::from(
+            "../shared/meshes/coarse_decimated-knight.off",
+        )];
+        let meshes = if meshes.is_empty() { &default } else { meshes };
+        std::fs::create_dir_all(out_dir)
+            .map_err(|e| Fail(1, format!("cannot create '{}': {e}", out_dir.display())))?;
+        let mut conv_csv = String::from("mesh,pair,iteration,seconds,gradient_norm,objective\n");
+        let mut conv_series = Vec::new();
+        let mut abl_csv =
+            String::from("mesh,pair,guide_frames,seconds,iterations,rms_difference_to_finest\n");
+        let mut abl_series = Vec::new();
+        for path in meshes {
+            let mesh = read_mesh(path).map_err(input)?;
+            let name = path
+                .file_stem()
+                .map_or("mesh".into(), |s| s.to_string_lossy().to_string());
+            for kind in PairKind::ALL {
+                let (a, b) = keyframe_pair(&mesh, kind, wavelengths).map_err(op)?;
+                let opts = InterpOptions {
+                    guide_frames: frames,
+                    ..Default::default()
+                };
+                let (anim, rep, _) =
+                    interpolate_with_progress(&a, &b, &opts, &mut |_| true).map_err(op)?;
+                for h in &rep.history {
+                    let _ = writeln!(
+                        conv_csv,
+                        "{name},{},{},{},{:e},{:e}",
+                        kind.name(),
+                        h.iteration,
+                        h.seconds,
+                        h.gradient_norm,
+                        h.objective
+                    );
+                }
+                println!(
+                    "{name} / {}: {} after {} iterations, {:.2} s, gradient {:.2e}",
+                    kind.name(),
+                    rep.stop.name(),
+                    rep.iterations,
+                    rep.history.last().map_or(0.0, |h| h.seconds),
+                    rep.final_gradient_norm()
+                );
+                conv_series.push(Series {
+                    label: format!("{name} {}", kind.name()),
+                    points: rep
+                        .history
+                        .iter()
+                        .map(|h| (h.seconds, h.gradient_norm))
+                        .collect(),
+                });
+                // ablation B.7.1: z̃(t) with fewer guide frames against the finest run
+                let samples: Vec<f64> = (1..16).map(|i| i as f64 / 16.0).collect();
+                let mut pts = Vec::new();
+                for n in [1usize, 2, 5, 10, 25] {
+                    let o = InterpOptions {
+                        guide_frames: n,
+                        ..opts
+                    };
+                    let (an, r, _) =
+                        interpolate_with_progress(&a, &b, &o, &mut |_| true).map_err(op)?;
+                    let mut sum = 0.0;
+                    let mut count = 0usize;
+                    for &t in &samples {
+                        let (p, q) = (an.frame_at(t).map_err(op)?, anim.frame_at(t).map_err(op)?);
+                        for (x, y) in p.zeta().iter().zip(q.zeta()) {
+                            sum += (*x - *y).norm_sqr();
+                            count += 1;
+                        }
+                    }
+                    let rms = (sum / count.max(1) as f64).sqrt();
+                    let secs = r.history.last().map_or(0.0, |h| h.seconds);
+                    let _ = writeln!(
+                        abl_csv,
+                        "{name},{},{n},{secs},{},{rms:e}",
+                        kind.name(),
+                        r.iterations
+                    );
+                    pts.push((n as f64, rms));
+                }
+                abl_series.push(Series {
+                    label: format!("{name} {}", kind.name()),
+                    points: pts,
+                });
+            }
+        }
+        let write = |file: &str, text: &str| {
+            let p = out_dir.join(file);
+            std::fs::write(&p, text)
+                .map_err(|e| Fail(1, format!("cannot write '{}': {e}", p.display())))
+        };
+        write("interp_convergence.csv", &conv_csv)?;
+        write(
+            "interp_convergence.svg",
+            &svg_plot(
+                "Interpolation: residual vs time",
+                "seconds",
+                "gradient norm (log10)",
+                &conv_series,
+                true,
+            ),
+        )?;
+        write("interp_guide_frames.csv", &abl_csv)?;
+        write(
+            "interp_guide_frames.svg",
+            &svg_plot(
+                &format!("Ablation B.7.1: difference to N' = {frames}"),
+                "guide frames N'",
+                "RMS |z̃ − z̃_ref| (log10)",
+                &abl_series,
+                true,
+            ),
+        )?;
+        println!(
+            "wrote {}/interp_convergence.{{csv,svg}} and interp_guide_frames.{{csv,svg}}",
+            out_dir.display()
+        );
+        Ok(())
+    }
+
     fn plane_wave(base: &Path, k: &[f64], amplitude: Option<f64>, out: &Path) -> Result<(), Fail> {
         let mesh = read_mesh(base).map_err(input)?;
         if k.len() != 3 || k.iter().any(|c| !c.is_finite()) {
@@ -736,11 +1056,16 @@ mod wrinkle_cmd {
 /// Stand-in when the binary was built without the `wrinkle` feature.
 #[cfg(not(feature = "wrinkle"))]
 mod wrinkle_cmd {
-    use super::{WrinkleCommand, EXIT_INPUT};
+    use super::{BenchCommand, WrinkleCommand, EXIT_INPUT};
     use std::process::ExitCode;
 
     pub fn run(_cmd: WrinkleCommand) -> ExitCode {
         eprintln!("pleat wrinkle: this pleat was built without the `wrinkle` feature");
+        ExitCode::from(EXIT_INPUT)
+    }
+
+    pub fn bench(_cmd: BenchCommand) -> ExitCode {
+        eprintln!("pleat bench wrinkle: this pleat was built without the `wrinkle` feature");
         ExitCode::from(EXIT_INPUT)
     }
 }

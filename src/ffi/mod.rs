@@ -16,6 +16,7 @@
 
 mod common;
 mod edges;
+mod interpolate;
 mod lod;
 mod mesh;
 mod offset;
@@ -25,6 +26,7 @@ mod wrinkle;
 
 pub use common::*;
 pub use edges::*;
+pub use interpolate::*;
 pub use lod::*;
 pub use mesh::*;
 pub use offset::*;

@@ -90,9 +90,9 @@ pub const PLEAT_CORNER_OMEGA_TOLERANCE: f64 = 1e-6;
 /// copied out) from several threads at once; destroying it while in use is undefined.
 pub struct PleatCwf {
     #[cfg(feature = "wrinkle")]
-    cwf: crate::wrinkle::Cwf,
+    pub(super) cwf: crate::wrinkle::Cwf,
     #[cfg(feature = "wrinkle")]
-    knoppel: Option<crate::wrinkle::KnoppelReport>,
+    pub(super) knoppel: Option<crate::wrinkle::KnoppelReport>,
 }
 
 /// Optional per-vertex (and per-edge) fields of one evaluation (opaque), requested with
@@ -234,7 +234,7 @@ const MIN_STRUCT_SIZE: u32 = 8;
 /// # Safety
 /// `p` is NULL or points to `p->struct_size` readable bytes, the first 4 being `struct_size`.
 #[cfg_attr(not(feature = "wrinkle"), allow(dead_code))]
-unsafe fn read_versioned<T: Copy>(p: *const T, default: T, name: &str) -> Result<T> {
+pub(super) unsafe fn read_versioned<T: Copy>(p: *const T, default: T, name: &str) -> Result<T> {
     if p.is_null() {
         return Ok(default);
     }
@@ -257,7 +257,7 @@ unsafe fn read_versioned<T: Copy>(p: *const T, default: T, name: &str) -> Result
 /// # Safety
 /// `p` is non-NULL and its first 4 bytes are readable.
 #[cfg_attr(not(feature = "wrinkle"), allow(dead_code))]
-unsafe fn output_size<T>(p: *mut T, name: &str) -> Result<usize> {
+pub(super) unsafe fn output_size<T>(p: *mut T, name: &str) -> Result<usize> {
     let size = std::ptr::read_unaligned(p as *const u32);
     if size < MIN_STRUCT_SIZE {
         return Err(Error::InvalidArgument(format!(
@@ -272,7 +272,7 @@ unsafe fn output_size<T>(p: *mut T, name: &str) -> Result<usize> {
 /// # Safety
 /// `p` is valid for `n` bytes of writes; `n ≤ size_of::<T>()`.
 #[cfg_attr(not(feature = "wrinkle"), allow(dead_code))]
-unsafe fn write_versioned<T: Copy>(p: *mut T, mut v: T, n: usize) {
+pub(super) unsafe fn write_versioned<T: Copy>(p: *mut T, mut v: T, n: usize) {
     std::ptr::write_unaligned(&mut v as *mut T as *mut u32, n as u32);
     std::ptr::copy_nonoverlapping(&v as *const T as *const u8, p as *mut u8, n);
 }

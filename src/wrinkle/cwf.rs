@@ -124,6 +124,27 @@ impl Cwf {
         Cwf::from_one_form(base, omega, amplitude, opts)
     }
 
+    /// A CWF on the same (already validated) base mesh with other fields. Crate-internal: the
+    /// caller guarantees the lengths (one ω per edge, one amplitude and z̃ per vertex) and that
+    /// every value is finite and every amplitude ≥ 0, as [`Cwf::new`] would check.
+    pub(crate) fn with_fields(
+        &self,
+        omega: Vec<f64>,
+        amplitude: Vec<f64>,
+        zeta: Vec<Complex>,
+    ) -> Cwf {
+        debug_assert_eq!(omega.len(), self.omega.len());
+        debug_assert_eq!(amplitude.len(), self.amplitude.len());
+        debug_assert_eq!(zeta.len(), self.zeta.len());
+        Cwf {
+            base: self.base.clone(),
+            omega,
+            amplitude,
+            zeta,
+            topo: self.topo.clone(),
+        }
+    }
+
     /// The base mesh.
     pub fn base(&self) -> &TriMesh {
         &self.base

@@ -12,6 +12,9 @@
 //! - [`evaluate`]: [`Cwf::evaluate`] — `levels` refinements, then the displacement
 //!   `Re(z) n̂` of §3.5.
 //! - [`io`]: the `.cwf` text format ([`write_cwf`], [`read_cwf`]).
+//! - [`interpolate`](mod@interpolate): animation between two keyframes (§3.4) — the explicit
+//!   `ω(t)`, linear `a(t)` and the spacetime phase solve — giving a [`CwfAnimation`]
+//!   ([`animation`]: frames at any `t`, the `.cwfa` format).
 //!
 //! **Edge convention.** Every one-form (input, file, outputs, every subdivision level) is one
 //! value per edge of [`TriMesh::edges`](crate::mesh::TriMesh::edges): edges sorted by
@@ -33,17 +36,29 @@
 //! # Ok::<(), pleat::Error>(())
 //! ```
 
+pub mod animation;
 mod complex;
 pub mod cwf;
 pub mod evaluate;
+pub mod interp_bench;
+pub mod interpolate;
 pub mod io;
 pub mod knoppel;
+mod omega_path;
 pub mod subdivide;
 mod topology;
 
+pub use animation::{
+    animation_to_string, parse_animation, read_animation, write_animation, CwfAnimation,
+    ANIMATION_FORMAT_VERSION,
+};
 pub use complex::Complex;
 pub use cwf::{one_form_from_vectors, Cwf, FrequencyField, OmegaDecomposition};
 pub use evaluate::{EvalOptions, Evaluated};
+pub use interpolate::{
+    explicit_omega, interpolate, interpolate_with_progress, linear_interpolation, HessianModel,
+    InterpOptions, InterpReport, IterationRecord, StopReason,
+};
 pub use io::{
     connectivity_hash, cwf_to_string, parse_cwf, read_cwf, write_cwf, CWF_FORMAT_VERSION,
 };

@@ -1,0 +1,1007 @@
+//! Wrinkle animation (§3.4): the geodesic-like interpolant between two CWF keyframes of
+//! eqs. 3.11–3.17 / B.31–B.47, computed on `N'` guide frames.
+//!
+//! # What is computed
+//!
+//! For keyframes `(ω⁰, a⁰, z̃⁰)` and `(ω¹, a¹, z̃¹)` on one base mesh:
+//!
+//! 1. **Incompatible keyframes (eq. 3.17).** Each `ω^i` is split as `ω^i_com + δω^i` with
+//!    `δω ∈ [−π, π)` ([`Cwf::decompose_omega`]); the solve below uses the compatible parts and
+//!    `δω(t)` is added back at the end.
+//! 2. **Amplitude (B.35):** `a(t) = (1−t) a⁰ + t a¹` per vertex.
+//! 3. **Frequency (B.34, B.36–B.46):** the explicit magnitude/angle path of
+//!    [`omega_path`](super::omega_path) (derivation there), applied to `ω_com` and to `δω`,
+//!    with the linear fallback where an endpoint amplitude vanishes.
+//! 4. **Phase (eq. 3.12, B.29, B.47):** `z̃` on the guide times `t_n = n/N'` minimizes
+//!
+//!    ```text
+//!    F(z̃) = ½ Σ_j A_j g_bd,j Σ_{n<N'} |z̃_{n+1,j} − z̃_{n,j}|² / δt          (E_smooth, B.47)
+//!         + c δt Σ_{0<n<N'} [ Σ_e A_e |z̃_{n,k} e^{iω_{n,kl}} − z̃_{n,l}|²     (E_compat, 3.5)
+//!                           + Σ_j A_j (|z̃_{n,j}|² − 1)² ]                    (E_unit, 3.6)
+//!    ```
+//!
+//!    with `z̃_0 = z̃⁰`, `z̃_{N'} = z̃¹` fixed, `δt = 1/N'`, `A` the barycentric areas,
+//!    `c = c_scale · g_ave` (`c_scale` = 10³ by default, §3.4.1). The keyframe terms of
+//!    `E_opt` are constant and dropped. The solver minimizes `F / (A_total · g_ave)`, which has
+//!    the same minimizers and makes the gradient tolerance independent of the mesh's size and
+//!    of the amplitude unit. When every amplitude is zero (`g_ave = 0`, no wrinkles anywhere)
+//!    the weights `g_bd` are replaced by 1 and `g_ave` by 1, so the phase still moves smoothly.
+//!
+//! # Solver (chosen by measurement)
+//!
+//! All unknown frames at once, `2 V (N'−1)` reals. `E_smooth + c E_compat` is a constant
+//! positive semi-definite quadratic `K`; `E_unit` contributes a 2×2 block per unknown vertex.
+//! Each iteration factors `K + D(z̃) + μ I` with faer's sparse Cholesky (the symbolic analysis is
+//! done once and reused: the pattern never changes) and takes an Armijo line-search step:
+//!
+//! - [`HessianModel::Exact`] (default): `D` is the exact Hessian of `E_unit`,
+//!   `4w(|z|²−1) I + 8w zzᵀ`; where the sum is indefinite the Cholesky factorization fails and
+//!   `μ` is raised until it succeeds;
+//! - [`HessianModel::Projected`]: each 2×2 block's eigenvalues clamped at 0 (`4w(3|z|²−1)`
+//!   along `z`, `4w(|z|²−1)` across) — always PSD, "projected Newton";
+//! - [`HessianModel::GaussNewton`]: `D = 8w zzᵀ`, the Gauss–Newton matrix of the residual
+//!   `|z|² − 1`.
+//!
+//! `μ` is a Levenberg–Marquardt damping (relative to the mean diagonal): divided by 10 after a
+//! full step, multiplied by 10 when the factorization fails or the line search needs a step
+//! below 1/16, so far from the solution the method behaves like a trust-region method and near
+//! it like Newton. All three converge to the same point, but measured on a sphere with Knöppel
+//! keyframes (642 vertices, 20 guide frames, tolerance 1e-6) the exact Hessian needed 7
+//! iterations (8 factorizations), the projected one 75 and Gauss–Newton 80: near phase
+//! singularities the minimizer has `|z|² < 1/3`, where both PSD models throw away the negative
+//! curvature of `E_unit` that the compatibility term already compensates, and lose Newton's
+//! quadratic convergence. The failed factorizations of the exact model cost less than that, so
+//! it is the default (`tests/wrinkle_interp.rs` and `benches/wrinkle_interp.rs` print the
+//! counts).
+//!
+//! The initial guess is one projected Newton step from `z̃ = 0` (where `E_unit`'s projected
+//! Hessian vanishes, so it is the minimizer of the quadratic part `E_smooth + c E_compat` alone),
+//! normalized per vertex: a temporally smooth, compatible start without singular lines.
+//!
+//! Stops when `‖∇(F / (A_total g_ave))‖₂ ≤ gradient_tolerance` ([`StopReason::Converged`]), after
+//! `max_iterations` ([`StopReason::IterationCap`]), or when no step decreases the objective any
+//! more ([`StopReason::Stalled`], e.g. for a huge `c` where round-off dominates).
+//! Identical keyframes give the constant path without iterating
+//! ([`StopReason::IdenticalKeyframes`]).
+//!
+//! Deterministic: every sum is taken in a fixed order and the parallel parts (per-frame energy
+//! and gradient evaluation) write disjoint outputs.
+
+use std::time::Instant;
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Mat, Side};
+use rayon::prelude::*;
+
+use super::animation::CwfAnimation;
+use super::complex::Complex;
+use super::cwf::{barycentric_areas, Cwf};
+use super::omega_path::OmegaPath;
+use crate::report::{Progress, ProgressFn, Stats};
+use crate::{Error, Result};
+
+/// Hessian model of the phase solve (see the [module docs](self)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[repr(u32)]
+pub enum HessianModel {
+    /// Exact Hessian with each vertex's 2×2 `E_unit` block projected to PSD.
+    Projected = 0,
+    /// Gauss–Newton matrix of `E_unit`.
+    GaussNewton = 1,
+    /// The exact Hessian; indefiniteness is handled by the damping `μ` alone (a failed
+    /// Cholesky factorization raises it). The default.
+    #[default]
+    Exact = 2,
+}
+
+/// Parameters of [`interpolate`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InterpOptions {
+    /// `N'`: number of guide intervals; guide frames sit at `t = n/N'`, `n = 0..=N'`
+    /// (`N' − 1` of them are solved for). `1` is plain linear interpolation. Default 50.
+    pub guide_frames: usize,
+    /// `k`: linear sub-steps per guide interval; the animation has `N'·k + 1` frames.
+    /// Default 4.
+    pub substeps: usize,
+    /// `c = c_scale · g_ave` (eq. 3.16). Default 1e3 (§3.4.1).
+    pub c_scale: f64,
+    /// Stop when the normalized gradient norm is at most this. Default 1e-6.
+    pub gradient_tolerance: f64,
+    /// Iteration cap. Default 200.
+    pub max_iterations: usize,
+    /// Hessian model. Default [`HessianModel::Exact`].
+    pub hessian: HessianModel,
+}
+
+impl Default for InterpOptions {
+    fn default() -> Self {
+        InterpOptions {
+            guide_frames: 50,
+            substeps: 4,
+            c_scale: 1e3,
+            gradient_tolerance: 1e-6,
+            max_iterations: 200,
+            hessian: HessianModel::Exact,
+        }
+    }
+}
+
+/// Why the phase solve stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum StopReason {
+    /// The gradient norm reached the tolerance.
+    Converged = 0,
+    /// `max_iterations` were done first.
+    IterationCap = 1,
+    /// No step along the (damped) Newton direction decreases the objective any more: the
+    /// iterate is as good as round-off allows (reported with its gradient norm).
+    Stalled = 2,
+    /// The keyframes are identical: the constant path, no iteration.
+    IdenticalKeyframes = 3,
+    /// Nothing to solve: `guide_frames == 1` (linear interpolation).
+    NoUnknowns = 4,
+}
+
+impl StopReason {
+    /// A short lowercase name ("converged", "iteration cap", ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            StopReason::Converged => "converged",
+            StopReason::IterationCap => "iteration cap",
+            StopReason::Stalled => "stalled",
+            StopReason::IdenticalKeyframes => "identical keyframes",
+            StopReason::NoUnknowns => "no unknowns",
+        }
+    }
+}
+
+/// One point of the convergence history.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IterationRecord {
+    /// Iterations done (0 = the initial guess).
+    pub iteration: usize,
+    /// Wall seconds since the start of [`interpolate`].
+    pub seconds: f64,
+    /// Normalized gradient norm (the stopping residual).
+    pub gradient_norm: f64,
+    /// Normalized objective `F / (A_total g_ave)`.
+    pub objective: f64,
+}
+
+/// What the phase solve did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InterpReport {
+    /// Newton iterations done (the initial-guess step not counted).
+    pub iterations: usize,
+    /// Why it stopped.
+    pub stop: StopReason,
+    /// Residual and wall time after the initial guess and after every iteration.
+    pub history: Vec<IterationRecord>,
+    /// Final `E_smooth` (eq. 3.13 discretized, unnormalized).
+    pub smooth_energy: f64,
+    /// Final `∫ E_compat dt` over the guide frames (unnormalized).
+    pub compat_energy: f64,
+    /// Final `∫ E_unit dt` over the guide frames (unnormalized).
+    pub unit_energy: f64,
+    /// `g_ave` (eq. 3.16, area-weighted mean; 0 when every amplitude is zero).
+    pub g_ave: f64,
+    /// The penalty `c` used (`c_scale · g_ave`, or `c_scale` when `g_ave = 0`).
+    pub c: f64,
+    /// Sparse Cholesky factorizations done.
+    pub factorizations: usize,
+    /// Unknown reals (`2 V (N' − 1)`).
+    pub unknowns: usize,
+}
+
+impl InterpReport {
+    /// Final normalized gradient norm (the last history entry).
+    pub fn final_gradient_norm(&self) -> f64 {
+        self.history.last().map_or(0.0, |r| r.gradient_norm)
+    }
+}
+
+/// Interpolates between keyframes `a` (t = 0) and `b` (t = 1) on the same base mesh. See the
+/// [module docs](self). Errors with [`Error::InvalidArgument`] when the keyframes' base meshes
+/// differ (connectivity, or a position by more than 1e-9 of the bounding-box diagonal) or an
+/// option is out of range, [`Error::Numerical`] if the factorization fails even with heavy
+/// damping.
+pub fn interpolate(
+    a: &Cwf,
+    b: &Cwf,
+    opts: &InterpOptions,
+) -> Result<(CwfAnimation, InterpReport, Stats)> {
+    interpolate_with_progress(a, b, opts, &mut |_| true)
+}
+
+/// As [`interpolate`], reporting progress after each iteration (stage `"interpolate"`); the
+/// callback returning `false` stops with [`Error::Cancelled`].
+pub fn interpolate_with_progress(
+    a: &Cwf,
+    b: &Cwf,
+    opts: &InterpOptions,
+    progress: &mut ProgressFn<'_>,
+) -> Result<(CwfAnimation, InterpReport, Stats)> {
+    let start = Instant::now();
+    check_options(opts)?;
+    check_same_base(a, b)?;
+    let mut stats = Stats::default();
+    let setup = stats.time("setup", || Setup::new(a, b, opts));
+    let n = opts.guide_frames;
+    let omega_com: Vec<Vec<f64>> = (0..=n)
+        .map(|i| setup.com.at(&a.topo, i as f64 / n as f64))
+        .collect();
+    let (zeta, report) = if identical(a, b) {
+        let r = trivial_report(&setup, StopReason::IdenticalKeyframes, start);
+        (vec![a.zeta().to_vec(); n + 1], r)
+    } else if n == 1 {
+        let r = trivial_report(&setup, StopReason::NoUnknowns, start);
+        (vec![a.zeta().to_vec(), b.zeta().to_vec()], r)
+    } else {
+        let problem = stats.time("assemble", || Problem::new(a, b, &setup, &omega_com, opts))?;
+        stats.time("solve", || problem.solve(opts, start, progress))?
+    };
+    let omega = if identical(a, b) {
+        vec![a.omega().to_vec(); n + 1]
+    } else {
+        full_omega(a, b, &setup, omega_com, n)
+    };
+    stats.metric("g_ave", report.g_ave);
+    stats.metric("c", report.c);
+    stats.metric("final gradient norm", report.final_gradient_norm());
+    stats.metric("E_smooth", report.smooth_energy);
+    stats.metric("E_compat", report.compat_energy);
+    stats.metric("E_unit", report.unit_energy);
+    stats.count("iterations", report.iterations as u64);
+    stats.count("factorizations", report.factorizations as u64);
+    stats.count("unknowns", report.unknowns as u64);
+    let anim = CwfAnimation::from_guides(
+        a,
+        [a.amplitude().to_vec(), b.amplitude().to_vec()],
+        omega,
+        zeta,
+        opts.substeps,
+    )?;
+    Ok((anim, report, stats))
+}
+
+/// `ω(t)` of the explicit path (B.34/B.46) between the keyframes' full one-forms, without the
+/// compatible/residual split: the frequency a per-frame baseline (e.g. Knöppel) would use.
+/// `t` in [0, 1]; `t = 0, 1` give the keyframes exactly.
+pub fn explicit_omega(a: &Cwf, b: &Cwf, t: f64) -> Result<Vec<f64>> {
+    check_same_base(a, b)?;
+    check_time(t)?;
+    let path = OmegaPath::new(
+        &a.topo,
+        a.base().positions(),
+        a.omega(),
+        b.omega(),
+        a.amplitude(),
+        b.amplitude(),
+    );
+    Ok(path.at(&a.topo, t))
+}
+
+/// The plain linear interpolant of §3.4.3 (`a`, `ω` and `z̃` each `(1−t)·a + t·b`), the baseline
+/// that shears rotating wrinkles into a singular line.
+pub fn linear_interpolation(a: &Cwf, b: &Cwf, t: f64) -> Result<Cwf> {
+    check_same_base(a, b)?;
+    check_time(t)?;
+    let lerp = |x: f64, y: f64| (1.0 - t) * x + t * y;
+    let omega = a.omega().iter().zip(b.omega()).map(|(&x, &y)| lerp(x, y));
+    let amp = a
+        .amplitude()
+        .iter()
+        .zip(b.amplitude())
+        .map(|(&x, &y)| lerp(x, y));
+    let zeta = a
+        .zeta()
+        .iter()
+        .zip(b.zeta())
+        .map(|(&x, &y)| Complex::new(lerp(x.re, y.re), lerp(x.im, y.im)));
+    Ok(a.with_fields(omega.collect(), amp.collect(), zeta.collect()))
+}
+
+pub(crate) fn check_time(t: f64) -> Result<()> {
+    if !(0.0..=1.0).contains(&t) {
+        return crate::invalid_arg!("t = {t} is outside [0, 1]");
+    }
+    Ok(())
+}
+
+fn check_options(o: &InterpOptions) -> Result<()> {
+    if !(1..=100_000).contains(&o.guide_frames) {
+        return crate::invalid_arg!("guide_frames = {}; allowed 1 to 100000", o.guide_frames);
+    }
+    if !(1..=100_000).contains(&o.substeps) {
+        return crate::invalid_arg!("substeps = {}; allowed 1 to 100000", o.substeps);
+    }
+    if !(o.c_scale.is_finite() && o.c_scale > 0.0) {
+        return crate::invalid_arg!("c_scale = {}; must be finite and > 0", o.c_scale);
+    }
+    if !(o.gradient_tolerance.is_finite() && o.gradient_tolerance >= 0.0) {
+        return crate::invalid_arg!(
+            "gradient_tolerance = {}; must be finite and ≥ 0",
+            o.gradient_tolerance
+        );
+    }
+    Ok(())
+}
+
+/// Rejects keyframes on different base meshes with a message naming the first difference.
+pub(crate) fn check_same_base(a: &Cwf, b: &Cwf) -> Result<()> {
+    let (ma, mb) = (a.base(), b.base());
+    if ma.vertex_count() != mb.vertex_count() || ma.triangle_count() != mb.triangle_count() {
+        return crate::invalid_arg!(
+            "the keyframes are on different base meshes: {} vertices / {} triangles vs {} / {}",
+            ma.vertex_count(),
+            ma.triangle_count(),
+            mb.vertex_count(),
+            mb.triangle_count()
+        );
+    }
+    if let Some(t) = (0..ma.triangle_count()).find(|&t| ma.triangles()[t] != mb.triangles()[t]) {
+        return crate::invalid_arg!(
+            "the keyframes are on different base meshes: triangle {t} is {:?} vs {:?}",
+            ma.triangles()[t],
+            mb.triangles()[t]
+        );
+    }
+    let tol = 1e-9 * ma.bbox_diagonal().max(f64::MIN_POSITIVE);
+    let far = |p: &[f64; 3], q: &[f64; 3]| {
+        (0..3).any(|i| (p[i] - q[i]).abs() > tol || (p[i] - q[i]).is_nan())
+    };
+    if let Some(v) = (0..ma.vertex_count()).find(|&v| far(&ma.positions()[v], &mb.positions()[v])) {
+        return crate::invalid_arg!(
+            "the keyframes are on different base meshes: vertex {v} is at {:?} vs {:?} (the \
+             interpolation needs one base geometry)",
+            ma.positions()[v],
+            mb.positions()[v]
+        );
+    }
+    Ok(())
+}
+
+fn identical(a: &Cwf, b: &Cwf) -> bool {
+    let bits = |s: &[f64], t: &[f64]| s.iter().zip(t).all(|(x, y)| x.to_bits() == y.to_bits());
+    bits(a.omega(), b.omega())
+        && bits(a.amplitude(), b.amplitude())
+        && a.zeta()
+            .iter()
+            .zip(b.zeta())
+            .all(|(x, y)| x.re.to_bits() == y.re.to_bits() && x.im.to_bits() == y.im.to_bits())
+}
+
+/// Keyframe-derived data shared by the solve and the output.
+struct Setup {
+    /// Path of the compatible parts.
+    com: OmegaPath,
+    /// Path of the residuals δω.
+    residual: OmegaPath,
+    g_bd: Vec<f64>,
+    g_ave: f64,
+    edge_area: Vec<f64>,
+    vertex_area: Vec<f64>,
+}
+
+impl Setup {
+    fn new(a: &Cwf, b: &Cwf, _opts: &InterpOptions) -> Setup {
+        let (da, db) = (a.decompose_omega(), b.decompose_omega());
+        let x = a.base().positions();
+        let (amp0, amp1) = (a.amplitude(), b.amplitude());
+        let com = OmegaPath::new(&a.topo, x, &da.compatible, &db.compatible, amp0, amp1);
+        let residual = OmegaPath::new(&a.topo, x, &da.residual, &db.residual, amp0, amp1);
+        let (edge_area, vertex_area) = barycentric_areas(&a.topo, x);
+        Setup {
+            g_bd: com.g_bd(&a.topo),
+            g_ave: com.g_ave(&a.topo, &vertex_area),
+            com,
+            residual,
+            edge_area,
+            vertex_area,
+        }
+    }
+
+    /// `(g per vertex, g_ref)`: `g_bd` and `g_ave`, or all ones when `g_ave` is 0.
+    fn weights(&self) -> (Vec<f64>, f64) {
+        if self.g_ave > 0.0 && self.g_ave.is_finite() {
+            (self.g_bd.clone(), self.g_ave)
+        } else {
+            (vec![1.0; self.g_bd.len()], 1.0)
+        }
+    }
+}
+
+fn trivial_report(setup: &Setup, stop: StopReason, start: Instant) -> InterpReport {
+    let (_, g_ref) = setup.weights();
+    InterpReport {
+        iterations: 0,
+        stop,
+        history: vec![IterationRecord {
+            iteration: 0,
+            seconds: start.elapsed().as_secs_f64(),
+            gradient_norm: 0.0,
+            objective: 0.0,
+        }],
+        smooth_energy: 0.0,
+        compat_energy: 0.0,
+        unit_energy: 0.0,
+        g_ave: setup.g_ave,
+        c: 0.0f64.max(g_ref),
+        factorizations: 0,
+        unknowns: 0,
+    }
+}
+
+/// `ω(t_n) = ω_com(t_n) + δω(t_n)` per guide frame; the keyframes' own one-forms at the ends.
+fn full_omega(a: &Cwf, b: &Cwf, setup: &Setup, com: Vec<Vec<f64>>, n: usize) -> Vec<Vec<f64>> {
+    com.into_iter()
+        .enumerate()
+        .map(|(i, w)| {
+            if i == 0 {
+                a.omega().to_vec()
+            } else if i == n {
+                b.omega().to_vec()
+            } else {
+                let d = setup.residual.at(&a.topo, i as f64 / n as f64);
+                w.iter().zip(&d).map(|(x, y)| x + y).collect()
+            }
+        })
+        .collect()
+}
+
+// ---------------------------------------------------------------------------------------------
+// The phase problem
+
+/// The discretized objective of eq. 3.12 over the unknown frames `1..N'`.
+struct Problem {
+    n_v: usize,
+    /// `N'`.
+    n_frames: usize,
+    edges: Vec<[u32; 2]>,
+    /// `e^{iω_n}` per guide frame `n` (interior ones used) and edge.
+    rot: Vec<Vec<Complex>>,
+    /// Normalized weights: `c_scale δt A_e / A_tot` per edge.
+    w_compat: Vec<f64>,
+    /// `c_scale δt A_j / A_tot` per vertex.
+    w_unit: Vec<f64>,
+    /// `½ A_j g_j / (δt A_tot g_ref)` per vertex.
+    w_smooth: Vec<f64>,
+    /// Keyframe phases (frames 0 and N').
+    z_ends: [Vec<Complex>; 2],
+    /// Unnormalization: `A_tot g_ref`, and `c`.
+    scale: f64,
+    c: f64,
+    g_ave: f64,
+}
+
+/// Per-part values of the normalized objective.
+#[derive(Debug, Clone, Copy, Default)]
+struct Parts {
+    smooth: f64,
+    compat: f64,
+    unit: f64,
+}
+
+impl Parts {
+    fn total(&self) -> f64 {
+        self.smooth + self.compat + self.unit
+    }
+}
+
+impl Problem {
+    fn new(
+        a: &Cwf,
+        b: &Cwf,
+        setup: &Setup,
+        omega_com: &[Vec<f64>],
+        opts: &InterpOptions,
+    ) -> Result<Problem> {
+        let n_frames = opts.guide_frames;
+        let dt = 1.0 / n_frames as f64;
+        let area: f64 = setup.vertex_area.iter().sum();
+        if !(area > 0.0 && area.is_finite()) {
+            return crate::invalid_arg!("the base mesh has no area");
+        }
+        let (g, g_ref) = setup.weights();
+        let cs = opts.c_scale;
+        Ok(Problem {
+            n_v: a.base().vertex_count(),
+            n_frames,
+            edges: a.edges().to_vec(),
+            rot: omega_com
+                .iter()
+                .map(|w| w.iter().map(|&x| Complex::cis(x)).collect())
+                .collect(),
+            w_compat: setup
+                .edge_area
+                .iter()
+                .map(|&ae| cs * dt * ae / area)
+                .collect(),
+            w_unit: setup
+                .vertex_area
+                .iter()
+                .map(|&aj| cs * dt * aj / area)
+                .collect(),
+            w_smooth: setup
+                .vertex_area
+                .iter()
+                .zip(&g)
+                .map(|(&aj, &gj)| 0.5 * aj * gj / (dt * area * g_ref))
+                .collect(),
+            z_ends: [a.zeta().to_vec(), b.zeta().to_vec()],
+            scale: area * g_ref,
+            c: cs * g_ref,
+            g_ave: setup.g_ave,
+        })
+    }
+
+    /// Unknown count in complex entries.
+    fn n_unknown(&self) -> usize {
+        (self.n_frames - 1) * self.n_v
+    }
+
+    /// The phases of guide frame `n` (keyframes at 0 and N').
+    fn frame<'a>(&'a self, x: &'a [Complex], n: usize) -> &'a [Complex] {
+        if n == 0 {
+            &self.z_ends[0]
+        } else if n == self.n_frames {
+            &self.z_ends[1]
+        } else {
+            &x[(n - 1) * self.n_v..n * self.n_v]
+        }
+    }
+
+    /// Normalized objective parts and (optionally) its gradient (as complex `∂x + i∂y`).
+    fn evaluate(&self, x: &[Complex], want_grad: bool) -> (Parts, Vec<Complex>) {
+        let nv = self.n_v;
+        let per_frame: Vec<(Parts, Vec<Complex>)> = (1..self.n_frames)
+            .into_par_iter()
+            .map(|n| self.frame_terms(x, n, want_grad))
+            .collect();
+        let mut parts = Parts::default();
+        let mut grad = Vec::with_capacity(if want_grad { x.len() } else { 0 });
+        for (p, g) in per_frame {
+            parts.compat += p.compat;
+            parts.unit += p.unit;
+            parts.smooth += p.smooth;
+            grad.extend(g);
+        }
+        // the last pair (N'−1, N') is not counted by frame_terms (each frame counts its
+        // pair with the previous frame)
+        let last = self.n_frames;
+        let (zp, zq) = (self.frame(x, last - 1), self.frame(x, last));
+        parts.smooth += (0..nv)
+            .map(|j| self.w_smooth[j] * (zq[j] - zp[j]).norm_sqr())
+            .sum::<f64>();
+        (parts, grad)
+    }
+
+    /// Terms of unknown frame `n`: its compat and unit energies, the smooth energy of the pair
+    /// `(n−1, n)`, and its gradient (all terms touching frame `n`).
+    fn frame_terms(&self, x: &[Complex], n: usize, want_grad: bool) -> (Parts, Vec<Complex>) {
+        let z = self.frame(x, n);
+        let (zp, zn) = (self.frame(x, n - 1), self.frame(x, n + 1));
+        let rot = &self.rot[n];
+        let mut p = Parts::default();
+        let mut g = if want_grad {
+            vec![Complex::ZERO; self.n_v]
+        } else {
+            Vec::new()
+        };
+        for (e, &[k, l]) in self.edges.iter().enumerate() {
+            let (k, l) = (k as usize, l as usize);
+            let w = self.w_compat[e];
+            let r = rot[e] * z[k] - z[l];
+            p.compat += w * r.norm_sqr();
+            if want_grad {
+                g[k] += (rot[e].conj() * r).scale(2.0 * w);
+                g[l] += r.scale(-2.0 * w);
+            }
+        }
+        for j in 0..self.n_v {
+            let m = z[j].norm_sqr() - 1.0;
+            p.unit += self.w_unit[j] * m * m;
+            let ws = self.w_smooth[j];
+            p.smooth += ws * (z[j] - zp[j]).norm_sqr();
+            if want_grad {
+                g[j] += z[j].scale(4.0 * self.w_unit[j] * m);
+                g[j] += (z[j] - zp[j] + z[j] - zn[j]).scale(2.0 * ws);
+            }
+        }
+        (p, g)
+    }
+
+    /// Unnormalized energies: `(E_smooth, ∫E_compat dt, ∫E_unit dt)`.
+    fn energies(&self, p: &Parts) -> (f64, f64, f64) {
+        let s = self.scale;
+        (p.smooth * s, p.compat * s / self.c, p.unit * s / self.c)
+    }
+
+    /// Runs the damped Newton iteration. Returns the guide-frame phases and the report.
+    fn solve(
+        &self,
+        opts: &InterpOptions,
+        start: Instant,
+        progress: &mut ProgressFn<'_>,
+    ) -> Result<(Vec<Vec<Complex>>, InterpReport)> {
+        let mut hess = Hessian::new(self)?;
+        let mut x = vec![Complex::ZERO; self.n_unknown()];
+        // initial guess: the quadratic part's minimizer (a projected Newton step from 0)
+        let (_, g0) = self.evaluate(&x, true);
+        let mut mu = 1e-10;
+        let d = hess.newton_direction(self, &x, &g0, &mut mu, HessianModel::Projected)?;
+        x = d;
+        normalize_unknowns(&mut x);
+        let mut history = Vec::new();
+        let mut iterations = 0;
+        let mut best_fraction: f64 = 0.0;
+        let stop = loop {
+            let (parts, grad) = self.evaluate(&x, true);
+            let gnorm = grad.iter().map(|g| g.norm_sqr()).sum::<f64>().sqrt();
+            history.push(IterationRecord {
+                iteration: iterations,
+                seconds: start.elapsed().as_secs_f64(),
+                gradient_norm: gnorm,
+                objective: parts.total(),
+            });
+            if !gnorm.is_finite() {
+                return Err(Error::Numerical(
+                    "the interpolation objective became non-finite".into(),
+                ));
+            }
+            if gnorm <= opts.gradient_tolerance {
+                break StopReason::Converged;
+            }
+            if iterations >= opts.max_iterations {
+                break StopReason::IterationCap;
+            }
+            let g_first = history[0].gradient_norm.max(f64::MIN_POSITIVE);
+            let frac = progress_fraction(g_first, gnorm, opts, iterations);
+            best_fraction = best_fraction.max(frac);
+            if !progress(Progress {
+                stage: "interpolate",
+                fraction: best_fraction,
+            }) {
+                return Err(Error::Cancelled);
+            }
+            match self.step(&mut hess, &mut x, &grad, parts.total(), &mut mu, opts)? {
+                true => iterations += 1,
+                false => break StopReason::Stalled,
+            }
+        };
+        let (parts, _) = self.evaluate(&x, false);
+        let (es, ec, eu) = self.energies(&parts);
+        let frames = (0..=self.n_frames)
+            .map(|n| self.frame(&x, n).to_vec())
+            .collect();
+        let report = InterpReport {
+            iterations,
+            stop,
+            history,
+            smooth_energy: es,
+            compat_energy: ec,
+            unit_energy: eu,
+            g_ave: self.g_ave,
+            c: self.c,
+            factorizations: hess.factorizations,
+            unknowns: 2 * self.n_unknown(),
+        };
+        Ok((frames, report))
+    }
+
+    /// One damped Newton step with Armijo backtracking; `false` when no decrease is possible.
+    fn step(
+        &self,
+        hess: &mut Hessian,
+        x: &mut Vec<Complex>,
+        grad: &[Complex],
+        f0: f64,
+        mu: &mut f64,
+        opts: &InterpOptions,
+    ) -> Result<bool> {
+        const MU_MAX: f64 = 1e12;
+        const MU_MIN: f64 = 1e-12;
+        while *mu <= MU_MAX {
+            let d = hess.newton_direction(self, x, grad, mu, opts.hessian)?;
+            let slope: f64 = grad
+                .iter()
+                .zip(&d)
+                .map(|(g, d)| g.re * d.re + g.im * d.im)
+                .sum();
+            if slope.is_nan() || slope >= 0.0 {
+                *mu = (*mu * 10.0).max(MU_MIN);
+                continue;
+            }
+            let mut alpha = 1.0;
+            while alpha >= 1.0 / 16.0 {
+                let trial: Vec<Complex> = x
+                    .iter()
+                    .zip(&d)
+                    .map(|(&xi, &di)| xi + di.scale(alpha))
+                    .collect();
+                let (p, _) = self.evaluate(&trial, false);
+                if p.total() <= f0 + 1e-4 * alpha * slope {
+                    *x = trial;
+                    *mu = if alpha == 1.0 {
+                        (*mu * 0.1).max(MU_MIN)
+                    } else {
+                        *mu
+                    };
+                    return Ok(true);
+                }
+                alpha *= 0.5;
+            }
+            *mu = (*mu * 10.0).max(MU_MIN);
+        }
+        Ok(false)
+    }
+}
+
+/// Progress in [0, 1]: the larger of the iteration fraction and the log-gradient decrease.
+fn progress_fraction(g_first: f64, g: f64, opts: &InterpOptions, it: usize) -> f64 {
+    let by_it = it as f64 / opts.max_iterations.max(1) as f64;
+    let tol = opts.gradient_tolerance.max(1e-300);
+    let by_g = if g_first > tol {
+        ((g_first / g).ln() / (g_first / tol).ln()).clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    by_it.max(by_g).clamp(0.0, 0.999)
+}
+
+/// Scales every unknown to unit modulus (zeros stay zero).
+fn normalize_unknowns(x: &mut [Complex]) {
+    for z in x.iter_mut() {
+        let r = z.abs();
+        if r > 1e-12 {
+            *z = z.scale(1.0 / r);
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Hessian assembly and factorization
+
+/// The constant quadratic part `K` (lower triangle, CSC), the slots of the 2×2 diagonal blocks
+/// and the cached symbolic factorization.
+struct Hessian {
+    k: SparseColMat<usize, f64>,
+    /// Per unknown vertex: value slots of `(2u,2u)`, `(2u+1,2u)`, `(2u+1,2u+1)`.
+    diag_slots: Vec<[usize; 3]>,
+    /// Mean of K's diagonal (the damping unit).
+    diag_mean: f64,
+    symbolic: SymbolicLlt<usize>,
+    factorizations: usize,
+    /// The last successful factorization, reused as a preconditioner (see `lagged_solve`).
+    last: Option<Llt<usize, f64>>,
+}
+
+impl Hessian {
+    fn new(p: &Problem) -> Result<Hessian> {
+        let nu = p.n_unknown();
+        let mut t: Vec<Triplet<usize, usize, f64>> = Vec::new();
+        let idx = |n: usize, j: usize| (n - 1) * p.n_v + j;
+        for n in 1..p.n_frames {
+            for j in 0..p.n_v {
+                let u = idx(n, j);
+                let d = 4.0 * p.w_smooth[j];
+                t.push(Triplet::new(2 * u, 2 * u, d));
+                t.push(Triplet::new(2 * u + 1, 2 * u, 0.0));
+                t.push(Triplet::new(2 * u + 1, 2 * u + 1, d));
+                if n + 1 < p.n_frames {
+                    let v = idx(n + 1, j);
+                    let o = -2.0 * p.w_smooth[j];
+                    t.push(Triplet::new(2 * v, 2 * u, o));
+                    t.push(Triplet::new(2 * v + 1, 2 * u + 1, o));
+                }
+            }
+            for (e, &[k, l]) in p.edges.iter().enumerate() {
+                let (uk, ul) = (idx(n, k as usize), idx(n, l as usize));
+                let w2 = 2.0 * p.w_compat[e];
+                for uu in [uk, ul] {
+                    t.push(Triplet::new(2 * uu, 2 * uu, w2));
+                    t.push(Triplet::new(2 * uu + 1, 2 * uu + 1, w2));
+                }
+                // block (l, k) = −2w [t], [t] = [[c, −s], [s, c]]; l > k so it is lower
+                let r = p.rot[n][e];
+                for (a, q, v) in [(0, 0, r.re), (0, 1, -r.im), (1, 0, r.im), (1, 1, r.re)] {
+                    t.push(Triplet::new(2 * ul + a, 2 * uk + q, -w2 * v));
+                }
+            }
+        }
+        let k =
+            SparseColMat::<usize, f64>::try_new_from_triplets(2 * nu, 2 * nu, &t).map_err(|e| {
+                Error::Numerical(format!("assembling the interpolation Hessian: {e:?}"))
+            })?;
+        let slot = |r: usize, c: usize| -> usize {
+            let cp = k.symbolic().col_ptr();
+            let rows = &k.symbolic().row_idx()[cp[c]..cp[c + 1]];
+            cp[c] + rows.binary_search(&r).expect("diagonal block in pattern")
+        };
+        let diag_slots: Vec<[usize; 3]> = (0..nu)
+            .map(|u| {
+                [
+                    slot(2 * u, 2 * u),
+                    slot(2 * u + 1, 2 * u),
+                    slot(2 * u + 1, 2 * u + 1),
+                ]
+            })
+            .collect();
+        let vals = k.val();
+        let diag_mean = diag_slots
+            .iter()
+            .map(|s| vals[s[0]] + vals[s[2]])
+            .sum::<f64>()
+            / (2 * nu).max(1) as f64;
+        let symbolic = SymbolicLlt::try_new(k.symbolic(), Side::Lower)
+            .map_err(|e| Error::Numerical(format!("symbolic Cholesky analysis failed: {e:?}")))?;
+        Ok(Hessian {
+            k,
+            diag_slots,
+            diag_mean: if diag_mean > 0.0 { diag_mean } else { 1.0 },
+            symbolic,
+            factorizations: 0,
+            last: None,
+        })
+    }
+
+    /// `K + D(x) + μ·mean(diag K)·I` (lower triangle).
+    fn assemble(
+        &self,
+        p: &Problem,
+        x: &[Complex],
+        mu: f64,
+        model: HessianModel,
+    ) -> SparseColMat<usize, f64> {
+        let mut h = self.k.clone();
+        let vals = h.val_mut();
+        for (u, s) in self.diag_slots.iter().enumerate() {
+            let w = p.w_unit[u % p.n_v];
+            let b = unit_block(x[u], w, model);
+            vals[s[0]] += b[0] + mu * self.diag_mean;
+            vals[s[1]] += b[1];
+            vals[s[2]] += b[2] + mu * self.diag_mean;
+        }
+        h
+    }
+
+    /// Solves `(K + D(x) + μ·mean(diag K)·I) d = −g`. First by conjugate gradients
+    /// preconditioned with the previous iteration's factorization (the Hessian changes only in
+    /// its 2×2 diagonal blocks between iterations, so a few steps suffice), else by a fresh
+    /// factorization, raising `μ` until it succeeds.
+    fn newton_direction(
+        &mut self,
+        p: &Problem,
+        x: &[Complex],
+        g: &[Complex],
+        mu: &mut f64,
+        model: HessianModel,
+    ) -> Result<Vec<Complex>> {
+        let rhs: Vec<f64> = g.iter().flat_map(|c| [-c.re, -c.im]).collect();
+        if let Some(llt) = &self.last {
+            let h = self.assemble(p, x, *mu, model);
+            if let Some(d) = lagged_solve(&h, llt, &rhs) {
+                return Ok(to_complex(&d));
+            }
+        }
+        for _ in 0..40 {
+            let h = self.assemble(p, x, *mu, model);
+            self.factorizations += 1;
+            if let Ok(llt) =
+                Llt::try_new_with_symbolic(self.symbolic.clone(), h.as_ref(), Side::Lower)
+            {
+                let mut b = Mat::<f64>::from_fn(rhs.len(), 1, |i, _| rhs[i]);
+                llt.solve_in_place(&mut b);
+                let d: Vec<f64> = (0..rhs.len()).map(|i| b[(i, 0)]).collect();
+                if d.iter().all(|v| v.is_finite()) {
+                    self.last = Some(llt);
+                    return Ok(to_complex(&d));
+                }
+            }
+            *mu = (*mu * 100.0).max(1e-10);
+        }
+        Err(Error::Numerical(
+            "the interpolation Hessian could not be factorized even with heavy damping".into(),
+        ))
+    }
+}
+
+fn to_complex(d: &[f64]) -> Vec<Complex> {
+    d.chunks_exact(2)
+        .map(|c| Complex::new(c[0], c[1]))
+        .collect()
+}
+
+/// `y = H v` for `H` stored as its lower triangle (CSC).
+fn sym_matvec(h: &SparseColMat<usize, f64>, v: &[f64]) -> Vec<f64> {
+    let cp = h.symbolic().col_ptr();
+    let ri = h.symbolic().row_idx();
+    let val = h.val();
+    let mut y = vec![0.0; v.len()];
+    for j in 0..v.len() {
+        for k in cp[j]..cp[j + 1] {
+            let (i, a) = (ri[k], val[k]);
+            y[i] += a * v[j];
+            if i != j {
+                y[j] += a * v[i];
+            }
+        }
+    }
+    y
+}
+
+/// Preconditioned CG on `H d = b` with a stale factorization as preconditioner. `None` when it
+/// does not reach a relative residual of 1e-8 within 12 steps or meets non-positive curvature
+/// (`H` indefinite): the caller then factorizes.
+fn lagged_solve(
+    h: &SparseColMat<usize, f64>,
+    pre: &Llt<usize, f64>,
+    b: &[f64],
+) -> Option<Vec<f64>> {
+    let apply_pre = |r: &[f64]| -> Vec<f64> {
+        let mut m = Mat::<f64>::from_fn(r.len(), 1, |i, _| r[i]);
+        pre.solve_in_place(&mut m);
+        (0..r.len()).map(|i| m[(i, 0)]).collect()
+    };
+    let dotv = |a: &[f64], c: &[f64]| a.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
+    let bnorm = dotv(b, b).sqrt();
+    if bnorm == 0.0 {
+        return Some(vec![0.0; b.len()]);
+    }
+    let mut x = apply_pre(b);
+    let hx = sym_matvec(h, &x);
+    let mut r: Vec<f64> = b.iter().zip(&hx).map(|(bi, hi)| bi - hi).collect();
+    let mut z = apply_pre(&r);
+    let mut pdir = z.clone();
+    let mut rz = dotv(&r, &z);
+    for _ in 0..12 {
+        if dotv(&r, &r).sqrt() <= 1e-8 * bnorm {
+            return Some(x);
+        }
+        let hp = sym_matvec(h, &pdir);
+        let php = dotv(&pdir, &hp);
+        if php.is_nan() || php <= 0.0 {
+            return None;
+        }
+        let alpha = rz / php;
+        for i in 0..x.len() {
+            x[i] += alpha * pdir[i];
+            r[i] -= alpha * hp[i];
+        }
+        z = apply_pre(&r);
+        let rz_new = dotv(&r, &z);
+        let beta = rz_new / rz;
+        rz = rz_new;
+        for i in 0..x.len() {
+            pdir[i] = z[i] + beta * pdir[i];
+        }
+    }
+    (dotv(&r, &r).sqrt() <= 1e-8 * bnorm && x.iter().all(|v| v.is_finite())).then_some(x)
+}
+
+/// The PSD 2×2 Hessian block `(h00, h10, h11)` of `w (|z|² − 1)²` at `z`.
+fn unit_block(z: Complex, w: f64, model: HessianModel) -> [f64; 3] {
+    let r2 = z.norm_sqr();
+    let (l_par, l_perp) = match model {
+        // exact Hessian 4w(|z|²−1) I + 8w zzᵀ: eigenvalues along z and across, clamped at 0
+        HessianModel::Projected => (
+            (4.0 * w * (3.0 * r2 - 1.0)).max(0.0),
+            (4.0 * w * (r2 - 1.0)).max(0.0),
+        ),
+        HessianModel::GaussNewton => (8.0 * w * r2, 0.0),
+        HessianModel::Exact => (4.0 * w * (3.0 * r2 - 1.0), 4.0 * w * (r2 - 1.0)),
+    };
+    if r2 == 0.0 {
+        return [l_perp, 0.0, l_perp];
+    }
+    // l_perp I + (l_par − l_perp) ẑẑᵀ
+    let dl = (l_par - l_perp) / r2;
+    [
+        l_perp + dl * z.re * z.re,
+        dl * z.re * z.im,
+        l_perp + dl * z.im * z.im,
+    ]
+}
