@@ -2,7 +2,7 @@
 //! shared corpus (`../shared/meshes`, or `$PLEAT_MESHES`). Each case runs in a child process so
 //! that its peak resident memory (VmHWM) is its own.
 //!
-//! `cargo bench --bench offset [-- <name filter>] [-- --np 200]`
+//! `cargo bench --bench offset [-- <name filter>] [-- --np 200,400]`
 //! Targets: median total ≤ 2 s at n_p = 200; peak ≤ 1 GiB at n_p = 400.
 
 use std::path::{Path, PathBuf};
@@ -107,17 +107,19 @@ fn main() {
         eprintln!("offset bench: corpus not found (set PLEAT_MESHES); skipping");
         return;
     };
+    // `--np 200` or `--np 200,400`; any other argument not starting with '-' filters by name.
+    let np_at = args.iter().position(|a| a == "--np");
     let filter = args
         .iter()
+        .enumerate()
         .skip(1)
-        .find(|a| !a.starts_with('-') && a.parse::<f64>().is_err())
-        .cloned();
-    let nps: Vec<f64> = match args.iter().position(|a| a == "--np") {
+        .find(|(i, a)| !a.starts_with('-') && Some(i - 1) != np_at)
+        .map(|(_, a)| a.clone());
+    let nps: Vec<f64> = match np_at {
         Some(i) => args
             .get(i + 1)
-            .and_then(|s| s.parse().ok())
-            .into_iter()
-            .collect(),
+            .map(|s| s.split(',').filter_map(|x| x.parse().ok()).collect())
+            .unwrap_or_default(),
         None => vec![50.0, 100.0, 200.0, 400.0],
     };
     let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
