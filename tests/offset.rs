@@ -5,6 +5,9 @@
 
 use std::collections::HashMap;
 
+#[path = "common/meshcheck.rs"]
+mod meshcheck;
+
 use pleat::lowpoly::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};
 use pleat::mesh::TriMesh;
 use pleat::{Error, Stats};
@@ -666,7 +669,12 @@ fn corpus_offsets_are_closed_manifolds() {
         }
         for n in [50.0, 100.0, 200.0] {
             let name = format!("{} @{n}", f.file_name().unwrap().to_string_lossy());
-            run_and_check(&name, &mesh, &np(n), 200);
+            let (out, _, _) = run_and_check(&name, &mesh, &np(n), 200);
+            // The CGAL checker takes seconds per output at n_p ≥ 100; CI checks n_p = 50 and
+            // `PLEAT_FULL_CORPUS=1` every size.
+            if n <= 50.0 || std::env::var_os("PLEAT_FULL_CORPUS").is_some() {
+                meshcheck::assert_valid(&out, &name);
+            }
         }
     }
 }
