@@ -13,6 +13,10 @@ use pleat::mesh::{MeshReport, ReportOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+#[cfg(feature = "lod")]
+#[path = "pleat/bench_lod.rs"]
+mod bench_lod;
+
 #[derive(Parser)]
 #[command(
     name = "pleat",
@@ -81,6 +85,18 @@ enum Command {
     /// Complex wrinkle fields: build (.cwf files) and evaluate wrinkled meshes.
     #[command(subcommand)]
     Wrinkle(WrinkleCommand),
+    /// Benchmarks over a folder of meshes (CSV + SVG reports).
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+/// `pleat bench ...`: one sub-subcommand per benchmark, each in its own module.
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// LOD error against run time: sweep screen sizes over a mesh folder, write
+    /// lod_bench.csv and lod_bench.svg (Hausdorff/l against seconds, log-log).
+    #[cfg(feature = "lod")]
+    Lod(bench_lod::LodBenchArgs),
 }
 
 /// Options shared by `lod` and `cage`.
@@ -212,6 +228,15 @@ fn main() -> ExitCode {
         #[cfg(feature = "cage")]
         Command::Cage { input, bake: b } => bake(&input, &b, true),
         Command::Wrinkle(cmd) => wrinkle_cmd::run(cmd),
+        Command::Bench(cmd) => bench(cmd),
+    }
+}
+
+/// `pleat bench ...`.
+fn bench(cmd: BenchCommand) -> ExitCode {
+    match cmd {
+        #[cfg(feature = "lod")]
+        BenchCommand::Lod(args) => bench_lod::run(&args),
     }
 }
 

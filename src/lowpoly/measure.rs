@@ -20,6 +20,9 @@ use crate::spatial::{FastWindingNumber, TriangleBvh};
 /// Samples per bounding-box diagonal of the final Hausdorff measurement (spacing `l / 400`).
 pub const FINAL_SAMPLES_PER_DIAGONAL: f64 = 400.0;
 
+/// Cap on the per-edge subdivisions of one triangle in the final measurement.
+pub(crate) const FINAL_MAX_SUBDIVISIONS: usize = 32;
+
 /// A triangle set with its BVH.
 pub(crate) struct Surface {
     pub positions: Vec<P3>,
@@ -107,6 +110,23 @@ pub(crate) fn hausdorff(a: &Surface, b: &Surface, spacing: f64, max_k: usize) ->
     let ab = one_sided(&a.positions, &a.tris, b, spacing, max_k);
     let ba = one_sided(&b.positions, &b.tris, a, spacing, max_k);
     ab.max(ba)
+}
+
+/// Two-sided sampled Hausdorff distance between `output` and `input`, exactly as the pipeline
+/// reports it in `Stats` (`hausdorff`, `hausdorff_rel`): both surfaces sampled at their
+/// vertices plus a barycentric grid of spacing `l / 400` (`l` = the input's bounding-box
+/// diagonal, at most 32 subdivisions per triangle edge), see the module docs. Works on any two
+/// triangle soups, so benchmarks use it to score other simplifiers with the same measure.
+pub fn hausdorff_to_input(output: &TriMesh, input: &TriMesh) -> f64 {
+    let l = input.bbox_diagonal();
+    let a = Surface::new(output);
+    let b = Surface::new(input);
+    hausdorff(
+        &a,
+        &b,
+        l / FINAL_SAMPLES_PER_DIAGONAL,
+        FINAL_MAX_SUBDIVISIONS,
+    )
 }
 
 /// What the independent verification ([`MeshReport`]) found.

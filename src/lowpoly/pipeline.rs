@@ -11,7 +11,7 @@ use std::time::Instant;
 use super::align::{align_sweep, reference_normals};
 use super::flow::flow_sweep;
 use super::guard::{Guard, GuardStats, InputModel};
-use super::measure::{self, Surface, Verification, FINAL_SAMPLES_PER_DIAGONAL};
+use super::measure::{self, Surface, Verification};
 use super::offset::{offset_surface_with_progress, OffsetDistance, OffsetParams};
 use super::simplify::{simplify_pass, SimplifyOptions, SimplifyReport};
 use crate::mesh::{HalfEdgeMesh, TriMesh};
@@ -363,7 +363,7 @@ fn bake_level(
     }
     rep.check("measure", 0.5)?;
     let t0 = Instant::now();
-    let h = final_hausdorff(&mesh, input, l);
+    let h = measure::hausdorff_to_input(&mesh, input);
     stats
         .stages
         .push(("measure".into(), t0.elapsed().as_secs_f64()));
@@ -407,13 +407,6 @@ fn record_verification(stats: &mut Stats, v: (Verification, bool), mode: Mode) {
     if mode == Mode::Cage {
         stats.verify("cage_encloses_without_touching", v.1);
     }
-}
-
-/// Two-sided Hausdorff between the result and the input (sampling in `measure`).
-fn final_hausdorff(mesh: &TriMesh, input: &TriMesh, l: f64) -> f64 {
-    let a = Surface::new(mesh);
-    let b = Surface::new(input);
-    measure::hausdorff(&a, &b, l / FINAL_SAMPLES_PER_DIAGONAL, 32)
 }
 
 /// Settings of the loop for one level.
