@@ -426,6 +426,8 @@ struct LoopConfig {
 #[derive(Debug, Default)]
 struct LoopStats {
     simplify_s: f64,
+    /// Seconds of the first simplification pass (the one on the dense offset surface).
+    simplify_first_s: f64,
     flow_s: f64,
     align_s: f64,
     converge_s: f64,
@@ -446,6 +448,7 @@ impl LoopStats {
         s.stages.push(("flow".into(), self.flow_s));
         s.stages.push(("align".into(), self.align_s));
         s.stages.push(("convergence".into(), self.converge_s));
+        s.metric("simplify_first_pass_s", self.simplify_first_s);
         s.count("rounds", self.rounds);
         for (i, f) in self.faces_per_round.iter().enumerate() {
             s.count(&format!("faces_round_{}", i + 1), *f);
@@ -526,6 +529,9 @@ fn optimize(
         };
         add_simplify(&mut ls.simplify, &sr);
         ls.simplify_s += t0.elapsed().as_secs_f64();
+        if i == 0 {
+            ls.simplify_first_s = ls.simplify_s;
+        }
         let reference = reference_normals(&g);
         let t0 = Instant::now();
         {

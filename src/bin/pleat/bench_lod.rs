@@ -64,6 +64,9 @@ struct Row {
     status: String,
     faces_out: usize,
     seconds: f64,
+    /// User + system CPU seconds of the bake (all threads): an upper bound of its wall time
+    /// on an unloaded machine, so a robust figure when the machine is shared.
+    cpu_seconds: f64,
     hausdorff_over_l: f64,
     watertight: bool,
     manifold: bool,
@@ -304,10 +307,12 @@ fn bake_case(
         ..Default::default()
     };
     let t0 = Instant::now();
+    let c0 = cpu_seconds();
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         bake_mesh(mesh, &params, cage, prog)
     }));
     row.seconds = t0.elapsed().as_secs_f64();
+    row.cpu_seconds = cpu_seconds() - c0;
     let (out, stats) = match result {
         Ok(Ok(r)) => r,
         Ok(Err(e)) => {
@@ -321,6 +326,17 @@ fn bake_case(
     };
     fill_from_output(&mut row, mesh, &out, &stats, cage);
     (row, Some(out))
+}
+
+/// User + system CPU seconds of this process so far (0 when unavailable).
+fn cpu_seconds() -> f64 {
+    // SAFETY: getrusage only writes into the struct it is given.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
+        return 0.0;
+    }
+    let t = |tv: libc::timeval| tv.tv_sec as f64 + tv.tv_usec as f64 * 1e-6;
+    t(u.ru_utime) + t(u.ru_stime)
 }
 
 /// `generate` or the cage `generate`.
@@ -419,7 +435,7 @@ fn num(v: f64) -> String {
 /// The whole CSV: header, then one line per row.
 fn csv_text(rows: &[Row], cage: bool) -> String {
     let mut s = String::from(
-        "mesh,faces_in,n_p,target_faces,status,faces_out,seconds,hausdorff_over_l,\
+        "mesh,faces_in,n_p,target_faces,status,faces_out,seconds,cpu_seconds,hausdorff_over_l,\
          watertight,manifold,self_intersection_free",
     );
     if cage {
@@ -460,6 +476,11 @@ fn csv_line(r: &Row, cage: bool) -> String {
         } else {
             String::new()
         },
+        if r.n_p.is_finite() {
+            format!("{:.4}", r.cpu_seconds)
+        } else {
+            String::new()
+        },
         if ok {
             num(r.hausdorff_over_l)
         } else {
@@ -488,12 +509,13 @@ fn csv_line(r: &Row, cage: bool) -> String {
 fn row_line(r: &Row) -> String {
     if r.ok() || r.status.starts_with("ok") {
         format!(
-            "{:<34} n_p={:<5} {:>6} -> {:>5} faces  {:>7.2} s  HD/l={:.4}  {}",
+            "{:<34} n_p={:<5} {:>6} -> {:>5} faces  {:>7.2} s ({:>6.2} s cpu)  HD/l={:.4}  {}",
             r.mesh,
             r.n_p,
             r.faces_in,
             r.faces_out,
             r.seconds,
+            r.cpu_seconds,
             r.hausdorff_over_l,
             if r.valid() { "valid" } else { "INVALID" }
         )
@@ -505,22 +527,24 @@ fn row_line(r: &Row) -> String {
 /// Per screen size: cases, valid cases, mean and median seconds, mean Hausdorff/l.
 fn print_summary(rows: &[Row], sizes: &[f64]) {
     println!(
-        "\n{:>6} {:>6} {:>6} {:>10} {:>10} {:>10} {:>8}",
-        "n_p", "cases", "valid", "median s", "mean s", "mean HD/l", "mean #F"
+        "\n{:>6} {:>6} {:>6} {:>10} {:>10} {:>12} {:>10} {:>8}",
+        "n_p", "cases", "valid", "median s", "mean s", "median cpu s", "mean HD/l", "mean #F"
     );
     for &n_p in sizes {
         let all: Vec<&Row> = rows.iter().filter(|r| r.n_p == n_p).collect();
         let ok: Vec<&Row> = all.iter().copied().filter(|r| r.valid()).collect();
         let secs: Vec<f64> = ok.iter().map(|r| r.seconds).collect();
+        let cpu: Vec<f64> = ok.iter().map(|r| r.cpu_seconds).collect();
         let hd: Vec<f64> = ok.iter().map(|r| r.hausdorff_over_l).collect();
         let faces: Vec<f64> = ok.iter().map(|r| r.faces_out as f64).collect();
         println!(
-            "{:>6} {:>6} {:>6} {:>10.2} {:>10.2} {:>10.4} {:>8.0}",
+            "{:>6} {:>6} {:>6} {:>10.2} {:>10.2} {:>12.2} {:>10.4} {:>8.0}",
             n_p,
             all.len(),
             ok.len(),
             median(&secs),
             mean(&secs),
+            median(&cpu),
             mean(&hd),
             mean(&faces)
         );
@@ -810,7 +834,7 @@ mod tests {
         let text = csv_text(&[row("a.obj", 50.0, 1.5, 0.02), bad], false);
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines.len(), 3);
-        assert!(lines[1].starts_with("a.obj,100,50,,ok,10,1.5000,0.02,true,true,true"));
+        assert!(lines[1].starts_with("a.obj,100,50,,ok,10,1.5000,0.0000,0.02,true,true,true"));
         assert!(lines[2].starts_with("\"b,c.obj\",100,50,,\"error: bad \"\"mesh\"\", sorry\",,"));
     }
 
