@@ -103,6 +103,21 @@ fn sphere_torus_box_at_three_screen_sizes() {
     }
 }
 
+/// The reported error ignores the interior of zero-area input triangles (their corners count):
+/// a needle from one corner of a box through its inside to the opposite corner is invisible,
+/// and area-weighted samplers (Metro, the CGAL `compare` tool) never land on it.
+#[test]
+fn hausdorff_ignores_the_inside_of_zero_area_triangles() {
+    let cube = shapes::box_grid(1.0, 1.0, 1.0, 4);
+    let (lo, hi) = cube.bbox();
+    let find = |q: [f64; 3]| cube.positions().iter().position(|p| *p == q).unwrap() as u32;
+    let (a, b) = (find(lo), find(hi));
+    let mut tris = cube.triangles().to_vec();
+    tris.push([a, a, b]);
+    let needle = TriMesh::new(cube.positions().to_vec(), tris).unwrap();
+    assert_eq!(pleat::lowpoly::hausdorff_to_input(&cube, &needle), 0.0);
+}
+
 #[test]
 fn face_target_is_met() {
     let m = shapes::icosphere(1.0, 4);

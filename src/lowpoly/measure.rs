@@ -2,7 +2,8 @@
 //! verification of the loop's output.
 //!
 //! # Sampling density
-//! A surface is sampled at all its referenced vertices plus, on every triangle, a regular
+//! A surface is sampled at all its referenced vertices plus, on every triangle of nonzero area
+//! (exactly collinear corners are skipped, as area-weighted sampling would), a regular
 //! barycentric grid with `k = clamp(⌈longest edge / spacing⌉, 1, max_k)` subdivisions per edge
 //! (`(k+1)(k+2)/2` points, corners included once via the vertices; the centroid is always
 //! added). Each sample's exact distance to the other surface comes from a BVH closest-point
@@ -72,6 +73,11 @@ pub(crate) fn one_sided(
         .par_iter()
         .map(|t| {
             let tri = t.map(|v| from_pos[v as usize]);
+            if crate::spatial::is_collinear(tri[0], tri[1], tri[2]) {
+                // Zero area: nothing of it is visible, and area-weighted sampling (Metro,
+                // the CGAL `compare` tool) never lands on it; its corners are sampled above.
+                return 0.0;
+            }
             let k = sample_resolution(&tri, spacing, max_k);
             let mut m: f64 = 0.0;
             for_each_sample(&tri, k, true, |p| m = m.max(to.distance(p)));
