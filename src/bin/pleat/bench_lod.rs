@@ -49,6 +49,11 @@ pub struct LodBenchArgs {
     /// Also write each output mesh to OUT_DIR/meshes/<mesh>_<n_p>.obj.
     #[arg(long)]
     pub keep_meshes: bool,
+    /// Re-plot instead of baking: read the rows of these lod_bench.csv files (comma
+    /// separated; a later file's row replaces an earlier one of the same mesh and n_p) and
+    /// write the merged CSV and its SVG to OUT_DIR.
+    #[arg(long, value_delimiter = ',')]
+    pub from_csv: Vec<PathBuf>,
     /// No progress bar and no summary table.
     #[arg(short, long)]
     pub quiet: bool,
@@ -122,6 +127,9 @@ pub fn run(args: &LodBenchArgs) -> ExitCode {
 /// The whole command; `Err((exit code, message))` only for problems with the arguments or the
 /// output folder — a failing mesh is a CSV row.
 fn sweep(args: &LodBenchArgs) -> Result<(), (u8, String)> {
+    if !args.from_csv.is_empty() {
+        return replot(args);
+    }
     let dir = args
         .dir
         .clone()
@@ -197,6 +205,126 @@ fn sweep(args: &LodBenchArgs) -> Result<(), (u8, String)> {
         println!("wrote {} and {}", csv.display(), svg.display());
     }
     Ok(())
+}
+
+/// `--from-csv`: merge earlier results and write them again with their plot.
+fn replot(args: &LodBenchArgs) -> Result<(), (u8, String)> {
+    let mut rows: Vec<Row> = Vec::new();
+    let mut cage = false;
+    for path in &args.from_csv {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| (EXIT_INPUT, format!("cannot read {}: {e}", path.display())))?;
+        let (new, has_cage) =
+            parse_csv(&text).map_err(|e| (EXIT_INPUT, format!("{}: {e}", path.display())))?;
+        cage |= has_cage;
+        for r in new {
+            rows.retain(|o| !(o.mesh == r.mesh && o.n_p.to_bits() == r.n_p.to_bits()));
+            rows.push(r);
+        }
+    }
+    rows.sort_by(|a, b| a.mesh.cmp(&b.mesh).then(a.n_p.total_cmp(&b.n_p)));
+    let mut sizes: Vec<f64> = rows
+        .iter()
+        .map(|r| r.n_p)
+        .filter(|n| n.is_finite())
+        .collect();
+    sizes.sort_by(f64::total_cmp);
+    sizes.dedup();
+    std::fs::create_dir_all(&args.out_dir).map_err(|e| {
+        (
+            EXIT_FAILED,
+            format!("cannot create {}: {e}", args.out_dir.display()),
+        )
+    })?;
+    let csv = args.out_dir.join("lod_bench.csv");
+    let svg = args.out_dir.join("lod_bench.svg");
+    write_file(&csv, &csv_text(&rows, cage))?;
+    write_file(&svg, &svg_text(&rows, &sizes, cage))?;
+    if !args.quiet {
+        print_summary(&rows, &sizes);
+        println!("wrote {} and {}", csv.display(), svg.display());
+    }
+    Ok(())
+}
+
+/// Splits one CSV line, honouring double-quoted fields with `""` escapes.
+fn split_csv_line(line: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut cur = String::new();
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                cur.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => out.push(std::mem::take(&mut cur)),
+            _ => cur.push(c),
+        }
+    }
+    out.push(cur);
+    out
+}
+
+/// Rows of a CSV written by [`csv_text`]; also whether it has the cage columns.
+fn parse_csv(text: &str) -> Result<(Vec<Row>, bool), String> {
+    let mut lines = text.lines();
+    let header = split_csv_line(lines.next().unwrap_or(""));
+    let col = |name: &str| header.iter().position(|h| h == name);
+    let need = |name: &str| col(name).ok_or_else(|| format!("no `{name}` column"));
+    let c = [
+        need("mesh")?,
+        need("faces_in")?,
+        need("n_p")?,
+        need("status")?,
+        need("faces_out")?,
+        need("seconds")?,
+        need("hausdorff_over_l")?,
+        need("watertight")?,
+        need("manifold")?,
+        need("self_intersection_free")?,
+    ];
+    let cage_cols = col("encloses").zip(col("untouched"));
+    let cpu = col("cpu_seconds");
+    let mut rows = Vec::new();
+    for line in lines.filter(|l| !l.trim().is_empty()) {
+        let f = split_csv_line(line);
+        let get = |i: usize| f.get(i).map(String::as_str).unwrap_or("");
+        let num = |i: usize| get(i).parse::<f64>().unwrap_or(f64::NAN);
+        let flag = |i: usize| get(i) == "true";
+        let mut stages = Vec::new();
+        for st in STAGES {
+            if let Some(i) = col(&format!("{st}_s")) {
+                stages.push((st.to_string(), num(i)));
+            }
+        }
+        rows.push(Row {
+            mesh: get(c[0]).to_string(),
+            faces_in: get(c[1]).parse().unwrap_or(0),
+            n_p: num(c[2]),
+            target_faces: col("target_faces").and_then(|i| get(i).parse().ok()),
+            status: get(c[3]).to_string(),
+            faces_out: get(c[4]).parse().unwrap_or(0),
+            seconds: num(c[5]),
+            cpu_seconds: cpu.map_or(f64::NAN, num),
+            hausdorff_over_l: num(c[6]),
+            watertight: flag(c[7]),
+            manifold: flag(c[8]),
+            self_intersection_free: flag(c[9]),
+            cage: cage_cols.map(|(e, u)| (flag(e), flag(u))),
+            rounds: col("rounds").and_then(|i| get(i).parse().ok()).unwrap_or(0),
+            faces_offset: col("faces_offset")
+                .and_then(|i| get(i).parse().ok())
+                .unwrap_or(0),
+            reruns_exact: col("reruns_exact")
+                .and_then(|i| get(i).parse().ok())
+                .unwrap_or(0),
+            stages,
+        });
+    }
+    Ok((rows, cage_cols.is_some()))
 }
 
 /// Rejects bad screen sizes and a cage request without the `cage` feature.
@@ -836,6 +964,21 @@ mod tests {
         assert_eq!(lines.len(), 3);
         assert!(lines[1].starts_with("a.obj,100,50,,ok,10,1.5000,0.0000,0.02,true,true,true"));
         assert!(lines[2].starts_with("\"b,c.obj\",100,50,,\"error: bad \"\"mesh\"\", sorry\",,"));
+    }
+
+    #[test]
+    fn csv_round_trips_through_the_replot_parser() {
+        let mut bad = row("b,c.obj", 50.0, 1.0, 0.1);
+        bad.status = "error: bad \"mesh\"".into();
+        let rows = [row("a.obj", 50.0, 1.5, 0.02), bad];
+        let text = csv_text(&rows, false);
+        let (back, cage) = parse_csv(&text).unwrap();
+        assert!(!cage);
+        assert_eq!(back.len(), 2);
+        assert_eq!(back[1].mesh, "b,c.obj");
+        assert_eq!(back[1].status, "error: bad \"mesh\"");
+        assert!(back[0].valid() && !back[1].valid());
+        assert_eq!(csv_text(&back, false), text);
     }
 
     #[test]
