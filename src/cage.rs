@@ -44,3 +44,33 @@ pub fn generate_chain(
 ) -> Result<Vec<(TriMesh, Stats)>> {
     run_chain(input, screen_sizes, params, Mode::Cage, progress)
 }
+
+/// Result of [`check`]: the two cage properties, tested independently of the guard.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CageCheck {
+    /// No cage triangle touches or intersects an input triangle (exact tests on BVH
+    /// candidates; touching counts as contact).
+    pub untouched: bool,
+    /// Every referenced input vertex has winding number above 1/2 with respect to the cage
+    /// (hierarchical fast winding numbers, Barill et al. 2018).
+    pub encloses: bool,
+}
+
+impl CageCheck {
+    /// Both properties hold.
+    pub fn is_cage(&self) -> bool {
+        self.untouched && self.encloses
+    }
+}
+
+/// Checks that `cage` encloses every vertex of `input` and touches none of its triangles —
+/// the verification the pipeline runs on its own output, usable on any mesh (benchmarks,
+/// tests, other cage generators).
+pub fn check(cage: &TriMesh, input: &TriMesh) -> CageCheck {
+    let model = crate::lowpoly::guard::InputModel::new(input, false);
+    let (untouched, encloses) = crate::lowpoly::measure::verify_cage(cage, &model);
+    CageCheck {
+        untouched,
+        encloses,
+    }
+}

@@ -103,6 +103,21 @@ fn sphere_torus_box_at_three_screen_sizes() {
     }
 }
 
+/// The reported error ignores the interior of zero-area input triangles (their corners count):
+/// a needle from one corner of a box through its inside to the opposite corner is invisible,
+/// and area-weighted samplers (Metro, the CGAL `compare` tool) never land on it.
+#[test]
+fn hausdorff_ignores_the_inside_of_zero_area_triangles() {
+    let cube = shapes::box_grid(1.0, 1.0, 1.0, 4);
+    let (lo, hi) = cube.bbox();
+    let find = |q: [f64; 3]| cube.positions().iter().position(|p| *p == q).unwrap() as u32;
+    let (a, b) = (find(lo), find(hi));
+    let mut tris = cube.triangles().to_vec();
+    tris.push([a, a, b]);
+    let needle = TriMesh::new(cube.positions().to_vec(), tris).unwrap();
+    assert_eq!(pleat::lowpoly::hausdorff_to_input(&cube, &needle), 0.0);
+}
+
 #[test]
 fn face_target_is_met() {
     let m = shapes::icosphere(1.0, 4);
@@ -250,4 +265,198 @@ fn output_does_not_depend_on_thread_count() {
         pool.install(|| bake(&m, &params(100.0), false).unwrap().0)
     };
     assert_eq!(run(1), run(2));
+}
+
+/// The public corpus (`../shared/meshes` or `$PLEAT_MESHES`), inputs of at most 200k
+/// triangles, sorted by name.
+fn corpus_meshes() -> Vec<std::path::PathBuf> {
+    let dir = [
+        std::env::var("PLEAT_MESHES")
+            .ok()
+            .map(std::path::PathBuf::from),
+        Some(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes")),
+        Some("/work/shared/meshes".into()),
+    ]
+    .into_iter()
+    .flatten()
+    .find(|p| p.is_dir())
+    .expect("corpus not found: set PLEAT_MESHES");
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let ext = p.extension().and_then(|e| e.to_str()).unwrap_or("");
+            ["obj", "ply", "off", "stl"].contains(&ext)
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+/// The CGAL checker: `$PLEAT_MESHCHECK`, else the tools' default build location.
+fn meshcheck_tool() -> std::path::PathBuf {
+    let tool = std::env::var("PLEAT_MESHCHECK").unwrap_or("/tmp/pleat-tools/meshcheck".into());
+    let tool = std::path::PathBuf::from(tool);
+    assert!(
+        tool.exists(),
+        "meshcheck not found at {}: build ../shared/tools and set PLEAT_MESHCHECK",
+        tool.display()
+    );
+    tool
+}
+
+/// Runs `tool` on `file`; `Err(json)` unless watertight, manifold and intersection-free.
+fn meshcheck_file(tool: &std::path::Path, file: &std::path::Path) -> Result<(), String> {
+    let out = std::process::Command::new(tool)
+        .arg(file)
+        .output()
+        .map_err(|e| format!("cannot run meshcheck: {e}"))?;
+    let json = String::from_utf8_lossy(&out.stdout).replace(' ', "");
+    let ok = [
+        "\"is_watertight\":true",
+        "\"is_manifold\":true",
+        "\"self_intersection_free\":true",
+    ]
+    .iter()
+    .all(|k| json.contains(k));
+    if ok {
+        Ok(())
+    } else {
+        Err(json.trim().to_string())
+    }
+}
+
+/// CGAL `compare --cage` (beside meshcheck, when built): `Err(json)` unless `is_cage`.
+fn compare_cage(
+    meshcheck: &std::path::Path,
+    input: &std::path::Path,
+    cage: &std::path::Path,
+) -> Option<Result<(), String>> {
+    let tool = meshcheck.with_file_name("compare");
+    if !tool.exists() {
+        return None;
+    }
+    let out = std::process::Command::new(tool)
+        .args(["--cage", "--samples", "20000"])
+        .arg(input)
+        .arg(cage)
+        .output()
+        .ok()?;
+    let json = String::from_utf8_lossy(&out.stdout).replace(' ', "");
+    Some(if json.contains("\"is_cage\":true") {
+        Ok(())
+    } else {
+        Err(json.trim().to_string())
+    })
+}
+
+/// Issue 4's validity target on the public corpus: every mesh of at most 200k triangles at
+/// n_p = 50, 100, 200 is watertight, manifold and intersection-free according to the CGAL
+/// `meshcheck` (`PLEAT_MESHCHECK`), and its cage at n_p = 50 encloses every input vertex
+/// (winding number) without touching the input (exact triangle tests; also CGAL `compare
+/// --cage` when built beside meshcheck). Outputs go to a temp dir, kept when something fails.
+/// Ignored because it takes longer than CI's budget:
+/// `cargo test --release --test lod -- --ignored corpus --nocapture`.
+#[test]
+#[ignore = "tens of minutes; run with --ignored corpus"]
+fn corpus_outputs_pass_the_independent_checker() {
+    let tool = meshcheck_tool();
+    let dir = std::env::temp_dir().join(format!("pleat-corpus-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut failures = Vec::new();
+    let mut cases = 0;
+    for file in corpus_meshes() {
+        let name = file.file_stem().unwrap().to_string_lossy().to_string();
+        let m = pleat::mesh::io::read_mesh(&file).unwrap();
+        if m.triangle_count() > 200_000 {
+            continue;
+        }
+        let runs = [(50.0, false), (100.0, false), (200.0, false)]
+            .into_iter()
+            .chain(cfg!(feature = "cage").then_some((50.0, true)));
+        for (np, cage) in runs {
+            cases += 1;
+            let what = format!("{name} n_p={np}{}", if cage { " cage" } else { "" });
+            let t0 = std::time::Instant::now();
+            let r = corpus_case(&m, &file, np, cage, &tool, &dir, &what);
+            println!(
+                "{what:<44} {:>7.2} s  {}",
+                t0.elapsed().as_secs_f64(),
+                r.as_ref()
+                    .map_or_else(|e| format!("FAIL {e}"), |s| s.clone())
+            );
+            if let Err(e) = r {
+                failures.push(format!("{what}: {e}"));
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {cases} corpus cases failed (outputs in {}):\n{}",
+        failures.len(),
+        dir.display(),
+        failures.join("\n")
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// One corpus case: bake, write, meshcheck, and for cages winding numbers plus contact.
+fn corpus_case(
+    m: &TriMesh,
+    file: &std::path::Path,
+    np: f64,
+    cage: bool,
+    tool: &std::path::Path,
+    dir: &std::path::Path,
+    what: &str,
+) -> Result<String, String> {
+    let (out, s) = bake(m, &params(np), cage).map_err(|e| format!("error: {e}"))?;
+    let path = dir.join(format!("{}.obj", what.replace([' ', '='], "_")));
+    pleat::mesh::io::write_mesh(&path, &out).map_err(|e| e.to_string())?;
+    meshcheck_file(tool, &path).map_err(|j| format!("meshcheck: {j}"))?;
+    if cage {
+        cage_checks(m, &out)?;
+        if let Some(r) = compare_cage(tool, file, &path) {
+            r.map_err(|j| format!("compare --cage: {j}"))?;
+        }
+    }
+    let _ = std::fs::remove_file(&path);
+    Ok(format!(
+        "{} faces, HD/l {:.4}",
+        out.triangle_count(),
+        rel_hausdorff(&s)
+    ))
+}
+
+/// Every referenced input vertex has winding number > 1/2, and no triangle touches the input.
+#[cfg(feature = "cage")]
+fn cage_checks(input: &TriMesh, cage: &TriMesh) -> Result<(), String> {
+    let mut used = vec![false; input.vertex_count()];
+    for t in input.triangles() {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let pts: Vec<[f64; 3]> = (0..input.vertex_count())
+        .filter(|&v| used[v])
+        .map(|v| input.positions()[v])
+        .collect();
+    let fwn = pleat::spatial::FastWindingNumber::new(cage);
+    let outside = fwn
+        .winding_numbers(&pts)
+        .iter()
+        .filter(|&&w| w <= 0.5)
+        .count();
+    if outside > 0 {
+        return Err(format!("{outside} input vertices outside the cage"));
+    }
+    if !pleat::cage::check(cage, input).untouched {
+        return Err("the cage touches the input".into());
+    }
+    Ok(())
+}
+
+#[cfg(not(feature = "cage"))]
+fn cage_checks(_input: &TriMesh, _cage: &TriMesh) -> Result<(), String> {
+    Ok(())
 }

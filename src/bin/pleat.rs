@@ -13,6 +13,10 @@ use pleat::mesh::{MeshReport, ReportOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+#[cfg(feature = "lod")]
+#[path = "pleat/bench_lod.rs"]
+mod bench_lod;
+
 #[derive(Parser)]
 #[command(
     name = "pleat",
@@ -86,9 +90,13 @@ enum Command {
     Bench(BenchCommand),
 }
 
-/// `pleat bench ...`.
+/// `pleat bench ...`: one sub-subcommand per benchmark.
 #[derive(Subcommand)]
 enum BenchCommand {
+    /// LOD error against run time: sweep screen sizes over a mesh folder, write
+    /// lod_bench.csv and lod_bench.svg (Hausdorff/l against seconds, log-log).
+    #[cfg(feature = "lod")]
+    Lod(bench_lod::LodBenchArgs),
     /// Wrinkle interpolation: residual vs seconds per keyframe pair (rotation, frequency ×3,
     /// local rotation) and quality vs number of guide frames (ablation B.7.1). Writes
     /// interp_convergence.csv/.svg and interp_guide_frames.csv/.svg into OUT_DIR.
@@ -283,7 +291,16 @@ fn main() -> ExitCode {
         #[cfg(feature = "cage")]
         Command::Cage { input, bake: b } => bake(&input, &b, true),
         Command::Wrinkle(cmd) => wrinkle_cmd::run(cmd),
-        Command::Bench(cmd) => wrinkle_cmd::bench(cmd),
+        Command::Bench(cmd) => bench(cmd),
+    }
+}
+
+/// `pleat bench ...`.
+fn bench(cmd: BenchCommand) -> ExitCode {
+    match cmd {
+        #[cfg(feature = "lod")]
+        BenchCommand::Lod(args) => bench_lod::run(&args),
+        cmd @ BenchCommand::Wrinkle { .. } => wrinkle_cmd::bench(cmd),
     }
 }
 
@@ -877,12 +894,16 @@ mod wrinkle_cmd {
 
     /// `pleat bench ...`.
     pub fn bench(cmd: BenchCommand) -> ExitCode {
+        #[allow(irrefutable_let_patterns)] // one variant in builds without `lod`
         let BenchCommand::Wrinkle {
             mesh,
             out_dir,
             frames,
             wavelengths,
-        } = cmd;
+        } = cmd
+        else {
+            unreachable!("only called for `bench wrinkle`")
+        };
         match bench_wrinkle(&mesh, &out_dir, frames, wavelengths) {
             Ok(()) => ExitCode::SUCCESS,
             Err(Fail(code, msg)) => {

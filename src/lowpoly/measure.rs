@@ -2,7 +2,8 @@
 //! verification of the loop's output.
 //!
 //! # Sampling density
-//! A surface is sampled at all its referenced vertices plus, on every triangle, a regular
+//! A surface is sampled at all its referenced vertices plus, on every triangle of nonzero area
+//! (exactly collinear corners are skipped, as area-weighted sampling would), a regular
 //! barycentric grid with `k = clamp(⌈longest edge / spacing⌉, 1, max_k)` subdivisions per edge
 //! (`(k+1)(k+2)/2` points, corners included once via the vertices; the centroid is always
 //! added). Each sample's exact distance to the other surface comes from a BVH closest-point
@@ -19,6 +20,9 @@ use crate::spatial::{FastWindingNumber, TriangleBvh};
 
 /// Samples per bounding-box diagonal of the final Hausdorff measurement (spacing `l / 400`).
 pub const FINAL_SAMPLES_PER_DIAGONAL: f64 = 400.0;
+
+/// Cap on the per-edge subdivisions of one triangle in the final measurement.
+pub(crate) const FINAL_MAX_SUBDIVISIONS: usize = 32;
 
 /// A triangle set with its BVH.
 pub(crate) struct Surface {
@@ -69,6 +73,11 @@ pub(crate) fn one_sided(
         .par_iter()
         .map(|t| {
             let tri = t.map(|v| from_pos[v as usize]);
+            if crate::spatial::is_collinear(tri[0], tri[1], tri[2]) {
+                // Zero area: nothing of it is visible, and area-weighted sampling (Metro,
+                // the CGAL `compare` tool) never lands on it; its corners are sampled above.
+                return 0.0;
+            }
             let k = sample_resolution(&tri, spacing, max_k);
             let mut m: f64 = 0.0;
             for_each_sample(&tri, k, true, |p| m = m.max(to.distance(p)));
@@ -107,6 +116,23 @@ pub(crate) fn hausdorff(a: &Surface, b: &Surface, spacing: f64, max_k: usize) ->
     let ab = one_sided(&a.positions, &a.tris, b, spacing, max_k);
     let ba = one_sided(&b.positions, &b.tris, a, spacing, max_k);
     ab.max(ba)
+}
+
+/// Two-sided sampled Hausdorff distance between `output` and `input`, exactly as the pipeline
+/// reports it in `Stats` (`hausdorff`, `hausdorff_rel`): both surfaces sampled at their
+/// vertices plus a barycentric grid of spacing `l / 400` (`l` = the input's bounding-box
+/// diagonal, at most 32 subdivisions per triangle edge), see the module docs. Works on any two
+/// triangle soups, so benchmarks use it to score other simplifiers with the same measure.
+pub fn hausdorff_to_input(output: &TriMesh, input: &TriMesh) -> f64 {
+    let l = input.bbox_diagonal();
+    let a = Surface::new(output);
+    let b = Surface::new(input);
+    hausdorff(
+        &a,
+        &b,
+        l / FINAL_SAMPLES_PER_DIAGONAL,
+        FINAL_MAX_SUBDIVISIONS,
+    )
 }
 
 /// What the independent verification ([`MeshReport`]) found.

@@ -11,7 +11,7 @@ use std::time::Instant;
 use super::align::{align_sweep, reference_normals};
 use super::flow::flow_sweep;
 use super::guard::{Guard, GuardStats, InputModel};
-use super::measure::{self, Surface, Verification, FINAL_SAMPLES_PER_DIAGONAL};
+use super::measure::{self, Surface, Verification};
 use super::offset::{offset_surface_with_progress, OffsetDistance, OffsetParams};
 use super::simplify::{simplify_pass, SimplifyOptions, SimplifyReport};
 use crate::mesh::{HalfEdgeMesh, TriMesh};
@@ -363,7 +363,7 @@ fn bake_level(
     }
     rep.check("measure", 0.5)?;
     let t0 = Instant::now();
-    let h = final_hausdorff(&mesh, input, l);
+    let h = measure::hausdorff_to_input(&mesh, input);
     stats
         .stages
         .push(("measure".into(), t0.elapsed().as_secs_f64()));
@@ -409,13 +409,6 @@ fn record_verification(stats: &mut Stats, v: (Verification, bool), mode: Mode) {
     }
 }
 
-/// Two-sided Hausdorff between the result and the input (sampling in `measure`).
-fn final_hausdorff(mesh: &TriMesh, input: &TriMesh, l: f64) -> f64 {
-    let a = Surface::new(mesh);
-    let b = Surface::new(input);
-    measure::hausdorff(&a, &b, l / FINAL_SAMPLES_PER_DIAGONAL, 32)
-}
-
 /// Settings of the loop for one level.
 #[derive(Debug, Clone, Copy)]
 struct LoopConfig {
@@ -433,6 +426,8 @@ struct LoopConfig {
 #[derive(Debug, Default)]
 struct LoopStats {
     simplify_s: f64,
+    /// Seconds of the first simplification pass (the one on the dense offset surface).
+    simplify_first_s: f64,
     flow_s: f64,
     align_s: f64,
     converge_s: f64,
@@ -453,6 +448,7 @@ impl LoopStats {
         s.stages.push(("flow".into(), self.flow_s));
         s.stages.push(("align".into(), self.align_s));
         s.stages.push(("convergence".into(), self.converge_s));
+        s.metric("simplify_first_pass_s", self.simplify_first_s);
         s.count("rounds", self.rounds);
         for (i, f) in self.faces_per_round.iter().enumerate() {
             s.count(&format!("faces_round_{}", i + 1), *f);
@@ -533,6 +529,9 @@ fn optimize(
         };
         add_simplify(&mut ls.simplify, &sr);
         ls.simplify_s += t0.elapsed().as_secs_f64();
+        if i == 0 {
+            ls.simplify_first_s = ls.simplify_s;
+        }
         let reference = reference_normals(&g);
         let t0 = Instant::now();
         {

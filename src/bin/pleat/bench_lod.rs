@@ -1,0 +1,1008 @@
+//! `pleat bench lod`: error against run time (issue 4, item 8).
+//!
+//! Bakes every mesh of a folder at every screen size `n_p` with [`pleat::lowpoly::generate`]
+//! (or [`pleat::cage::generate`] with `--cage`), checks each output independently with
+//! [`MeshReport`] (and the cage checks of [`pleat::cage::check`]), and writes
+//! - `lod_bench.csv`: one row per (mesh, `n_p`) with faces, wall seconds, per-stage seconds,
+//!   the sampled two-sided Hausdorff distance relative to the bounding-box diagonal `l`
+//!   ([`pleat::lowpoly::hausdorff_to_input`]: vertices plus a barycentric grid of spacing
+//!   `l / 400`), the validity flags, and a `status` column (`ok`, or why the case failed);
+//! - `lod_bench.svg`: Hausdorff/l against seconds, both log scale, one polyline per mesh
+//!   (points in `n_p` order) and the mean over the meshes.
+//!
+//! A failing mesh (unreadable, rejected, error or panic inside the bake) becomes a CSV row with
+//! its status; the sweep always continues.
+
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use pleat::mesh::io::read_mesh;
+use pleat::mesh::{MeshReport, TriMesh};
+use pleat::Stats;
+
+use super::{progress_bar, EXIT_FAILED, EXIT_INPUT};
+
+/// Options of `pleat bench lod`.
+#[derive(clap::Args)]
+pub struct LodBenchArgs {
+    /// Folder of meshes (obj, ply, off, stl, glb, gltf) [default: ../shared/meshes].
+    pub dir: Option<PathBuf>,
+    /// Screen sizes n_p to sweep, comma separated.
+    #[arg(long, value_delimiter = ',', default_value = "25,50,100,200,400")]
+    pub screen_sizes: Vec<f64>,
+    /// Folder for lod_bench.csv and lod_bench.svg (created if missing).
+    #[arg(long, default_value = ".")]
+    pub out_dir: PathBuf,
+    /// Bake cages instead of LODs (adds the enclosure and contact columns).
+    #[arg(long)]
+    pub cage: bool,
+    /// Face target per (mesh, n_p) from a CSV with columns `mesh`, `n_p`, `meshopt_faces`
+    /// (the one `cargo bench --bench lod` writes) [default: target/bench/lod_vs_meshopt.csv].
+    #[arg(long, num_args = 0..=1, default_missing_value = "target/bench/lod_vs_meshopt.csv")]
+    pub faces_from_meshopt: Option<PathBuf>,
+    /// Skip meshes with more input triangles than this (status `skipped` in the CSV).
+    #[arg(long)]
+    pub max_input_faces: Option<usize>,
+    /// Also write each output mesh to OUT_DIR/meshes/<mesh>_<n_p>.obj.
+    #[arg(long)]
+    pub keep_meshes: bool,
+    /// Re-plot instead of baking: read the rows of these lod_bench.csv files (comma
+    /// separated; a later file's row replaces an earlier one of the same mesh and n_p) and
+    /// write the merged CSV and its SVG to OUT_DIR.
+    #[arg(long, value_delimiter = ',')]
+    pub from_csv: Vec<PathBuf>,
+    /// No progress bar and no summary table.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// One CSV row: one mesh at one screen size.
+#[derive(Debug, Clone, Default)]
+struct Row {
+    mesh: String,
+    faces_in: usize,
+    n_p: f64,
+    target_faces: Option<usize>,
+    status: String,
+    faces_out: usize,
+    seconds: f64,
+    /// User + system CPU seconds of the bake (all threads): an upper bound of its wall time
+    /// on an unloaded machine, so a robust figure when the machine is shared.
+    cpu_seconds: f64,
+    hausdorff_over_l: f64,
+    watertight: bool,
+    manifold: bool,
+    self_intersection_free: bool,
+    /// Cage mode: `(encloses every input vertex, touches no input triangle)`.
+    cage: Option<(bool, bool)>,
+    rounds: u64,
+    faces_offset: u64,
+    reruns_exact: u64,
+    stages: Vec<(String, f64)>,
+}
+
+impl Row {
+    fn ok(&self) -> bool {
+        self.status == "ok"
+    }
+
+    /// Watertight, manifold, self-intersection-free, and in cage mode enclosing and untouched.
+    fn valid(&self) -> bool {
+        self.ok()
+            && self.watertight
+            && self.manifold
+            && self.self_intersection_free
+            && self.cage.is_none_or(|(e, u)| e && u)
+    }
+}
+
+/// Stage columns of the CSV (seconds from `Stats::stages`).
+const STAGES: [&str; 7] = [
+    "offset",
+    "simplify",
+    "flow",
+    "align",
+    "convergence",
+    "verify",
+    "measure",
+];
+
+/// Mesh file extensions the sweep picks up.
+const EXTENSIONS: [&str; 6] = ["obj", "ply", "off", "stl", "glb", "gltf"];
+
+/// `pleat bench lod`.
+pub fn run(args: &LodBenchArgs) -> ExitCode {
+    match sweep(args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err((code, msg)) => {
+            eprintln!("pleat bench lod: {msg}");
+            ExitCode::from(code)
+        }
+    }
+}
+
+/// The whole command; `Err((exit code, message))` only for problems with the arguments or the
+/// output folder — a failing mesh is a CSV row.
+fn sweep(args: &LodBenchArgs) -> Result<(), (u8, String)> {
+    if !args.from_csv.is_empty() {
+        return replot(args);
+    }
+    let dir = args
+        .dir
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("../shared/meshes"));
+    check_arguments(args)?;
+    let files = list_meshes(&dir).map_err(|e| (EXIT_INPUT, e))?;
+    let targets = match &args.faces_from_meshopt {
+        Some(p) => read_face_targets(p).map_err(|e| (EXIT_INPUT, e))?,
+        None => HashMap::new(),
+    };
+    std::fs::create_dir_all(&args.out_dir).map_err(|e| {
+        (
+            EXIT_FAILED,
+            format!("cannot create {}: {e}", args.out_dir.display()),
+        )
+    })?;
+    let sizes = &args.screen_sizes;
+    let bar = progress_bar(args.quiet);
+    if let Some(b) = &bar {
+        b.set_length((files.len() * sizes.len() * 1000) as u64);
+    }
+    let mut rows = Vec::new();
+    for (i, file) in files.iter().enumerate() {
+        let name = file_name(file);
+        let base = (i * sizes.len() * 1000) as u64;
+        if let Some(b) = &bar {
+            b.set_position(base);
+            b.set_message(format!("{name}: loading"));
+        }
+        let mesh = match load(file, args.max_input_faces) {
+            Ok(m) => m,
+            Err(status) => {
+                rows.push(Row {
+                    mesh: name,
+                    n_p: f64::NAN,
+                    status,
+                    ..Row::default()
+                });
+                continue;
+            }
+        };
+        for (j, &n_p) in sizes.iter().enumerate() {
+            let job = base + (j * 1000) as u64;
+            let mut prog = |p: pleat::Progress<'_>| {
+                if let Some(b) = &bar {
+                    b.set_position(job + (p.fraction * 1000.0) as u64);
+                    b.set_message(format!("{name} n_p={n_p}: {}", p.stage));
+                }
+                true
+            };
+            let target = targets.get(&(name.clone(), n_p.to_bits())).copied();
+            let (row, out) = bake_case(&name, &mesh, n_p, target, args.cage, &mut prog);
+            if let (true, Some(out)) = (args.keep_meshes, out) {
+                keep_mesh(&args.out_dir, &name, n_p, &out);
+            }
+            if let (Some(b), false) = (&bar, args.quiet) {
+                b.println(row_line(&row));
+            } else if !args.quiet {
+                println!("{}", row_line(&row));
+            }
+            rows.push(row);
+        }
+    }
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let csv = args.out_dir.join("lod_bench.csv");
+    let svg = args.out_dir.join("lod_bench.svg");
+    write_file(&csv, &csv_text(&rows, args.cage))?;
+    write_file(&svg, &svg_text(&rows, sizes, args.cage))?;
+    if !args.quiet {
+        print_summary(&rows, sizes);
+        println!("wrote {} and {}", csv.display(), svg.display());
+    }
+    Ok(())
+}
+
+/// `--from-csv`: merge earlier results and write them again with their plot.
+fn replot(args: &LodBenchArgs) -> Result<(), (u8, String)> {
+    let mut rows: Vec<Row> = Vec::new();
+    let mut cage = false;
+    for path in &args.from_csv {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| (EXIT_INPUT, format!("cannot read {}: {e}", path.display())))?;
+        let (new, has_cage) =
+            parse_csv(&text).map_err(|e| (EXIT_INPUT, format!("{}: {e}", path.display())))?;
+        cage |= has_cage;
+        for r in new {
+            rows.retain(|o| !(o.mesh == r.mesh && o.n_p.to_bits() == r.n_p.to_bits()));
+            rows.push(r);
+        }
+    }
+    rows.sort_by(|a, b| a.mesh.cmp(&b.mesh).then(a.n_p.total_cmp(&b.n_p)));
+    let mut sizes: Vec<f64> = rows
+        .iter()
+        .map(|r| r.n_p)
+        .filter(|n| n.is_finite())
+        .collect();
+    sizes.sort_by(f64::total_cmp);
+    sizes.dedup();
+    std::fs::create_dir_all(&args.out_dir).map_err(|e| {
+        (
+            EXIT_FAILED,
+            format!("cannot create {}: {e}", args.out_dir.display()),
+        )
+    })?;
+    let csv = args.out_dir.join("lod_bench.csv");
+    let svg = args.out_dir.join("lod_bench.svg");
+    write_file(&csv, &csv_text(&rows, cage))?;
+    write_file(&svg, &svg_text(&rows, &sizes, cage))?;
+    if !args.quiet {
+        print_summary(&rows, &sizes);
+        println!("wrote {} and {}", csv.display(), svg.display());
+    }
+    Ok(())
+}
+
+/// Splits one CSV line, honouring double-quoted fields with `""` escapes.
+fn split_csv_line(line: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut cur = String::new();
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                cur.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => out.push(std::mem::take(&mut cur)),
+            _ => cur.push(c),
+        }
+    }
+    out.push(cur);
+    out
+}
+
+/// Rows of a CSV written by [`csv_text`]; also whether it has the cage columns.
+fn parse_csv(text: &str) -> Result<(Vec<Row>, bool), String> {
+    let mut lines = text.lines();
+    let header = split_csv_line(lines.next().unwrap_or(""));
+    let col = |name: &str| header.iter().position(|h| h == name);
+    let need = |name: &str| col(name).ok_or_else(|| format!("no `{name}` column"));
+    let c = [
+        need("mesh")?,
+        need("faces_in")?,
+        need("n_p")?,
+        need("status")?,
+        need("faces_out")?,
+        need("seconds")?,
+        need("hausdorff_over_l")?,
+        need("watertight")?,
+        need("manifold")?,
+        need("self_intersection_free")?,
+    ];
+    let cage_cols = col("encloses").zip(col("untouched"));
+    let cpu = col("cpu_seconds");
+    let mut rows = Vec::new();
+    for line in lines.filter(|l| !l.trim().is_empty()) {
+        let f = split_csv_line(line);
+        let get = |i: usize| f.get(i).map(String::as_str).unwrap_or("");
+        let num = |i: usize| get(i).parse::<f64>().unwrap_or(f64::NAN);
+        let flag = |i: usize| get(i) == "true";
+        let mut stages = Vec::new();
+        for st in STAGES {
+            if let Some(i) = col(&format!("{st}_s")) {
+                stages.push((st.to_string(), num(i)));
+            }
+        }
+        rows.push(Row {
+            mesh: get(c[0]).to_string(),
+            faces_in: get(c[1]).parse().unwrap_or(0),
+            n_p: num(c[2]),
+            target_faces: col("target_faces").and_then(|i| get(i).parse().ok()),
+            status: get(c[3]).to_string(),
+            faces_out: get(c[4]).parse().unwrap_or(0),
+            seconds: num(c[5]),
+            cpu_seconds: cpu.map_or(f64::NAN, num),
+            hausdorff_over_l: num(c[6]),
+            watertight: flag(c[7]),
+            manifold: flag(c[8]),
+            self_intersection_free: flag(c[9]),
+            cage: cage_cols.map(|(e, u)| (flag(e), flag(u))),
+            rounds: col("rounds").and_then(|i| get(i).parse().ok()).unwrap_or(0),
+            faces_offset: col("faces_offset")
+                .and_then(|i| get(i).parse().ok())
+                .unwrap_or(0),
+            reruns_exact: col("reruns_exact")
+                .and_then(|i| get(i).parse().ok())
+                .unwrap_or(0),
+            stages,
+        });
+    }
+    Ok((rows, cage_cols.is_some()))
+}
+
+/// Rejects bad screen sizes and a cage request without the `cage` feature.
+fn check_arguments(args: &LodBenchArgs) -> Result<(), (u8, String)> {
+    if args.screen_sizes.is_empty()
+        || args
+            .screen_sizes
+            .iter()
+            .any(|s| !(s.is_finite() && *s > 0.0))
+    {
+        return Err((
+            EXIT_INPUT,
+            format!(
+                "--screen-sizes must be finite and > 0, got {:?}",
+                args.screen_sizes
+            ),
+        ));
+    }
+    if args.cage && !cfg!(feature = "cage") {
+        return Err((EXIT_INPUT, "--cage needs the `cage` feature".into()));
+    }
+    Ok(())
+}
+
+/// The mesh files of `dir`, sorted by name.
+fn list_meshes(dir: &Path) -> Result<Vec<PathBuf>, String> {
+    let entries =
+        std::fs::read_dir(dir).map_err(|e| format!("cannot list {}: {e}", dir.display()))?;
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.is_file()
+                && p.extension()
+                    .and_then(|x| x.to_str())
+                    .is_some_and(|x| EXTENSIONS.contains(&x.to_ascii_lowercase().as_str()))
+        })
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        return Err(format!("no mesh files in {}", dir.display()));
+    }
+    Ok(files)
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name()
+        .map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into())
+}
+
+/// Reads a mesh; `Err(status)` when it cannot be read or is over the size limit.
+fn load(file: &Path, max_faces: Option<usize>) -> Result<TriMesh, String> {
+    let mesh = read_mesh(file).map_err(|e| format!("load error: {e}"))?;
+    match max_faces {
+        Some(n) if mesh.triangle_count() > n => Err(format!(
+            "skipped: {} input triangles > --max-input-faces {n}",
+            mesh.triangle_count()
+        )),
+        _ => Ok(mesh),
+    }
+}
+
+/// Face targets keyed by `(mesh file name, n_p bits)` from a CSV with a header naming the
+/// columns `mesh`, `n_p` and `meshopt_faces`.
+fn read_face_targets(path: &Path) -> Result<HashMap<(String, u64), usize>, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h.trim() == name)
+            .ok_or_else(|| format!("{} has no `{name}` column", path.display()))
+    };
+    let (cm, cn, cf) = (col("mesh")?, col("n_p")?, col("meshopt_faces")?);
+    let mut out = HashMap::new();
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let get = |i: usize| f.get(i).map(|s| s.trim()).unwrap_or("");
+        if let (Ok(n_p), Ok(faces)) = (get(cn).parse::<f64>(), get(cf).parse::<usize>()) {
+            if faces >= 4 {
+                out.insert((get(cm).to_string(), n_p.to_bits()), faces);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Bakes one case and checks it; never panics (a panic in the bake becomes the status).
+fn bake_case(
+    name: &str,
+    mesh: &TriMesh,
+    n_p: f64,
+    target: Option<usize>,
+    cage: bool,
+    prog: &mut pleat::report::ProgressFn<'_>,
+) -> (Row, Option<TriMesh>) {
+    let mut row = Row {
+        mesh: name.to_string(),
+        faces_in: mesh.triangle_count(),
+        n_p,
+        target_faces: target,
+        ..Row::default()
+    };
+    let params = pleat::lowpoly::LodParams {
+        screen_size: n_p,
+        target_faces: target,
+        ..Default::default()
+    };
+    let t0 = Instant::now();
+    let c0 = cpu_seconds();
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        bake_mesh(mesh, &params, cage, prog)
+    }));
+    row.seconds = t0.elapsed().as_secs_f64();
+    row.cpu_seconds = cpu_seconds() - c0;
+    let (out, stats) = match result {
+        Ok(Ok(r)) => r,
+        Ok(Err(e)) => {
+            row.status = format!("error: {e}");
+            return (row, None);
+        }
+        Err(p) => {
+            row.status = format!("panic: {}", panic_message(&p));
+            return (row, None);
+        }
+    };
+    fill_from_output(&mut row, mesh, &out, &stats, cage);
+    (row, Some(out))
+}
+
+/// User + system CPU seconds of this process so far (0 when unavailable).
+fn cpu_seconds() -> f64 {
+    // SAFETY: getrusage only writes into the struct it is given.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
+        return 0.0;
+    }
+    let t = |tv: libc::timeval| tv.tv_sec as f64 + tv.tv_usec as f64 * 1e-6;
+    t(u.ru_utime) + t(u.ru_stime)
+}
+
+/// `generate` or the cage `generate`.
+fn bake_mesh(
+    mesh: &TriMesh,
+    params: &pleat::lowpoly::LodParams,
+    cage: bool,
+    prog: &mut pleat::report::ProgressFn<'_>,
+) -> pleat::Result<(TriMesh, Stats)> {
+    #[cfg(feature = "cage")]
+    if cage {
+        return pleat::cage::generate(mesh, params, prog);
+    }
+    let _ = cage;
+    pleat::lowpoly::generate(mesh, params, prog)
+}
+
+/// Counts, error, stage times from the stats; validity from independent checks of `out`.
+fn fill_from_output(row: &mut Row, input: &TriMesh, out: &TriMesh, stats: &Stats, cage: bool) {
+    row.status = "ok".into();
+    row.faces_out = out.triangle_count();
+    row.hausdorff_over_l = stats.get_metric("hausdorff_rel").unwrap_or(f64::NAN);
+    row.rounds = stats.get_count("rounds").unwrap_or(0);
+    row.faces_offset = stats.get_count("faces_offset").unwrap_or(0);
+    row.reruns_exact = stats.get_count("reruns_exact").unwrap_or(0);
+    row.stages = stats.stages.clone();
+    let r = MeshReport::compute(out);
+    row.watertight = r.is_watertight;
+    row.manifold = r.is_manifold && r.consistently_oriented;
+    row.self_intersection_free = r.self_intersection_free == Some(true);
+    if cage {
+        row.cage = Some(cage_flags(out, input));
+    }
+    if !row.valid() {
+        row.status = "ok (INVALID output)".into();
+    }
+}
+
+/// `(encloses, untouched)` from [`pleat::cage::check`].
+#[cfg(feature = "cage")]
+fn cage_flags(out: &TriMesh, input: &TriMesh) -> (bool, bool) {
+    let c = pleat::cage::check(out, input);
+    (c.encloses, c.untouched)
+}
+
+#[cfg(not(feature = "cage"))]
+fn cage_flags(_out: &TriMesh, _input: &TriMesh) -> (bool, bool) {
+    (false, false)
+}
+
+fn panic_message(p: &Box<dyn std::any::Any + Send>) -> String {
+    p.downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| p.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into())
+}
+
+/// Writes `out` to `OUT_DIR/meshes/<mesh stem>_<n_p>.obj`, warning on failure.
+fn keep_mesh(out_dir: &Path, name: &str, n_p: f64, out: &TriMesh) {
+    let dir = out_dir.join("meshes");
+    let stem = Path::new(name)
+        .file_stem()
+        .map_or(name.into(), |s| s.to_string_lossy().to_string());
+    let path = dir.join(format!("{stem}_{n_p}.obj"));
+    let r = std::fs::create_dir_all(&dir)
+        .map_err(|e| e.to_string())
+        .and_then(|_| pleat::mesh::io::write_mesh(&path, out).map_err(|e| e.to_string()));
+    if let Err(e) = r {
+        eprintln!("pleat bench lod: cannot write {}: {e}", path.display());
+    }
+}
+
+fn write_file(path: &Path, text: &str) -> Result<(), (u8, String)> {
+    std::fs::write(path, text)
+        .map_err(|e| (EXIT_FAILED, format!("cannot write {}: {e}", path.display())))
+}
+
+/// A CSV field, quoted when it holds a comma, quote or line break.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\"").replace(['\n', '\r'], " "))
+    } else {
+        s.to_string()
+    }
+}
+
+/// A number for the CSV (empty when not finite).
+fn num(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v}")
+    } else {
+        String::new()
+    }
+}
+
+/// The whole CSV: header, then one line per row.
+fn csv_text(rows: &[Row], cage: bool) -> String {
+    let mut s = String::from(
+        "mesh,faces_in,n_p,target_faces,status,faces_out,seconds,cpu_seconds,hausdorff_over_l,\
+         watertight,manifold,self_intersection_free",
+    );
+    if cage {
+        s.push_str(",encloses,untouched");
+    }
+    s.push_str(",rounds,faces_offset,reruns_exact");
+    for st in STAGES {
+        let _ = write!(s, ",{st}_s");
+    }
+    s.push('\n');
+    for r in rows {
+        s.push_str(&csv_line(r, cage));
+        s.push('\n');
+    }
+    s
+}
+
+fn csv_line(r: &Row, cage: bool) -> String {
+    let ok = r.ok() || r.status.starts_with("ok");
+    let flag = |b: bool| if ok { b.to_string() } else { String::new() };
+    let mut f = vec![
+        csv_field(&r.mesh),
+        if r.faces_in > 0 {
+            r.faces_in.to_string()
+        } else {
+            String::new()
+        },
+        num(r.n_p),
+        r.target_faces.map_or(String::new(), |t| t.to_string()),
+        csv_field(&r.status),
+        if ok {
+            r.faces_out.to_string()
+        } else {
+            String::new()
+        },
+        if r.n_p.is_finite() {
+            format!("{:.4}", r.seconds)
+        } else {
+            String::new()
+        },
+        if r.n_p.is_finite() {
+            format!("{:.4}", r.cpu_seconds)
+        } else {
+            String::new()
+        },
+        if ok {
+            num(r.hausdorff_over_l)
+        } else {
+            String::new()
+        },
+        flag(r.watertight),
+        flag(r.manifold),
+        flag(r.self_intersection_free),
+    ];
+    if cage {
+        let (e, u) = r.cage.unwrap_or((false, false));
+        f.push(flag(e));
+        f.push(flag(u));
+    }
+    for c in [r.rounds, r.faces_offset, r.reruns_exact] {
+        f.push(if ok { c.to_string() } else { String::new() });
+    }
+    for st in STAGES {
+        let t: f64 = r.stages.iter().filter(|s| s.0 == st).map(|s| s.1).sum();
+        f.push(if ok { format!("{t:.4}") } else { String::new() });
+    }
+    f.join(",")
+}
+
+/// One progress line per case.
+fn row_line(r: &Row) -> String {
+    if r.ok() || r.status.starts_with("ok") {
+        format!(
+            "{:<34} n_p={:<5} {:>6} -> {:>5} faces  {:>7.2} s ({:>6.2} s cpu)  HD/l={:.4}  {}",
+            r.mesh,
+            r.n_p,
+            r.faces_in,
+            r.faces_out,
+            r.seconds,
+            r.cpu_seconds,
+            r.hausdorff_over_l,
+            if r.valid() { "valid" } else { "INVALID" }
+        )
+    } else {
+        format!("{:<34} n_p={:<5} {}", r.mesh, r.n_p, r.status)
+    }
+}
+
+/// Per screen size: cases, valid cases, mean and median seconds, mean Hausdorff/l.
+fn print_summary(rows: &[Row], sizes: &[f64]) {
+    println!(
+        "\n{:>6} {:>6} {:>6} {:>10} {:>10} {:>12} {:>10} {:>8}",
+        "n_p", "cases", "valid", "median s", "mean s", "median cpu s", "mean HD/l", "mean #F"
+    );
+    for &n_p in sizes {
+        let all: Vec<&Row> = rows.iter().filter(|r| r.n_p == n_p).collect();
+        let ok: Vec<&Row> = all.iter().copied().filter(|r| r.valid()).collect();
+        let secs: Vec<f64> = ok.iter().map(|r| r.seconds).collect();
+        let cpu: Vec<f64> = ok.iter().map(|r| r.cpu_seconds).collect();
+        let hd: Vec<f64> = ok.iter().map(|r| r.hausdorff_over_l).collect();
+        let faces: Vec<f64> = ok.iter().map(|r| r.faces_out as f64).collect();
+        println!(
+            "{:>6} {:>6} {:>6} {:>10.2} {:>10.2} {:>12.2} {:>10.4} {:>8.0}",
+            n_p,
+            all.len(),
+            ok.len(),
+            median(&secs),
+            mean(&secs),
+            median(&cpu),
+            mean(&hd),
+            mean(&faces)
+        );
+    }
+}
+
+fn mean(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        f64::NAN
+    } else {
+        v.iter().sum::<f64>() / v.len() as f64
+    }
+}
+
+fn median(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        0.5 * (s[n / 2 - 1] + s[n / 2])
+    }
+}
+
+/// Plot geometry of the SVG.
+struct Frame {
+    left: f64,
+    top: f64,
+    width: f64,
+    height: f64,
+    /// log10 ranges `[lo, hi]` of the axes.
+    x: (f64, f64),
+    y: (f64, f64),
+}
+
+impl Frame {
+    fn px(&self, seconds: f64) -> f64 {
+        self.left + (seconds.log10() - self.x.0) / (self.x.1 - self.x.0) * self.width
+    }
+
+    fn py(&self, hd: f64) -> f64 {
+        self.top + self.height - (hd.log10() - self.y.0) / (self.y.1 - self.y.0) * self.height
+    }
+}
+
+/// Decade range `[floor log10 min, ceil log10 max]` of positive finite values.
+fn decades(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite() && *v > 0.0) {
+        lo = lo.min(v.log10());
+        hi = hi.max(v.log10());
+    }
+    if !lo.is_finite() {
+        return (-1.0, 1.0);
+    }
+    let (lo, hi) = (lo.floor(), hi.ceil());
+    if hi > lo {
+        (lo, hi)
+    } else {
+        (lo, lo + 1.0)
+    }
+}
+
+/// Distinct colour of series `i` of `n` (HSL hue wheel).
+fn colour(i: usize, n: usize) -> String {
+    let hue = 360.0 * i as f64 / n.max(1) as f64;
+    format!("hsl({hue:.0},65%,45%)")
+}
+
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// The error-against-time plot as an SVG document.
+fn svg_text(rows: &[Row], sizes: &[f64], cage: bool) -> String {
+    let ok: Vec<&Row> = rows
+        .iter()
+        .filter(|r| r.valid() && r.hausdorff_over_l > 0.0 && r.seconds > 0.0)
+        .collect();
+    let mut meshes: Vec<&str> = ok.iter().map(|r| r.mesh.as_str()).collect();
+    meshes.dedup();
+    let f = Frame {
+        left: 80.0,
+        top: 50.0,
+        width: 620.0,
+        height: 480.0,
+        x: decades(ok.iter().map(|r| r.seconds)),
+        y: decades(ok.iter().map(|r| r.hausdorff_over_l)),
+    };
+    let (w, h) = (1000.0, 600.0);
+    let mut s = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
+         viewBox=\"0 0 {w} {h}\" font-family=\"sans-serif\" font-size=\"12\">\n\
+         <rect width=\"{w}\" height=\"{h}\" fill=\"white\"/>\n"
+    );
+    let title = if cage { "pleat cages" } else { "pleat LODs" };
+    let _ = writeln!(
+        s,
+        "<text x=\"{}\" y=\"28\" font-size=\"16\" text-anchor=\"middle\">{title}: error \
+         against run time, n_p = {}</text>",
+        f.left + f.width / 2.0,
+        sizes
+            .iter()
+            .map(|n| n.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    svg_axes(&mut s, &f);
+    for (i, m) in meshes.iter().enumerate() {
+        let pts: Vec<(f64, f64)> = sizes
+            .iter()
+            .filter_map(|&n| ok.iter().find(|r| r.mesh == *m && r.n_p == n))
+            .map(|r| (r.seconds, r.hausdorff_over_l))
+            .collect();
+        svg_series(&mut s, &f, &pts, &colour(i, meshes.len()), 1.2, 0.75);
+        svg_legend_entry(&mut s, i, m, &colour(i, meshes.len()));
+    }
+    let means: Vec<(f64, f64, f64)> = sizes
+        .iter()
+        .filter_map(|&n| {
+            let at: Vec<&&Row> = ok.iter().filter(|r| r.n_p == n).collect();
+            (!at.is_empty()).then(|| {
+                let t = at.iter().map(|r| r.seconds).sum::<f64>() / at.len() as f64;
+                let e = at.iter().map(|r| r.hausdorff_over_l).sum::<f64>() / at.len() as f64;
+                (n, t, e)
+            })
+        })
+        .collect();
+    let pts: Vec<(f64, f64)> = means.iter().map(|m| (m.1, m.2)).collect();
+    svg_series(&mut s, &f, &pts, "black", 3.0, 1.0);
+    for (n, t, e) in &means {
+        let _ = writeln!(
+            s,
+            "<text x=\"{:.1}\" y=\"{:.1}\" font-weight=\"bold\">{n}</text>",
+            f.px(*t) + 6.0,
+            f.py(*e) - 6.0
+        );
+    }
+    svg_legend_entry(&mut s, meshes.len(), "mean (labels: n_p)", "black");
+    s.push_str("</svg>\n");
+    s
+}
+
+/// Frame, decade grid lines with labels (1, 2, 5 per decade), axis titles.
+fn svg_axes(s: &mut String, f: &Frame) {
+    let _ = writeln!(
+        s,
+        "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#333\"/>",
+        f.left, f.top, f.width, f.height
+    );
+    for e in f.x.0 as i32..=f.x.1 as i32 {
+        for m in [1.0, 2.0, 5.0] {
+            let v = m * 10f64.powi(e);
+            if v.log10() > f.x.1 + 1e-9 {
+                continue;
+            }
+            let x = f.px(v);
+            grid_line(s, (x, f.top), (x, f.top + f.height), m == 1.0);
+            let _ = writeln!(
+                s,
+                "<text x=\"{x:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{}</text>",
+                f.top + f.height + 16.0,
+                short_number(v)
+            );
+        }
+    }
+    for e in f.y.0 as i32..=f.y.1 as i32 {
+        for m in [1.0, 2.0, 5.0] {
+            let v = m * 10f64.powi(e);
+            if v.log10() > f.y.1 + 1e-9 {
+                continue;
+            }
+            let y = f.py(v);
+            grid_line(s, (f.left, y), (f.left + f.width, y), m == 1.0);
+            let _ = writeln!(
+                s,
+                "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>",
+                f.left - 6.0,
+                y + 4.0,
+                short_number(v)
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">wall time per bake (s, log \
+         scale)</text>",
+        f.left + f.width / 2.0,
+        f.top + f.height + 40.0
+    );
+    let _ = writeln!(
+        s,
+        "<text transform=\"translate(24,{:.1}) rotate(-90)\" text-anchor=\"middle\">two-sided \
+         Hausdorff / bbox diagonal (log scale)</text>",
+        f.top + f.height / 2.0
+    );
+}
+
+fn grid_line(s: &mut String, a: (f64, f64), b: (f64, f64), major: bool) {
+    let _ = writeln!(
+        s,
+        "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"{}\"/>",
+        a.0,
+        a.1,
+        b.0,
+        b.1,
+        if major { "#bbb" } else { "#e6e6e6" }
+    );
+}
+
+/// `0.002`, `0.05`, `1`, `20`, `500` — a label without trailing noise.
+fn short_number(v: f64) -> String {
+    let s = format!("{v:.6}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
+/// A polyline with a dot at each point.
+fn svg_series(s: &mut String, f: &Frame, pts: &[(f64, f64)], col: &str, width: f64, op: f64) {
+    if pts.is_empty() {
+        return;
+    }
+    let coords: Vec<String> = pts
+        .iter()
+        .map(|&(t, e)| format!("{:.1},{:.1}", f.px(t), f.py(e)))
+        .collect();
+    let _ = writeln!(
+        s,
+        "<polyline points=\"{}\" fill=\"none\" stroke=\"{col}\" stroke-width=\"{width}\" \
+         opacity=\"{op}\"/>",
+        coords.join(" ")
+    );
+    for &(t, e) in pts {
+        let _ = writeln!(
+            s,
+            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"{:.1}\" fill=\"{col}\" opacity=\"{op}\"/>",
+            f.px(t),
+            f.py(e),
+            width + 1.0
+        );
+    }
+}
+
+fn svg_legend_entry(s: &mut String, i: usize, label: &str, col: &str) {
+    let (x, y) = (720.0, 58.0 + 19.0 * i as f64);
+    let _ = writeln!(
+        s,
+        "<line x1=\"{x}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"{col}\" stroke-width=\"3\"/>\
+         <text x=\"{}\" y=\"{}\">{}</text>",
+        x + 18.0,
+        x + 24.0,
+        y + 4.0,
+        xml_escape(label)
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(mesh: &str, n_p: f64, t: f64, e: f64) -> Row {
+        Row {
+            mesh: mesh.into(),
+            faces_in: 100,
+            n_p,
+            status: "ok".into(),
+            faces_out: 10,
+            seconds: t,
+            hausdorff_over_l: e,
+            watertight: true,
+            manifold: true,
+            self_intersection_free: true,
+            ..Row::default()
+        }
+    }
+
+    #[test]
+    fn csv_quotes_statuses_and_blanks_failed_cases() {
+        let mut bad = row("b,c.obj", 50.0, 1.0, 0.1);
+        bad.status = "error: bad \"mesh\", sorry".into();
+        let text = csv_text(&[row("a.obj", 50.0, 1.5, 0.02), bad], false);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 3);
+        assert!(lines[1].starts_with("a.obj,100,50,,ok,10,1.5000,0.0000,0.02,true,true,true"));
+        assert!(lines[2].starts_with("\"b,c.obj\",100,50,,\"error: bad \"\"mesh\"\", sorry\",,"));
+    }
+
+    #[test]
+    fn csv_round_trips_through_the_replot_parser() {
+        let mut bad = row("b,c.obj", 50.0, 1.0, 0.1);
+        bad.status = "error: bad \"mesh\"".into();
+        let rows = [row("a.obj", 50.0, 1.5, 0.02), bad];
+        let text = csv_text(&rows, false);
+        let (back, cage) = parse_csv(&text).unwrap();
+        assert!(!cage);
+        assert_eq!(back.len(), 2);
+        assert_eq!(back[1].mesh, "b,c.obj");
+        assert_eq!(back[1].status, "error: bad \"mesh\"");
+        assert!(back[0].valid() && !back[1].valid());
+        assert_eq!(csv_text(&back, false), text);
+    }
+
+    #[test]
+    fn svg_has_one_polyline_per_mesh_and_the_mean() {
+        let rows = [
+            row("a", 50.0, 0.5, 0.05),
+            row("a", 100.0, 2.0, 0.02),
+            row("b", 50.0, 0.8, 0.04),
+            row("b", 100.0, 3.0, 0.01),
+        ];
+        let svg = svg_text(&rows, &[50.0, 100.0], false);
+        assert_eq!(svg.matches("<polyline").count(), 3);
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    }
+
+    #[test]
+    fn face_targets_are_read_by_header() {
+        let dir = std::env::temp_dir().join(format!("pleat-bench-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("t.csv");
+        std::fs::write(&p, "n_p,mesh,meshopt_faces\n100,a.obj,240\n200,a.obj,\n").unwrap();
+        let t = read_face_targets(&p).unwrap();
+        assert_eq!(t.get(&("a.obj".into(), 100f64.to_bits())), Some(&240));
+        assert_eq!(t.len(), 1);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
