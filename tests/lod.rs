@@ -2,6 +2,8 @@
 //! `meshcheck` when present), chains, stability on extreme inputs, determinism, cancellation.
 #![cfg(feature = "lod")]
 
+#[path = "common/meshcheck.rs"]
+mod meshcheck;
 #[path = "common/shapes.rs"]
 mod shapes;
 
@@ -41,38 +43,7 @@ fn assert_valid(out: &TriMesh, s: &Stats, what: &str) {
         Some(true),
         "{what}: self-intersects"
     );
-    meshcheck(out, what);
-}
-
-/// Runs the independent CGAL checker when it is installed.
-fn meshcheck(m: &TriMesh, what: &str) {
-    let tool = std::env::var("PLEAT_MESHCHECK").unwrap_or("/tmp/pleat-tools/meshcheck".into());
-    if !std::path::Path::new(&tool).exists() {
-        return;
-    }
-    let dir = std::env::temp_dir().join(format!("pleat-lod-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join(format!(
-        "{}.obj",
-        what.replace(|c: char| !c.is_alphanumeric(), "_")
-    ));
-    pleat::mesh::io::write_mesh(&file, m).unwrap();
-    let out = std::process::Command::new(&tool)
-        .arg(&file)
-        .output()
-        .unwrap();
-    let _ = std::fs::remove_file(&file);
-    let json = String::from_utf8_lossy(&out.stdout);
-    for key in [
-        "\"is_watertight\":true",
-        "\"is_manifold\":true",
-        "\"self_intersection_free\":true",
-    ] {
-        assert!(
-            json.replace(' ', "").contains(key),
-            "{what}: meshcheck disagrees ({key}): {json}"
-        );
-    }
+    meshcheck::assert_valid(out, what);
 }
 
 fn rel_hausdorff(s: &Stats) -> f64 {
