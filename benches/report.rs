@@ -6,11 +6,13 @@
 //! `cargo bench --bench report` (release). Options after `--`: `--subdivisions N` (default 8),
 //! `--threads N` (default: rayon's), `--repeat N` (default 1).
 
-use std::collections::HashMap;
 use std::time::Instant;
 
 use pleat::mesh::{MeshReport, ReportOptions, TriMesh};
 use pleat::Stats;
+
+#[path = "../tests/common/shapes.rs"]
+mod shapes;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -152,77 +154,18 @@ fn corpus(repeat: usize) {
     }
 }
 
-/// An icosphere subdivided `n` times (20·4ⁿ triangles), displaced radially by
-/// `1 + 0.08 sin(7x) cos(5y) + 0.03 sin(23z)` (make_big.py's bumps).
+/// An icosphere subdivided `n` times (20·4ⁿ triangles, `tests/common/shapes.rs`), displaced
+/// radially by `1 + 0.08 sin(7x) cos(5y) + 0.03 sin(23z)` (make_big.py's bumps).
 fn bumpy_sphere(n: u32) -> TriMesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut p: Vec<[f64; 3]> = vec![
-        [-1., t, 0.],
-        [1., t, 0.],
-        [-1., -t, 0.],
-        [1., -t, 0.],
-        [0., -1., t],
-        [0., 1., t],
-        [0., -1., -t],
-        [0., 1., -t],
-        [t, 0., -1.],
-        [t, 0., 1.],
-        [-t, 0., -1.],
-        [-t, 0., 1.],
-    ];
-    let mut f: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for v in &mut p {
-        *v = normalize(*v);
-    }
-    for _ in 0..n {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::with_capacity(f.len() * 3 / 2);
-        let mut next = Vec::with_capacity(f.len() * 4);
-        for tri in &f {
-            let mut m = [0u32; 3];
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                m[k] = *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                    let (pa, pb) = (p[a as usize], p[b as usize]);
-                    p.push(normalize([pa[0] + pb[0], pa[1] + pb[1], pa[2] + pb[2]]));
-                    p.len() as u32 - 1
-                });
-            }
-            next.push([tri[0], m[0], m[2]]);
-            next.push([tri[1], m[1], m[0]]);
-            next.push([tri[2], m[2], m[1]]);
-            next.push(m);
-        }
-        f = next;
-    }
-    for v in &mut p {
-        let r = 1.0 + 0.08 * (7.0 * v[0]).sin() * (5.0 * v[1]).cos() + 0.03 * (23.0 * v[2]).sin();
-        *v = v.map(|c| c * r);
-    }
-    TriMesh::new(p, f).unwrap()
-}
-
-fn normalize(v: [f64; 3]) -> [f64; 3] {
-    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    v.map(|c| c / n)
+    let sphere = shapes::icosphere(1.0, n);
+    let p = sphere
+        .positions()
+        .iter()
+        .map(|v| {
+            let r =
+                1.0 + 0.08 * (7.0 * v[0]).sin() * (5.0 * v[1]).cos() + 0.03 * (23.0 * v[2]).sin();
+            v.map(|c| c * r)
+        })
+        .collect();
+    TriMesh::new(p, sphere.triangles().to_vec()).unwrap()
 }

@@ -3,6 +3,9 @@
 
 use pleat::mesh::TriMesh;
 
+#[path = "../common/shapes.rs"]
+mod shapes;
+
 /// xorshift64* — deterministic, no dependency.
 pub struct Rng(u64);
 
@@ -79,68 +82,10 @@ pub fn tilt(m: &TriMesh) -> TriMesh {
     TriMesh::new(p, m.triangles().to_vec()).unwrap()
 }
 
-/// Icosphere: the icosahedron refined `level` times (midpoints projected to the unit sphere).
+/// Icosphere: the icosahedron refined `level` times, on the unit sphere
+/// (`tests/common/shapes.rs`).
 pub fn icosphere(level: usize) -> TriMesh {
-    let g = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut p: Vec<[f64; 3]> = vec![
-        [-1., g, 0.],
-        [1., g, 0.],
-        [-1., -g, 0.],
-        [1., -g, 0.],
-        [0., -1., g],
-        [0., 1., g],
-        [0., -1., -g],
-        [0., 1., -g],
-        [g, 0., -1.],
-        [g, 0., 1.],
-        [-g, 0., -1.],
-        [-g, 0., 1.],
-    ];
-    let mut t: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..level {
-        let mut mid = std::collections::HashMap::new();
-        let mut nt = Vec::new();
-        let mut midpoint = |a: u32, b: u32, p: &mut Vec<[f64; 3]>| -> u32 {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                let (x, y) = (p[a as usize], p[b as usize]);
-                p.push([(x[0] + y[0]) / 2., (x[1] + y[1]) / 2., (x[2] + y[2]) / 2.]);
-                (p.len() - 1) as u32
-            })
-        };
-        for &[a, b, c] in &t {
-            let ab = midpoint(a, b, &mut p);
-            let bc = midpoint(b, c, &mut p);
-            let ca = midpoint(c, a, &mut p);
-            nt.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        t = nt;
-    }
-    for q in &mut p {
-        let l = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
-        *q = [q[0] / l, q[1] / l, q[2] / l];
-    }
-    TriMesh::new(p, t).unwrap()
+    shapes::icosphere(1.0, level as u32)
 }
 
 /// Torus with `nu × nv` quads split into triangles, radii 1 and 0.35, jittered parameters.
