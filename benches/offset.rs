@@ -76,6 +76,11 @@ fn child(path: &Path, np: f64) {
     match offset_surface_with_progress(&mesh, &params, &mut progress) {
         Ok((out, stats)) => {
             let total = t.elapsed().as_secs_f64();
+            if trace {
+                for (n, c) in &stats.counts {
+                    eprintln!("  {n:<24} {c}");
+                }
+            }
             let cpu = cpu_seconds() - cpu0;
             let stages: Vec<String> = stats
                 .stages

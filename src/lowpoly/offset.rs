@@ -158,7 +158,8 @@ pub fn offset_surface_with_progress(
         refine_steps: params.iso_refinement_steps,
     };
     let t = Instant::now();
-    let set = extract(&grid, &input, &xp, &mut |f| {
+    let grid_bytes = grid.memory_bytes();
+    let set = extract(grid, &input, &xp, &mut |f| {
         progress(Progress {
             stage: "extract",
             fraction: 0.5 + 0.28 * f,
@@ -168,8 +169,10 @@ pub fn offset_surface_with_progress(
         .stages
         .push(("extract".into(), t.elapsed().as_secs_f64()));
     record_extraction(&mut stats, &set);
-    let mut peak = grid.memory_bytes() + patchset_bytes(&set);
-    drop(grid);
+    // The extraction holds the grid, the iso-points (key + 64 B) and the packed mixed cubes
+    // (8 B) together; after dropping the grid it builds the patch set.
+    let transient = set.n_iso as u64 * 72 + set.counts.mixed * 8;
+    let mut peak = (grid_bytes + transient).max(transient + patchset_bytes(&set));
     step(progress, "interior", 0.8)?;
     let visible = if params.remove_interior {
         let t = Instant::now();
