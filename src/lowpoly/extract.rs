@@ -50,6 +50,9 @@ pub(crate) struct ExtractParams {
     pub d: f64,
     /// Compute feature vertices (eq. 4.3).
     pub features: bool,
+    /// Only disk patches whose iso-point normals spread at least this much (degrees) get a
+    /// feature vertex (0: every disk patch).
+    pub feature_min_spread_deg: f32,
     /// Regula-falsi steps refining each iso-point against the exact distance (0 = off).
     pub refine_steps: u32,
 }
@@ -343,29 +346,30 @@ pub(crate) fn extract(
     let chunk = 512;
     let (keys, mixed) = crossed_edges(&grid, p.d, chunk, &mut counts, keep_going)?;
     // Iso-points and their normals (eq. 4.3).
-    let iso: Vec<IsoPoint> = keys
+    let (iso_pos, iso): (Vec<V3>, Vec<IsoNormal>) = keys
         .par_iter()
         .map(|&k| iso_point(&grid, input, k, p))
-        .collect();
-    counts.gradient_normals = iso.iter().filter(|x| x.gradient).count() as u64;
+        .unzip();
+    counts.gradient_normals = iso.iter().filter(|x| x.fallback).count() as u64;
     let (spec, cap) = (grid.spec, grid.cap);
     drop(grid);
     if !keep_going(0.5) {
         return Err(Error::Cancelled);
     }
-    // Pass 2: patches.
+    // Pass 2: patches. Feature and center vertices collect in `extra` (ids from `n_iso`).
     let mut set = PatchSet {
-        positions: iso.iter().map(|x| x.pos).collect(),
         n_iso: keys.len(),
         loop_off: vec![0],
         plain_off: vec![0],
         ..PatchSet::default()
     };
+    let mut extra = Vec::new();
     let ctx = CubeCtx {
         spec,
         cap,
         input,
         keys: &keys,
+        iso_pos: &iso_pos,
         iso: &iso,
         p,
     };
@@ -380,12 +384,15 @@ pub(crate) fn extract(
             })
             .collect();
         for bp in part {
-            append(&mut set, bp);
+            append(&mut set, &mut extra, bp);
         }
         if !keep_going(0.5 + 0.5 * (ci + 1) as f64 / n_chunks as f64) {
             return Err(Error::Cancelled);
         }
     }
+    drop((iso, mixed, keys));
+    set.positions = iso_pos;
+    set.positions.extend(extra);
     set.counts.add(&counts);
     set.feature_patch = vec![NONE; set.positions.len() - set.n_iso];
     for (p, &f) in set.feature.iter().enumerate() {
@@ -487,21 +494,26 @@ fn crossed_edges(
     Ok((keys, mixed))
 }
 
-/// An iso-point with its normal (eq. 4.3).
+/// What pass 2 needs of an iso-point besides its position (kept apart: positions go straight
+/// into [`PatchSet::positions`]).
 #[derive(Debug, Clone, Copy)]
-struct IsoPoint {
-    pos: V3,
-    /// Unit normal `(p − p*)/‖p − p*‖`, or the direction of increasing `f` along the edge
-    /// when there is no usable closest point (`fallback`).
+struct IsoNormal {
+    /// Unit normal `(p − p*)/‖p − p*‖` (eq. 4.3), or the direction of increasing `f` along
+    /// the edge when there is no usable closest point (`fallback`).
     normal: V3,
-    /// The normal is the edge-direction fallback.
-    gradient: bool,
     /// Input primitive of the closest point (`u32::MAX` when unknown).
     prim: u32,
+    /// The normal is the edge-direction fallback.
+    fallback: bool,
 }
 
 /// The iso-point of edge `k` with its normal.
-fn iso_point(grid: &DistanceGrid, input: &InputDistance, k: u64, p: &ExtractParams) -> IsoPoint {
+fn iso_point(
+    grid: &DistanceGrid,
+    input: &InputDistance,
+    k: u64,
+    p: &ExtractParams,
+) -> (V3, IsoNormal) {
     let (g, a) = edge_from_key(k);
     let mut g1 = g;
     g1[a as usize] += 1;
@@ -517,25 +529,25 @@ fn iso_point(grid: &DistanceGrid, input: &InputDistance, k: u64, p: &ExtractPara
     if p.features {
         if let Some(c) = input.closest(x, grid.cap * 2.0) {
             prim = c.prim;
-            if let Some(n) = normalized(sub(x, c.point)) {
-                return IsoPoint {
-                    pos: x,
-                    normal: n,
-                    gradient: false,
+            if let Some(normal) = normalized(sub(x, c.point)) {
+                let n = IsoNormal {
+                    normal,
                     prim,
+                    fallback: false,
                 };
+                return (x, n);
             }
         }
     }
     // The direction of increasing f along the edge is a usable fallback normal.
-    let mut nv = [0.0; 3];
-    nv[a as usize] = if f1 > f0 { 1.0 } else { -1.0 };
-    IsoPoint {
-        pos: x,
-        normal: nv,
-        gradient: p.features,
+    let mut normal = [0.0; 3];
+    normal[a as usize] = if f1 > f0 { 1.0 } else { -1.0 };
+    let n = IsoNormal {
+        normal,
         prim,
-    }
+        fallback: p.features,
+    };
+    (x, n)
 }
 
 /// Linear-interpolation parameter of `d` between `f0` and `f1` (which straddle `d`).
@@ -605,7 +617,8 @@ struct CubeCtx<'a> {
     cap: f64,
     input: &'a InputDistance,
     keys: &'a [u64],
-    iso: &'a [IsoPoint],
+    iso_pos: &'a [V3],
+    iso: &'a [IsoNormal],
     p: &'a ExtractParams,
 }
 
@@ -659,7 +672,7 @@ fn cube_patches(
         };
         ids[e] = i as u32;
         let ip = ctx.iso[i];
-        local[e] = scale(sub(ip.pos, origin), 1.0 / h);
+        local[e] = scale(sub(ctx.iso_pos[i], origin), 1.0 / h);
         normals[e] = ip.normal;
         if ip.prim != u32::MAX {
             hint = Some(ip.prim);
@@ -677,7 +690,13 @@ fn cube_patches(
         let y = lerp(c.point, add(c.point, n), d);
         Some(scale(sub(y, origin), 1.0 / h))
     };
-    let (patches, flags) = cube_geometry(topo, &local, normals, Some(&project));
+    let (patches, flags) = cube_geometry(
+        topo,
+        &local,
+        normals,
+        ctx.p.feature_min_spread_deg,
+        Some(&project),
+    );
     out.counts.add_flags(&flags);
     let world = |x: V3| {
         [
@@ -713,9 +732,10 @@ fn cube_patches(
     }
 }
 
-fn append(set: &mut PatchSet, bp: BrickPatches) {
-    let base = set.positions.len() as u32;
-    set.positions.extend(bp.extra);
+/// Appends one brick's patches; its extra vertices go to `extra` (ids from `set.n_iso`).
+fn append(set: &mut PatchSet, extra: &mut Vec<V3>, bp: BrickPatches) {
+    let base = (set.n_iso + extra.len()) as u32;
+    extra.extend(bp.extra);
     let shift = |x: u32| if x == NONE { NONE } else { base + x };
     set.center.extend(bp.center.into_iter().map(shift));
     set.feature.extend(bp.feature.into_iter().map(shift));

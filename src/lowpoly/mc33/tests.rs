@@ -96,7 +96,7 @@ pub(crate) fn triangulate_cube(
     iso: &[V3; 12],
     normals: Option<&[V3; 12]>,
 ) -> (Vec<[u32; 3]>, HashMap<u32, V3>, CubeFlags) {
-    let (patches, flags) = cube_geometry(topo, iso, normals, None);
+    let (patches, flags) = cube_geometry(topo, iso, normals, 0.0, None);
     let mut tris = Vec::new();
     let mut pos: HashMap<u32, V3> = HashMap::new();
     for e in 0..12u8 {
