@@ -78,8 +78,6 @@ pub(crate) struct PatchSet {
     pub center: Vec<u32>,
     /// Feature vertex, or [`NONE`].
     pub feature: Vec<u32>,
-    /// Largest angle between two iso-point normals of the patch, in degrees.
-    pub normal_spread_deg: Vec<f32>,
     /// Patch of each extra vertex (id `n_iso + i`), [`NONE`] for centers.
     pub feature_patch: Vec<u32>,
     /// Counters.
@@ -633,7 +631,6 @@ struct BrickPatches {
     extra: Vec<V3>,
     center: Vec<u32>,
     feature: Vec<u32>,
-    spread: Vec<f32>,
     counts: ExtractCounts,
 }
 
@@ -728,7 +725,6 @@ fn cube_patches(
         let f = push_extra(pg.feature);
         out.center.push(c);
         out.feature.push(f);
-        out.spread.push(pg.normal_spread_deg);
     }
 }
 
@@ -739,7 +735,6 @@ fn append(set: &mut PatchSet, extra: &mut Vec<V3>, bp: BrickPatches) {
     let shift = |x: u32| if x == NONE { NONE } else { base + x };
     set.center.extend(bp.center.into_iter().map(shift));
     set.feature.extend(bp.feature.into_iter().map(shift));
-    set.normal_spread_deg.extend(bp.spread);
     set.loop_ids.extend(bp.loop_ids);
     for l in bp.loop_len {
         let last = *set.loop_off.last().unwrap_or(&0);

@@ -134,7 +134,7 @@ pub(crate) fn visible_components(
         if candidates.is_empty() {
             continue;
         }
-        for a in hidden_inside(pos, &triangles(b), boxes, &candidates) {
+        for a in hidden_inside(pos, triangles(b), boxes, &candidates) {
             keep[a as usize] = false;
         }
     }
@@ -161,7 +161,7 @@ fn containers_largest_first(boxes: &[ComponentBox], inside_of: &[Vec<u32>]) -> V
 /// of the hierarchy of Barill et al. 2018). One container's hierarchy is alive at a time.
 fn hidden_inside(
     pos: &[V3],
-    tris: &[[u32; 3]],
+    tris: Vec<[u32; 3]>,
     boxes: &[ComponentBox],
     candidates: &[u32],
 ) -> Vec<u32> {
@@ -177,22 +177,18 @@ fn hidden_inside(
         .collect()
 }
 
-/// The triangles `tris` (indexing `pos`) as a compact mesh.
-fn component_mesh(pos: &[V3], tris: &[[u32; 3]]) -> Option<TriMesh> {
+/// The triangles `tris` (indexing `pos`) as a compact mesh, renumbered in place.
+fn component_mesh(pos: &[V3], mut tris: Vec<[u32; 3]>) -> Option<TriMesh> {
     let mut map = std::collections::HashMap::new();
     let mut p = Vec::new();
-    let t: Vec<[u32; 3]> = tris
-        .iter()
-        .map(|t| {
-            t.map(|v| {
-                *map.entry(v).or_insert_with(|| {
-                    p.push(pos[v as usize]);
-                    (p.len() - 1) as u32
-                })
-            })
-        })
-        .collect();
-    TriMesh::new(p, t).ok()
+    for v in tris.iter_mut().flatten() {
+        *v = *map.entry(*v).or_insert_with(|| {
+            p.push(pos[*v as usize]);
+            (p.len() - 1) as u32
+        });
+    }
+    drop(map);
+    TriMesh::new(p, tris).ok()
 }
 
 fn contains(outer: &ComponentBox, inner: &ComponentBox) -> bool {

@@ -289,9 +289,9 @@ fn surface_with_features(
         return Ok((pos, tris));
     }
     let t = Instant::now();
-    // Phase 1 fans only the patches that can straddle a crease (see `CREASE_CANDIDATE_DEG`).
-    let (pos, tris, back) =
-        set.assemble(&|p| mode(p, set.normal_spread_deg[p] >= CREASE_CANDIDATE_DEG));
+    // Phase 1 fans only the patches that can straddle a crease: the only ones with a feature
+    // vertex (see `CREASE_CANDIDATE_DEG`).
+    let (pos, tris, back) = set.assemble(&|p| mode(p, true));
     let cos_sharp = (180.0 - params.theta0_deg).to_radians().cos();
     let (mesh, flips1) = flipped(pos, tris, &back, set, h, Some(cos_sharp))?;
     stats
