@@ -11,6 +11,17 @@
 //! Determinism: bricks are visited in sorted key order, cubes in a fixed order inside a brick,
 //! edge keys are sorted before vertex ids are assigned, and parallel results are concatenated
 //! in brick order.
+//!
+//! Memory layout (what is alive when): pass 1 reads the distance grid and records the sorted
+//! keys of the crossed grid edges (8 B each) and every mixed cube's MC33 [`Decisions`] packed
+//! with its index in its brick ([`MixedCubes`], 8 B per cube). The iso-points are computed from
+//! the grid — positions (24 B) directly into [`PatchSet::positions`], normal and closest input
+//! primitive ([`IsoNormal`], 32 B) beside them — and the grid is dropped before pass 2, which
+//! builds the patches from the packed decisions alone. Since every cube reads the same stored
+//! corner values in pass 1, cubes sharing a face agree on its decisions. Keys, cubes and
+//! normals are dropped when pass 2 ends. Only crease candidates (normal spread at least
+//! [`ExtractParams::feature_min_spread_deg`]) get a feature vertex, so extra vertices are
+//! few.
 
 use rayon::prelude::*;
 
