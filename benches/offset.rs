@@ -25,15 +25,20 @@ fn load(path: &Path) -> Option<TriMesh> {
     pleat::mesh::io::read_mesh(path).ok()
 }
 
-fn peak_rss_bytes() -> u64 {
+/// A `/proc/self/status` memory field (`VmHWM`, `VmRSS`) in bytes.
+fn status_bytes(field: &str) -> u64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
             s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
+                .find(|l| l.starts_with(field))
                 .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
         })
         .map_or(0, |kb| kb * 1024)
+}
+
+fn peak_rss_bytes() -> u64 {
+    status_bytes("VmHWM:")
 }
 
 /// User + system CPU seconds of this process.
@@ -64,10 +69,11 @@ fn child(path: &Path, np: f64) {
     let mut progress = |p: pleat::Progress<'_>| {
         if trace && p.stage != last {
             eprintln!(
-                "  [{:>8.3} s] {:<10} VmHWM {:7.1} MiB",
+                "  [{:>8.3} s] {:<10} VmHWM {:7.1} MiB  VmRSS {:7.1} MiB",
                 t.elapsed().as_secs_f64(),
                 p.stage,
-                peak_rss_bytes() as f64 / 1048576.0
+                peak_rss_bytes() as f64 / 1048576.0,
+                status_bytes("VmRSS:") as f64 / 1048576.0
             );
             last = p.stage.to_string();
         }
@@ -76,6 +82,11 @@ fn child(path: &Path, np: f64) {
     match offset_surface_with_progress(&mesh, &params, &mut progress) {
         Ok((out, stats)) => {
             let total = t.elapsed().as_secs_f64();
+            if trace {
+                for (n, c) in &stats.counts {
+                    eprintln!("  {n:<24} {c}");
+                }
+            }
             let cpu = cpu_seconds() - cpu0;
             let stages: Vec<String> = stats
                 .stages

@@ -11,15 +11,26 @@
 //! Determinism: bricks are visited in sorted key order, cubes in a fixed order inside a brick,
 //! edge keys are sorted before vertex ids are assigned, and parallel results are concatenated
 //! in brick order.
+//!
+//! Memory layout (what is alive when): pass 1 reads the distance grid and records the sorted
+//! keys of the crossed grid edges (8 B each) and every mixed cube's MC33 [`Decisions`] packed
+//! with its index in its brick ([`MixedCubes`], 8 B per cube). The iso-points are computed from
+//! the grid — positions (24 B) directly into [`PatchSet::positions`], normal and closest input
+//! primitive ([`IsoNormal`], 32 B) beside them — and the grid is dropped before pass 2, which
+//! builds the patches from the packed decisions alone. Since every cube reads the same stored
+//! corner values in pass 1, cubes sharing a face agree on its decisions. Keys, cubes and
+//! normals are dropped when pass 2 ends. Only crease candidates (normal spread at least
+//! [`ExtractParams::feature_min_spread_deg`]) get a feature vertex, so extra vertices are
+//! few.
 
 use rayon::prelude::*;
 
-use super::distance::{brick_coords, brick_key, DistanceGrid, InputDistance, BRICK};
+use super::distance::{brick_coords, brick_key, DistanceGrid, GridSpec, InputDistance, BRICK};
 use super::features::{cube_geometry, CubeFlags};
 use super::geom::{add, lerp, normalized, scale, sub, V3};
 use super::mc33::tables::{CORNER_POS, EDGE_AXIS, EDGE_CORNERS};
 use super::mc33::triangulate::{fan, LocalTri};
-use super::mc33::{decide, topology, trilinear, CubeTopology};
+use super::mc33::{decide, topology, CubeTopology, Decisions};
 use crate::{Error, Result};
 
 /// Clamp of the iso-point parameter away from grid points.
@@ -50,6 +61,9 @@ pub(crate) struct ExtractParams {
     pub d: f64,
     /// Compute feature vertices (eq. 4.3).
     pub features: bool,
+    /// Only disk patches whose iso-point normals spread at least this much (degrees) get a
+    /// feature vertex (0: every disk patch).
+    pub feature_min_spread_deg: f32,
     /// Regula-falsi steps refining each iso-point against the exact distance (0 = off).
     pub refine_steps: u32,
 }
@@ -75,8 +89,6 @@ pub(crate) struct PatchSet {
     pub center: Vec<u32>,
     /// Feature vertex, or [`NONE`].
     pub feature: Vec<u32>,
-    /// Largest angle between two iso-point normals of the patch, in degrees.
-    pub normal_spread_deg: Vec<f32>,
     /// Patch of each extra vertex (id `n_iso + i`), [`NONE`] for centers.
     pub feature_patch: Vec<u32>,
     /// Counters.
@@ -100,7 +112,7 @@ pub(crate) struct ExtractCounts {
     pub unseparated: u64,
     /// Cubes that failed their exact check.
     pub unresolved: u64,
-    /// Iso-points whose normal came from the trilinear gradient.
+    /// Iso-points whose normal fell back to the edge direction (no usable closest point).
     pub gradient_normals: u64,
 }
 
@@ -330,81 +342,66 @@ fn cube_edge_key(g: [u32; 3], e: usize) -> u64 {
     )
 }
 
-/// Runs the extraction. `keep_going(fraction)` is called on this thread between chunks.
+/// Runs the extraction, consuming the grid (it is dropped as soon as the iso-points are
+/// known: pass 2 works from the decisions recorded in pass 1). `keep_going(fraction)` is
+/// called on this thread between chunks.
 pub(crate) fn extract(
-    grid: &DistanceGrid,
+    grid: DistanceGrid,
     input: &InputDistance,
     p: &ExtractParams,
     keep_going: &mut dyn FnMut(f64) -> bool,
 ) -> Result<PatchSet> {
-    // Pass 1: crossed edges.
-    let mut keys: Vec<u64> = Vec::new();
     let mut counts = ExtractCounts::default();
     let chunk = 512;
-    let n_chunks = grid.keys.len().div_ceil(chunk).max(1);
-    for (ci, ks) in grid.keys.chunks(chunk).enumerate() {
-        let part: Vec<(Vec<u64>, u64, u64)> = ks
-            .par_iter()
-            .map(|&k| {
-                let mut out = Vec::new();
-                let mut mixed = 0;
-                let cells = for_mixed_cubes(grid, k, p.d, |g, v| {
-                    mixed += 1;
-                    // Each grid edge is edge 0, 4 or 8 (leaving corner 0) of exactly one cube:
-                    // emit it from there only, so every key appears once.
-                    for e in [0usize, 4, 8] {
-                        let ec = EDGE_CORNERS[e];
-                        if (v[ec[0] as usize] < 0.0) != (v[ec[1] as usize] < 0.0) {
-                            out.push(cube_edge_key(g, e));
-                        }
-                    }
-                });
-                (out, cells, mixed)
-            })
-            .collect();
-        for (o, c, m) in part {
-            keys.extend(o);
-            counts.cells += c;
-            counts.mixed += m;
-        }
-        if !keep_going(0.3 * (ci + 1) as f64 / n_chunks as f64) {
-            return Err(Error::Cancelled);
-        }
-    }
-    keys.par_sort_unstable();
+    let (keys, mixed) = crossed_edges(&grid, p.d, chunk, &mut counts, keep_going)?;
     // Iso-points and their normals (eq. 4.3).
-    let iso: Vec<IsoPoint> = keys
+    let (iso_pos, iso): (Vec<V3>, Vec<IsoNormal>) = keys
         .par_iter()
-        .map(|&k| iso_point(grid, input, k, p))
-        .collect();
-    counts.gradient_normals = iso.iter().filter(|x| x.gradient).count() as u64;
+        .map(|&k| iso_point(&grid, input, k, p))
+        .unzip();
+    counts.gradient_normals = iso.iter().filter(|x| x.fallback).count() as u64;
+    let (spec, cap) = (grid.spec, grid.cap);
+    drop(grid);
     if !keep_going(0.5) {
         return Err(Error::Cancelled);
     }
-    // Pass 2: patches.
+    // Pass 2: patches. Feature and center vertices collect in `extra` (ids from `n_iso`).
     let mut set = PatchSet {
-        positions: iso.iter().map(|x| x.pos).collect(),
         n_iso: keys.len(),
         loop_off: vec![0],
         plain_off: vec![0],
         ..PatchSet::default()
     };
+    let mut extra = Vec::new();
     let ctx = CubeCtx {
-        grid,
+        spec,
+        cap,
         input,
         keys: &keys,
+        iso_pos: &iso_pos,
         iso: &iso,
         p,
     };
-    for (ci, ks) in grid.keys.chunks(chunk).enumerate() {
-        let part: Vec<BrickPatches> = ks.par_iter().map(|&k| brick_patches(&ctx, k)).collect();
+    let n_bricks = mixed.bricks.len();
+    let n_chunks = n_bricks.div_ceil(chunk).max(1);
+    for ci in 0..n_chunks {
+        let part: Vec<BrickPatches> = (ci * chunk..((ci + 1) * chunk).min(n_bricks))
+            .into_par_iter()
+            .map(|b| {
+                let (key, cubes) = mixed.brick(b);
+                brick_patches(&ctx, key, cubes)
+            })
+            .collect();
         for bp in part {
-            append(&mut set, bp);
+            append(&mut set, &mut extra, bp);
         }
         if !keep_going(0.5 + 0.5 * (ci + 1) as f64 / n_chunks as f64) {
             return Err(Error::Cancelled);
         }
     }
+    drop((iso, mixed, keys));
+    set.positions = iso_pos;
+    set.positions.extend(extra);
     set.counts.add(&counts);
     set.feature_patch = vec![NONE; set.positions.len() - set.n_iso];
     for (p, &f) in set.feature.iter().enumerate() {
@@ -415,20 +412,117 @@ pub(crate) fn extract(
     Ok(set)
 }
 
-/// An iso-point with its normal (eq. 4.3).
+/// The mixed cubes found by pass 1, packed (8 bytes per cube): what pass 2 needs once the
+/// distance grid is gone.
+#[derive(Debug, Default)]
+struct MixedCubes {
+    /// Per cube: its [`Decisions::pack`] shifted left by 9, or'ed with its index inside its
+    /// brick (`x | y << 3 | z << 6`). Grouped by brick, bricks in sorted key order, cubes in
+    /// the order [`for_mixed_cubes`] visits them.
+    cubes: Vec<u64>,
+    /// Per brick with mixed cubes: its key and the end of its cubes in `cubes`.
+    bricks: Vec<(u64, u32)>,
+}
+
+/// Bits of a cube's index inside its brick.
+const LOCAL_BITS: u32 = 9;
+const _: () = assert!(LOCAL_BITS + Decisions::PACKED_BITS <= 64);
+
+impl MixedCubes {
+    /// The cubes of brick `i`: its key and its packed cubes.
+    fn brick(&self, i: usize) -> (u64, &[u64]) {
+        let start = if i == 0 { 0 } else { self.bricks[i - 1].1 };
+        let (key, end) = self.bricks[i];
+        (key, &self.cubes[start as usize..end as usize])
+    }
+
+    /// Global min corner and decisions of a packed cube of the brick at `base` (its min point).
+    fn unpack(base: [u32; 3], c: u64) -> ([u32; 3], Decisions) {
+        let l = (c & ((1 << LOCAL_BITS) - 1)) as u32;
+        let g = [
+            base[0] + (l & 7),
+            base[1] + (l >> 3 & 7),
+            base[2] + (l >> 6),
+        ];
+        (g, Decisions::unpack(c >> LOCAL_BITS))
+    }
+}
+
+/// Packs a mixed cube (global min corner `g`, decisions `dec`) for [`MixedCubes::cubes`].
+fn pack_cube(g: [u32; 3], dec: &Decisions) -> u64 {
+    let l = (g[0] % BRICK) | (g[1] % BRICK) << 3 | (g[2] % BRICK) << 6;
+    dec.pack() << LOCAL_BITS | l as u64
+}
+
+/// Pass 1: sorted keys of the crossed grid edges (each once) and the mixed cubes.
+fn crossed_edges(
+    grid: &DistanceGrid,
+    d: f64,
+    chunk: usize,
+    counts: &mut ExtractCounts,
+    keep_going: &mut dyn FnMut(f64) -> bool,
+) -> Result<(Vec<u64>, MixedCubes)> {
+    let mut keys: Vec<u64> = Vec::new();
+    let mut mixed = MixedCubes::default();
+    let n_chunks = grid.keys.len().div_ceil(chunk).max(1);
+    for (ci, ks) in grid.keys.chunks(chunk).enumerate() {
+        let part: Vec<(Vec<u64>, Vec<u64>, u64)> = ks
+            .par_iter()
+            .map(|&k| {
+                let mut out = Vec::new();
+                let mut cubes = Vec::new();
+                let cells = for_mixed_cubes(grid, k, d, |g, v| {
+                    cubes.push(pack_cube(g, &decide(v)));
+                    // Each grid edge is edge 0, 4 or 8 (leaving corner 0) of exactly one cube:
+                    // emit it from there only, so every key appears once.
+                    for e in [0usize, 4, 8] {
+                        let ec = EDGE_CORNERS[e];
+                        if (v[ec[0] as usize] < 0.0) != (v[ec[1] as usize] < 0.0) {
+                            out.push(cube_edge_key(g, e));
+                        }
+                    }
+                });
+                (out, cubes, cells)
+            })
+            .collect();
+        for (&k, (o, m, c)) in ks.iter().zip(part) {
+            keys.extend(o);
+            counts.cells += c;
+            counts.mixed += m.len() as u64;
+            if !m.is_empty() {
+                mixed.cubes.extend(m);
+                mixed.bricks.push((k, mixed.cubes.len() as u32));
+            }
+        }
+        if !keep_going(0.3 * (ci + 1) as f64 / n_chunks as f64) {
+            return Err(Error::Cancelled);
+        }
+    }
+    keys.par_sort_unstable();
+    mixed.cubes.shrink_to_fit();
+    Ok((keys, mixed))
+}
+
+/// What pass 2 needs of an iso-point besides its position (kept apart: positions go straight
+/// into [`PatchSet::positions`]).
 #[derive(Debug, Clone, Copy)]
-struct IsoPoint {
-    pos: V3,
-    /// Unit normal `(p − p*)/‖p − p*‖`, or the edge direction when `gradient`.
+struct IsoNormal {
+    /// Unit normal `(p − p*)/‖p − p*‖` (eq. 4.3), or the direction of increasing `f` along
+    /// the edge when there is no usable closest point (`fallback`).
     normal: V3,
-    /// The normal must come from the trilinear gradient (no usable closest point).
-    gradient: bool,
     /// Input primitive of the closest point (`u32::MAX` when unknown).
     prim: u32,
+    /// The normal is the edge-direction fallback.
+    fallback: bool,
 }
 
 /// The iso-point of edge `k` with its normal.
-fn iso_point(grid: &DistanceGrid, input: &InputDistance, k: u64, p: &ExtractParams) -> IsoPoint {
+fn iso_point(
+    grid: &DistanceGrid,
+    input: &InputDistance,
+    k: u64,
+    p: &ExtractParams,
+) -> (V3, IsoNormal) {
     let (g, a) = edge_from_key(k);
     let mut g1 = g;
     g1[a as usize] += 1;
@@ -444,25 +538,25 @@ fn iso_point(grid: &DistanceGrid, input: &InputDistance, k: u64, p: &ExtractPara
     if p.features {
         if let Some(c) = input.closest(x, grid.cap * 2.0) {
             prim = c.prim;
-            if let Some(n) = normalized(sub(x, c.point)) {
-                return IsoPoint {
-                    pos: x,
-                    normal: n,
-                    gradient: false,
+            if let Some(normal) = normalized(sub(x, c.point)) {
+                let n = IsoNormal {
+                    normal,
                     prim,
+                    fallback: false,
                 };
+                return (x, n);
             }
         }
     }
     // The direction of increasing f along the edge is a usable fallback normal.
-    let mut nv = [0.0; 3];
-    nv[a as usize] = if f1 > f0 { 1.0 } else { -1.0 };
-    IsoPoint {
-        pos: x,
-        normal: nv,
-        gradient: p.features,
+    let mut normal = [0.0; 3];
+    normal[a as usize] = if f1 > f0 { 1.0 } else { -1.0 };
+    let n = IsoNormal {
+        normal,
         prim,
-    }
+        fallback: p.features,
+    };
+    (x, n)
 }
 
 /// Linear-interpolation parameter of `d` between `f0` and `f1` (which straddle `d`).
@@ -528,10 +622,12 @@ fn refine(
 }
 
 struct CubeCtx<'a> {
-    grid: &'a DistanceGrid,
+    spec: GridSpec,
+    cap: f64,
     input: &'a InputDistance,
     keys: &'a [u64],
-    iso: &'a [IsoPoint],
+    iso_pos: &'a [V3],
+    iso: &'a [IsoNormal],
     p: &'a ExtractParams,
 }
 
@@ -546,18 +642,16 @@ struct BrickPatches {
     extra: Vec<V3>,
     center: Vec<u32>,
     feature: Vec<u32>,
-    spread: Vec<f32>,
     counts: ExtractCounts,
 }
 
-fn brick_patches(ctx: &CubeCtx, key: u64) -> BrickPatches {
+fn brick_patches(ctx: &CubeCtx, key: u64, cubes: &[u64]) -> BrickPatches {
     let mut out = BrickPatches::default();
-    let d = ctx.p.d;
-    let mut cubes: Vec<([u32; 3], [f64; 8])> = Vec::new();
-    for_mixed_cubes(ctx.grid, key, d, |g, v| cubes.push((g, *v)));
-    for (g, v) in cubes {
-        let topo = topology(&decide(&v));
-        cube_patches(ctx, g, &v, &topo, &mut out);
+    let base = brick_coords(key).map(|b| b * BRICK);
+    for &c in cubes {
+        let (g, dec) = MixedCubes::unpack(base, c);
+        let topo = topology(&dec);
+        cube_patches(ctx, g, dec.inside, &topo, &mut out);
     }
     out
 }
@@ -565,20 +659,20 @@ fn brick_patches(ctx: &CubeCtx, key: u64) -> BrickPatches {
 fn cube_patches(
     ctx: &CubeCtx,
     g: [u32; 3],
-    v: &[f64; 8],
+    inside: u8,
     topo: &CubeTopology,
     out: &mut BrickPatches,
 ) {
-    let h = ctx.grid.spec.h;
+    let h = ctx.spec.h;
     let d = ctx.p.d;
-    let origin = ctx.grid.spec.point(g);
+    let origin = ctx.spec.point(g);
     let mut ids = [NONE; 12];
     let mut local = [[0.0; 3]; 12];
     let mut normals = [[0.0; 3]; 12];
     let mut hint = None;
     for e in 0..12 {
         let ec = EDGE_CORNERS[e];
-        if (v[ec[0] as usize] < 0.0) == (v[ec[1] as usize] < 0.0) {
+        if (inside >> ec[0] & 1) == (inside >> ec[1] & 1) {
             continue;
         }
         let Ok(i) = ctx.keys.binary_search(&cube_edge_key(g, e)) else {
@@ -586,12 +680,8 @@ fn cube_patches(
         };
         ids[e] = i as u32;
         let ip = ctx.iso[i];
-        local[e] = scale(sub(ip.pos, origin), 1.0 / h);
-        normals[e] = if ip.gradient {
-            trilinear_gradient(v, local[e]).unwrap_or(ip.normal)
-        } else {
-            ip.normal
-        };
+        local[e] = scale(sub(ctx.iso_pos[i], origin), 1.0 / h);
+        normals[e] = ip.normal;
         if ip.prim != u32::MAX {
             hint = Some(ip.prim);
         }
@@ -603,12 +693,18 @@ fn cube_patches(
             origin[1] + h * x[1],
             origin[2] + h * x[2],
         ];
-        let c = ctx.input.closest_hinted(w, 2.0 * ctx.grid.cap, hint)?;
+        let c = ctx.input.closest_hinted(w, 2.0 * ctx.cap, hint)?;
         let n = normalized(sub(w, c.point))?;
         let y = lerp(c.point, add(c.point, n), d);
         Some(scale(sub(y, origin), 1.0 / h))
     };
-    let (patches, flags) = cube_geometry(topo, &local, normals, Some(&project));
+    let (patches, flags) = cube_geometry(
+        topo,
+        &local,
+        normals,
+        ctx.p.feature_min_spread_deg,
+        Some(&project),
+    );
     out.counts.add_flags(&flags);
     let world = |x: V3| {
         [
@@ -640,29 +736,16 @@ fn cube_patches(
         let f = push_extra(pg.feature);
         out.center.push(c);
         out.feature.push(f);
-        out.spread.push(pg.normal_spread_deg);
     }
 }
 
-/// Unit gradient of the trilinear interpolant at local point `x`.
-fn trilinear_gradient(v: &[f64; 8], x: V3) -> Option<V3> {
-    let e = 1e-4;
-    let g: V3 = std::array::from_fn(|k| {
-        let (mut a, mut b) = (x, x);
-        a[k] = (a[k] - e).max(0.0);
-        b[k] = (b[k] + e).min(1.0);
-        (trilinear(v, b) - trilinear(v, a)) / (b[k] - a[k])
-    });
-    normalized(g)
-}
-
-fn append(set: &mut PatchSet, bp: BrickPatches) {
-    let base = set.positions.len() as u32;
-    set.positions.extend(bp.extra);
+/// Appends one brick's patches; its extra vertices go to `extra` (ids from `set.n_iso`).
+fn append(set: &mut PatchSet, extra: &mut Vec<V3>, bp: BrickPatches) {
+    let base = (set.n_iso + extra.len()) as u32;
+    extra.extend(bp.extra);
     let shift = |x: u32| if x == NONE { NONE } else { base + x };
     set.center.extend(bp.center.into_iter().map(shift));
     set.feature.extend(bp.feature.into_iter().map(shift));
-    set.normal_spread_deg.extend(bp.spread);
     set.loop_ids.extend(bp.loop_ids);
     for l in bp.loop_len {
         let last = *set.loop_off.last().unwrap_or(&0);

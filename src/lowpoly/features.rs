@@ -292,13 +292,15 @@ pub(crate) type Projector<'a> = &'a dyn Fn(V3) -> Option<V3>;
 
 /// Geometry of all patches of one cube. `iso[e]` is the iso-point of crossed edge `e` and
 /// `normals[e]` its unit normal (eq. 4.3), both in cube-local coordinates (unit cube);
-/// `normals = None` computes no feature vertices. With `project`, each apex (feature or
-/// center vertex) is moved onto the exact iso-surface when the moved point still satisfies its
-/// polyhedron's constraints (so the embedding argument is unaffected).
+/// `normals = None` computes no feature vertices; otherwise a disk patch gets one when its
+/// normal spread is at least `min_spread_deg` (0 for every disk patch). With `project`, each
+/// apex (feature or center vertex) is moved onto the exact iso-surface when the moved point
+/// still satisfies its polyhedron's constraints (so the embedding argument is unaffected).
 pub(crate) fn cube_geometry(
     topo: &CubeTopology,
     iso: &[V3; 12],
     normals: Option<&[V3; 12]>,
+    min_spread_deg: f32,
     project: Option<Projector<'_>>,
 ) -> (Vec<PatchGeom>, CubeFlags) {
     let mut flags = CubeFlags::default();
@@ -343,7 +345,8 @@ pub(crate) fn cube_geometry(
             let ok = strip(a, ea, b, eb, &[], &mut g.plain);
             debug_assert!(ok, "strip was validated in patch_groups");
         } else {
-            disk_geometry(&mut g, &pts[k], &cons[k], separated[k], normals, project);
+            let feature = normals.map(|n| (n, min_spread_deg));
+            disk_geometry(&mut g, &pts[k], &cons[k], separated[k], feature, project);
         }
         out.push(g);
     }
@@ -405,13 +408,14 @@ fn centroid(p: &[V3]) -> V3 {
     )
 }
 
-/// Feature vertex and template triangulation of a disk patch.
+/// Feature vertex and template triangulation of a disk patch. `feature` holds the normals and
+/// the least normal spread (degrees) for which the feature vertex is computed.
 fn disk_geometry(
     g: &mut PatchGeom,
     pts: &[V3],
     cons: &[HalfSpace],
     separated: bool,
-    normals: Option<&[V3; 12]>,
+    feature: Option<(&[V3; 12], f32)>,
     project: Option<Projector<'_>>,
 ) {
     let c = centroid(pts);
@@ -422,9 +426,11 @@ fn disk_geometry(
             .filter(|y| cons.iter().all(|h| dot(h.n, *y) <= h.c))
             .unwrap_or(x)
     };
-    if let (Some(nrm), true) = (normals, separated) {
-        g.feature = feature_vertex(pts, &g.edges, nrm, c, cons).map(onto_surface);
+    if let (Some((nrm, min_spread)), true) = (feature, separated) {
         g.normal_spread_deg = normal_spread(&g.edges, nrm);
+        if g.normal_spread_deg >= min_spread {
+            g.feature = feature_vertex(pts, &g.edges, nrm, c, cons).map(onto_surface);
+        }
     }
     if !plain_disk(pts, &g.edges, &mut g.plain) {
         // Template needs a center: the centroid projected into the polyhedron.

@@ -1,6 +1,14 @@
 //! [`offset_surface`]: stage 1 of the LOD pipeline — a watertight, manifold,
 //! self-intersection-free, feature-preserving `d`-offset surface of any triangle soup
 //! (dissertation §4.3.1, Algorithm 1).
+//!
+//! Peak memory (measured with the offset benchmark's per-stage VmHWM/VmRSS trace,
+//! `PLEAT_BENCH_MEMTRACE=1`): the input's distance structures live throughout; the distance
+//! grid is dropped inside the extraction before the patch set is built (see `extract`); the
+//! interior test then holds the patch set plus one container's winding-number tree (see
+//! `interior`); the flip phases hold the patch set plus the assembled half-edge mesh. On
+//! `large_cycloidal_mid16` at n_p = 400 these three peaks are now about 750, 850 and 870 MiB
+//! (VmHWM) where they were 1170, 1300 and 1300 MiB.
 
 use std::time::Instant;
 
@@ -155,10 +163,12 @@ pub fn offset_surface_with_progress(
     let xp = ExtractParams {
         d: r.d,
         features: params.features,
+        feature_min_spread_deg: CREASE_CANDIDATE_DEG,
         refine_steps: params.iso_refinement_steps,
     };
     let t = Instant::now();
-    let set = extract(&grid, &input, &xp, &mut |f| {
+    let grid_bytes = grid.memory_bytes();
+    let set = extract(grid, &input, &xp, &mut |f| {
         progress(Progress {
             stage: "extract",
             fraction: 0.5 + 0.28 * f,
@@ -168,8 +178,11 @@ pub fn offset_surface_with_progress(
         .stages
         .push(("extract".into(), t.elapsed().as_secs_f64()));
     record_extraction(&mut stats, &set);
-    let mut peak = grid.memory_bytes() + patchset_bytes(&set);
-    drop(grid);
+    // The extraction holds the grid, the iso-points (key 8 B, position 24 B, normal and
+    // closest primitive 32 B) and the packed mixed cubes (8 B) together; after dropping the
+    // grid it builds the patch set.
+    let transient = set.n_iso as u64 * 64 + set.counts.mixed * 8;
+    let mut peak = (grid_bytes + transient).max(transient + patchset_bytes(&set));
     step(progress, "interior", 0.8)?;
     let visible = if params.remove_interior {
         let t = Instant::now();
@@ -259,6 +272,8 @@ fn distance_field(
 /// normals `180° − θ0 = 60°` apart or more; 30° leaves room for the difference between mesh
 /// and exact normals. Flat and gently curved patches (most of the surface) keep their template
 /// in phase 1, which halves its size; they would have been reverted by the filter anyway.
+/// The extraction computes feature vertices for these candidates only, which saves their QP,
+/// their projection and their storage (24 + 4 bytes each).
 /// Measured at n_p = 100 against fanning every patch: feature vertices kept 332 vs 320
 /// (fandisk), 209 vs 181 (homer), 980 vs 975 (truck); output sizes within 0.1%.
 const CREASE_CANDIDATE_DEG: f32 = 30.0;
@@ -282,9 +297,9 @@ fn surface_with_features(
         return Ok((pos, tris));
     }
     let t = Instant::now();
-    // Phase 1 fans only the patches that can straddle a crease (see `CREASE_CANDIDATE_DEG`).
-    let (pos, tris, back) =
-        set.assemble(&|p| mode(p, set.normal_spread_deg[p] >= CREASE_CANDIDATE_DEG));
+    // Phase 1 fans only the patches that can straddle a crease: the only ones with a feature
+    // vertex (see `CREASE_CANDIDATE_DEG`).
+    let (pos, tris, back) = set.assemble(&|p| mode(p, true));
     let cos_sharp = (180.0 - params.theta0_deg).to_radians().cos();
     let (mesh, flips1) = flipped(pos, tris, &back, set, h, Some(cos_sharp))?;
     stats

@@ -41,7 +41,7 @@
 pub(crate) mod tables;
 pub(crate) mod triangulate;
 
-use tables::{CORNER_POS, EDGE_CORNERS, FACE_CORNERS, FACE_EDGES};
+use tables::{EDGE_CORNERS, FACE_CORNERS, FACE_EDGES};
 
 /// Sign decisions of one cube: everything the topology depends on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -54,6 +54,34 @@ pub(crate) struct Decisions {
     pub n_joins: u8,
     /// Same-sign corner pairs connected through the cube interior only.
     pub joins: [[u8; 2]; 4],
+}
+
+impl Decisions {
+    /// Bits used by [`Decisions::pack`].
+    pub(crate) const PACKED_BITS: u32 = 41;
+
+    /// The decisions in the low [`Decisions::PACKED_BITS`] bits of a `u64`: `inside` (8),
+    /// `outside_joined` (6), `n_joins` (3), then the eight corner indices of `joins` (3 each).
+    pub(crate) fn pack(&self) -> u64 {
+        let mut x = self.inside as u64
+            | (self.outside_joined as u64 & 0x3F) << 8
+            | (self.n_joins as u64 & 7) << 14;
+        for (i, &c) in self.joins.iter().flatten().enumerate() {
+            x |= (c as u64 & 7) << (17 + 3 * i);
+        }
+        x
+    }
+
+    /// Inverse of [`Decisions::pack`] (bits above [`Decisions::PACKED_BITS`] are ignored).
+    pub(crate) fn unpack(x: u64) -> Decisions {
+        let corner = |i: usize| (x >> (17 + 3 * i) & 7) as u8;
+        Decisions {
+            inside: x as u8,
+            outside_joined: (x >> 8 & 0x3F) as u8,
+            n_joins: (x >> 14 & 7) as u8,
+            joins: std::array::from_fn(|j| [corner(2 * j), corner(2 * j + 1)]),
+        }
+    }
 }
 
 /// The loops and patches of one cube.
@@ -404,9 +432,10 @@ fn push_patch(topo: &mut CubeTopology, loops: [u8; 2]) {
 }
 
 /// Trilinear interpolation of corner values `v` at local coordinates `p ∈ [0, 1]³`.
+#[cfg(test)]
 pub(crate) fn trilinear(v: &[f64; 8], p: [f64; 3]) -> f64 {
     let mut s = 0.0;
-    for (c, pos) in CORNER_POS.iter().enumerate() {
+    for (c, pos) in tables::CORNER_POS.iter().enumerate() {
         let mut w = 1.0;
         for k in 0..3 {
             w *= if pos[k] == 1 { p[k] } else { 1.0 - p[k] };

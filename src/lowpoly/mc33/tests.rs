@@ -96,7 +96,7 @@ pub(crate) fn triangulate_cube(
     iso: &[V3; 12],
     normals: Option<&[V3; 12]>,
 ) -> (Vec<[u32; 3]>, HashMap<u32, V3>, CubeFlags) {
-    let (patches, flags) = cube_geometry(topo, iso, normals, None);
+    let (patches, flags) = cube_geometry(topo, iso, normals, 0.0, None);
     let mut tris = Vec::new();
     let mut pos: HashMap<u32, V3> = HashMap::new();
     for e in 0..12u8 {
@@ -377,4 +377,28 @@ fn value_consistent_cubes_separate_and_embed() {
     );
     assert_eq!(stats[0], 0);
     assert_eq!(stats[1], 0);
+}
+
+#[test]
+fn packed_decisions_round_trip() {
+    let mut rng = Rng(11);
+    for _ in 0..20_000 {
+        let v: [f64; 8] = std::array::from_fn(|_| (rng.unit() - 0.5) * rng.magnitude());
+        let dec = decide(&v);
+        let x = dec.pack();
+        assert!(x < 1 << Decisions::PACKED_BITS);
+        assert_eq!(Decisions::unpack(x), dec);
+    }
+    for inside in 0..=255u8 {
+        for dec in all_resolutions(inside) {
+            assert_eq!(Decisions::unpack(dec.pack()), dec);
+        }
+    }
+    let full = Decisions {
+        inside: 0xA5,
+        outside_joined: 0x3F,
+        n_joins: 4,
+        joins: [[7, 6], [5, 4], [3, 2], [1, 0]],
+    };
+    assert_eq!(Decisions::unpack(full.pack()), full);
 }
