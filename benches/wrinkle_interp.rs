@@ -2,7 +2,8 @@
 //! time to converge (gradient ≤ 1e-6) with 50 guide frames on the coarse corpus meshes
 //! (`../shared/meshes/coarse_*` relative to the crate, or `$PLEAT_MESHES`) for the keyframe
 //! pairs of the dissertation (global 90° rotation, frequency ×3 with amplitude ÷3, a local
-//! rotation), and the iteration counts of the three Hessian models on one pair.
+//! rotation) with the default trust-region solver, and on the rotation pair the three direct
+//! (sparse-Cholesky) solvers it replaced, for comparison.
 //!
 //! Environment: `PLEAT_BENCH_FRAMES` (default 50), `PLEAT_BENCH_MAX_ITER` (default 200),
 //! `PLEAT_BENCH_MESHES` (comma-separated file-name filter), `PLEAT_BENCH_HESSIANS=1` to also
@@ -69,8 +70,8 @@ fn main() {
         rayon::current_num_threads()
     );
     println!(
-        "{:28} {:>6} {:16} {:>14} {:>6} {:>6} {:>10} {:>9}",
-        "mesh", "verts", "pair", "stop", "iters", "facts", "gradient", "seconds"
+        "{:28} {:>6} {:16} {:>14} {:>6} {:>6} {:>6} {:>10} {:>9}",
+        "mesh", "verts", "pair", "stop", "iters", "facts", "cg", "gradient", "seconds"
     );
     let mut times = Vec::new();
     for path in &files {
@@ -100,28 +101,34 @@ fn main() {
             let secs = t0.elapsed().as_secs_f64();
             times.push(secs);
             println!(
-                "{name:28} {:>6} {:16} {:>14} {:>6} {:>6} {:>10.2e} {secs:>9.2}",
+                "{name:28} {:>6} {:16} {:>14} {:>6} {:>6} {:>6} {:>10.2e} {secs:>9.2}",
                 mesh.vertex_count(),
                 kind.name(),
                 r.stop.name(),
                 r.iterations,
                 r.factorizations,
+                r.cg_iterations,
                 r.final_gradient_norm()
             );
             if std::env::var_os("PLEAT_BENCH_HESSIANS").is_some()
                 && kind == PairKind::GlobalRotation
             {
-                for h in [HessianModel::Projected, HessianModel::GaussNewton] {
+                for h in [
+                    HessianModel::Exact,
+                    HessianModel::Projected,
+                    HessianModel::GaussNewton,
+                ] {
                     let o = InterpOptions { hessian: h, ..opts };
                     let t0 = std::time::Instant::now();
                     let (_, r, _) = interpolate(&a, &b, &o).expect("interpolate");
                     println!(
-                        "{name:28} {:>6} {:16} {:>14} {:>6} {:>6} {:>10.2e} {:>9.2}  ({h:?})",
+                        "{name:28} {:>6} {:16} {:>14} {:>6} {:>6} {:>6} {:>10.2e} {:>9.2}  ({h:?})",
                         mesh.vertex_count(),
                         kind.name(),
                         r.stop.name(),
                         r.iterations,
                         r.factorizations,
+                        r.cg_iterations,
                         r.final_gradient_norm(),
                         t0.elapsed().as_secs_f64()
                     );

@@ -164,7 +164,7 @@ static void misuse(void) {
     p.hessian = 99;
     CHECK_STATUS(pleat_cwf_interpolate(a, b, &p, NULL, NULL, &anim, NULL),
                  PLEAT_STATUS_INVALID_ARGUMENT);
-    p.hessian = PLEAT_INTERP_HESSIAN_EXACT;
+    p.hessian = PLEAT_INTERP_HESSIAN_TRUST_REGION;
     p.struct_size = 4;
     CHECK_STATUS(pleat_cwf_interpolate(a, b, &p, NULL, NULL, &anim, NULL),
                  PLEAT_STATUS_INVALID_ARGUMENT);

@@ -56,9 +56,13 @@ pub const PLEAT_INTERP_STOP_NO_UNKNOWNS: u32 = 4;
 pub const PLEAT_INTERP_HESSIAN_PROJECTED: u32 = 0;
 /// `PleatWrinkleInterpParams::hessian`: Gauss–Newton.
 pub const PLEAT_INTERP_HESSIAN_GAUSS_NEWTON: u32 = 1;
-/// `PleatWrinkleInterpParams::hessian`: exact Hessian with Levenberg–Marquardt damping
-/// (default; fastest measured).
+/// `PleatWrinkleInterpParams::hessian`: exact Hessian, direct sparse Cholesky of the whole
+/// spacetime system with Levenberg–Marquardt damping (seconds per iteration on 500+ vertices).
 pub const PLEAT_INTERP_HESSIAN_EXACT: u32 = 2;
+/// `PleatWrinkleInterpParams::hessian`: exact Hessian, matrix-free trust-region Newton–CG with
+/// a per-frame block preconditioner (default; 10–30× faster than the direct solvers on the
+/// coarse corpus, same minimizer).
+pub const PLEAT_INTERP_HESSIAN_TRUST_REGION: u32 = 3;
 
 /// A wrinkle animation (opaque): guide frames between two keyframes on one base mesh (a private
 /// copy). Created by `pleat_cwf_interpolate` or `pleat_cwf_animation_read_file`, destroyed by
@@ -93,7 +97,7 @@ pub struct PleatWrinkleInterpParams {
     pub c_scale: f64,
     /// Stop when the normalized gradient norm is ≤ this; finite, ≥ 0; default 1e-6.
     pub gradient_tolerance: f64,
-    /// `PLEAT_INTERP_HESSIAN_*`; default `PLEAT_INTERP_HESSIAN_EXACT`.
+    /// `PLEAT_INTERP_HESSIAN_*`; default `PLEAT_INTERP_HESSIAN_TRUST_REGION`.
     pub hessian: u32,
     /// Reserved, set to 0.
     pub reserved: u32,
@@ -110,7 +114,8 @@ pub struct PleatWrinkleInterpStats {
     pub iterations: u32,
     /// `PLEAT_INTERP_STOP_*`.
     pub stop_reason: u32,
-    /// Sparse Cholesky factorizations done (including failed, damped ones).
+    /// Sparse Cholesky factorizations done (including failed, damped ones); for the trust-region
+    /// solver, of the per-frame blocks.
     pub factorizations: u32,
     /// Wall seconds of the whole call.
     pub total_seconds: f64,
@@ -140,7 +145,7 @@ pub extern "C" fn pleat_wrinkle_interp_params_default() -> PleatWrinkleInterpPar
         max_iterations: 200,
         c_scale: 1e3,
         gradient_tolerance: 1e-6,
-        hessian: PLEAT_INTERP_HESSIAN_EXACT,
+        hessian: PLEAT_INTERP_HESSIAN_TRUST_REGION,
         reserved: 0,
     }
 }
@@ -377,6 +382,7 @@ mod imp {
             PLEAT_INTERP_HESSIAN_PROJECTED => HessianModel::Projected,
             PLEAT_INTERP_HESSIAN_GAUSS_NEWTON => HessianModel::GaussNewton,
             PLEAT_INTERP_HESSIAN_EXACT => HessianModel::Exact,
+            PLEAT_INTERP_HESSIAN_TRUST_REGION => HessianModel::TrustRegion,
             h => {
                 return Err(Error::InvalidArgument(format!(
                     "params->hessian is {h}; use a PLEAT_INTERP_HESSIAN_* value"

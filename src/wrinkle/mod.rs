@@ -45,6 +45,7 @@ pub mod interpolate;
 pub mod io;
 pub mod knoppel;
 mod omega_path;
+mod spacetime;
 pub mod subdivide;
 mod topology;
 
