@@ -34,7 +34,9 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-use super::guard::Guard;
+use rayon::prelude::*;
+
+use super::guard::{patches_intersect, Guard, GuardScratch, GuardStats};
 use super::vec3::{
     add, cross, dist, dot, for_each_sample, norm, normalized, point_triangle_distance,
     sample_resolution, scale, sub, tri_normal, P3,
@@ -70,6 +72,9 @@ pub(crate) struct SimplifyReport {
     pub rejected_hausdorff: u64,
     pub rejected_distance: u64,
     pub rejected_guard: u64,
+    /// Accepted collapses whose new faces met those of an earlier collapse of their batch and
+    /// were evaluated again (see `Pass::run`).
+    pub rechecked: u64,
 }
 
 /// A symmetric quadric `Q(x) = xᵀAx + 2bᵀx + c`.
@@ -225,6 +230,13 @@ impl Ord for Entry {
     }
 }
 
+/// Largest number of candidate collapses evaluated together (see [`Pass::run`]).
+const BATCH: usize = 64;
+
+/// Batches are formed while the mesh has at least this many faces; below, candidates are
+/// evaluated one at a time (a batch of one), in pure cost order.
+const BATCH_MIN_FACES: usize = 2048;
+
 /// The state of one pass.
 struct Pass<'g, 'a> {
     g: &'g mut Guard<'a>,
@@ -237,7 +249,36 @@ struct Pass<'g, 'a> {
     face_dist: Vec<f64>,
     /// Distance to the input per vertex (NaN = not computed yet).
     vert_dist: Vec<f64>,
+    /// Vertex marks of the batch being formed: `mark_w[v] == epoch` ⇔ `v` is written by a
+    /// selected collapse (endpoint or one-ring), `mark_r[v] == epoch` ⇔ `v` is read by one (its
+    /// two-ring, which holds the vertices of its `M_1`).
+    mark_w: Vec<u32>,
+    mark_r: Vec<u32>,
+    epoch: u32,
+    /// Scratch: the vertices `W` of a candidate's footprint.
+    footprint: Vec<u32>,
+    scratch: GuardScratch,
     report: SimplifyReport,
+}
+
+/// A candidate collapse that passed every check (see [`Pass::evaluate`]).
+struct Accepted {
+    h: u32,
+    a: u32,
+    b: u32,
+    x: P3,
+    new: Patch,
+    new_face_dist: Vec<f64>,
+}
+
+/// The result of evaluating one candidate collapse against an unchanged mesh, with the
+/// distances computed on the way (cache fills, written when the result is applied) and the
+/// guard's counters.
+struct Eval {
+    outcome: std::result::Result<Accepted, Rejection>,
+    vert_dist: Vec<(u32, f64)>,
+    face_dist: Vec<(u32, f64)>,
+    guard: GuardStats,
 }
 
 /// Runs one pass of Alg. 5 on the guard's mesh. `keep_going` is polled now and then with the
@@ -261,7 +302,12 @@ impl<'g, 'a> Pass<'g, 'a> {
             targets: vec![[0.0; 3]; m.edge_capacity()],
             face_dist: vec![f64::NAN; m.face_capacity()],
             vert_dist: vec![f64::NAN; m.vertex_capacity()],
+            mark_w: vec![0; m.vertex_capacity()],
+            mark_r: vec![0; m.vertex_capacity()],
+            epoch: 0,
+            footprint: Vec::new(),
             heap: BinaryHeap::with_capacity(m.edge_count()),
+            scratch: GuardScratch::default(),
             quadrics,
             opt,
             report: SimplifyReport::default(),
@@ -294,75 +340,195 @@ impl<'g, 'a> Pass<'g, 'a> {
         });
     }
 
+    /// The queue loop. Candidates are taken in cost order in **batches** of collapses whose
+    /// neighbourhoods are disjoint (no vertex written by one is read by another; see
+    /// [`reserve`](Self::reserve)); a candidate that overlaps the batch goes back to the queue
+    /// for the next one. A batch is evaluated read-only — in parallel — against the mesh as it
+    /// was before the batch, then applied sequentially in queue order. Disjointness makes each
+    /// evaluation valid after the earlier collapses of its batch, except for one thing: the
+    /// guard's `M_e`-against-the-rest test (§4.3.3) saw the *old* faces of the other collapses.
+    /// So before a collapse is applied, its new faces are tested against the new faces of the
+    /// collapses already applied from its batch ([`patches_intersect`]); if they meet, the
+    /// candidate is evaluated again against the current mesh. The batches depend only on the
+    /// queue and the mesh, never on the thread count, so the output is the same for any number
+    /// of threads.
     fn run(&mut self, keep_going: &mut dyn FnMut(f64) -> bool) -> Result<()> {
         let total = self.heap.len().max(1) as f64;
         let mut pops = 0u64;
-        while !self.target_reached() {
-            let Some(entry) = self.heap.pop() else { break };
-            pops += 1;
-            if pops % 512 == 0 && !keep_going((pops as f64 / total).min(1.0)) {
-                return Err(Error::Cancelled);
+        let mut batch: Vec<u32> = Vec::with_capacity(BATCH);
+        let mut deferred: Vec<Entry> = Vec::with_capacity(BATCH);
+        let mut applied: Vec<Vec<[P3; 3]>> = Vec::with_capacity(BATCH);
+        'pass: while !self.target_reached() {
+            let cap = if self.g.mesh().face_count() >= BATCH_MIN_FACES {
+                BATCH
+            } else {
+                1
+            };
+            self.new_epoch();
+            batch.clear();
+            deferred.clear();
+            while batch.len() < cap && deferred.len() < cap {
+                let Some(entry) = self.heap.pop() else { break };
+                pops += 1;
+                if pops % 512 == 0 && !keep_going((pops as f64 / total).min(1.0)) {
+                    return Err(Error::Cancelled);
+                }
+                let e = entry.edge;
+                if entry.version != self.version[e as usize] || !self.g.mesh().is_edge_live(e) {
+                    continue;
+                }
+                if cap > 1 && !self.reserve(e) {
+                    deferred.push(entry);
+                    continue;
+                }
+                batch.push(e);
             }
-            let e = entry.edge;
-            if entry.version != self.version[e as usize] || !self.g.mesh().is_edge_live(e) {
-                continue;
+            self.heap.extend(deferred.drain(..));
+            if batch.is_empty() {
+                break;
             }
-            self.report.candidates += 1;
-            self.try_edge(e, self.targets[e as usize]);
+            let evals: Vec<Eval> = if batch.len() == 1 {
+                let mut s = std::mem::take(&mut self.scratch);
+                let ev = self.evaluate(batch[0], &mut s);
+                self.scratch = s;
+                vec![ev]
+            } else {
+                let this = &*self;
+                batch
+                    .par_iter()
+                    .map_init(GuardScratch::default, |s, &e| this.evaluate(e, s))
+                    .collect()
+            };
+            applied.clear();
+            for (&e, mut ev) in batch.iter().zip(evals) {
+                if self.target_reached() {
+                    break 'pass;
+                }
+                self.report.candidates += 1;
+                let meets = match &ev.outcome {
+                    Ok(acc) => {
+                        let st = &mut self.g.stats;
+                        applied
+                            .iter()
+                            .any(|p| patches_intersect(&acc.new.tris, p, st))
+                    }
+                    Err(_) => false,
+                };
+                if meets {
+                    self.report.rechecked += 1;
+                    self.fill_caches(&mut ev);
+                    let mut s = std::mem::take(&mut self.scratch);
+                    ev = self.evaluate(e, &mut s);
+                    self.scratch = s;
+                }
+                if let Ok(acc) = &ev.outcome {
+                    applied.push(acc.new.tris.clone());
+                }
+                self.apply(ev);
+            }
         }
         Ok(())
     }
 
-    /// Checks and performs the collapse of edge `e`, trying the quadric optimum `x` first and
-    /// then the edge midpoint and the two endpoints (see the module docs).
-    fn try_edge(&mut self, e: u32, x: P3) {
+    /// Starts a new batch (clears the vertex marks).
+    fn new_epoch(&mut self) {
+        self.epoch = self.epoch.wrapping_add(1);
+        if self.epoch == 0 {
+            self.mark_w.fill(0);
+            self.mark_r.fill(0);
+            self.epoch = 1;
+        }
+    }
+
+    /// Adds the collapse of edge `e` to the batch being formed if its neighbourhood is
+    /// disjoint from the batch's: it writes its endpoints and their one-ring `W` (positions,
+    /// connectivity, cached distances) and reads `W`'s one-ring `R` (the vertices of its guard
+    /// neighbourhood `M_1`). It joins when `W ∩ R' = ∅` and `R ∩ W' = ∅` for the batch's `W'`,
+    /// `R'`; then no collapse of the batch changes anything another one reads except through
+    /// the BVH, which [`run`](Self::run) handles.
+    fn reserve(&mut self, e: u32) -> bool {
+        let m = self.g.mesh();
+        let h = m.edge_halfedge(e);
+        let (a, b) = (m.origin(h), m.target(h));
+        let ep = self.epoch;
+        let mut w = std::mem::take(&mut self.footprint);
+        w.clear();
+        w.extend([a, b]);
+        w.extend(m.vertex_neighbors(a));
+        w.extend(m.vertex_neighbors(b));
+        let free = w.iter().all(|&v| {
+            self.mark_r[v as usize] != ep
+                && !m.vertex_neighbors(v).any(|u| self.mark_w[u as usize] == ep)
+        });
+        if free {
+            for &v in &w {
+                self.mark_w[v as usize] = ep;
+                self.mark_r[v as usize] = ep;
+                for u in m.vertex_neighbors(v) {
+                    self.mark_r[u as usize] = ep;
+                }
+            }
+        }
+        self.footprint = w;
+        free
+    }
+
+    /// Checks the collapse of edge `e` without changing anything, trying the quadric optimum
+    /// first and then the edge midpoint and the two endpoints (see the module docs).
+    fn evaluate(&self, e: u32, s: &mut GuardScratch) -> Eval {
+        let mut ev = Eval {
+            outcome: Err(Rejection::Guard),
+            vert_dist: Vec::new(),
+            face_dist: Vec::new(),
+            guard: GuardStats::default(),
+        };
         let m = self.g.mesh();
         let h0 = m.edge_halfedge(e);
         let Some(h) = [h0, h0 ^ 1]
             .into_iter()
             .find(|&h| m.can_collapse(h).is_ok())
         else {
-            self.report.rejected_guard += 1;
-            return;
+            return ev;
         };
         let (a, b) = (m.origin(h), m.target(h));
         let (pa, pb) = (m.position(a), m.position(b));
-        let mut candidates = vec![x];
+        let mut candidates = [self.targets[e as usize]; 4];
+        let mut n = 1;
         for c in [scale(add(pa, pb), 0.5), pa, pb] {
-            if !candidates.contains(&c) {
-                candidates.push(c);
+            if !candidates[..n].contains(&c) {
+                candidates[n] = c;
+                n += 1;
             }
         }
-        let mut last = Rejection::Guard;
-        for c in candidates {
-            match self.try_position(h, a, b, c) {
-                Ok(()) => return,
+        for &c in &candidates[..n] {
+            match self.try_position(h, a, b, c, &mut ev, s) {
+                Ok(acc) => {
+                    ev.outcome = Ok(acc);
+                    return ev;
+                }
                 // Another position can cure a fold-over or a patch farther from the input;
                 // a too large change or a guard refusal is rarely cured by moving along the
                 // edge, and retrying would double the cost of those rejections.
-                Err(r @ (Rejection::Fold | Rejection::Distance)) => last = r,
+                Err(r @ (Rejection::Fold | Rejection::Distance)) => ev.outcome = Err(r),
                 Err(r) => {
-                    last = r;
+                    ev.outcome = Err(r);
                     break;
                 }
             }
         }
-        match last {
-            Rejection::Fold => self.report.rejected_fold += 1,
-            Rejection::Hausdorff => self.report.rejected_hausdorff += 1,
-            Rejection::Distance => self.report.rejected_distance += 1,
-            Rejection::Guard => self.report.rejected_guard += 1,
-        }
+        ev
     }
 
-    /// All checks for collapsing `h = a→b` to `x`, and the collapse when they pass.
+    /// All checks for collapsing `h = a→b` to `x`, cheapest first.
     fn try_position(
-        &mut self,
+        &self,
         h: u32,
         a: u32,
         b: u32,
         x: P3,
-    ) -> std::result::Result<(), Rejection> {
+        ev: &mut Eval,
+        s: &mut GuardScratch,
+    ) -> std::result::Result<Accepted, Rejection> {
         let (old, new) = self.patches(h, x);
         if folds_over(&old, &new) {
             return Err(Rejection::Fold);
@@ -370,15 +536,51 @@ impl<'g, 'a> Pass<'g, 'a> {
         if !self.within_hausdorff(a, b, x, &old, &new) {
             return Err(Rejection::Hausdorff);
         }
-        let Some(new_face_dist) = self.distance_not_increased(a, b, x, &old, &new) else {
+        let Some(new_face_dist) = self.distance_not_increased(a, b, x, &old, &new, ev) else {
             return Err(Rejection::Distance);
         };
-        match self.g.try_collapse(h, x) {
-            Ok(rec) => {
-                self.commit(a, b, x, &rec.modified_faces, &new, &new_face_dist);
-                Ok(())
+        self.g
+            .check_collapse(h, x, s, &mut ev.guard)
+            .map_err(|_| Rejection::Guard)?;
+        Ok(Accepted {
+            h,
+            a,
+            b,
+            x,
+            new,
+            new_face_dist,
+        })
+    }
+
+    /// Writes the distances an evaluation computed into the caches.
+    fn fill_caches(&mut self, ev: &mut Eval) {
+        for (v, d) in ev.vert_dist.drain(..) {
+            self.vert_dist[v as usize] = d;
+        }
+        for (f, d) in ev.face_dist.drain(..) {
+            self.face_dist[f as usize] = d;
+        }
+    }
+
+    /// Applies an evaluation: caches, counters and, when accepted, the collapse.
+    fn apply(&mut self, mut ev: Eval) {
+        self.fill_caches(&mut ev);
+        self.g.stats.add(&ev.guard);
+        match ev.outcome {
+            Ok(acc) => {
+                let rec = self.g.commit_collapse(acc.h, acc.x);
+                self.commit(
+                    acc.a,
+                    acc.b,
+                    &rec.modified_faces,
+                    &acc.new,
+                    &acc.new_face_dist,
+                );
             }
-            Err(_) => Err(Rejection::Guard),
+            Err(Rejection::Fold) => self.report.rejected_fold += 1,
+            Err(Rejection::Hausdorff) => self.report.rejected_hausdorff += 1,
+            Err(Rejection::Distance) => self.report.rejected_distance += 1,
+            Err(Rejection::Guard) => self.report.rejected_guard += 1,
         }
     }
 
@@ -390,11 +592,12 @@ impl<'g, 'a> Pass<'g, 'a> {
         let dying = [m.face(h), m.face(h ^ 1)];
         let mut old = Patch::default();
         let mut new = Patch::default();
+        // The link condition (checked before) makes the edge's faces the only ones with both
+        // endpoints.
         let faces_b = m
             .vertex_faces(b)
-            .filter(|f| !m.vertex_faces(a).any(|g| g == *f));
-        let all: Vec<u32> = m.vertex_faces(a).chain(faces_b).collect();
-        for f in all {
+            .filter(|&f| !m.face_vertices(f).contains(&a));
+        for f in m.vertex_faces(a).chain(faces_b) {
             let vs = m.face_vertices(f);
             let t = vs.map(|v| m.position(v));
             old.push(f, vs, t);
@@ -450,13 +653,17 @@ impl<'g, 'a> Pass<'g, 'a> {
             && one_side(old, new, &[(a, m.position(a)), (b, m.position(b))])
     }
 
-    fn vertex_distance(&mut self, v: u32) -> f64 {
+    /// Distance of vertex `v` to the input, from the cache or computed (and noted in `ev`).
+    fn vertex_distance(&self, v: u32, ev: &mut Eval) -> f64 {
         let d = self.vert_dist[v as usize];
         if !d.is_nan() {
             return d;
         }
+        if let Some(&(_, d)) = ev.vert_dist.iter().find(|(u, _)| *u == v) {
+            return d;
+        }
         let d = self.g.input().distance(self.g.mesh().position(v));
-        self.vert_dist[v as usize] = d;
+        ev.vert_dist.push((v, d));
         d
     }
 
@@ -476,14 +683,19 @@ impl<'g, 'a> Pass<'g, 'a> {
         (sum + self.g.input().distance_bounded(c, ub)) / 4.0
     }
 
-    fn face_distance(&mut self, f: u32, vs: [u32; 3], t: &[P3; 3]) -> f64 {
+    /// Distance of face `f` (vertices `vs`, corners `t`) to the input, from the cache or
+    /// computed (and noted in `ev`).
+    fn face_distance(&self, f: u32, vs: [u32; 3], t: &[P3; 3], ev: &mut Eval) -> f64 {
         let d = self.face_dist[f as usize];
         if !d.is_nan() {
             return d;
         }
-        let corner = vs.map(|v| self.vertex_distance(v));
+        if let Some(&(_, d)) = ev.face_dist.iter().find(|(g, _)| *g == f) {
+            return d;
+        }
+        let corner = vs.map(|v| self.vertex_distance(v, ev));
         let d = self.triangle_distance(t, corner);
-        self.face_dist[f as usize] = d;
+        ev.face_dist.push((f, d));
         d
     }
 
@@ -492,17 +704,18 @@ impl<'g, 'a> Pass<'g, 'a> {
     /// faces' sampled mean distances (see the module docs for why not the maximum). Returns
     /// the new faces' distances when it holds.
     fn distance_not_increased(
-        &mut self,
+        &self,
         a: u32,
         b: u32,
         x: P3,
         old: &Patch,
         new: &Patch,
+        ev: &mut Eval,
     ) -> Option<Vec<f64>> {
         let (mut old_sum, mut old_area) = (0.0, 0.0);
         for i in 0..old.ids.len() {
             let w = norm(tri_normal(&old.tris[i]));
-            old_sum += w * self.face_distance(old.ids[i], old.verts[i], &old.tris[i]);
+            old_sum += w * self.face_distance(old.ids[i], old.verts[i], &old.tris[i], ev);
             old_area += w;
         }
         let old_mean = if old_area > 0.0 {
@@ -513,7 +726,8 @@ impl<'g, 'a> Pass<'g, 'a> {
         let limit = old_mean.max(self.opt.slack) * (1.0 + 1e-9);
         let m = self.g.mesh();
         let (pa, pb) = (m.position(a), m.position(b));
-        let ub = (self.vertex_distance(a) + dist(x, pa)).min(self.vertex_distance(b) + dist(x, pb));
+        let ub = (self.vertex_distance(a, ev) + dist(x, pa))
+            .min(self.vertex_distance(b, ev) + dist(x, pb));
         let dx = self.g.input().distance_bounded(x, ub);
         let (mut new_sum, mut new_area) = (0.0, 0.0);
         let mut out = Vec::with_capacity(new.ids.len());
@@ -524,7 +738,7 @@ impl<'g, 'a> Pass<'g, 'a> {
                 corner[k] = if vs[k] == a {
                     dx
                 } else {
-                    self.vertex_distance(vs[k])
+                    self.vertex_distance(vs[k], ev)
                 };
             }
             let fd = self.triangle_distance(&new.tris[i], corner);
@@ -541,10 +755,9 @@ impl<'g, 'a> Pass<'g, 'a> {
         (new_mean <= limit).then_some(out)
     }
 
-    /// Book-keeping after an accepted collapse of `b` into `a` at `x`.
-    fn commit(&mut self, a: u32, b: u32, x: P3, modified: &[u32], new: &Patch, fd: &[f64]) {
+    /// Book-keeping after an accepted collapse of `b` into `a`.
+    fn commit(&mut self, a: u32, b: u32, modified: &[u32], new: &Patch, fd: &[f64]) {
         self.report.collapses += 1;
-        let _ = x;
         self.quadrics[a as usize] = self.quadrics[a as usize].add(&self.quadrics[b as usize]);
         self.vert_dist[a as usize] = f64::NAN;
         for (i, &f) in new.ids.iter().enumerate() {
