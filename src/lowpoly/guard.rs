@@ -619,7 +619,8 @@ pub(crate) fn patches_intersect(a: &[[P3; 3]], b: &[[P3; 3]], st: &mut GuardStat
     })
 }
 
-fn boxes_overlap(a: (P3, P3), b: (P3, P3)) -> bool {
+/// Closed box overlap test.
+pub(crate) fn boxes_overlap(a: (P3, P3), b: (P3, P3)) -> bool {
     (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
 }
 

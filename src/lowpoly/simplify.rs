@@ -31,14 +31,11 @@
 //!
 //! The pass stops when the queue is empty or the face count reaches the target `n_F`.
 
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
-
 use rayon::prelude::*;
 
-use super::guard::{patches_intersect, Guard, GuardScratch, GuardStats};
+use super::guard::{boxes_overlap, patches_intersect, Guard, GuardScratch, GuardStats};
 use super::vec3::{
-    add, cross, dist, dot, for_each_sample, norm, normalized, point_triangle_distance,
+    add, bbox_of, cross, dist, dot, for_each_sample, norm, normalized, point_triangle_distance,
     sample_resolution, scale, sub, tri_normal, P3,
 };
 use crate::mesh::halfedge::INVALID;
@@ -210,23 +207,77 @@ struct Entry {
     version: u32,
 }
 
-impl PartialEq for Entry {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
+impl Entry {
+    /// Queue order: cheapest first, ties by smallest edge id.
+    fn before(&self, o: &Entry) -> bool {
+        self.cost
+            .total_cmp(&o.cost)
+            .then_with(|| self.edge.cmp(&o.edge))
+            .is_lt()
     }
 }
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
+
+/// The collapse queue: a 4-ary min-heap in [`Entry::before`] order. A first pass pops millions
+/// of entries, most of them stale (lazy deletion: an edge is pushed again whenever its cost
+/// changes); four children per node halve the depth of a binary heap and sit in one or two
+/// cache lines, which is what a pop on a heap of a million entries pays for.
+#[derive(Debug, Default)]
+struct Queue {
+    v: Vec<Entry>,
 }
-impl Ord for Entry {
-    /// Reversed, so that `BinaryHeap` pops the cheapest edge (ties: smallest edge id).
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.cost
-            .total_cmp(&self.cost)
-            .then_with(|| o.edge.cmp(&self.edge))
+
+impl Queue {
+    fn with_capacity(n: usize) -> Queue {
+        Queue {
+            v: Vec::with_capacity(n),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.v.len()
+    }
+
+    fn push(&mut self, e: Entry) {
+        let mut i = self.v.len();
+        self.v.push(e);
+        while i > 0 {
+            let p = (i - 1) / 4;
+            if !e.before(&self.v[p]) {
+                break;
+            }
+            self.v[i] = self.v[p];
+            i = p;
+        }
+        self.v[i] = e;
+    }
+
+    fn pop(&mut self) -> Option<Entry> {
+        let last = self.v.pop()?;
+        if self.v.is_empty() {
+            return Some(last);
+        }
+        let top = self.v[0];
+        let n = self.v.len();
+        let mut i = 0;
+        loop {
+            let c = 4 * i + 1;
+            if c >= n {
+                break;
+            }
+            let mut best = c;
+            for j in c + 1..(c + 4).min(n) {
+                if self.v[j].before(&self.v[best]) {
+                    best = j;
+                }
+            }
+            if !self.v[best].before(&last) {
+                break;
+            }
+            self.v[i] = self.v[best];
+            i = best;
+        }
+        self.v[i] = last;
+        Some(top)
     }
 }
 
@@ -244,7 +295,7 @@ struct Pass<'g, 'a> {
     quadrics: Vec<Quadric>,
     version: Vec<u32>,
     targets: Vec<P3>,
-    heap: BinaryHeap<Entry>,
+    heap: Queue,
     /// Sampled max distance to the input per face (NaN = not computed yet).
     face_dist: Vec<f64>,
     /// Distance to the input per vertex (NaN = not computed yet).
@@ -306,7 +357,7 @@ impl<'g, 'a> Pass<'g, 'a> {
             mark_r: vec![0; m.vertex_capacity()],
             epoch: 0,
             footprint: Vec::new(),
-            heap: BinaryHeap::with_capacity(m.edge_count()),
+            heap: Queue::with_capacity(m.edge_count()),
             scratch: GuardScratch::default(),
             quadrics,
             opt,
@@ -357,7 +408,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         let mut pops = 0u64;
         let mut batch: Vec<u32> = Vec::with_capacity(BATCH);
         let mut deferred: Vec<Entry> = Vec::with_capacity(BATCH);
-        let mut applied: Vec<Vec<[P3; 3]>> = Vec::with_capacity(BATCH);
+        let mut applied: Vec<(Vec<[P3; 3]>, (P3, P3))> = Vec::with_capacity(BATCH);
         'pass: while !self.target_reached() {
             let cap = if self.g.mesh().face_count() >= BATCH_MIN_FACES {
                 BATCH
@@ -383,7 +434,9 @@ impl<'g, 'a> Pass<'g, 'a> {
                 }
                 batch.push(e);
             }
-            self.heap.extend(deferred.drain(..));
+            for d in deferred.drain(..) {
+                self.heap.push(d);
+            }
             if batch.is_empty() {
                 break;
             }
@@ -406,13 +459,14 @@ impl<'g, 'a> Pass<'g, 'a> {
                 }
                 self.report.candidates += 1;
                 let meets = match &ev.outcome {
-                    Ok(acc) => {
+                    Ok(acc) if !applied.is_empty() => {
                         let st = &mut self.g.stats;
-                        applied
-                            .iter()
-                            .any(|p| patches_intersect(&acc.new.tris, p, st))
+                        let abox = bbox_of(acc.new.tris.iter().flatten().copied());
+                        applied.iter().any(|(p, pbox)| {
+                            boxes_overlap(abox, *pbox) && patches_intersect(&acc.new.tris, p, st)
+                        })
                     }
-                    Err(_) => false,
+                    _ => false,
                 };
                 if meets {
                     self.report.rechecked += 1;
@@ -422,7 +476,8 @@ impl<'g, 'a> Pass<'g, 'a> {
                     self.scratch = s;
                 }
                 if let Ok(acc) = &ev.outcome {
-                    applied.push(acc.new.tris.clone());
+                    let abox = bbox_of(acc.new.tris.iter().flatten().copied());
+                    applied.push((acc.new.tris.clone(), abox));
                 }
                 self.apply(ev);
             }
@@ -451,25 +506,32 @@ impl<'g, 'a> Pass<'g, 'a> {
         let h = m.edge_halfedge(e);
         let (a, b) = (m.origin(h), m.target(h));
         let ep = self.epoch;
-        let mut w = std::mem::take(&mut self.footprint);
-        w.clear();
-        w.extend([a, b]);
-        w.extend(m.vertex_neighbors(a));
-        w.extend(m.vertex_neighbors(b));
-        let free = w.iter().all(|&v| {
-            self.mark_r[v as usize] != ep
-                && !m.vertex_neighbors(v).any(|u| self.mark_w[u as usize] == ep)
-        });
+        // W first, then the rest of R (with repeats).
+        let mut fp = std::mem::take(&mut self.footprint);
+        fp.clear();
+        fp.extend([a, b]);
+        fp.extend(m.vertex_neighbors(a));
+        fp.extend(m.vertex_neighbors(b));
+        let n_w = fp.len();
+        let mut free = true;
+        for i in 0..n_w {
+            let v = fp[i];
+            if self.mark_r[v as usize] == ep {
+                free = false;
+                break;
+            }
+            fp.extend(m.vertex_neighbors(v));
+        }
+        free = free && fp[n_w..].iter().all(|&u| self.mark_w[u as usize] != ep);
         if free {
-            for &v in &w {
+            for &v in &fp[..n_w] {
                 self.mark_w[v as usize] = ep;
+            }
+            for &v in &fp {
                 self.mark_r[v as usize] = ep;
-                for u in m.vertex_neighbors(v) {
-                    self.mark_r[u as usize] = ep;
-                }
             }
         }
-        self.footprint = w;
+        self.footprint = fp;
         free
     }
 
@@ -627,11 +689,19 @@ impl<'g, 'a> Pass<'g, 'a> {
         if dist(x, m.position(a)).max(dist(x, m.position(b))) <= d {
             return true;
         }
+        // Consecutive samples are close to each other, so the triangle that was near the last
+        // one is tried first.
+        let hint = std::cell::Cell::new(0usize);
         let near = |p: P3, other: &Patch| -> bool {
-            other
-                .tris
-                .iter()
-                .any(|t| point_triangle_distance(p, t) <= d)
+            let n = other.tris.len();
+            let start = hint.get().min(n.saturating_sub(1));
+            let found = (0..n)
+                .map(|i| (start + i) % n)
+                .find(|&i| point_triangle_distance(p, &other.tris[i]) <= d);
+            if let Some(i) = found {
+                hint.set(i);
+            }
+            found.is_some()
         };
         let one_side = |from: &Patch, to: &Patch, moved: &[(u32, P3)]| -> bool {
             for &(_, p) in moved {
@@ -662,7 +732,20 @@ impl<'g, 'a> Pass<'g, 'a> {
         if let Some(&(_, d)) = ev.vert_dist.iter().find(|(u, _)| *u == v) {
             return d;
         }
-        let d = self.g.input().distance(self.g.mesh().position(v));
+        // A neighbour's known distance bounds this one (the distance field is 1-Lipschitz),
+        // which lets the BVH prune everything farther.
+        let m = self.g.mesh();
+        let p = m.position(v);
+        let ub = m
+            .vertex_neighbors(v)
+            .map(|u| self.vert_dist[u as usize] + dist(p, m.position(u)))
+            .filter(|b| !b.is_nan())
+            .fold(f64::INFINITY, f64::min);
+        let d = if ub.is_finite() {
+            self.g.input().distance_bounded(p, ub)
+        } else {
+            self.g.input().distance(p)
+        };
         ev.vert_dist.push((v, d));
         d
     }
@@ -827,6 +910,35 @@ mod tests {
         assert!(dist(x, [1., 2., 3.]) < 1e-12);
         assert!(q.eval(x).abs() < 1e-12);
         assert!((q.eval([0., 2., 3.]) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn queue_pops_in_cost_then_edge_order() {
+        let mut q = Queue::default();
+        let mut expect = Vec::new();
+        let mut x = 12345u64;
+        for i in 0..1000u32 {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let cost = ((x >> 33) % 50) as f64;
+            let e = Entry {
+                cost,
+                edge: i % 300,
+                version: i,
+            };
+            q.push(e);
+            expect.push(e);
+        }
+        expect.sort_by(|a, b| a.cost.total_cmp(&b.cost).then(a.edge.cmp(&b.edge)));
+        let mut got = Vec::new();
+        while let Some(e) = q.pop() {
+            got.push(e);
+        }
+        assert_eq!(got.len(), expect.len());
+        for (g, e) in got.iter().zip(&expect) {
+            assert_eq!((g.cost, g.edge), (e.cost, e.edge));
+        }
     }
 
     #[test]
