@@ -30,6 +30,13 @@
 //! midpoint lies on the chord, closer to it.
 //!
 //! The pass stops when the queue is empty or the face count reaches the target `n_F`.
+//!
+//! On large meshes (the dense offset surface of the first pass) candidates are evaluated in
+//! parallel, in batches of collapses with disjoint neighbourhoods taken in queue order and
+//! applied in that order (see `Pass::run`); the batches never depend on the thread count, so
+//! neither does the output. Alg. 5 is sequential; the batches reorder it only where collapses
+//! are independent of each other, except that a collapse's re-queued neighbours wait for the
+//! rest of its batch.
 
 use rayon::prelude::*;
 
@@ -281,6 +288,9 @@ impl Queue {
     }
 }
 
+/// An axis-aligned box `(min, max)`.
+type Aabb = (P3, P3);
+
 /// Largest number of candidate collapses evaluated together (see [`Pass::run`]).
 const BATCH: usize = 64;
 
@@ -408,7 +418,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         let mut pops = 0u64;
         let mut batch: Vec<u32> = Vec::with_capacity(BATCH);
         let mut deferred: Vec<Entry> = Vec::with_capacity(BATCH);
-        let mut applied: Vec<(Vec<[P3; 3]>, (P3, P3))> = Vec::with_capacity(BATCH);
+        let mut applied: Vec<(Vec<[P3; 3]>, Aabb)> = Vec::with_capacity(BATCH);
         'pass: while !self.target_reached() {
             let cap = if self.g.mesh().face_count() >= BATCH_MIN_FACES {
                 BATCH
