@@ -225,17 +225,30 @@ fn cancellation_is_prompt() {
     assert_eq!(calls, 5);
 }
 
+/// Same bytes for 1, 2 and 3 threads. The first simplification pass evaluates batches of
+/// collapses in parallel (on offset surfaces of at least 2048 faces, which both cases reach)
+/// and the offset stage is parallel too; a cage exercises the guard's cage checks in batches.
 #[test]
 fn output_does_not_depend_on_thread_count() {
     let m = shapes::torus(1.0, 0.3, 48, 16);
-    let run = |n: usize| {
+    let run = |n: usize, np: f64, cage: bool| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()
             .unwrap();
-        pool.install(|| bake(&m, &params(100.0), false).unwrap().0)
+        pool.install(|| bake(&m, &params(np), cage).unwrap())
     };
-    assert_eq!(run(1), run(2));
+    for (np, cage) in [(100.0, false), (200.0, false), (100.0, true)] {
+        let (one, stats) = run(1, np, cage);
+        assert!(stats.get_count("faces_offset").unwrap() >= 2048);
+        for n in [2, 3] {
+            assert_eq!(
+                one,
+                run(n, np, cage).0,
+                "n_p = {np}, cage = {cage}, {n} threads"
+            );
+        }
+    }
 }
 
 /// The public corpus (`../shared/meshes` or `$PLEAT_MESHES`), inputs of at most 200k

@@ -32,7 +32,7 @@
 
 #[cfg(test)]
 use super::measure;
-use super::vec3::{bbox_of, dot, normalized, P3};
+use super::vec3::{bbox_of, dot, normalized, tri_normal, P3};
 use crate::mesh::halfedge::CollapseRecord;
 use crate::mesh::HalfEdgeMesh;
 use crate::spatial::solid_angle;
@@ -131,7 +131,9 @@ impl InputModel {
 /// Why the guard refused an operation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Reject {
-    /// The half-edge preconditions refuse the collapse (topology would change).
+    /// The half-edge preconditions refuse the collapse (topology would change). Collapses
+    /// outside tests check them before the guard (see `simplify`).
+    #[cfg_attr(not(test), allow(dead_code))]
     Topology,
     /// A modified face would be degenerate.
     Degenerate,
@@ -159,6 +161,32 @@ pub(crate) struct GuardStats {
     pub exact_tests: u64,
 }
 
+/// One face of the neighbourhood of an operation as it is *after* the operation: id, vertex
+/// ids and corner positions.
+#[derive(Debug, Clone, Copy)]
+struct NFace {
+    id: u32,
+    v: [u32; 3],
+    t: [P3; 3],
+}
+
+/// Reusable buffers of one guard check. Checks of collapses take them explicitly so that
+/// several checks can run in parallel on the same (unchanged) mesh, one scratch per thread.
+#[derive(Debug, Default)]
+pub(crate) struct GuardScratch {
+    /// `M_1` after the operation, `M_e` first (its first `n_e` entries).
+    m_1: Vec<NFace>,
+    n_e: usize,
+    /// Sorted ids of `M_1` and of the faces the operation removes: never candidates of `M_r`.
+    excluded: Vec<u32>,
+    /// Vertices of `M_e` (after the operation).
+    verts: Vec<u32>,
+    /// Geometry that `M_e` replaced (cage mode only).
+    old_patch: Vec<[P3; 3]>,
+    normals: Vec<P3>,
+    cand: Vec<u32>,
+}
+
 /// The working mesh plus everything needed to check local operations. See the module docs.
 pub(crate) struct Guard<'a> {
     mesh: HalfEdgeMesh,
@@ -169,18 +197,26 @@ pub(crate) struct Guard<'a> {
     cage: bool,
     exact_only: bool,
     cone_cos: f64,
-    /// Face marks: `in_e[f] == epoch` ⇔ f ∈ M_e; `in_1[f] == epoch` ⇔ f ∈ M_1.
-    in_e: Vec<u32>,
-    in_1: Vec<u32>,
-    epoch: u32,
-    /// Scratch lists.
-    m_e: Vec<u32>,
-    m_1: Vec<u32>,
-    cand: Vec<u32>,
+    scratch: GuardScratch,
     /// Leaf updates since the BVH was last built (it is rebuilt when they exceed the face
     /// count: incremental edits degrade the tree).
     edits: usize,
     pub stats: GuardStats,
+}
+
+impl GuardStats {
+    /// Adds `o`'s counters to these.
+    pub fn add(&mut self, o: &GuardStats) {
+        self.checks += o.checks;
+        self.accepted += o.accepted;
+        self.rejected_topology += o.rejected_topology;
+        self.rejected_degenerate += o.rejected_degenerate;
+        self.rejected_intersection += o.rejected_intersection;
+        self.rejected_touch += o.rejected_touch;
+        self.rejected_uncover += o.rejected_uncover;
+        self.cone_fast_path += o.cone_fast_path;
+        self.exact_tests += o.exact_tests;
+    }
 }
 
 impl<'a> Guard<'a> {
@@ -193,7 +229,6 @@ impl<'a> Guard<'a> {
             tris[f as usize] = mesh.face_vertices(f);
         }
         let bvh = TriangleBvh::from_subset(mesh.positions(), &tris, &live);
-        let n = mesh.face_capacity();
         Guard {
             mesh,
             tris,
@@ -202,12 +237,7 @@ impl<'a> Guard<'a> {
             cage,
             exact_only: false,
             cone_cos: CONE_HALF_ANGLE.cos(),
-            in_e: vec![0; n],
-            in_1: vec![0; n],
-            epoch: 0,
-            m_e: Vec::new(),
-            m_1: Vec::new(),
-            cand: Vec::new(),
+            scratch: GuardScratch::default(),
             edits: 0,
             stats: GuardStats::default(),
         }
@@ -228,89 +258,94 @@ impl<'a> Guard<'a> {
         self.input
     }
 
-    /// Corner positions of the live faces around `v`.
-    fn ring_triangles(&self, v: u32, out: &mut Vec<[P3; 3]>) {
-        out.extend(
-            self.mesh
-                .vertex_faces(v)
-                .map(|f| self.mesh.face_positions(f)),
-        );
-    }
-
     /// Moves vertex `v` to `p` if the result passes every check; returns whether it did.
     pub fn try_move(&mut self, v: u32, p: P3) -> Result<(), Reject> {
         let old_p = self.mesh.position(v);
-        let mut old_patch = Vec::new();
+        let mut s = std::mem::take(&mut self.scratch);
+        s.old_patch.clear();
         if self.cage {
-            self.ring_triangles(v, &mut old_patch);
+            let m = &self.mesh;
+            s.old_patch
+                .extend(m.vertex_faces(v).map(|f| m.face_positions(f)));
         }
         if self.mesh.set_position(v, p).is_err() {
+            self.scratch = s;
             return Err(Reject::Degenerate);
         }
-        let faces: Vec<u32> = self.mesh.vertex_faces(v).collect();
-        match self.check_patch(&faces, &old_patch) {
+        self.fill_move(v, &mut s);
+        let mut st = GuardStats::default();
+        let r = self.check(&mut s, &mut st);
+        self.stats.add(&st);
+        match r {
             Ok(()) => {
+                let faces: Vec<u32> = s.m_1[..s.n_e].iter().map(|f| f.id).collect();
                 self.bvh.update(self.mesh.positions(), &self.tris, &faces);
-                Ok(())
             }
-            Err(r) => {
+            Err(_) => {
                 self.mesh
                     .set_position(v, old_p)
                     .expect("restoring a previous finite position");
-                Err(r)
             }
         }
+        self.scratch = s;
+        r
     }
 
     /// Collapses half-edge `h` (its target merges into its origin, which moves to `p`) if the
-    /// result passes every check; the mesh is unchanged on `Err`.
+    /// result passes every check; the mesh is unchanged on `Err`. (The simplification pass
+    /// uses [`check_collapse`](Self::check_collapse) and
+    /// [`commit_collapse`](Self::commit_collapse), which this composes.)
+    #[cfg(test)]
     pub fn try_collapse(&mut self, h: u32, p: P3) -> Result<CollapseRecord, Reject> {
         if self.mesh.can_collapse(h).is_err() {
             self.stats.checks += 1;
             self.stats.rejected_topology += 1;
             return Err(Reject::Topology);
         }
-        let mut old_patch = Vec::new();
-        if self.cage {
-            let (a, b) = (self.mesh.origin(h), self.mesh.target(h));
-            self.ring_triangles(a, &mut old_patch);
-            let shared = self.mesh.face(h).into_iter().chain(self.mesh.face(h ^ 1));
-            let shared: Vec<u32> = shared.collect();
-            old_patch.extend(
-                self.mesh
-                    .vertex_faces(b)
-                    .filter(|f| !shared.contains(f))
-                    .map(|f| self.mesh.face_positions(f)),
-            );
+        let mut s = std::mem::take(&mut self.scratch);
+        let mut st = GuardStats::default();
+        let r = self.check_collapse(h, p, &mut s, &mut st);
+        self.stats.add(&st);
+        self.scratch = s;
+        r?;
+        Ok(self.commit_collapse(h, p))
+    }
+
+    /// Checks 2–4 of the module docs for collapsing `h` to `p`, **without changing anything**:
+    /// the state after the collapse is read through the unchanged mesh (faces around the
+    /// endpoints with the target renamed to the origin, the origin at `p`), so checks of
+    /// collapses with disjoint neighbourhoods can run in parallel. `h` must pass
+    /// [`HalfEdgeMesh::can_collapse`]. `st` counts the work.
+    pub fn check_collapse(
+        &self,
+        h: u32,
+        p: P3,
+        s: &mut GuardScratch,
+        st: &mut GuardStats,
+    ) -> Result<(), Reject> {
+        self.fill_collapse(h, p, s);
+        self.check(s, st)
+    }
+
+    /// Applies the collapse of `h` to `p` and updates the BVH. Only for a collapse that
+    /// `check_collapse` accepted on the current mesh — or on a mesh
+    /// that differs from it only by operations outside the collapse's `M_1` whose new faces
+    /// were then tested against its `M_e` (see [`patches_intersect`]).
+    pub fn commit_collapse(&mut self, h: u32, p: P3) -> CollapseRecord {
+        let rec = self
+            .mesh
+            .collapse_edge(h, p)
+            .expect("a collapse that passed the guard's checks");
+        for &f in &rec.removed_faces {
+            self.bvh.remove(f);
         }
-        let rec = match self.mesh.collapse_edge(h, p) {
-            Ok(r) => r,
-            Err(_) => {
-                self.stats.checks += 1;
-                self.stats.rejected_topology += 1;
-                return Err(Reject::Topology);
-            }
-        };
-        match self.check_patch(&rec.modified_faces, &old_patch) {
-            Ok(()) => {
-                for &f in &rec.removed_faces {
-                    self.bvh.remove(f);
-                }
-                for &f in &rec.modified_faces {
-                    self.tris[f as usize] = self.mesh.face_vertices(f);
-                }
-                self.bvh
-                    .update(self.mesh.positions(), &self.tris, &rec.modified_faces);
-                self.note_edits(rec.modified_faces.len() + rec.removed_faces.len());
-                Ok(rec)
-            }
-            Err(r) => {
-                self.mesh
-                    .undo(rec.undo)
-                    .expect("undo of the operation just applied");
-                Err(r)
-            }
+        for &f in &rec.modified_faces {
+            self.tris[f as usize] = self.mesh.face_vertices(f);
         }
+        self.bvh
+            .update(self.mesh.positions(), &self.tris, &rec.modified_faces);
+        self.note_edits(rec.modified_faces.len() + rec.removed_faces.len());
+        rec
     }
 
     /// Counts leaf edits and rebuilds the BVH when they exceed the live face count.
@@ -323,118 +358,174 @@ impl<'a> Guard<'a> {
         }
     }
 
-    /// Runs checks 2–4 of the module docs on the modified faces `m_e` of the current mesh.
-    /// `old_patch` (cage mode only) is the geometry `m_e` replaced.
-    fn check_patch(&mut self, m_e: &[u32], old_patch: &[[P3; 3]]) -> Result<(), Reject> {
-        self.stats.checks += 1;
-        let r = self.check_patch_inner(m_e, old_patch);
+    /// Neighbourhood of a vertex that was just moved (the mesh holds the new position).
+    fn fill_move(&self, v: u32, s: &mut GuardScratch) {
+        let m = &self.mesh;
+        s.m_1.clear();
+        s.verts.clear();
+        for f in m.vertex_faces(v) {
+            let fv = m.face_vertices(f);
+            s.m_1.push(NFace {
+                id: f,
+                v: fv,
+                t: fv.map(|u| m.position(u)),
+            });
+            s.verts.extend(fv);
+        }
+        s.n_e = s.m_1.len();
+        s.verts.sort_unstable();
+        s.verts.dedup();
+        s.excluded.clear();
+        for &u in &s.verts {
+            s.excluded.extend(m.vertex_faces(u));
+        }
+        s.excluded.sort_unstable();
+        s.excluded.dedup();
+        for &g in &s.excluded {
+            if s.m_1[..s.n_e].iter().any(|f| f.id == g) {
+                continue;
+            }
+            let gv = m.face_vertices(g);
+            s.m_1.push(NFace {
+                id: g,
+                v: gv,
+                t: gv.map(|u| m.position(u)),
+            });
+        }
+    }
+
+    /// Neighbourhood after collapsing `h = a→b` to `p`, read from the unchanged mesh: faces
+    /// keep their ids, `b` becomes `a`, `a` sits at `p`, the faces of the edge disappear.
+    fn fill_collapse(&self, h: u32, p: P3, s: &mut GuardScratch) {
+        let m = &self.mesh;
+        let (a, b) = (m.origin(h), m.target(h));
+        let dying = [m.face(h), m.face(h ^ 1)];
+        let map = |v: u32| if v == b { a } else { v };
+        let pos = |v: u32| if v == a { p } else { m.position(v) };
+        s.m_1.clear();
+        s.verts.clear();
+        s.old_patch.clear();
+        s.excluded.clear();
+        // M_e: the faces around a and b except the edge's own (the link condition makes those
+        // the only faces with both endpoints).
+        for f in m.vertex_faces(a).chain(
+            m.vertex_faces(b)
+                .filter(|&f| !m.face_vertices(f).contains(&a)),
+        ) {
+            let fv = m.face_vertices(f);
+            s.excluded.push(f);
+            if self.cage {
+                s.old_patch.push(fv.map(|u| m.position(u)));
+            }
+            if dying.contains(&Some(f)) {
+                continue;
+            }
+            let nv = fv.map(map);
+            s.m_1.push(NFace {
+                id: f,
+                v: nv,
+                t: nv.map(pos),
+            });
+            s.verts.extend(nv);
+        }
+        s.n_e = s.m_1.len();
+        s.verts.sort_unstable();
+        s.verts.dedup();
+        for &u in &s.verts {
+            if u != a {
+                s.excluded.extend(m.vertex_faces(u));
+            }
+        }
+        s.excluded.sort_unstable();
+        s.excluded.dedup();
+        for i in 0..s.excluded.len() {
+            let g = s.excluded[i];
+            if dying.contains(&Some(g)) || s.m_1[..s.n_e].iter().any(|f| f.id == g) {
+                continue;
+            }
+            let gv = m.face_vertices(g).map(map);
+            s.m_1.push(NFace {
+                id: g,
+                v: gv,
+                t: gv.map(pos),
+            });
+        }
+    }
+
+    /// Runs checks 2–4 of the module docs on the neighbourhood in `s`, counting in `st`.
+    fn check(&self, s: &mut GuardScratch, st: &mut GuardStats) -> Result<(), Reject> {
+        st.checks += 1;
+        let r = self.check_inner(s, st);
         match r {
-            Ok(()) => self.stats.accepted += 1,
-            Err(Reject::Topology) => self.stats.rejected_topology += 1,
-            Err(Reject::Degenerate) => self.stats.rejected_degenerate += 1,
-            Err(Reject::SelfIntersection) => self.stats.rejected_intersection += 1,
-            Err(Reject::TouchesInput) => self.stats.rejected_touch += 1,
-            Err(Reject::Uncovers) => self.stats.rejected_uncover += 1,
+            Ok(()) => st.accepted += 1,
+            Err(Reject::Topology) => st.rejected_topology += 1,
+            Err(Reject::Degenerate) => st.rejected_degenerate += 1,
+            Err(Reject::SelfIntersection) => st.rejected_intersection += 1,
+            Err(Reject::TouchesInput) => st.rejected_touch += 1,
+            Err(Reject::Uncovers) => st.rejected_uncover += 1,
         }
         r
     }
 
-    fn check_patch_inner(&mut self, m_e: &[u32], old_patch: &[[P3; 3]]) -> Result<(), Reject> {
-        if m_e.iter().any(|&f| {
-            let [a, b, c] = self.mesh.face_positions(f);
-            sp::is_collinear(a, b, c)
-        }) {
+    fn check_inner(&self, s: &mut GuardScratch, st: &mut GuardStats) -> Result<(), Reject> {
+        if s.m_1[..s.n_e]
+            .iter()
+            .any(|f| sp::is_collinear(f.t[0], f.t[1], f.t[2]))
+        {
             return Err(Reject::Degenerate);
         }
-        self.collect_neighbourhood(m_e);
-        let cone_ok = !self.exact_only && self.normal_cone_is_narrow();
+        let cone_ok = !self.exact_only && self.normal_cone_is_narrow(s);
         if cone_ok {
-            self.stats.cone_fast_path += 1;
+            st.cone_fast_path += 1;
         }
-        self.check_within_m1(cone_ok)?;
-        self.check_against_rest()?;
+        check_within_m1(s, cone_ok, st)?;
+        self.check_against_rest(s, st)?;
         if self.cage {
-            self.check_input_untouched()?;
-            self.check_enclosure(old_patch)?;
+            self.check_input_untouched(s, st)?;
+            self.check_enclosure(s)?;
         }
         Ok(())
     }
 
-    /// Fills `m_e`/`m_1` and their marks with a new epoch.
-    fn collect_neighbourhood(&mut self, m_e: &[u32]) {
-        self.epoch = self.epoch.wrapping_add(1);
-        if self.epoch == 0 {
-            self.in_e.fill(0);
-            self.in_1.fill(0);
-            self.epoch = 1;
-        }
-        let ep = self.epoch;
-        self.m_e.clear();
-        self.m_1.clear();
-        for &f in m_e {
-            self.in_e[f as usize] = ep;
-            self.m_e.push(f);
-        }
-        for &f in m_e {
-            for v in self.mesh.face_vertices(f) {
-                for g in self.mesh.vertex_faces(v) {
-                    if self.in_1[g as usize] != ep {
-                        self.in_1[g as usize] = ep;
-                        self.m_1.push(g);
-                    }
-                }
-            }
-        }
-    }
-
     /// Surface-normal test of §4.3.3 on `M_1`: all unit normals within [`CONE_HALF_ANGLE`] of
     /// their mean direction.
-    fn normal_cone_is_narrow(&self) -> bool {
-        let mut normals = Vec::with_capacity(self.m_1.len());
+    fn normal_cone_is_narrow(&self, s: &mut GuardScratch) -> bool {
+        s.normals.clear();
         let mut sum = [0.0; 3];
-        for &f in &self.m_1 {
-            let Some(n) = normalized(self.mesh.face_area_vector(f)) else {
+        for f in &s.m_1 {
+            let Some(n) = normalized(tri_normal(&f.t)) else {
                 return false;
             };
             sum = super::vec3::add(sum, n);
-            normals.push(n);
+            s.normals.push(n);
         }
         let Some(axis) = normalized(sum) else {
             return false;
         };
-        normals.iter().all(|&n| dot(n, axis) > self.cone_cos)
+        s.normals.iter().all(|&n| dot(n, axis) > self.cone_cos)
     }
 
-    fn faces_intersect(&mut self, f: u32, g: u32) -> bool {
-        self.stats.exact_tests += 1;
-        let a = self.mesh.face_vertices(f);
-        let b = self.mesh.face_vertices(g);
-        sp::faces_intersect(self.mesh.positions(), a, b)
-    }
-
-    /// `M_1` is intersection-free given it was before: pairs (f ∈ M_e, g ∈ M_1).
-    fn check_within_m1(&mut self, cone_ok: bool) -> Result<(), Reject> {
-        let ep = self.epoch;
-        for i in 0..self.m_e.len() {
-            let f = self.m_e[i];
-            let fv = self.mesh.face_vertices(f);
-            let fbox = bbox_of(fv.map(|v| self.mesh.position(v)));
-            for j in 0..self.m_1.len() {
-                let g = self.m_1[j];
-                // Pairs inside M_e once (f before g in m_e order).
-                if g == f || (self.in_e[g as usize] == ep && self.m_e[..i].contains(&g)) {
+    /// `M_e` does not meet `M_r` (Alg. 7 with exact tests on all BVH candidates): one BVH
+    /// query with the box of `M_e`, then per-face box filtering. Faces outside `M_1` do not
+    /// touch the operation's vertices, so their stored geometry is current.
+    fn check_against_rest(&self, s: &mut GuardScratch, st: &mut GuardStats) -> Result<(), Reject> {
+        let m_e = &s.m_1[..s.n_e];
+        let (lo, hi) = bbox_of(m_e.iter().flat_map(|f| f.t));
+        s.cand.clear();
+        s.cand.extend(
+            self.bvh
+                .query_box(lo, hi)
+                .filter(|&g| s.excluded.binary_search(&g).is_err() && self.mesh.is_face_live(g)),
+        );
+        for &g in &s.cand {
+            let gt = self.tris[g as usize].map(|v| self.mesh.position(v));
+            let gbox = bbox_of(gt);
+            for f in m_e {
+                if !boxes_overlap(bbox_of(f.t), gbox) {
                     continue;
                 }
-                let gv = self.mesh.face_vertices(g);
-                let shares = gv.iter().any(|v| fv.contains(v));
-                if shares && cone_ok {
-                    continue;
-                }
-                let gbox = bbox_of(gv.map(|v| self.mesh.position(v)));
-                if !boxes_overlap(fbox, gbox) {
-                    continue;
-                }
-                if self.faces_intersect(f, g) {
+                st.exact_tests += 1;
+                if sp::triangles_intersect(&f.t, &gt) {
                     return Err(Reject::SelfIntersection);
                 }
             }
@@ -442,55 +533,13 @@ impl<'a> Guard<'a> {
         Ok(())
     }
 
-    /// `M_e` does not meet `M_r` (Alg. 7 with exact tests on all BVH candidates): one BVH
-    /// query with the box of `M_e`, then per-face box filtering.
-    fn check_against_rest(&mut self) -> Result<(), Reject> {
-        let ep = self.epoch;
-        let tris: Vec<[P3; 3]> = self
-            .m_e
-            .iter()
-            .map(|&f| self.mesh.face_positions(f))
-            .collect();
-        let boxes: Vec<(P3, P3)> = tris.iter().map(|t| bbox_of(*t)).collect();
-        let (lo, hi) = bbox_of(boxes.iter().flat_map(|b| [b.0, b.1]));
-        let mut cand = std::mem::take(&mut self.cand);
-        cand.clear();
-        cand.extend(
-            self.bvh
-                .query_box(lo, hi)
-                .filter(|&g| self.in_1[g as usize] != ep && self.mesh.is_face_live(g)),
-        );
-        let mut hit = false;
-        'outer: for &g in &cand {
-            let gt = self.tris[g as usize].map(|v| self.mesh.position(v));
-            let gbox = bbox_of(gt);
-            for (tri, fbox) in tris.iter().zip(&boxes) {
-                if !boxes_overlap(*fbox, gbox) {
-                    continue;
-                }
-                self.stats.exact_tests += 1;
-                if sp::triangles_intersect(tri, &gt) {
-                    hit = true;
-                    break 'outer;
-                }
-            }
-        }
-        self.cand = cand;
-        if hit {
-            Err(Reject::SelfIntersection)
-        } else {
-            Ok(())
-        }
-    }
-
     /// Cage mode: `M_e` does not touch the input.
-    fn check_input_untouched(&mut self) -> Result<(), Reject> {
+    fn check_input_untouched(&self, s: &GuardScratch, st: &mut GuardStats) -> Result<(), Reject> {
         let input = self.input;
-        for &f in &self.m_e {
-            let tri = self.mesh.face_positions(f);
-            for t in input.bvh.query_triangle(&tri) {
-                self.stats.exact_tests += 1;
-                if touches_input_triangle(&tri, &input.triangle(t), input.degenerate[t as usize]) {
+        for f in &s.m_1[..s.n_e] {
+            for t in input.bvh.query_triangle(&f.t) {
+                st.exact_tests += 1;
+                if touches_input_triangle(&f.t, &input.triangle(t), input.degenerate[t as usize]) {
                     return Err(Reject::TouchesInput);
                 }
             }
@@ -499,19 +548,21 @@ impl<'a> Guard<'a> {
     }
 
     /// Cage mode: no input vertex in the swept box changes winding number.
-    fn check_enclosure(&self, old_patch: &[[P3; 3]]) -> Result<(), Reject> {
+    fn check_enclosure(&self, s: &GuardScratch) -> Result<(), Reject> {
         let Some((pts, pbvh)) = &self.input.points else {
             return Ok(());
         };
-        let new_patch: Vec<[P3; 3]> = self
-            .m_e
-            .iter()
-            .map(|&f| self.mesh.face_positions(f))
-            .collect();
-        let (lo, hi) = bbox_of(new_patch.iter().chain(old_patch).flatten().copied());
+        let new_patch = &s.m_1[..s.n_e];
+        let old_patch = &s.old_patch;
+        let (lo, hi) = bbox_of(
+            new_patch
+                .iter()
+                .flat_map(|f| f.t)
+                .chain(old_patch.iter().flatten().copied()),
+        );
         for i in pbvh.query_box(lo, hi) {
             let q = self.input.positions[pts[i as usize][0] as usize];
-            let new_w: f64 = new_patch.iter().map(|t| solid_angle(*t, q)).sum();
+            let new_w: f64 = new_patch.iter().map(|f| solid_angle(f.t, q)).sum();
             let old_w: f64 = old_patch.iter().map(|t| solid_angle(*t, q)).sum();
             let dw = (new_w - old_w) / (4.0 * std::f64::consts::PI);
             if dw.abs() > 0.25 {
@@ -522,7 +573,54 @@ impl<'a> Guard<'a> {
     }
 }
 
-fn boxes_overlap(a: (P3, P3), b: (P3, P3)) -> bool {
+/// `M_1` is intersection-free given it was before: pairs (f ∈ M_e, g ∈ M_1), each once. Pairs
+/// sharing a vertex (which no box test can cull) are skipped when the normal cone is narrow.
+fn check_within_m1(s: &GuardScratch, cone_ok: bool, st: &mut GuardStats) -> Result<(), Reject> {
+    for i in 0..s.n_e {
+        let f = &s.m_1[i];
+        let fbox = bbox_of(f.t);
+        for g in &s.m_1[i + 1..] {
+            let shares = g.v.iter().any(|v| f.v.contains(v));
+            if shares && cone_ok {
+                continue;
+            }
+            if !boxes_overlap(fbox, bbox_of(g.t)) {
+                continue;
+            }
+            st.exact_tests += 1;
+            if sp::faces_intersect_at(f.v, &f.t, g.v, &g.t) {
+                return Err(Reject::SelfIntersection);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether two new patches `M_e` of collapses checked in the same batch meet. The collapses'
+/// neighbourhoods `M_1` are disjoint, so the patches share no vertex and plain exact
+/// triangle–triangle tests (touching counts) decide; each patch was checked against everything
+/// else, so this is the only pair the batch's checks did not see (§4.3.3: `M_e` against the
+/// rest, with part of the rest changed by the other collapse).
+pub(crate) fn patches_intersect(a: &[[P3; 3]], b: &[[P3; 3]], st: &mut GuardStats) -> bool {
+    let (alo, ahi) = bbox_of(a.iter().flatten().copied());
+    let (blo, bhi) = bbox_of(b.iter().flatten().copied());
+    if !boxes_overlap((alo, ahi), (blo, bhi)) {
+        return false;
+    }
+    a.iter().any(|ta| {
+        let abox = bbox_of(*ta);
+        b.iter().any(|tb| {
+            if !boxes_overlap(abox, bbox_of(*tb)) {
+                return false;
+            }
+            st.exact_tests += 1;
+            sp::triangles_intersect(ta, tb)
+        })
+    })
+}
+
+/// Closed box overlap test.
+pub(crate) fn boxes_overlap(a: (P3, P3), b: (P3, P3)) -> bool {
     (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
 }
 

@@ -459,6 +459,7 @@ impl LoopStats {
         s.count("rejected_hausdorff", self.simplify.rejected_hausdorff);
         s.count("rejected_distance", self.simplify.rejected_distance);
         s.count("rejected_guard", self.simplify.rejected_guard);
+        s.count("collapses_rechecked", self.simplify.rechecked);
         let g = &self.guard;
         s.count("guard_checks", g.checks);
         s.count("guard_rejected_topology", g.rejected_topology);
@@ -483,6 +484,7 @@ fn add_simplify(acc: &mut SimplifyReport, r: &SimplifyReport) {
     acc.rejected_hausdorff += r.rejected_hausdorff;
     acc.rejected_distance += r.rejected_distance;
     acc.rejected_guard += r.rejected_guard;
+    acc.rechecked += r.rechecked;
 }
 
 /// Alg. 3 line 17: the sampled two-sided Hausdorff distance between the meshes before and

@@ -30,13 +30,19 @@
 //! midpoint lies on the chord, closer to it.
 //!
 //! The pass stops when the queue is empty or the face count reaches the target `n_F`.
+//!
+//! On large meshes (the dense offset surface of the first pass) candidates are evaluated in
+//! parallel, in batches of collapses with disjoint neighbourhoods taken in queue order and
+//! applied in that order (see `Pass::run`); the batches never depend on the thread count, so
+//! neither does the output. Alg. 5 is sequential; the batches reorder it only where collapses
+//! are independent of each other, except that a collapse's re-queued neighbours wait for the
+//! rest of its batch.
 
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
+use rayon::prelude::*;
 
-use super::guard::Guard;
+use super::guard::{boxes_overlap, patches_intersect, Guard, GuardScratch, GuardStats};
 use super::vec3::{
-    add, cross, dist, dot, for_each_sample, norm, normalized, point_triangle_distance,
+    add, bbox_of, cross, dist, dot, for_each_sample, norm, normalized, point_triangle_distance,
     sample_resolution, scale, sub, tri_normal, P3,
 };
 use crate::mesh::halfedge::INVALID;
@@ -70,6 +76,9 @@ pub(crate) struct SimplifyReport {
     pub rejected_hausdorff: u64,
     pub rejected_distance: u64,
     pub rejected_guard: u64,
+    /// Accepted collapses whose new faces met those of an earlier collapse of their batch and
+    /// were evaluated again (see `Pass::run`).
+    pub rechecked: u64,
 }
 
 /// A symmetric quadric `Q(x) = xᵀAx + 2bᵀx + c`.
@@ -205,25 +214,89 @@ struct Entry {
     version: u32,
 }
 
-impl PartialEq for Entry {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
+impl Entry {
+    /// Queue order: cheapest first, ties by smallest edge id.
+    fn before(&self, o: &Entry) -> bool {
+        self.cost
+            .total_cmp(&o.cost)
+            .then_with(|| self.edge.cmp(&o.edge))
+            .is_lt()
     }
 }
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
+
+/// The collapse queue: a 4-ary min-heap in [`Entry::before`] order. A first pass pops millions
+/// of entries, most of them stale (lazy deletion: an edge is pushed again whenever its cost
+/// changes); four children per node halve the depth of a binary heap and sit in one or two
+/// cache lines, which is what a pop on a heap of a million entries pays for.
+#[derive(Debug, Default)]
+struct Queue {
+    v: Vec<Entry>,
+}
+
+impl Queue {
+    fn with_capacity(n: usize) -> Queue {
+        Queue {
+            v: Vec::with_capacity(n),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.v.len()
+    }
+
+    fn push(&mut self, e: Entry) {
+        let mut i = self.v.len();
+        self.v.push(e);
+        while i > 0 {
+            let p = (i - 1) / 4;
+            if !e.before(&self.v[p]) {
+                break;
+            }
+            self.v[i] = self.v[p];
+            i = p;
+        }
+        self.v[i] = e;
+    }
+
+    fn pop(&mut self) -> Option<Entry> {
+        let last = self.v.pop()?;
+        if self.v.is_empty() {
+            return Some(last);
+        }
+        let top = self.v[0];
+        let n = self.v.len();
+        let mut i = 0;
+        loop {
+            let c = 4 * i + 1;
+            if c >= n {
+                break;
+            }
+            let mut best = c;
+            for j in c + 1..(c + 4).min(n) {
+                if self.v[j].before(&self.v[best]) {
+                    best = j;
+                }
+            }
+            if !self.v[best].before(&last) {
+                break;
+            }
+            self.v[i] = self.v[best];
+            i = best;
+        }
+        self.v[i] = last;
+        Some(top)
     }
 }
-impl Ord for Entry {
-    /// Reversed, so that `BinaryHeap` pops the cheapest edge (ties: smallest edge id).
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.cost
-            .total_cmp(&self.cost)
-            .then_with(|| o.edge.cmp(&self.edge))
-    }
-}
+
+/// An axis-aligned box `(min, max)`.
+type Aabb = (P3, P3);
+
+/// Largest number of candidate collapses evaluated together (see [`Pass::run`]).
+const BATCH: usize = 64;
+
+/// Batches are formed while the mesh has at least this many faces; below, candidates are
+/// evaluated one at a time (a batch of one), in pure cost order.
+const BATCH_MIN_FACES: usize = 2048;
 
 /// The state of one pass.
 struct Pass<'g, 'a> {
@@ -232,12 +305,41 @@ struct Pass<'g, 'a> {
     quadrics: Vec<Quadric>,
     version: Vec<u32>,
     targets: Vec<P3>,
-    heap: BinaryHeap<Entry>,
+    heap: Queue,
     /// Sampled max distance to the input per face (NaN = not computed yet).
     face_dist: Vec<f64>,
     /// Distance to the input per vertex (NaN = not computed yet).
     vert_dist: Vec<f64>,
+    /// Vertex marks of the batch being formed: `mark_w[v] == epoch` ⇔ `v` is written by a
+    /// selected collapse (endpoint or one-ring), `mark_r[v] == epoch` ⇔ `v` is read by one (its
+    /// two-ring, which holds the vertices of its `M_1`).
+    mark_w: Vec<u32>,
+    mark_r: Vec<u32>,
+    epoch: u32,
+    /// Scratch: the vertices `W` of a candidate's footprint.
+    footprint: Vec<u32>,
+    scratch: GuardScratch,
     report: SimplifyReport,
+}
+
+/// A candidate collapse that passed every check (see [`Pass::evaluate`]).
+struct Accepted {
+    h: u32,
+    a: u32,
+    b: u32,
+    x: P3,
+    new: Patch,
+    new_face_dist: Vec<f64>,
+}
+
+/// The result of evaluating one candidate collapse against an unchanged mesh, with the
+/// distances computed on the way (cache fills, written when the result is applied) and the
+/// guard's counters.
+struct Eval {
+    outcome: std::result::Result<Accepted, Rejection>,
+    vert_dist: Vec<(u32, f64)>,
+    face_dist: Vec<(u32, f64)>,
+    guard: GuardStats,
 }
 
 /// Runs one pass of Alg. 5 on the guard's mesh. `keep_going` is polled now and then with the
@@ -261,7 +363,12 @@ impl<'g, 'a> Pass<'g, 'a> {
             targets: vec![[0.0; 3]; m.edge_capacity()],
             face_dist: vec![f64::NAN; m.face_capacity()],
             vert_dist: vec![f64::NAN; m.vertex_capacity()],
-            heap: BinaryHeap::with_capacity(m.edge_count()),
+            mark_w: vec![0; m.vertex_capacity()],
+            mark_r: vec![0; m.vertex_capacity()],
+            epoch: 0,
+            footprint: Vec::new(),
+            heap: Queue::with_capacity(m.edge_count()),
+            scratch: GuardScratch::default(),
             quadrics,
             opt,
             report: SimplifyReport::default(),
@@ -294,75 +401,206 @@ impl<'g, 'a> Pass<'g, 'a> {
         });
     }
 
+    /// The queue loop. Candidates are taken in cost order in **batches** of collapses whose
+    /// neighbourhoods are disjoint (no vertex written by one is read by another; see
+    /// [`reserve`](Self::reserve)); a candidate that overlaps the batch goes back to the queue
+    /// for the next one. A batch is evaluated read-only — in parallel — against the mesh as it
+    /// was before the batch, then applied sequentially in queue order. Disjointness makes each
+    /// evaluation valid after the earlier collapses of its batch, except for one thing: the
+    /// guard's `M_e`-against-the-rest test (§4.3.3) saw the *old* faces of the other collapses.
+    /// So before a collapse is applied, its new faces are tested against the new faces of the
+    /// collapses already applied from its batch ([`patches_intersect`]); if they meet, the
+    /// candidate is evaluated again against the current mesh. The batches depend only on the
+    /// queue and the mesh, never on the thread count, so the output is the same for any number
+    /// of threads.
     fn run(&mut self, keep_going: &mut dyn FnMut(f64) -> bool) -> Result<()> {
         let total = self.heap.len().max(1) as f64;
         let mut pops = 0u64;
-        while !self.target_reached() {
-            let Some(entry) = self.heap.pop() else { break };
-            pops += 1;
-            if pops % 512 == 0 && !keep_going((pops as f64 / total).min(1.0)) {
-                return Err(Error::Cancelled);
+        let mut batch: Vec<u32> = Vec::with_capacity(BATCH);
+        let mut deferred: Vec<Entry> = Vec::with_capacity(BATCH);
+        let mut applied: Vec<(Vec<[P3; 3]>, Aabb)> = Vec::with_capacity(BATCH);
+        'pass: while !self.target_reached() {
+            let cap = if self.g.mesh().face_count() >= BATCH_MIN_FACES {
+                BATCH
+            } else {
+                1
+            };
+            self.new_epoch();
+            batch.clear();
+            deferred.clear();
+            while batch.len() < cap && deferred.len() < cap {
+                let Some(entry) = self.heap.pop() else { break };
+                pops += 1;
+                if pops % 512 == 0 && !keep_going((pops as f64 / total).min(1.0)) {
+                    return Err(Error::Cancelled);
+                }
+                let e = entry.edge;
+                if entry.version != self.version[e as usize] || !self.g.mesh().is_edge_live(e) {
+                    continue;
+                }
+                if cap > 1 && !self.reserve(e) {
+                    deferred.push(entry);
+                    continue;
+                }
+                batch.push(e);
             }
-            let e = entry.edge;
-            if entry.version != self.version[e as usize] || !self.g.mesh().is_edge_live(e) {
-                continue;
+            for d in deferred.drain(..) {
+                self.heap.push(d);
             }
-            self.report.candidates += 1;
-            self.try_edge(e, self.targets[e as usize]);
+            if batch.is_empty() {
+                break;
+            }
+            let evals: Vec<Eval> = if batch.len() == 1 {
+                let mut s = std::mem::take(&mut self.scratch);
+                let ev = self.evaluate(batch[0], &mut s);
+                self.scratch = s;
+                vec![ev]
+            } else {
+                let this = &*self;
+                batch
+                    .par_iter()
+                    .map_init(GuardScratch::default, |s, &e| this.evaluate(e, s))
+                    .collect()
+            };
+            applied.clear();
+            for (&e, mut ev) in batch.iter().zip(evals) {
+                if self.target_reached() {
+                    break 'pass;
+                }
+                self.report.candidates += 1;
+                let meets = match &ev.outcome {
+                    Ok(acc) if !applied.is_empty() => {
+                        let st = &mut self.g.stats;
+                        let abox = bbox_of(acc.new.tris.iter().flatten().copied());
+                        applied.iter().any(|(p, pbox)| {
+                            boxes_overlap(abox, *pbox) && patches_intersect(&acc.new.tris, p, st)
+                        })
+                    }
+                    _ => false,
+                };
+                if meets {
+                    self.report.rechecked += 1;
+                    self.fill_caches(&mut ev);
+                    let mut s = std::mem::take(&mut self.scratch);
+                    ev = self.evaluate(e, &mut s);
+                    self.scratch = s;
+                }
+                if let Ok(acc) = &ev.outcome {
+                    let abox = bbox_of(acc.new.tris.iter().flatten().copied());
+                    applied.push((acc.new.tris.clone(), abox));
+                }
+                self.apply(ev);
+            }
         }
         Ok(())
     }
 
-    /// Checks and performs the collapse of edge `e`, trying the quadric optimum `x` first and
-    /// then the edge midpoint and the two endpoints (see the module docs).
-    fn try_edge(&mut self, e: u32, x: P3) {
+    /// Starts a new batch (clears the vertex marks).
+    fn new_epoch(&mut self) {
+        self.epoch = self.epoch.wrapping_add(1);
+        if self.epoch == 0 {
+            self.mark_w.fill(0);
+            self.mark_r.fill(0);
+            self.epoch = 1;
+        }
+    }
+
+    /// Adds the collapse of edge `e` to the batch being formed if its neighbourhood is
+    /// disjoint from the batch's: it writes its endpoints and their one-ring `W` (positions,
+    /// connectivity, cached distances) and reads `W`'s one-ring `R` (the vertices of its guard
+    /// neighbourhood `M_1`). It joins when `W ∩ R' = ∅` and `R ∩ W' = ∅` for the batch's `W'`,
+    /// `R'`; then no collapse of the batch changes anything another one reads except through
+    /// the BVH, which [`run`](Self::run) handles.
+    fn reserve(&mut self, e: u32) -> bool {
+        let m = self.g.mesh();
+        let h = m.edge_halfedge(e);
+        let (a, b) = (m.origin(h), m.target(h));
+        let ep = self.epoch;
+        // W first, then the rest of R (with repeats).
+        let mut fp = std::mem::take(&mut self.footprint);
+        fp.clear();
+        fp.extend([a, b]);
+        fp.extend(m.vertex_neighbors(a));
+        fp.extend(m.vertex_neighbors(b));
+        let n_w = fp.len();
+        let mut free = true;
+        for i in 0..n_w {
+            let v = fp[i];
+            if self.mark_r[v as usize] == ep {
+                free = false;
+                break;
+            }
+            fp.extend(m.vertex_neighbors(v));
+        }
+        free = free && fp[n_w..].iter().all(|&u| self.mark_w[u as usize] != ep);
+        if free {
+            for &v in &fp[..n_w] {
+                self.mark_w[v as usize] = ep;
+            }
+            for &v in &fp {
+                self.mark_r[v as usize] = ep;
+            }
+        }
+        self.footprint = fp;
+        free
+    }
+
+    /// Checks the collapse of edge `e` without changing anything, trying the quadric optimum
+    /// first and then the edge midpoint and the two endpoints (see the module docs).
+    fn evaluate(&self, e: u32, s: &mut GuardScratch) -> Eval {
+        let mut ev = Eval {
+            outcome: Err(Rejection::Guard),
+            vert_dist: Vec::new(),
+            face_dist: Vec::new(),
+            guard: GuardStats::default(),
+        };
         let m = self.g.mesh();
         let h0 = m.edge_halfedge(e);
         let Some(h) = [h0, h0 ^ 1]
             .into_iter()
             .find(|&h| m.can_collapse(h).is_ok())
         else {
-            self.report.rejected_guard += 1;
-            return;
+            return ev;
         };
         let (a, b) = (m.origin(h), m.target(h));
         let (pa, pb) = (m.position(a), m.position(b));
-        let mut candidates = vec![x];
+        let mut candidates = [self.targets[e as usize]; 4];
+        let mut n = 1;
         for c in [scale(add(pa, pb), 0.5), pa, pb] {
-            if !candidates.contains(&c) {
-                candidates.push(c);
+            if !candidates[..n].contains(&c) {
+                candidates[n] = c;
+                n += 1;
             }
         }
-        let mut last = Rejection::Guard;
-        for c in candidates {
-            match self.try_position(h, a, b, c) {
-                Ok(()) => return,
+        for &c in &candidates[..n] {
+            match self.try_position(h, a, b, c, &mut ev, s) {
+                Ok(acc) => {
+                    ev.outcome = Ok(acc);
+                    return ev;
+                }
                 // Another position can cure a fold-over or a patch farther from the input;
                 // a too large change or a guard refusal is rarely cured by moving along the
                 // edge, and retrying would double the cost of those rejections.
-                Err(r @ (Rejection::Fold | Rejection::Distance)) => last = r,
+                Err(r @ (Rejection::Fold | Rejection::Distance)) => ev.outcome = Err(r),
                 Err(r) => {
-                    last = r;
+                    ev.outcome = Err(r);
                     break;
                 }
             }
         }
-        match last {
-            Rejection::Fold => self.report.rejected_fold += 1,
-            Rejection::Hausdorff => self.report.rejected_hausdorff += 1,
-            Rejection::Distance => self.report.rejected_distance += 1,
-            Rejection::Guard => self.report.rejected_guard += 1,
-        }
+        ev
     }
 
-    /// All checks for collapsing `h = a→b` to `x`, and the collapse when they pass.
+    /// All checks for collapsing `h = a→b` to `x`, cheapest first.
     fn try_position(
-        &mut self,
+        &self,
         h: u32,
         a: u32,
         b: u32,
         x: P3,
-    ) -> std::result::Result<(), Rejection> {
+        ev: &mut Eval,
+        s: &mut GuardScratch,
+    ) -> std::result::Result<Accepted, Rejection> {
         let (old, new) = self.patches(h, x);
         if folds_over(&old, &new) {
             return Err(Rejection::Fold);
@@ -370,15 +608,51 @@ impl<'g, 'a> Pass<'g, 'a> {
         if !self.within_hausdorff(a, b, x, &old, &new) {
             return Err(Rejection::Hausdorff);
         }
-        let Some(new_face_dist) = self.distance_not_increased(a, b, x, &old, &new) else {
+        let Some(new_face_dist) = self.distance_not_increased(a, b, x, &old, &new, ev) else {
             return Err(Rejection::Distance);
         };
-        match self.g.try_collapse(h, x) {
-            Ok(rec) => {
-                self.commit(a, b, x, &rec.modified_faces, &new, &new_face_dist);
-                Ok(())
+        self.g
+            .check_collapse(h, x, s, &mut ev.guard)
+            .map_err(|_| Rejection::Guard)?;
+        Ok(Accepted {
+            h,
+            a,
+            b,
+            x,
+            new,
+            new_face_dist,
+        })
+    }
+
+    /// Writes the distances an evaluation computed into the caches.
+    fn fill_caches(&mut self, ev: &mut Eval) {
+        for (v, d) in ev.vert_dist.drain(..) {
+            self.vert_dist[v as usize] = d;
+        }
+        for (f, d) in ev.face_dist.drain(..) {
+            self.face_dist[f as usize] = d;
+        }
+    }
+
+    /// Applies an evaluation: caches, counters and, when accepted, the collapse.
+    fn apply(&mut self, mut ev: Eval) {
+        self.fill_caches(&mut ev);
+        self.g.stats.add(&ev.guard);
+        match ev.outcome {
+            Ok(acc) => {
+                let rec = self.g.commit_collapse(acc.h, acc.x);
+                self.commit(
+                    acc.a,
+                    acc.b,
+                    &rec.modified_faces,
+                    &acc.new,
+                    &acc.new_face_dist,
+                );
             }
-            Err(_) => Err(Rejection::Guard),
+            Err(Rejection::Fold) => self.report.rejected_fold += 1,
+            Err(Rejection::Hausdorff) => self.report.rejected_hausdorff += 1,
+            Err(Rejection::Distance) => self.report.rejected_distance += 1,
+            Err(Rejection::Guard) => self.report.rejected_guard += 1,
         }
     }
 
@@ -390,11 +664,12 @@ impl<'g, 'a> Pass<'g, 'a> {
         let dying = [m.face(h), m.face(h ^ 1)];
         let mut old = Patch::default();
         let mut new = Patch::default();
+        // The link condition (checked before) makes the edge's faces the only ones with both
+        // endpoints.
         let faces_b = m
             .vertex_faces(b)
-            .filter(|f| !m.vertex_faces(a).any(|g| g == *f));
-        let all: Vec<u32> = m.vertex_faces(a).chain(faces_b).collect();
-        for f in all {
+            .filter(|&f| !m.face_vertices(f).contains(&a));
+        for f in m.vertex_faces(a).chain(faces_b) {
             let vs = m.face_vertices(f);
             let t = vs.map(|v| m.position(v));
             old.push(f, vs, t);
@@ -424,11 +699,19 @@ impl<'g, 'a> Pass<'g, 'a> {
         if dist(x, m.position(a)).max(dist(x, m.position(b))) <= d {
             return true;
         }
+        // Consecutive samples are close to each other, so the triangle that was near the last
+        // one is tried first.
+        let hint = std::cell::Cell::new(0usize);
         let near = |p: P3, other: &Patch| -> bool {
-            other
-                .tris
-                .iter()
-                .any(|t| point_triangle_distance(p, t) <= d)
+            let n = other.tris.len();
+            let start = hint.get().min(n.saturating_sub(1));
+            let found = (0..n)
+                .map(|i| (start + i) % n)
+                .find(|&i| point_triangle_distance(p, &other.tris[i]) <= d);
+            if let Some(i) = found {
+                hint.set(i);
+            }
+            found.is_some()
         };
         let one_side = |from: &Patch, to: &Patch, moved: &[(u32, P3)]| -> bool {
             for &(_, p) in moved {
@@ -450,13 +733,30 @@ impl<'g, 'a> Pass<'g, 'a> {
             && one_side(old, new, &[(a, m.position(a)), (b, m.position(b))])
     }
 
-    fn vertex_distance(&mut self, v: u32) -> f64 {
+    /// Distance of vertex `v` to the input, from the cache or computed (and noted in `ev`).
+    fn vertex_distance(&self, v: u32, ev: &mut Eval) -> f64 {
         let d = self.vert_dist[v as usize];
         if !d.is_nan() {
             return d;
         }
-        let d = self.g.input().distance(self.g.mesh().position(v));
-        self.vert_dist[v as usize] = d;
+        if let Some(&(_, d)) = ev.vert_dist.iter().find(|(u, _)| *u == v) {
+            return d;
+        }
+        // A neighbour's known distance bounds this one (the distance field is 1-Lipschitz),
+        // which lets the BVH prune everything farther.
+        let m = self.g.mesh();
+        let p = m.position(v);
+        let ub = m
+            .vertex_neighbors(v)
+            .map(|u| self.vert_dist[u as usize] + dist(p, m.position(u)))
+            .filter(|b| !b.is_nan())
+            .fold(f64::INFINITY, f64::min);
+        let d = if ub.is_finite() {
+            self.g.input().distance_bounded(p, ub)
+        } else {
+            self.g.input().distance(p)
+        };
+        ev.vert_dist.push((v, d));
         d
     }
 
@@ -476,14 +776,19 @@ impl<'g, 'a> Pass<'g, 'a> {
         (sum + self.g.input().distance_bounded(c, ub)) / 4.0
     }
 
-    fn face_distance(&mut self, f: u32, vs: [u32; 3], t: &[P3; 3]) -> f64 {
+    /// Distance of face `f` (vertices `vs`, corners `t`) to the input, from the cache or
+    /// computed (and noted in `ev`).
+    fn face_distance(&self, f: u32, vs: [u32; 3], t: &[P3; 3], ev: &mut Eval) -> f64 {
         let d = self.face_dist[f as usize];
         if !d.is_nan() {
             return d;
         }
-        let corner = vs.map(|v| self.vertex_distance(v));
+        if let Some(&(_, d)) = ev.face_dist.iter().find(|(g, _)| *g == f) {
+            return d;
+        }
+        let corner = vs.map(|v| self.vertex_distance(v, ev));
         let d = self.triangle_distance(t, corner);
-        self.face_dist[f as usize] = d;
+        ev.face_dist.push((f, d));
         d
     }
 
@@ -492,17 +797,18 @@ impl<'g, 'a> Pass<'g, 'a> {
     /// faces' sampled mean distances (see the module docs for why not the maximum). Returns
     /// the new faces' distances when it holds.
     fn distance_not_increased(
-        &mut self,
+        &self,
         a: u32,
         b: u32,
         x: P3,
         old: &Patch,
         new: &Patch,
+        ev: &mut Eval,
     ) -> Option<Vec<f64>> {
         let (mut old_sum, mut old_area) = (0.0, 0.0);
         for i in 0..old.ids.len() {
             let w = norm(tri_normal(&old.tris[i]));
-            old_sum += w * self.face_distance(old.ids[i], old.verts[i], &old.tris[i]);
+            old_sum += w * self.face_distance(old.ids[i], old.verts[i], &old.tris[i], ev);
             old_area += w;
         }
         let old_mean = if old_area > 0.0 {
@@ -513,7 +819,8 @@ impl<'g, 'a> Pass<'g, 'a> {
         let limit = old_mean.max(self.opt.slack) * (1.0 + 1e-9);
         let m = self.g.mesh();
         let (pa, pb) = (m.position(a), m.position(b));
-        let ub = (self.vertex_distance(a) + dist(x, pa)).min(self.vertex_distance(b) + dist(x, pb));
+        let ub = (self.vertex_distance(a, ev) + dist(x, pa))
+            .min(self.vertex_distance(b, ev) + dist(x, pb));
         let dx = self.g.input().distance_bounded(x, ub);
         let (mut new_sum, mut new_area) = (0.0, 0.0);
         let mut out = Vec::with_capacity(new.ids.len());
@@ -524,7 +831,7 @@ impl<'g, 'a> Pass<'g, 'a> {
                 corner[k] = if vs[k] == a {
                     dx
                 } else {
-                    self.vertex_distance(vs[k])
+                    self.vertex_distance(vs[k], ev)
                 };
             }
             let fd = self.triangle_distance(&new.tris[i], corner);
@@ -541,10 +848,9 @@ impl<'g, 'a> Pass<'g, 'a> {
         (new_mean <= limit).then_some(out)
     }
 
-    /// Book-keeping after an accepted collapse of `b` into `a` at `x`.
-    fn commit(&mut self, a: u32, b: u32, x: P3, modified: &[u32], new: &Patch, fd: &[f64]) {
+    /// Book-keeping after an accepted collapse of `b` into `a`.
+    fn commit(&mut self, a: u32, b: u32, modified: &[u32], new: &Patch, fd: &[f64]) {
         self.report.collapses += 1;
-        let _ = x;
         self.quadrics[a as usize] = self.quadrics[a as usize].add(&self.quadrics[b as usize]);
         self.vert_dist[a as usize] = f64::NAN;
         for (i, &f) in new.ids.iter().enumerate() {
@@ -614,6 +920,35 @@ mod tests {
         assert!(dist(x, [1., 2., 3.]) < 1e-12);
         assert!(q.eval(x).abs() < 1e-12);
         assert!((q.eval([0., 2., 3.]) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn queue_pops_in_cost_then_edge_order() {
+        let mut q = Queue::default();
+        let mut expect = Vec::new();
+        let mut x = 12345u64;
+        for i in 0..1000u32 {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let cost = ((x >> 33) % 50) as f64;
+            let e = Entry {
+                cost,
+                edge: i % 300,
+                version: i,
+            };
+            q.push(e);
+            expect.push(e);
+        }
+        expect.sort_by(|a, b| a.cost.total_cmp(&b.cost).then(a.edge.cmp(&b.edge)));
+        let mut got = Vec::new();
+        while let Some(e) = q.pop() {
+            got.push(e);
+        }
+        assert_eq!(got.len(), expect.len());
+        for (g, e) in got.iter().zip(&expect) {
+            assert_eq!((g.cost, g.edge), (e.cost, e.edge));
+        }
     }
 
     #[test]

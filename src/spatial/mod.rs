@@ -12,8 +12,8 @@ pub use self_intersect::{
     has_self_intersection_in, self_intersections, SelfIntersections,
 };
 pub use tritri::{
-    are_coplanar, coplanar_same_side, faces_intersect, is_collinear, orient2d, orient3d,
-    segment_triangle_intersect, sharing, triangles_intersect, Point3, Sharing,
+    are_coplanar, coplanar_same_side, faces_intersect, faces_intersect_at, is_collinear, orient2d,
+    orient3d, segment_triangle_intersect, sharing, triangles_intersect, Point3, Sharing,
 };
 pub use winding::{
     solid_angle, winding_number, winding_number_in, winding_numbers, FastWindingNumber,

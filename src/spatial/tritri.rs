@@ -197,22 +197,23 @@ pub fn sharing(a: [u32; 3], b: [u32; 3]) -> Sharing {
 /// - nothing shared: [`triangles_intersect`] (touching counts).
 pub fn faces_intersect(positions: &[Point3], a: [u32; 3], b: [u32; 3]) -> bool {
     let p = |v: u32| positions[v as usize];
+    faces_intersect_at(a, &a.map(p), b, &b.map(p))
+}
+
+/// [`faces_intersect`] with the corners given: faces `a` and `b` (vertex indices, which decide
+/// what they share) with corner positions `ta` and `tb`. Used to test a hypothetical state
+/// (a vertex at a new position) without writing it into a position buffer.
+pub fn faces_intersect_at(a: [u32; 3], ta: &[Point3; 3], b: [u32; 3], tb: &[Point3; 3]) -> bool {
     match sharing(a, b) {
         Sharing::All => true,
         Sharing::Edge { ia, ib } => {
             let ra = 3 - ia[0] - ia[1];
             let rb = 3 - ib[0] - ib[1];
-            let (pp, pq, pr, ps) = (p(a[ia[0]]), p(a[ia[1]]), p(a[ra]), p(b[rb]));
+            let (pp, pq, pr, ps) = (ta[ia[0]], ta[ia[1]], ta[ra], tb[rb]);
             are_coplanar(pp, pq, pr, ps) && coplanar_same_side(pp, pq, pr, ps)
         }
-        Sharing::Vertex { ia, ib } => {
-            let ta = [p(a[0]), p(a[1]), p(a[2])];
-            let tb = [p(b[0]), p(b[1]), p(b[2])];
-            shared_vertex_faces_intersect(&ta, &tb, ia, ib)
-        }
-        Sharing::None => {
-            triangles_intersect(&[p(a[0]), p(a[1]), p(a[2])], &[p(b[0]), p(b[1]), p(b[2])])
-        }
+        Sharing::Vertex { ia, ib } => shared_vertex_faces_intersect(ta, tb, ia, ib),
+        Sharing::None => triangles_intersect(ta, tb),
     }
 }
 
