@@ -644,6 +644,36 @@ impl Problem {
         (p, g)
     }
 
+    /// The guide-frame phases and the report of a finished solve; `counts` are the iterations,
+    /// factorizations and CG iterations done.
+    fn finish(
+        &self,
+        x: &[Complex],
+        stop: StopReason,
+        history: Vec<IterationRecord>,
+        counts: [usize; 3],
+    ) -> (Vec<Vec<Complex>>, InterpReport) {
+        let (parts, _) = self.evaluate(x, false);
+        let (es, ec, eu) = self.energies(&parts);
+        let frames = (0..=self.n_frames)
+            .map(|n| self.frame(x, n).to_vec())
+            .collect();
+        let report = InterpReport {
+            iterations: counts[0],
+            stop,
+            history,
+            smooth_energy: es,
+            compat_energy: ec,
+            unit_energy: eu,
+            g_ave: self.g_ave,
+            c: self.c,
+            factorizations: counts[1],
+            cg_iterations: counts[2],
+            unknowns: 2 * self.n_unknown(),
+        };
+        (frames, report)
+    }
+
     /// Unnormalized energies: `(E_smooth, ∫E_compat dt, ∫E_unit dt)`.
     fn energies(&self, p: &Parts) -> (f64, f64, f64) {
         let s = self.scale;
@@ -705,25 +735,8 @@ impl Problem {
                 false => break StopReason::Stalled,
             }
         };
-        let (parts, _) = self.evaluate(&x, false);
-        let (es, ec, eu) = self.energies(&parts);
-        let frames = (0..=self.n_frames)
-            .map(|n| self.frame(&x, n).to_vec())
-            .collect();
-        let report = InterpReport {
-            iterations,
-            stop,
-            history,
-            smooth_energy: es,
-            compat_energy: ec,
-            unit_energy: eu,
-            g_ave: self.g_ave,
-            c: self.c,
-            factorizations: hess.factorizations,
-            cg_iterations: 0,
-            unknowns: 2 * self.n_unknown(),
-        };
-        Ok((frames, report))
+        let counts = [iterations, hess.factorizations, 0];
+        Ok(self.finish(&x, stop, history, counts))
     }
 
     /// One damped Newton step with Armijo backtracking; `false` when no decrease is possible.
@@ -918,25 +931,8 @@ impl Problem {
                 }
             }
         };
-        let (parts, _) = self.evaluate(&x, false);
-        let (es, ec, eu) = self.energies(&parts);
-        let frames = (0..=self.n_frames)
-            .map(|n| self.frame(&x, n).to_vec())
-            .collect();
-        let report = InterpReport {
-            iterations,
-            stop,
-            history,
-            smooth_energy: es,
-            compat_energy: ec,
-            unit_energy: eu,
-            g_ave: self.g_ave,
-            c: self.c,
-            factorizations,
-            cg_iterations,
-            unknowns: 2 * nu,
-        };
-        Ok((frames, report))
+        let counts = [iterations, factorizations, cg_iterations];
+        Ok(self.finish(&x, stop, history, counts))
     }
 }
 

@@ -378,18 +378,10 @@ pub(super) fn steihaug(
     for it in 0..max_iter {
         hess(&d, &mut hd);
         let dhd = dot(&d, &hd);
-        if dhd.is_nan() || dhd <= 0.0 {
-            to_boundary(&mut s, &d, sms, smd, dmd);
-            return TrustStep {
-                step: s,
-                m_norm: delta,
-                on_boundary: true,
-                iterations: it + 1,
-            };
-        }
+        // negative curvature (followed to the boundary) or a step leaving the region
         let alpha = ry / dhd;
         let sms_next = sms + 2.0 * alpha * smd + alpha * alpha * dmd;
-        if sms_next >= delta * delta {
+        if dhd.is_nan() || dhd <= 0.0 || sms_next >= delta * delta {
             to_boundary(&mut s, &d, sms, smd, dmd);
             return TrustStep {
                 step: s,
