@@ -99,17 +99,6 @@ fn corpus_files(dir: &Path, filter: Option<&str>) -> Vec<PathBuf> {
     files
 }
 
-/// User + system CPU seconds of this process so far (0 when unavailable).
-fn cpu_seconds() -> f64 {
-    // SAFETY: getrusage only writes into the struct it is given.
-    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
-    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
-        return 0.0;
-    }
-    let t = |tv: libc::timeval| tv.tv_sec as f64 + tv.tv_usec as f64 * 1e-6;
-    t(u.ru_utime) + t(u.ru_stime)
-}
-
 fn load_average() -> String {
     std::fs::read_to_string("/proc/loadavg")
         .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
@@ -158,10 +147,10 @@ fn run_pleat(mesh: &TriMesh, n_p: f64, tag: &str) -> Outcome {
         ..LodParams::default()
     };
     let t0 = Instant::now();
-    let c0 = cpu_seconds();
+    let c0 = pleat::report::process_cpu_seconds();
     let r = generate(mesh, &params, &mut |_| true);
     let seconds = t0.elapsed().as_secs_f64();
-    let cpu_seconds = cpu_seconds() - c0;
+    let cpu_seconds = pleat::report::process_cpu_seconds() - c0;
     match r {
         Ok((out, _stats)) => Outcome {
             status: "ok".into(),
@@ -228,10 +217,10 @@ fn meshopt_to(mesh: &TriMesh, target: usize) -> (TriMesh, &'static str) {
 /// meshopt at pleat's face count.
 fn run_meshopt(mesh: &TriMesh, target: usize, tag: &str) -> Outcome {
     let t0 = Instant::now();
-    let c0 = cpu_seconds();
+    let c0 = pleat::report::process_cpu_seconds();
     let (out, method) = meshopt_to(mesh, target);
     let seconds = t0.elapsed().as_secs_f64();
-    let cpu_seconds = cpu_seconds() - c0;
+    let cpu_seconds = pleat::report::process_cpu_seconds() - c0;
     if out.triangle_count() == 0 {
         return Outcome {
             status: "error: no triangles left".into(),

@@ -41,17 +41,6 @@ fn peak_rss_bytes() -> u64 {
     status_bytes("VmHWM:")
 }
 
-/// User + system CPU seconds of this process.
-fn cpu_seconds() -> f64 {
-    // SAFETY: getrusage only writes into the struct we pass.
-    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
-    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
-        return 0.0;
-    }
-    let t = |tv: libc::timeval| tv.tv_sec as f64 + tv.tv_usec as f64 * 1e-6;
-    t(u.ru_utime) + t(u.ru_stime)
-}
-
 fn child(path: &Path, np: f64) {
     let Some(mesh) = load(path) else {
         println!("SKIP");
@@ -63,7 +52,7 @@ fn child(path: &Path, np: f64) {
         ..Default::default()
     };
     let t = Instant::now();
-    let cpu0 = cpu_seconds();
+    let cpu0 = pleat::report::process_cpu_seconds();
     let trace = std::env::var("PLEAT_BENCH_MEMTRACE").is_ok();
     let mut last = String::new();
     let mut progress = |p: pleat::Progress<'_>| {
@@ -87,7 +76,7 @@ fn child(path: &Path, np: f64) {
                     eprintln!("  {n:<24} {c}");
                 }
             }
-            let cpu = cpu_seconds() - cpu0;
+            let cpu = pleat::report::process_cpu_seconds() - cpu0;
             let stages: Vec<String> = stats
                 .stages
                 .iter()

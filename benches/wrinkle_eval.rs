@@ -103,24 +103,15 @@ fn corpus(dir: &Path) {
     }
 }
 
-/// Process CPU seconds (user + system) so far: robust against waiting for a shared CPU.
-fn cpu_seconds() -> f64 {
-    // SAFETY: getrusage only writes the struct we pass.
-    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
-    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
-    let t = |v: libc::timeval| v.tv_sec as f64 + v.tv_usec as f64 * 1e-6;
-    t(u.ru_utime) + t(u.ru_stime)
-}
-
 /// Smallest CPU time of one single-threaded evaluation over `REPEATS` runs.
 fn best_cpu_time(cwf: &Cwf, levels: usize) -> f64 {
     (0..REPEATS)
         .map(|_| {
             in_pool(1, || {
-                let t = cpu_seconds();
+                let t = pleat::report::process_cpu_seconds();
                 let r = cwf.evaluate(levels, &EvalOptions::default()).unwrap();
                 std::hint::black_box(r);
-                cpu_seconds() - t
+                pleat::report::process_cpu_seconds() - t
             })
         })
         .fold(f64::INFINITY, f64::min)

@@ -435,12 +435,12 @@ fn bake_case(
         ..Default::default()
     };
     let t0 = Instant::now();
-    let c0 = cpu_seconds();
+    let c0 = pleat::report::process_cpu_seconds();
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         bake_mesh(mesh, &params, cage, prog)
     }));
     row.seconds = t0.elapsed().as_secs_f64();
-    row.cpu_seconds = cpu_seconds() - c0;
+    row.cpu_seconds = pleat::report::process_cpu_seconds() - c0;
     let (out, stats) = match result {
         Ok(Ok(r)) => r,
         Ok(Err(e)) => {
@@ -454,17 +454,6 @@ fn bake_case(
     };
     fill_from_output(&mut row, mesh, &out, &stats, cage);
     (row, Some(out))
-}
-
-/// User + system CPU seconds of this process so far (0 when unavailable).
-fn cpu_seconds() -> f64 {
-    // SAFETY: getrusage only writes into the struct it is given.
-    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
-    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
-        return 0.0;
-    }
-    let t = |tv: libc::timeval| tv.tv_sec as f64 + tv.tv_usec as f64 * 1e-6;
-    t(u.ru_utime) + t(u.ru_stime)
 }
 
 /// `generate` or the cage `generate`.
