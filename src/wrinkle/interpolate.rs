@@ -698,37 +698,12 @@ impl Problem {
         let d = hess.newton_direction(self, &x, &g0, &mut mu, HessianModel::Projected)?;
         x = d;
         normalize_unknowns(&mut x);
-        let mut history = Vec::new();
+        let mut log = IterationLog::new(start);
         let mut iterations = 0;
-        let mut best_fraction: f64 = 0.0;
         let stop = loop {
             let (parts, grad) = self.evaluate(&x, true);
-            let gnorm = grad.iter().map(|g| g.norm_sqr()).sum::<f64>().sqrt();
-            history.push(IterationRecord {
-                iteration: iterations,
-                seconds: start.elapsed().as_secs_f64(),
-                gradient_norm: gnorm,
-                objective: parts.total(),
-            });
-            if !gnorm.is_finite() {
-                return Err(Error::Numerical(
-                    "the interpolation objective became non-finite".into(),
-                ));
-            }
-            if gnorm <= opts.gradient_tolerance {
-                break StopReason::Converged;
-            }
-            if iterations >= opts.max_iterations {
-                break StopReason::IterationCap;
-            }
-            let g_first = history[0].gradient_norm.max(f64::MIN_POSITIVE);
-            let frac = progress_fraction(g_first, gnorm, opts, iterations);
-            best_fraction = best_fraction.max(frac);
-            if !progress(Progress {
-                stage: "interpolate",
-                fraction: best_fraction,
-            }) {
-                return Err(Error::Cancelled);
+            if let Some(stop) = log.record(iterations, parts.total(), &grad, opts, progress)? {
+                break stop;
             }
             match self.step(&mut hess, &mut x, &grad, parts.total(), &mut mu, opts)? {
                 true => iterations += 1,
@@ -736,7 +711,7 @@ impl Problem {
             }
         };
         let counts = [iterations, hess.factorizations, 0];
-        Ok(self.finish(&x, stop, history, counts))
+        Ok(self.finish(&x, stop, log.history, counts))
     }
 
     /// One damped Newton step with Armijo backtracking; `false` when no decrease is possible.
@@ -839,9 +814,8 @@ impl Problem {
             x = to_complex(&st.step);
             normalize_unknowns(&mut x);
         }
-        let mut history = Vec::new();
+        let mut log = IterationLog::new(start);
         let mut iterations = 0;
-        let mut best_fraction: f64 = 0.0;
         let (mut delta, mut first): (Option<f64>, Option<f64>) = (None, None);
         let mut pre = None;
         let (mut since_factor, mut last_cg) = (0usize, 0usize);
@@ -849,32 +823,10 @@ impl Problem {
         let stop = 'outer: loop {
             let (parts, grad) = self.evaluate(&x, true);
             let f0 = parts.total();
-            let gnorm = grad.iter().map(|g| g.norm_sqr()).sum::<f64>().sqrt();
-            history.push(IterationRecord {
-                iteration: iterations,
-                seconds: start.elapsed().as_secs_f64(),
-                gradient_norm: gnorm,
-                objective: f0,
-            });
-            if !gnorm.is_finite() || !f0.is_finite() {
-                return Err(Error::Numerical(
-                    "the interpolation objective became non-finite".into(),
-                ));
+            if let Some(stop) = log.record(iterations, f0, &grad, opts, progress)? {
+                break stop;
             }
-            if gnorm <= opts.gradient_tolerance {
-                break StopReason::Converged;
-            }
-            if iterations >= opts.max_iterations {
-                break StopReason::IterationCap;
-            }
-            let g_first = history[0].gradient_norm.max(f64::MIN_POSITIVE);
-            best_fraction = best_fraction.max(progress_fraction(g_first, gnorm, opts, iterations));
-            if !progress(Progress {
-                stage: "interpolate",
-                fraction: best_fraction,
-            }) {
-                return Err(Error::Cancelled);
-            }
+            let gnorm = log.last_gradient_norm();
             let g = to_real(&grad);
             // The preconditioner only shapes CG and the trust region: it is refactored when it is
             // `REFACTOR_EVERY` iterations old or CG needed many iterations with it.
@@ -932,12 +884,76 @@ impl Problem {
             }
         };
         let counts = [iterations, factorizations, cg_iterations];
-        Ok(self.finish(&x, stop, history, counts))
+        Ok(self.finish(&x, stop, log.history, counts))
     }
 }
 
 fn to_real(z: &[Complex]) -> Vec<f64> {
     z.iter().flat_map(|c| [c.re, c.im]).collect()
+}
+
+/// The convergence history of a solve and the per-iteration checks both solvers share.
+struct IterationLog {
+    start: Instant,
+    history: Vec<IterationRecord>,
+    /// Largest progress fraction reported so far (reports never go backwards).
+    best_fraction: f64,
+}
+
+impl IterationLog {
+    fn new(start: Instant) -> IterationLog {
+        IterationLog {
+            start,
+            history: Vec::new(),
+            best_fraction: 0.0,
+        }
+    }
+
+    /// Records iterate `iteration` (normalized objective, gradient) and decides: `Some` stop
+    /// reason when converged or at the cap, an error when non-finite or cancelled by
+    /// `progress`, `None` to go on.
+    fn record(
+        &mut self,
+        iteration: usize,
+        objective: f64,
+        grad: &[Complex],
+        opts: &InterpOptions,
+        progress: &mut ProgressFn<'_>,
+    ) -> Result<Option<StopReason>> {
+        let gnorm = grad.iter().map(|g| g.norm_sqr()).sum::<f64>().sqrt();
+        self.history.push(IterationRecord {
+            iteration,
+            seconds: self.start.elapsed().as_secs_f64(),
+            gradient_norm: gnorm,
+            objective,
+        });
+        if !gnorm.is_finite() || !objective.is_finite() {
+            return Err(Error::Numerical(
+                "the interpolation objective became non-finite".into(),
+            ));
+        }
+        if gnorm <= opts.gradient_tolerance {
+            return Ok(Some(StopReason::Converged));
+        }
+        if iteration >= opts.max_iterations {
+            return Ok(Some(StopReason::IterationCap));
+        }
+        let g_first = self.history[0].gradient_norm.max(f64::MIN_POSITIVE);
+        let frac = progress_fraction(g_first, gnorm, opts, iteration);
+        self.best_fraction = self.best_fraction.max(frac);
+        if !progress(Progress {
+            stage: "interpolate",
+            fraction: self.best_fraction,
+        }) {
+            return Err(Error::Cancelled);
+        }
+        Ok(None)
+    }
+
+    /// Gradient norm of the last recorded iterate.
+    fn last_gradient_norm(&self) -> f64 {
+        self.history.last().map_or(0.0, |r| r.gradient_norm)
+    }
 }
 
 /// Progress in [0, 1]: the larger of the iteration fraction and the log-gradient decrease.
