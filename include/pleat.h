@@ -51,6 +51,11 @@
 // `PleatLodParams::flags` bit: skip the feature-alignment step (Alg. 6).
 #define PLEAT_LOD_NO_ALIGN 1
 
+// `PleatLodParams::flags` bit: also measure the error floor of the offset stage (stats
+// metric `hausdorff_floor_rel`, the input-to-offset-surface distance over `l`); one more
+// distance measurement per level.
+#define PLEAT_LOD_MEASURE_FLOOR 2
+
 // `pleat_mesh_check` flag: skip the self-intersection test (the most expensive part);
 // `self_intersections_checked` is then 0.
 #define PLEAT_CHECK_SKIP_SELF_INTERSECTIONS 1

@@ -51,6 +51,15 @@ impl Stats {
         self.metrics.iter().find(|m| m.0 == name).map(|m| m.1)
     }
 
+    /// Seconds spent in stages named `name` (0 when there is none).
+    pub fn stage_seconds(&self, name: &str) -> f64 {
+        self.stages
+            .iter()
+            .filter(|s| s.0 == name)
+            .map(|s| s.1)
+            .sum()
+    }
+
     /// Looks up a count by name.
     pub fn get_count(&self, name: &str) -> Option<u64> {
         self.counts.iter().find(|m| m.0 == name).map(|m| m.1)

@@ -74,6 +74,76 @@ fn sphere_torus_box_at_three_screen_sizes() {
     }
 }
 
+/// Two meshes as one soup (`b`'s indices shifted).
+fn union(a: &TriMesh, b: &TriMesh) -> TriMesh {
+    let mut p = a.positions().to_vec();
+    let n = p.len() as u32;
+    p.extend_from_slice(b.positions());
+    let mut t = a.triangles().to_vec();
+    t.extend(b.triangles().iter().map(|f| f.map(|v| v + n)));
+    TriMesh::new(p, t).unwrap()
+}
+
+/// The error split and its floor, against analytic values: a sphere of radius 1/2 buried in
+/// one of radius 1 is hidden by the offset, so the floor (input to offset surface) is the
+/// gap `1/2 + d` (up to the polygonal radii) and the output cannot beat it; the one-sided
+/// parts make up the two-sided figure.
+#[test]
+fn error_split_and_floor_match_a_buried_sphere() {
+    let outer = shapes::icosphere(1.0, 3);
+    let inner = shapes::icosphere(0.5, 2);
+    let soup = union(&outer, &inner);
+    let np = 50.0;
+    let p = LodParams {
+        measure_floor: true,
+        ..params(np)
+    };
+    let (out, s) = bake(&soup, &p, false).unwrap();
+    assert_valid(&out, &s, "buried sphere");
+    let l = soup.bbox_diagonal();
+    let d = l / np;
+    let m = |k: &str| s.get_metric(k).unwrap_or_else(|| panic!("no {k}"));
+    let (h, hio, hoi, floor) = (
+        m("hausdorff_rel"),
+        m("hausdorff_in_to_out_rel"),
+        m("hausdorff_out_to_in_rel"),
+        m("hausdorff_floor_rel"),
+    );
+    assert_eq!(h, hio.max(hoi));
+    // The icosphere's vertices are on the sphere, its faces inside by ≤ 2% of the radius.
+    assert!(
+        floor * l > 0.5 && floor * l < 0.5 + 2.0 * d,
+        "floor {} not in (1/2, 1/2 + 2d)",
+        floor * l
+    );
+    assert!(hio * l > 0.45, "the buried sphere cannot be reached: {hio}");
+    assert!(hoi < 3.0 * d / l, "output to input {hoi} over 3d");
+    let (_, s2) = bake(&soup, &params(np), false).unwrap();
+    assert!(s2.get_metric("hausdorff_floor_rel").is_none());
+}
+
+/// An open box (no lid, walls of zero thickness): its offset has an inner wall facing a
+/// concave hollow, where per-collapse checks relative to the current patch let the surface
+/// walk away from the input. The drift caps keep every output sample within about `2d`.
+#[test]
+fn open_container_output_stays_near_its_walls() {
+    let b = shapes::box_grid(1.0, 1.0, 0.8, 10);
+    let keep: Vec<[u32; 3]> = b
+        .triangles()
+        .iter()
+        .copied()
+        .filter(|t| t.iter().any(|&v| b.positions()[v as usize][2] < 0.8 - 1e-9))
+        .collect();
+    let cup = TriMesh::new(b.positions().to_vec(), keep).unwrap();
+    for np in [50.0, 100.0] {
+        let (out, s) = bake(&cup, &params(np), false).unwrap();
+        let what = format!("open box n_p={np}");
+        assert_valid(&out, &s, &what);
+        let hoi = s.get_metric("hausdorff_out_to_in_rel").unwrap();
+        assert!(hoi < 3.0 / np, "{what}: output to input {hoi} over 3d/l");
+    }
+}
+
 /// The reported error ignores the interior of zero-area input triangles (their corners count):
 /// a needle from one corner of a box through its inside to the opposite corner is invisible,
 /// and area-weighted samplers (Metro, the CGAL `compare` tool) never land on it.

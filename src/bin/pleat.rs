@@ -126,8 +126,12 @@ struct BakeArgs {
     /// Target triangle count (only with a single screen size).
     #[arg(long)]
     faces: Option<usize>,
-    /// Output file; `{n}` is replaced by the screen size (required with several sizes).
-    #[arg(short, long)]
+    // An explicit `help`: in doc comments clap turns `{n}` into a line break.
+    #[arg(
+        short,
+        long,
+        help = "Output file; `{n}` is replaced by the screen size (required with several sizes)"
+    )]
     output: PathBuf,
     /// Maximum optimization rounds N.
     #[arg(long, default_value_t = 50)]

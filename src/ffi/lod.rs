@@ -11,6 +11,11 @@ use crate::{Error, Result};
 /// `PleatLodParams::flags` bit: skip the feature-alignment step (Alg. 6).
 pub const PLEAT_LOD_NO_ALIGN: u32 = 1;
 
+/// `PleatLodParams::flags` bit: also measure the error floor of the offset stage (stats
+/// metric `hausdorff_floor_rel`, the input-to-offset-surface distance over `l`); one more
+/// distance measurement per level.
+pub const PLEAT_LOD_MEASURE_FLOOR: u32 = 2;
+
 /// Parameters of `pleat_lod_generate`, `pleat_lod_generate_chain` and `pleat_cage_generate`.
 /// Get the defaults from `pleat_lod_params_default()` and change what you need; the defaults
 /// are the dissertation's (n_p = 200, N = 50, r = 1/8, ε = 1e-4, θ0 = 120°, l0 = 4).
@@ -180,7 +185,7 @@ mod imp {
                 Error::InvalidArgument(format!("target_faces {n} is out of range"))
             })?),
         };
-        let known = PLEAT_LOD_NO_ALIGN;
+        let known = PLEAT_LOD_NO_ALIGN | PLEAT_LOD_MEASURE_FLOOR;
         if p.flags & !known != 0 {
             return Err(Error::InvalidArgument(format!(
                 "unknown flags {:#x}",
@@ -197,6 +202,7 @@ mod imp {
             l0: p.l0,
             memory_budget_bytes: p.memory_budget_bytes,
             align: p.flags & PLEAT_LOD_NO_ALIGN == 0,
+            measure_floor: p.flags & PLEAT_LOD_MEASURE_FLOOR != 0,
         })
     }
 

@@ -12,6 +12,13 @@
 //! `Σ (|e|² I − e eᵀ)/c_f² · v = Σ (e × y_f) / c_f` (using `[e]ₓᵀ = −[e]ₓ`). The 3×3 system is
 //! solved directly (with a tiny Tikhonov term for rings whose edges are all parallel); the
 //! step `v_opt − v` is clamped to `max_step` and applied with the line search of Alg. 4.
+//!
+//! Drift cap (not in the text): eq. 4.5 sees only normals, so it does not anchor a vertex to
+//! the input — on developable or nearly flat rings its optimum can slide, and a vertex whose
+//! flow step the guard keeps refusing can be walked away round after round (the teapot's
+//! inner wall drifted 8·d over rounds 35–50 before this). A step may therefore not take the
+//! vertex farther from the input than `max(cap, its current distance)`; a longer step is
+//! halved until it does (at most [`CAP_HALVINGS`] times), else the vertex stays.
 
 use super::flow::{local_update, record, MoveReport};
 use super::guard::Guard;
@@ -86,12 +93,40 @@ fn solve3(h: [[f64; 3]; 3], r: P3) -> Option<P3> {
     x.iter().all(|c| c.is_finite()).then_some(x)
 }
 
+/// Halvings of an alignment step that would end farther from the input than the drift cap.
+pub const CAP_HALVINGS: u32 = 4;
+
+/// Shortens `d` (halving) until `p + d` is within `max(cap, dist(p))` of the input; `None`
+/// when [`CAP_HALVINGS`] halvings do not suffice.
+fn capped_step(g: &Guard<'_>, p: P3, mut d: P3, cap: f64) -> Option<P3> {
+    let input = g.input();
+    let mut allowed = cap;
+    let mut current_known = false;
+    for _ in 0..=CAP_HALVINGS {
+        let dn = input.distance(add(p, d));
+        if dn <= allowed {
+            return Some(d);
+        }
+        if !current_known {
+            current_known = true;
+            allowed = allowed.max(input.distance(p));
+            if dn <= allowed {
+                return Some(d);
+            }
+        }
+        d = scale(d, 0.5);
+    }
+    None
+}
+
 /// One alignment sweep (Alg. 3 lines 12–16): every vertex in id order towards its eq. 4.5
-/// optimum, step length at most `max_step`, through the guarded line search.
+/// optimum, step length at most `max_step`, through the guarded line search; no step ends
+/// farther than `max(cap, current distance)` from the input (module docs).
 pub(crate) fn align_sweep(
     g: &mut Guard<'_>,
     reference: &[P3],
     max_step: f64,
+    cap: f64,
     keep_going: &mut dyn FnMut(f64) -> bool,
 ) -> Result<MoveReport> {
     let verts: Vec<u32> = g
@@ -113,12 +148,44 @@ pub(crate) fn align_sweep(
         if len > max_step {
             d = scale(d, max_step / len);
         }
-        let moved = if len > 0.0 {
-            local_update(g, v, d)
+        let step = if len > 0.0 {
+            capped_step(g, g.mesh().position(v), d, cap)
         } else {
-            0.0
+            None
         };
+        let moved = step.map_or(0.0, |d| local_update(g, v, d));
         record(&mut rep, moved);
     }
     Ok(rep)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lowpoly::guard::tests::cube;
+    use crate::lowpoly::guard::InputModel;
+    use crate::mesh::halfedge::HalfEdgeMesh;
+
+    /// The drift cap against distances known in closed form, around the unit cube's top face
+    /// (`z = 1`) with cap `0.31`: from `z = 1.1`, a step to `z = 1.5` is halved once (to
+    /// `z = 1.3`), a step to `z = 1.15` and a sideways step along the face pass unchanged;
+    /// from `z = 1.6` (already beyond the cap) a step away is refused and a step back passes.
+    #[test]
+    fn capped_step_keeps_vertices_within_the_cap_or_their_distance() {
+        let m = cube(1.0, 0.0);
+        let input = InputModel::new(&m, false);
+        let g = Guard::new(HalfEdgeMesh::from_trimesh(&m).unwrap(), &input, false);
+        let close = |a: P3, b: P3| (0..3).all(|i| (a[i] - b[i]).abs() < 1e-12);
+        let p = [0.5, 0.5, 1.1];
+        let cap = 0.31;
+        let d = capped_step(&g, p, [0.0, 0.0, 0.4], cap).unwrap();
+        assert!(close(d, [0.0, 0.0, 0.2]), "{d:?}");
+        let d = capped_step(&g, p, [0.0, 0.0, 0.05], cap).unwrap();
+        assert!(close(d, [0.0, 0.0, 0.05]), "{d:?}");
+        let d = capped_step(&g, p, [0.3, 0.0, 0.0], cap).unwrap();
+        assert!(close(d, [0.3, 0.0, 0.0]), "{d:?}");
+        assert!(capped_step(&g, [0.5, 0.5, 1.6], [0.0, 0.0, 0.1], cap).is_none());
+        let d = capped_step(&g, [0.5, 0.5, 1.6], [0.0, 0.0, -0.1], cap).unwrap();
+        assert!(close(d, [0.0, 0.0, -0.1]), "{d:?}");
+    }
 }

@@ -634,7 +634,7 @@ pub(crate) fn touches_input_triangle(tri: &[P3; 3], t: &[P3; 3], degenerate: boo
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::mesh::TriMesh;
 

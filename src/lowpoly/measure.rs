@@ -111,28 +111,48 @@ pub(crate) fn one_sided_exceeds(
     })
 }
 
-/// Two-sided sampled Hausdorff distance between `a` and `b`.
-pub(crate) fn hausdorff(a: &Surface, b: &Surface, spacing: f64, max_k: usize) -> f64 {
-    let ab = one_sided(&a.positions, &a.tris, b, spacing, max_k);
-    let ba = one_sided(&b.positions, &b.tris, a, spacing, max_k);
-    ab.max(ba)
-}
-
 /// Two-sided sampled Hausdorff distance between `output` and `input`, exactly as the pipeline
 /// reports it in `Stats` (`hausdorff`, `hausdorff_rel`): both surfaces sampled at their
 /// vertices plus a barycentric grid of spacing `l / 400` (`l` = the input's bounding-box
 /// diagonal, at most 32 subdivisions per triangle edge), see the module docs. Works on any two
 /// triangle soups, so benchmarks use it to score other simplifiers with the same measure.
 pub fn hausdorff_to_input(output: &TriMesh, input: &TriMesh) -> f64 {
-    let l = input.bbox_diagonal();
+    let s = hausdorff_sides(output, input);
+    s.input_to_output.max(s.output_to_input)
+}
+
+/// The two one-sided distances whose larger is [`hausdorff_to_input`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HausdorffSides {
+    /// Farthest input sample from the output: input the output does not cover (buried parts,
+    /// cavities closed by the offset, features cut off).
+    pub input_to_output: f64,
+    /// Farthest output sample from the input: output surface that is not on the input
+    /// (bridges over gaps, chords, drift).
+    pub output_to_input: f64,
+}
+
+/// Both one-sided sampled distances between `output` and `input`, with the sampling of
+/// [`hausdorff_to_input`].
+pub fn hausdorff_sides(output: &TriMesh, input: &TriMesh) -> HausdorffSides {
+    let spacing = input.bbox_diagonal() / FINAL_SAMPLES_PER_DIAGONAL;
     let a = Surface::new(output);
     let b = Surface::new(input);
-    hausdorff(
-        &a,
-        &b,
-        l / FINAL_SAMPLES_PER_DIAGONAL,
-        FINAL_MAX_SUBDIVISIONS,
-    )
+    HausdorffSides {
+        input_to_output: one_sided(&b.positions, &b.tris, &a, spacing, FINAL_MAX_SUBDIVISIONS),
+        output_to_input: one_sided(&a.positions, &a.tris, &b, spacing, FINAL_MAX_SUBDIVISIONS),
+    }
+}
+
+/// One-sided sampled distance from `input` to `surface` (sampling of [`hausdorff_to_input`]).
+/// Applied to the offset surface it gives the *floor* of the input-to-output error: input
+/// the offset already hides (buried components, cavities and crevices narrower than `2d`)
+/// stays hidden through the loop, since the loop keeps the offset's topology.
+pub fn input_to_surface(surface: &TriMesh, input: &TriMesh) -> f64 {
+    let spacing = input.bbox_diagonal() / FINAL_SAMPLES_PER_DIAGONAL;
+    let a = Surface::new(surface);
+    let b = Surface::new(input);
+    one_sided(&b.positions, &b.tris, &a, spacing, FINAL_MAX_SUBDIVISIONS)
 }
 
 /// What the independent verification ([`MeshReport`]) found.

@@ -29,7 +29,10 @@ mod simplify;
 mod vec3;
 
 pub use guard::CONE_HALF_ANGLE;
-pub use measure::{hausdorff_to_input, FINAL_SAMPLES_PER_DIAGONAL};
+pub use measure::{
+    hausdorff_sides, hausdorff_to_input, input_to_surface, HausdorffSides,
+    FINAL_SAMPLES_PER_DIAGONAL,
+};
 pub use offset::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};
 pub use pipeline::{generate, generate_chain, LodParams};
 #[cfg(feature = "cage")]

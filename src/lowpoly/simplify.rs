@@ -54,6 +54,13 @@ pub const VIRTUAL_PLANE_WEIGHT: f64 = 0.01;
 /// Largest sampling grid per triangle edge in the local Hausdorff check.
 const MAX_SAMPLE_RES: usize = 4;
 
+/// Drift cap, in units of `d`: a collapse may not leave a new face with a sample farther
+/// than `DRIFT_CAP·d` from the input unless the old patch already had one that far (then the
+/// farthest sample may not grow). See the module docs: the per-collapse checks are relative
+/// to the current patch, so without an absolute bound many collapses in a row can walk a
+/// concave patch away from the input, `d` at a time.
+pub const DRIFT_CAP: f64 = 2.0;
+
 /// Options of one simplification pass.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct SimplifyOptions {
@@ -306,8 +313,8 @@ struct Pass<'g, 'a> {
     version: Vec<u32>,
     targets: Vec<P3>,
     heap: Queue,
-    /// Sampled max distance to the input per face (NaN = not computed yet).
-    face_dist: Vec<f64>,
+    /// Sampled distance to the input per face (NaN mean = not computed yet).
+    face_dist: Vec<FaceDist>,
     /// Distance to the input per vertex (NaN = not computed yet).
     vert_dist: Vec<f64>,
     /// Vertex marks of the batch being formed: `mark_w[v] == epoch` ⇔ `v` is written by a
@@ -329,7 +336,22 @@ struct Accepted {
     b: u32,
     x: P3,
     new: Patch,
-    new_face_dist: Vec<f64>,
+    new_face_dist: Vec<FaceDist>,
+}
+
+/// A face's sampled distance to the input: mean and largest of its samples (corners, and
+/// the centroid when the face is longer than the sample spacing).
+#[derive(Debug, Clone, Copy)]
+struct FaceDist {
+    mean: f64,
+    max: f64,
+}
+
+impl FaceDist {
+    const UNKNOWN: FaceDist = FaceDist {
+        mean: f64::NAN,
+        max: f64::NAN,
+    };
 }
 
 /// The result of evaluating one candidate collapse against an unchanged mesh, with the
@@ -338,7 +360,7 @@ struct Accepted {
 struct Eval {
     outcome: std::result::Result<Accepted, Rejection>,
     vert_dist: Vec<(u32, f64)>,
-    face_dist: Vec<(u32, f64)>,
+    face_dist: Vec<(u32, FaceDist)>,
     guard: GuardStats,
 }
 
@@ -361,7 +383,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         let mut pass = Pass {
             version: vec![0; m.edge_capacity()],
             targets: vec![[0.0; 3]; m.edge_capacity()],
-            face_dist: vec![f64::NAN; m.face_capacity()],
+            face_dist: vec![FaceDist::UNKNOWN; m.face_capacity()],
             vert_dist: vec![f64::NAN; m.vertex_capacity()],
             mark_w: vec![0; m.vertex_capacity()],
             mark_r: vec![0; m.vertex_capacity()],
@@ -760,27 +782,35 @@ impl<'g, 'a> Pass<'g, 'a> {
         d
     }
 
-    /// Mean distance of a triangle to the input, sampled at its corners (given) and, when it
-    /// is longer than the sample spacing, at its centroid. Smaller triangles use their corners
+    /// Distance of a triangle to the input, sampled at its corners (given) and, when it is
+    /// longer than the sample spacing, at its centroid. Smaller triangles use their corners
     /// only: the distance field is 1-Lipschitz and, at the offset distance, smooth at that
     /// scale, so an interior sample adds little there.
-    fn triangle_distance(&self, t: &[P3; 3], corner: [f64; 3]) -> f64 {
+    fn triangle_distance(&self, t: &[P3; 3], corner: [f64; 3]) -> FaceDist {
         let sum = corner[0] + corner[1] + corner[2];
+        let cmax = corner[0].max(corner[1]).max(corner[2]);
         if sample_resolution(t, self.opt.spacing, 2) == 1 {
-            return sum / 3.0;
+            return FaceDist {
+                mean: sum / 3.0,
+                max: cmax,
+            };
         }
         let c = scale(add(add(t[0], t[1]), t[2]), 1.0 / 3.0);
         let ub = (0..3)
             .map(|i| corner[i] + dist(c, t[i]))
             .fold(f64::INFINITY, f64::min);
-        (sum + self.g.input().distance_bounded(c, ub)) / 4.0
+        let dc = self.g.input().distance_bounded(c, ub);
+        FaceDist {
+            mean: (sum + dc) / 4.0,
+            max: cmax.max(dc),
+        }
     }
 
     /// Distance of face `f` (vertices `vs`, corners `t`) to the input, from the cache or
     /// computed (and noted in `ev`).
-    fn face_distance(&self, f: u32, vs: [u32; 3], t: &[P3; 3], ev: &mut Eval) -> f64 {
+    fn face_distance(&self, f: u32, vs: [u32; 3], t: &[P3; 3], ev: &mut Eval) -> FaceDist {
         let d = self.face_dist[f as usize];
-        if !d.is_nan() {
+        if !d.mean.is_nan() {
             return d;
         }
         if let Some(&(_, d)) = ev.face_dist.iter().find(|(g, _)| *g == f) {
@@ -794,8 +824,9 @@ impl<'g, 'a> Pass<'g, 'a> {
 
     /// Alg. 5 line 17: the one-sided distance from the new patch to the input does not exceed
     /// the old patch's (or the slack). The patch distance is the area-weighted mean of the
-    /// faces' sampled mean distances (see the module docs for why not the maximum). Returns
-    /// the new faces' distances when it holds.
+    /// faces' sampled mean distances (see the module docs for why not the maximum). Also the
+    /// drift cap: no new sample farther than `max(DRIFT_CAP·d, old patch's farthest sample)`.
+    /// Returns the new faces' distances when both hold.
     fn distance_not_increased(
         &self,
         a: u32,
@@ -804,13 +835,16 @@ impl<'g, 'a> Pass<'g, 'a> {
         old: &Patch,
         new: &Patch,
         ev: &mut Eval,
-    ) -> Option<Vec<f64>> {
-        let (mut old_sum, mut old_area) = (0.0, 0.0);
+    ) -> Option<Vec<FaceDist>> {
+        let (mut old_sum, mut old_area, mut old_max) = (0.0, 0.0, 0.0f64);
         for i in 0..old.ids.len() {
             let w = norm(tri_normal(&old.tris[i]));
-            old_sum += w * self.face_distance(old.ids[i], old.verts[i], &old.tris[i], ev);
+            let fd = self.face_distance(old.ids[i], old.verts[i], &old.tris[i], ev);
+            old_sum += w * fd.mean;
             old_area += w;
+            old_max = old_max.max(fd.max);
         }
+        let cap = old_max.max(DRIFT_CAP * self.opt.d) * (1.0 + 1e-9);
         let old_mean = if old_area > 0.0 {
             old_sum / old_area
         } else {
@@ -835,8 +869,11 @@ impl<'g, 'a> Pass<'g, 'a> {
                 };
             }
             let fd = self.triangle_distance(&new.tris[i], corner);
+            if fd.max > cap {
+                return None;
+            }
             let w = norm(tri_normal(&new.tris[i]));
-            new_sum += w * fd;
+            new_sum += w * fd.mean;
             new_area += w;
             out.push(fd);
         }
@@ -849,7 +886,7 @@ impl<'g, 'a> Pass<'g, 'a> {
     }
 
     /// Book-keeping after an accepted collapse of `b` into `a`.
-    fn commit(&mut self, a: u32, b: u32, modified: &[u32], new: &Patch, fd: &[f64]) {
+    fn commit(&mut self, a: u32, b: u32, modified: &[u32], new: &Patch, fd: &[FaceDist]) {
         self.report.collapses += 1;
         self.quadrics[a as usize] = self.quadrics[a as usize].add(&self.quadrics[b as usize]);
         self.vert_dist[a as usize] = f64::NAN;
