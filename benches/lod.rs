@@ -64,6 +64,8 @@ struct Outcome {
     /// User + system CPU seconds (all threads): bounds the wall time on an unloaded machine.
     cpu_seconds: f64,
     hd_rel: f64,
+    /// pleat only: the offset's error floor (input to offset surface, over `l`); NaN else.
+    floor_rel: f64,
     valid: Validity,
 }
 
@@ -144,23 +146,30 @@ fn meshcheck(m: &TriMesh, tag: &str) -> Option<bool> {
 fn run_pleat(mesh: &TriMesh, n_p: f64, tag: &str) -> Outcome {
     let params = LodParams {
         screen_size: n_p,
+        measure_floor: true,
         ..LodParams::default()
     };
     let t0 = Instant::now();
     let c0 = pleat::report::process_cpu_seconds();
     let r = generate(mesh, &params, &mut |_| true);
-    let seconds = t0.elapsed().as_secs_f64();
-    let cpu_seconds = pleat::report::process_cpu_seconds() - c0;
+    let mut seconds = t0.elapsed().as_secs_f64();
+    let mut cpu_seconds = pleat::report::process_cpu_seconds() - c0;
     match r {
-        Ok((out, _stats)) => Outcome {
-            status: "ok".into(),
-            method: "pleat".into(),
-            faces: out.triangle_count(),
-            seconds,
-            cpu_seconds,
-            hd_rel: hausdorff_to_input(&out, mesh) / mesh.bbox_diagonal(),
-            valid: validity(&out, tag),
-        },
+        Ok((out, stats)) => {
+            // The floor is measured for this table, not part of the bake.
+            seconds -= stats.stage_seconds("floor");
+            cpu_seconds -= stats.get_metric("floor_cpu_seconds").unwrap_or(0.0);
+            Outcome {
+                status: "ok".into(),
+                method: "pleat".into(),
+                faces: out.triangle_count(),
+                seconds,
+                cpu_seconds,
+                hd_rel: hausdorff_to_input(&out, mesh) / mesh.bbox_diagonal(),
+                floor_rel: stats.get_metric("hausdorff_floor_rel").unwrap_or(f64::NAN),
+                valid: validity(&out, tag),
+            }
+        }
         Err(e) => Outcome {
             status: format!("error: {e}"),
             seconds,
@@ -236,6 +245,7 @@ fn run_meshopt(mesh: &TriMesh, target: usize, tag: &str) -> Outcome {
         seconds,
         cpu_seconds,
         hd_rel: hausdorff_to_input(&out, mesh) / mesh.bbox_diagonal(),
+        floor_rel: f64::NAN,
         valid: validity(&out, tag),
     }
 }
@@ -294,7 +304,7 @@ fn csv_header() -> &'static str {
     "mesh,faces_in,n_p,pleat_status,pleat_faces,pleat_seconds,pleat_cpu_seconds,pleat_hd_rel,pleat_watertight,\
      pleat_manifold,pleat_self_intersection_free,pleat_meshcheck,meshopt_method,meshopt_faces,\
      meshopt_seconds,meshopt_cpu_seconds,meshopt_hd_rel,meshopt_watertight,meshopt_manifold,\
-     meshopt_self_intersection_free,meshopt_meshcheck,time_ratio_pleat_over_meshopt"
+     meshopt_self_intersection_free,meshopt_meshcheck,time_ratio_pleat_over_meshopt,pleat_floor_rel"
 }
 
 fn csv_outcome(o: &Outcome) -> String {
@@ -314,14 +324,15 @@ fn csv_outcome(o: &Outcome) -> String {
 fn csv_line(c: &Case) -> String {
     let status = c.pleat.status.replace([',', '"', '\n'], " ");
     format!(
-        "{},{},{},{status},{},{},{},{:.3}",
+        "{},{},{},{status},{},{},{},{:.3},{}",
         c.mesh,
         c.faces_in,
         c.n_p,
         csv_outcome(&c.pleat),
         c.meshopt.method,
         csv_outcome(&c.meshopt),
-        c.pleat.seconds / c.meshopt.seconds.max(1e-9)
+        c.pleat.seconds / c.meshopt.seconds.max(1e-9),
+        c.pleat.floor_rel
     )
 }
 
@@ -479,14 +490,21 @@ fn print_summary(cases: &[Case]) {
                 .filter(|c| ok(&c.pleat))
                 .map(|c| c.pleat.hd_rel)
                 .collect();
+            let floor: Vec<f64> = at
+                .iter()
+                .filter(|c| ok(&c.pleat))
+                .map(|c| c.pleat.floor_rel)
+                .collect();
             println!(
-                "  target: mean pleat HD/l at n_p = 200 ≤ {PAPER_HD_200} (Table 4.3): {:.4} → {}",
+                "  target: mean pleat HD/l at n_p = 200 ≤ {PAPER_HD_200} (Table 4.3): {:.4} → {}; \
+                 the offset's floor (input it hides, which no later step uncovers): mean {:.4}",
                 mean(&hd),
                 if mean(&hd) <= PAPER_HD_200 {
                     "met"
                 } else {
                     "MISSED"
-                }
+                },
+                mean(&floor)
             );
         }
     }
