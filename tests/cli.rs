@@ -90,6 +90,21 @@ fn lod_chain_writes_one_valid_file_per_screen_size() {
         assert!(r.is_watertight && r.self_intersection_free == Some(true));
         assert!(m.triangle_count() < torus.triangle_count());
     }
+    // `{np}` works like `{n}`, and `--help` shows it intact (clap eats a literal `{n}`).
+    let o = pleat(&[
+        "lod",
+        input.to_str().unwrap(),
+        "--screen-size",
+        "25",
+        "--rounds",
+        "2",
+        "-o",
+        dir.join("np_{np}.obj").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(dir.join("np_25.obj").is_file());
+    let help = String::from_utf8_lossy(&pleat(&["lod", "--help"]).stdout).to_string();
+    assert!(help.contains("`{np}` is replaced"), "{help}");
     // Several sizes need a {n} placeholder; --faces needs a single size.
     let o = pleat(&[
         "lod",

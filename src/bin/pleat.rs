@@ -126,12 +126,10 @@ struct BakeArgs {
     /// Target triangle count (only with a single screen size).
     #[arg(long)]
     faces: Option<usize>,
-    // An explicit `help`: in doc comments clap turns `{n}` into a line break.
-    #[arg(
-        short,
-        long,
-        help = "Output file; `{n}` is replaced by the screen size (required with several sizes)"
-    )]
+    // clap turns `{n}` into a line break anywhere in help text, so the help names `{np}`,
+    // which works the same (see `output_path`).
+    /// Output file; `{np}` is replaced by the screen size (required with several sizes).
+    #[arg(short, long)]
     output: PathBuf,
     /// Maximum optimization rounds N.
     #[arg(long, default_value_t = 50)]
@@ -312,11 +310,19 @@ fn bench(cmd: BenchCommand) -> ExitCode {
 #[cfg(feature = "lod")]
 const EXIT_FAILED: u8 = 1;
 
+/// Placeholders of the output path replaced by the screen size: `{n}` (the and the
+/// README's spelling) and `{np}` (the one `--help` can show).
+#[cfg(feature = "lod")]
+const SIZE_PLACEHOLDERS: [&str; 2] = ["{n}", "{np}"];
+
 /// The output path of screen size `n_p`.
 #[cfg(feature = "lod")]
 fn output_path(pattern: &std::path::Path, n_p: f64) -> PathBuf {
-    let s = pattern.to_string_lossy();
-    PathBuf::from(s.replace("{n}", &format!("{n_p}")))
+    let mut s = pattern.to_string_lossy().to_string();
+    for p in SIZE_PLACEHOLDERS {
+        s = s.replace(p, &format!("{n_p}"));
+    }
+    PathBuf::from(s)
 }
 
 /// `pleat lod` / `pleat cage`.
@@ -325,8 +331,11 @@ fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
     let cmd = if cage { "cage" } else { "lod" };
     let sizes = &args.screen_size;
     let many = sizes.len() > 1;
-    if many && !args.output.to_string_lossy().contains("{n}") {
-        eprintln!("pleat {cmd}: with several screen sizes the output needs a {{n}} placeholder");
+    let pattern = args.output.to_string_lossy();
+    if many && !SIZE_PLACEHOLDERS.iter().any(|p| pattern.contains(p)) {
+        eprintln!(
+            "pleat {cmd}: with several screen sizes the output needs a {{n}} or {{np}} placeholder"
+        );
         return ExitCode::from(EXIT_INPUT);
     }
     if many && args.faces.is_some() {

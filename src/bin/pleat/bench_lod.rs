@@ -970,6 +970,9 @@ mod tests {
             faces_out: 10,
             seconds: t,
             hausdorff_over_l: e,
+            in_to_out_over_l: e,
+            out_to_in_over_l: 0.5 * e,
+            floor_over_l: f64::NAN,
             watertight: true,
             manifold: true,
             self_intersection_free: true,
@@ -984,7 +987,8 @@ mod tests {
         let text = csv_text(&[row("a.obj", 50.0, 1.5, 0.02), bad], false);
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines.len(), 3);
-        assert!(lines[1].starts_with("a.obj,100,50,,ok,10,1.5000,0.0000,0.02,true,true,true"));
+        assert!(lines[1]
+            .starts_with("a.obj,100,50,,ok,10,1.5000,0.0000,0.02,0.02,0.01,,true,true,true"));
         assert!(lines[2].starts_with("\"b,c.obj\",100,50,,\"error: bad \"\"mesh\"\", sorry\",,"));
     }
 
