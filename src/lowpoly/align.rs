@@ -100,19 +100,12 @@ pub const CAP_HALVINGS: u32 = 4;
 /// when [`CAP_HALVINGS`] halvings do not suffice.
 fn capped_step(g: &Guard<'_>, p: P3, mut d: P3, cap: f64) -> Option<P3> {
     let input = g.input();
-    let mut allowed = cap;
-    let mut current_known = false;
+    // The allowance grows to the current distance only when the cap alone refuses a step.
+    let mut allowed = None;
     for _ in 0..=CAP_HALVINGS {
         let dn = input.distance(add(p, d));
-        if dn <= allowed {
+        if dn <= cap || dn <= *allowed.get_or_insert_with(|| cap.max(input.distance(p))) {
             return Some(d);
-        }
-        if !current_known {
-            current_known = true;
-            allowed = allowed.max(input.distance(p));
-            if dn <= allowed {
-                return Some(d);
-            }
         }
         d = scale(d, 0.5);
     }

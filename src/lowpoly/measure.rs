@@ -135,12 +135,9 @@ pub struct HausdorffSides {
 /// Both one-sided sampled distances between `output` and `input`, with the sampling of
 /// [`hausdorff_to_input`].
 pub fn hausdorff_sides(output: &TriMesh, input: &TriMesh) -> HausdorffSides {
-    let spacing = input.bbox_diagonal() / FINAL_SAMPLES_PER_DIAGONAL;
-    let a = Surface::new(output);
-    let b = Surface::new(input);
     HausdorffSides {
-        input_to_output: one_sided(&b.positions, &b.tris, &a, spacing, FINAL_MAX_SUBDIVISIONS),
-        output_to_input: one_sided(&a.positions, &a.tris, &b, spacing, FINAL_MAX_SUBDIVISIONS),
+        input_to_output: final_one_sided(input, &Surface::new(output), input),
+        output_to_input: final_one_sided(output, &Surface::new(input), input),
     }
 }
 
@@ -149,10 +146,20 @@ pub fn hausdorff_sides(output: &TriMesh, input: &TriMesh) -> HausdorffSides {
 /// the offset already hides (buried components, cavities and crevices narrower than `2d`)
 /// stays hidden through the loop, since the loop keeps the offset's topology.
 pub fn input_to_surface(surface: &TriMesh, input: &TriMesh) -> f64 {
+    final_one_sided(input, &Surface::new(surface), input)
+}
+
+/// [`one_sided`] from `from` to `to` at the final measurement's sampling (spacing from the
+/// input's diagonal `l`).
+fn final_one_sided(from: &TriMesh, to: &Surface, input: &TriMesh) -> f64 {
     let spacing = input.bbox_diagonal() / FINAL_SAMPLES_PER_DIAGONAL;
-    let a = Surface::new(surface);
-    let b = Surface::new(input);
-    one_sided(&b.positions, &b.tris, &a, spacing, FINAL_MAX_SUBDIVISIONS)
+    one_sided(
+        from.positions(),
+        from.triangles(),
+        to,
+        spacing,
+        FINAL_MAX_SUBDIVISIONS,
+    )
 }
 
 /// What the independent verification ([`MeshReport`]) found.
