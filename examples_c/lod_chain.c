@@ -64,6 +64,7 @@ static void bake_chain(const PleatMesh *input) {
     memset(stats, 0, sizeof stats);
     for (i = 0; i < 3; i++) stats[i].struct_size = sizeof stats[0];
     params.max_rounds = 8;
+    params.flags = PLEAT_LOD_MEASURE_FLOOR;
     CHECK_STATUS(pleat_lod_generate_chain(input, sizes, 3, &params, print_progress, &calls,
                                           levels, stats),
                  PLEAT_STATUS_OK);
@@ -82,6 +83,19 @@ static void bake_chain(const PleatMesh *input) {
         CHECK(stats[i].watertight == 1 && stats[i].manifold == 1);
         CHECK(stats[i].self_intersection_free == 1);
         CHECK(stats[i].hausdorff_relative > 0.0 && stats[i].hausdorff_relative < 4.0 / sizes[i]);
+        /* The two one-sided parts make up the two-sided figure. */
+        CHECK(stats[i].hausdorff_relative ==
+              (stats[i].hausdorff_in_to_out_relative > stats[i].hausdorff_out_to_in_relative
+                   ? stats[i].hausdorff_in_to_out_relative
+                   : stats[i].hausdorff_out_to_in_relative));
+        /* The floor is measured on the level baked from the offset surface (the finest, n_p =
+           100); coarser levels start from the finer result and report NaN. */
+        if (i == 2) {
+            CHECK(stats[i].hausdorff_floor_relative >= 0.0 &&
+                  stats[i].hausdorff_floor_relative < 2.0 / sizes[i]);
+        } else {
+            CHECK(stats[i].hausdorff_floor_relative != stats[i].hausdorff_floor_relative);
+        }
     }
     CHECK(pleat_mesh_triangle_count(levels[0]) <= pleat_mesh_triangle_count(levels[2]));
     for (i = 0; i < 3; i++) pleat_mesh_destroy(levels[i]);

@@ -341,6 +341,16 @@ typedef struct PleatLodStats {
   uint32_t exact_rerun;
   // 1 when a target face count was given and met.
   uint32_t target_met;
+  // The one-sided parts of `hausdorff_relative`: input to result (input the result does
+  // not cover) ...
+  double hausdorff_in_to_out_relative;
+  // ... and result to input.
+  double hausdorff_out_to_in_relative;
+  // With `PLEAT_LOD_MEASURE_FLOOR`, on levels baked from the offset surface: the distance
+  // from the input to the offset surface over `l`, the floor of
+  // `hausdorff_in_to_out_relative` (input the offset hides). NaN otherwise. Its time is
+  // the stats stage `floor` and is included in `seconds_total`.
+  double hausdorff_floor_relative;
 } PleatLodStats;
 
 // Parameters of `pleat_offset_surface`. Get defaults from `pleat_offset_params_default()` and

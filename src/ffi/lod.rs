@@ -98,6 +98,16 @@ pub struct PleatLodStats {
     pub exact_rerun: u32,
     /// 1 when a target face count was given and met.
     pub target_met: u32,
+    /// The one-sided parts of `hausdorff_relative`: input to result (input the result does
+    /// not cover) ...
+    pub hausdorff_in_to_out_relative: f64,
+    /// ... and result to input.
+    pub hausdorff_out_to_in_relative: f64,
+    /// With `PLEAT_LOD_MEASURE_FLOOR`, on levels baked from the offset surface: the distance
+    /// from the input to the offset surface over `l`, the floor of
+    /// `hausdorff_in_to_out_relative` (input the offset hides). NaN otherwise. Its time is
+    /// the stats stage `floor` and is included in `seconds_total`.
+    pub hausdorff_floor_relative: f64,
 }
 
 /// The defaults, with `struct_size = sizeof(PleatLodParams)`.
@@ -229,10 +239,6 @@ mod imp {
         crate::lowpoly::generate_chain(m, sizes, &to_rust(p)?, prog)
     }
 
-    fn stage(s: &Stats, name: &str) -> f64 {
-        s.stages.iter().filter(|x| x.0 == name).map(|x| x.1).sum()
-    }
-
     fn verified(s: &Stats, name: &str) -> u32 {
         s.verified.iter().any(|v| v.0 == name && v.1) as u32
     }
@@ -248,11 +254,11 @@ mod imp {
             start_face_count: count("faces_offset"),
             collapse_count: count("collapses"),
             seconds_total: s.total_seconds(),
-            seconds_offset: stage(s, "offset"),
-            seconds_simplify: stage(s, "simplify"),
-            seconds_flow: stage(s, "flow"),
-            seconds_align: stage(s, "align"),
-            seconds_verify: stage(s, "verify"),
+            seconds_offset: s.stage_seconds("offset"),
+            seconds_simplify: s.stage_seconds("simplify"),
+            seconds_flow: s.stage_seconds("flow"),
+            seconds_align: s.stage_seconds("align"),
+            seconds_verify: s.stage_seconds("verify"),
             offset_distance: metric("d"),
             hausdorff: metric("hausdorff"),
             hausdorff_relative: metric("hausdorff_rel"),
@@ -262,6 +268,9 @@ mod imp {
             encloses_input: verified(s, "cage_encloses_without_touching"),
             exact_rerun: (count("reruns_exact") > 0) as u32,
             target_met: count("target_met") as u32,
+            hausdorff_in_to_out_relative: metric("hausdorff_in_to_out_rel"),
+            hausdorff_out_to_in_relative: metric("hausdorff_out_to_in_rel"),
+            hausdorff_floor_relative: metric("hausdorff_floor_rel"),
         }
     }
 }
