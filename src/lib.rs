@@ -25,6 +25,7 @@
 #![warn(missing_docs)]
 
 mod error;
+pub mod geom;
 pub mod mesh;
 pub mod report;
 pub mod spatial;
