@@ -56,6 +56,13 @@ expect_run() { # expect_run EXE: runs the consumer, checks its line and that it 
   case $out in "pleat $version: LOD with "*" triangles") ;; *) echo "unexpected output" >&2; return 1 ;; esac
 }
 
+step "README's C example is examples_c/consumer/consumer.c"
+awk '/^<!-- examples_c\/consumer\/consumer.c/ { on = 1; next }
+     on && /^```c$/ { copy = 1; next }
+     copy && /^```$/ { exit }
+     copy { print }' README.md | diff - examples_c/consumer/consumer.c
+ok "README C example is the tested consumer"
+
 step "C consumer with CMake find_package(pleat) -> pleat::pleat, then pleat::pleat_static"
 if have cmake && have cc; then
   cmake -S examples_c/consumer -B "$tmp/cmake" -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
