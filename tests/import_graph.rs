@@ -4,7 +4,8 @@
 //!
 //! Each file is a module (`a/b.rs` and `a/b/mod.rs` are `crate::a::b`). Its references are the
 //! paths starting with `crate::`, `super::` or `self::`, in `use` items (trees expanded) and
-//! inline in code; comments, string literals and `#[cfg(test)] mod … { … }` blocks are skipped.
+//! inline in code; comments, string literals and `#[cfg(test)]` items (test modules, test-only
+//! imports) are skipped.
 //! `super`/`self` are resolved against the module the path is written in (inline modules such as
 //! `mod imp { … }` included), and every path to the deepest module that is a file. References
 //! from a file to itself are ignored.
@@ -183,48 +184,43 @@ fn is_ident(t: Option<&Tok>, s: &str) -> bool {
     matches!(t, Some(Tok::Ident(x)) if x == s)
 }
 
-/// Removes `#[cfg(test)] mod name { … }` blocks (brace matching) from the token stream.
-fn drop_test_modules(toks: Vec<Tok>) -> Vec<Tok> {
-    let pat = |i: usize| -> Option<usize> {
-        let want = [
-            Tok::Punct('#'),
-            Tok::Punct('['),
-            Tok::Ident("cfg".into()),
-            Tok::Punct('('),
-            Tok::Ident("test".into()),
-            Tok::Punct(')'),
-            Tok::Punct(']'),
-            Tok::Ident("mod".into()),
-        ];
-        if toks.len() < i + want.len() + 2 || toks[i..i + want.len()] != want {
-            return None;
-        }
-        let open = i + want.len() + 1;
-        (toks[open] == Tok::Punct('{')).then_some(open)
-    };
+/// Removes every item under `#[cfg(test)]` (a `mod tests { … }` block, a test-only `use`, …):
+/// after the attribute, everything up to the item's `;` or its closing brace (brace matching).
+fn drop_test_items(toks: Vec<Tok>) -> Vec<Tok> {
+    let attr = [
+        Tok::Punct('#'),
+        Tok::Punct('['),
+        Tok::Ident("cfg".into()),
+        Tok::Punct('('),
+        Tok::Ident("test".into()),
+        Tok::Punct(')'),
+        Tok::Punct(']'),
+    ];
     let mut out = Vec::with_capacity(toks.len());
     let mut i = 0;
     while i < toks.len() {
-        if let Some(open) = pat(i) {
-            let mut depth = 0;
-            let mut j = open;
-            while j < toks.len() {
-                match toks[j] {
-                    Tok::Punct('{') => depth += 1,
-                    Tok::Punct('}') => {
-                        depth -= 1;
-                        if depth == 0 {
-                            break;
-                        }
-                    }
-                    _ => {}
-                }
-                j += 1;
-            }
-            i = j + 1;
-        } else {
+        if toks.len() < i + attr.len() || toks[i..i + attr.len()] != attr {
             out.push(toks[i].clone());
             i += 1;
+            continue;
+        }
+        i += attr.len();
+        let mut depth = 0usize;
+        while i < toks.len() {
+            let t = &toks[i];
+            i += 1;
+            match t {
+                Tok::Punct('(' | '[' | '{') => depth += 1,
+                Tok::Punct(')' | ']') => depth = depth.saturating_sub(1),
+                Tok::Punct('}') => {
+                    depth = depth.saturating_sub(1);
+                    if depth == 0 {
+                        break;
+                    }
+                }
+                Tok::Punct(';') if depth == 0 => break,
+                _ => {}
+            }
         }
     }
     out
@@ -302,7 +298,7 @@ fn absolute(at: &[String], path: &[String]) -> Option<ModPath> {
 
 /// Every absolute path referenced by the file of module `module` with source `src`.
 fn references(module: &ModPath, src: &str) -> Vec<ModPath> {
-    let toks = drop_test_modules(tokenize(&strip_comments_and_strings(src)));
+    let toks = drop_test_items(tokenize(&strip_comments_and_strings(src)));
     let mut out = Vec::new();
     // inline modules: (brace depth inside the module, module path)
     let mut scopes: Vec<(usize, ModPath)> = vec![(0, module.clone())];
@@ -539,6 +535,11 @@ fn references_are_read_like_rustc_resolves_them() {
         #[cfg(test)]
         mod tests { use crate::ffi::Fake; fn g() { let _ = '}'; } }
         fn h() { self::inner(); super::super::report::Stats::new(); }
+        #[cfg(test)]
+        use crate::lowpoly::measure;
+        #[cfg(test)]
+        #[allow(dead_code)]
+        fn only_in_tests(x: [u8; 2]) { crate::cage::check(); }
     "##;
     let got: BTreeSet<String> = references(&m, src).iter().map(|p| p.join("::")).collect();
     let want: BTreeSet<String> = [
@@ -555,4 +556,18 @@ fn references_are_read_like_rustc_resolves_them() {
     .map(String::from)
     .into();
     assert_eq!(got, want);
+}
+
+/// Tarjan finds exactly the cycles of a small graph (a 2-cycle, a 3-cycle, an acyclic tail).
+#[test]
+fn cycles_are_found() {
+    let m = |s: &str| -> ModPath { vec!["crate".into(), s.into()] };
+    let mut g: BTreeMap<ModPath, BTreeSet<ModPath>> = BTreeMap::new();
+    for (a, b) in [("a", "b"), ("b", "a"), ("c", "d"), ("d", "e"), ("e", "c"), ("e", "f")] {
+        g.entry(m(a)).or_default().insert(m(b));
+        g.entry(m(b)).or_default();
+    }
+    let mut found = cycles(&g);
+    found.sort();
+    assert_eq!(found, vec![vec![m("a"), m("b")], vec![m("c"), m("d"), m("e")]]);
 }
