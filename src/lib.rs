@@ -6,7 +6,8 @@
 //! - `lod`: any triangle soup in, a watertight, manifold, self-intersection-free low-poly mesh
 //!   out that is indistinguishable from the input at a given screen size (dissertation ch. 4).
 //! - `cage`: the same, strictly enclosing the input without touching it (ch. 4.5.2).
-//! - `wrinkle`: complex wrinkle fields — evaluation, interpolation, design (ch. 3).
+//! - `wrinkle`: complex wrinkle fields — evaluation, interpolation, design (ch. 3); brings the
+//!   numerics module [`solve`] (sparse Cholesky, inverse iteration, Krylov; faer).
 //! - `cli`: the `pleat` command-line tool; `io-gltf`: glTF 2.0 reading and writing.
 //!
 //! The mesh core ([`mesh`], [`spatial`]) is always present.
@@ -38,7 +39,7 @@ pub mod cage;
 #[cfg(feature = "wrinkle")]
 pub mod wrinkle;
 
-/// Sparse factorization, eigen and Krylov solvers; built with the features that need faer.
+// Numerics (faer): built with the features that need it.
 #[cfg(feature = "wrinkle")]
 pub mod solve;
 

@@ -563,11 +563,21 @@ fn references_are_read_like_rustc_resolves_them() {
 fn cycles_are_found() {
     let m = |s: &str| -> ModPath { vec!["crate".into(), s.into()] };
     let mut g: BTreeMap<ModPath, BTreeSet<ModPath>> = BTreeMap::new();
-    for (a, b) in [("a", "b"), ("b", "a"), ("c", "d"), ("d", "e"), ("e", "c"), ("e", "f")] {
+    for (a, b) in [
+        ("a", "b"),
+        ("b", "a"),
+        ("c", "d"),
+        ("d", "e"),
+        ("e", "c"),
+        ("e", "f"),
+    ] {
         g.entry(m(a)).or_default().insert(m(b));
         g.entry(m(b)).or_default();
     }
     let mut found = cycles(&g);
     found.sort();
-    assert_eq!(found, vec![vec![m("a"), m("b")], vec![m("c"), m("d"), m("e")]]);
+    assert_eq!(
+        found,
+        vec![vec![m("a"), m("b")], vec![m("c"), m("d"), m("e")]]
+    );
 }

@@ -414,6 +414,45 @@ mod tests {
             .is_err());
     }
 
+    /// The factorization and solve are bit for bit those of faer's high-level `Llt` (which the
+    /// wrinkle solvers called before this module existed).
+    #[test]
+    fn bitwise_equal_to_faer_llt() {
+        use faer::linalg::solvers::Solve;
+        use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+        // a 2-D grid Laplacian plus a varying diagonal: supernodes with real dense blocks
+        let n = 30;
+        let id = |i: usize, j: usize| i * n + j;
+        let mut t = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                t.push(Entry::new(id(i, j), id(i, j), 4.1 + (i * j) as f64 * 1e-3));
+                if i + 1 < n {
+                    t.push(Entry::new(id(i + 1, j), id(i, j), -1.0 - 1e-3 * j as f64));
+                }
+                if j + 1 < n {
+                    t.push(Entry::new(id(i, j + 1), id(i, j), -0.7));
+                }
+            }
+        }
+        let a = assemble(n * n, &t, "a test matrix").unwrap();
+        let b: Vec<f64> = (0..n * n).map(|i| (i as f64 * 0.37).cos()).collect();
+        let ours = CholeskyAnalysis::new(&a)
+            .unwrap()
+            .factor(&a, Parallelism::Global)
+            .unwrap()
+            .solve(&b);
+        let sym = SymbolicLlt::try_new(a.symbolic(), Side::Lower).unwrap();
+        let llt = Llt::try_new_with_symbolic(sym, a.as_ref(), Side::Lower).unwrap();
+        let mut m = Mat::<f64>::from_fn(n * n, 1, |i, _| b[i]);
+        llt.solve_in_place(&mut m);
+        let theirs: Vec<f64> = (0..n * n).map(|i| m[(i, 0)]).collect();
+        assert!(ours
+            .iter()
+            .zip(&theirs)
+            .all(|(x, y)| x.to_bits() == y.to_bits()));
+    }
+
     #[test]
     fn missing_diagonal_is_refused() {
         let a = assemble(2, &[Entry::new(1, 0, 1.0), Entry::new(0, 0, 1.0)], "m").unwrap();
