@@ -41,6 +41,26 @@ macro_rules! requires {
 }
 pub(crate) use requires;
 
+/// Implements [`Versioned`] for a struct (`versioned!(Type, min_size)`), and
+/// [`VersionedParams`] too when its `*_default()` function is named
+/// (`versioned!(Type, min_size, default_fn)`).
+macro_rules! versioned {
+    ($t:ident, $min:literal $(, $default:ident)?) => {
+        // SAFETY: repr(C), leading `struct_size: u32`, integer and real fields only.
+        unsafe impl $crate::ffi::boundary::Versioned for $t {
+            const NAME: &'static str = stringify!($t);
+            const MIN_SIZE: u32 = $min;
+        }
+        $(impl $crate::ffi::boundary::VersionedParams for $t {
+            const DEFAULT_FN: &'static str = stringify!($default);
+            fn defaults() -> Self {
+                $default()
+            }
+        })?
+    };
+}
+pub(crate) use versioned;
+
 // ---------------------------------------------------------------------------------------------
 // Pointers
 

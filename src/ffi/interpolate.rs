@@ -12,12 +12,12 @@
 
 #[cfg(feature = "wrinkle")]
 use super::boundary::{arg_out, arg_ref, guard_value};
-use super::boundary::{destroy, full_size, requires, Versioned, VersionedParams};
+use super::boundary::{destroy, full_size, requires, versioned};
 #[cfg(feature = "wrinkle")]
 use super::common::{c_str_arg, guard};
 use super::common::{PleatProgressFn, PleatStatus};
 use super::mesh::PleatMesh;
-use super::wrinkle::{versioned, wrinkle_count, wrinkle_only, PleatCwf};
+use super::wrinkle::{wrinkle_count, wrinkle_only, PleatCwf};
 #[cfg(feature = "wrinkle")]
 use crate::Error;
 #[cfg(feature = "wrinkle")]
@@ -167,9 +167,11 @@ pub(super) fn defaults_without_wrinkle() -> PleatWrinkleInterpParams {
 }
 
 versioned!(
-    PleatWrinkleInterpParams = pleat_wrinkle_interp_params_default,
-    PleatWrinkleInterpStats,
+    PleatWrinkleInterpParams,
+    8,
+    pleat_wrinkle_interp_params_default
 );
+versioned!(PleatWrinkleInterpStats, 8);
 
 /// Interpolates between keyframe `a` (t = 0) and keyframe `b` (t = 1) (dissertation §3.4):
 /// linear amplitude, the explicit magnitude/angle path of ω, and the phase z̃ on the guide frames

@@ -5,8 +5,7 @@
 //! `PLEAT_STATUS_UNSUPPORTED`.
 
 use super::boundary::{
-    arg_out, arg_slice, check_flags, full_size, read_versioned, requires, versioned_out, Versioned,
-    VersionedParams,
+    arg_out, arg_slice, check_flags, full_size, read_versioned, requires, versioned, versioned_out,
 };
 use super::common::{guard_progress, PleatProgressFn, PleatStatus};
 use super::mesh::{mesh_ref, PleatMesh};
@@ -124,26 +123,9 @@ pub extern "C" fn pleat_lod_params_default() -> PleatLodParams {
     return defaults_without_lod();
 }
 
-// SAFETY: repr(C), leading `struct_size: u32`, integer and real fields only.
-unsafe impl Versioned for PleatLodParams {
-    const NAME: &'static str = "PleatLodParams";
-    /// Through `screen_size`.
-    const MIN_SIZE: u32 = 16;
-}
-
-impl VersionedParams for PleatLodParams {
-    const DEFAULT_FN: &'static str = "pleat_lod_params_default";
-    fn defaults() -> Self {
-        pleat_lod_params_default()
-    }
-}
-
-// SAFETY: repr(C), leading `struct_size: u32`, integer and real fields only.
-unsafe impl Versioned for PleatLodStats {
-    const NAME: &'static str = "PleatLodStats";
-    /// Through `rounds`.
-    const MIN_SIZE: u32 = 8;
-}
+// Smallest sizes: through `screen_size` (params), through `rounds` (stats).
+versioned!(PleatLodParams, 16, pleat_lod_params_default);
+versioned!(PleatLodStats, 8);
 
 #[cfg(feature = "lod")]
 impl From<&crate::lowpoly::LodParams> for PleatLodParams {

@@ -2,7 +2,7 @@
 
 #[cfg(feature = "lod")]
 use super::boundary::bool_field;
-use super::boundary::{arg_out, full_size, read_versioned, requires, Versioned, VersionedParams};
+use super::boundary::{arg_out, full_size, read_versioned, requires, versioned};
 use super::common::{guard, guard_progress, PleatProgressFn, PleatStatus};
 use super::mesh::{mesh_ref, PleatMesh};
 use super::stats::{emit_stats, PleatStats};
@@ -51,19 +51,8 @@ pub extern "C" fn pleat_offset_params_default() -> PleatOffsetParams {
     return defaults_without_lod();
 }
 
-// SAFETY: repr(C), leading `struct_size: u32`, integer and real fields only.
-unsafe impl Versioned for PleatOffsetParams {
-    const NAME: &'static str = "PleatOffsetParams";
-    /// Through `use_absolute_distance`.
-    const MIN_SIZE: u32 = 8;
-}
-
-impl VersionedParams for PleatOffsetParams {
-    const DEFAULT_FN: &'static str = "pleat_offset_params_default";
-    fn defaults() -> Self {
-        pleat_offset_params_default()
-    }
-}
+// Smallest size: through `use_absolute_distance`.
+versioned!(PleatOffsetParams, 8, pleat_offset_params_default);
 
 #[cfg(feature = "lod")]
 impl From<&crate::lowpoly::OffsetParams> for PleatOffsetParams {

@@ -1,6 +1,6 @@
 //! `pleat_mesh_check`: the validity report of any mesh, as a versioned C struct.
 
-use super::boundary::{check_flags, required_versioned_out, Versioned};
+use super::boundary::{check_flags, required_versioned_out, versioned};
 use super::common::{guard, PleatStatus};
 use super::mesh::{mesh_ref, PleatMesh};
 use crate::mesh::{MeshReport, ReportOptions};
@@ -109,12 +109,8 @@ fn to_c(r: &MeshReport) -> PleatMeshReport {
     }
 }
 
-// SAFETY: repr(C), leading `struct_size: u32`, integer and real fields only.
-unsafe impl Versioned for PleatMeshReport {
-    const NAME: &'static str = "PleatMeshReport";
-    /// Through `is_closed`.
-    const MIN_SIZE: u32 = 8;
-}
+// Smallest size: through `is_closed`.
+versioned!(PleatMeshReport, 8);
 
 /// Computes the validity report of `mesh` (any soup) into `*out`.
 ///

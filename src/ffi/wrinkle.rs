@@ -15,8 +15,7 @@
 #![allow(clippy::too_many_arguments)]
 
 use super::boundary::{
-    arg_out, arg_ref, destroy, full_size, guard_value, required_versioned_out, requires, Versioned,
-    VersionedParams,
+    arg_out, arg_ref, destroy, full_size, guard_value, required_versioned_out, requires, versioned,
 };
 use super::common::{guard, PleatProgressFn, PleatStatus};
 use super::mesh::PleatMesh;
@@ -298,31 +297,10 @@ pub(super) fn defaults_without_wrinkle() -> (PleatWrinkleEvalParams, PleatKnoppe
 // ---------------------------------------------------------------------------------------------
 // Versioned structs: every one accepts a `struct_size` down to 8 (the size field and one u32).
 
-/// Implements [`Versioned`] (minimum size 8) for the wrinkle structs, and [`VersionedParams`]
-/// for those with a `*_default()` function.
-macro_rules! versioned {
-    ($($t:ident $(= $default:ident)?),* $(,)?) => {$(
-        // SAFETY: repr(C), leading `struct_size: u32`, integer and real fields only.
-        unsafe impl Versioned for $t {
-            const NAME: &'static str = stringify!($t);
-            const MIN_SIZE: u32 = 8;
-        }
-        $(impl VersionedParams for $t {
-            const DEFAULT_FN: &'static str = stringify!($default);
-            fn defaults() -> Self {
-                $default()
-            }
-        })?
-    )*};
-}
-pub(super) use versioned;
-
-versioned!(
-    PleatWrinkleEvalParams = pleat_wrinkle_eval_params_default,
-    PleatKnoppelParams = pleat_knoppel_params_default,
-    PleatWrinkleEvalStats,
-    PleatKnoppelReport,
-);
+versioned!(PleatWrinkleEvalParams, 8, pleat_wrinkle_eval_params_default);
+versioned!(PleatKnoppelParams, 8, pleat_knoppel_params_default);
+versioned!(PleatWrinkleEvalStats, 8);
+versioned!(PleatKnoppelReport, 8);
 
 // ---------------------------------------------------------------------------------------------
 // Creation
