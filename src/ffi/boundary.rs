@@ -19,6 +19,9 @@
 //!
 //! This module imports only `crate::Error` and `ffi::common`.
 
+// Builds without a capability leave some helpers unused.
+#![cfg_attr(not(all(feature = "lod", feature = "wrinkle")), allow(dead_code))]
+
 use super::common::null_arg;
 use crate::{Error, Result};
 use std::panic::{catch_unwind, AssertUnwindSafe};

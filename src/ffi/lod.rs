@@ -4,11 +4,15 @@
 //! The functions exist in every build; without the cargo feature `lod` (or `cage`) they return
 //! `PLEAT_STATUS_UNSUPPORTED`.
 
-use super::boundary::{
-    arg_out, arg_slice, check_flags, full_size, read_versioned, requires, versioned, versioned_out,
-};
-use super::common::{guard_progress, PleatProgressFn, PleatStatus};
-use super::mesh::{mesh_ref, PleatMesh};
+#[cfg(feature = "lod")]
+use super::boundary::{arg_out, arg_slice, check_flags, read_versioned, versioned_out};
+use super::boundary::{full_size, requires, versioned};
+#[cfg(feature = "lod")]
+use super::common::guard_progress;
+use super::common::{PleatProgressFn, PleatStatus};
+#[cfg(feature = "lod")]
+use super::mesh::mesh_ref;
+use super::mesh::PleatMesh;
 #[cfg(feature = "lod")]
 use crate::{Error, Result};
 

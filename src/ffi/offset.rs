@@ -3,9 +3,13 @@
 #[cfg(feature = "lod")]
 use super::boundary::bool_field;
 use super::boundary::{arg_out, full_size, read_versioned, requires, versioned};
-use super::common::{guard, guard_progress, PleatProgressFn, PleatStatus};
+#[cfg(feature = "lod")]
+use super::common::guard_progress;
+use super::common::{guard, PleatProgressFn, PleatStatus};
 use super::mesh::{mesh_ref, PleatMesh};
-use super::stats::{emit_stats, PleatStats};
+#[cfg(feature = "lod")]
+use super::stats::emit_stats;
+use super::stats::PleatStats;
 use crate::Error;
 
 /// Parameters of `pleat_offset_surface`. Get defaults from `pleat_offset_params_default()` and

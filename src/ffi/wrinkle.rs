@@ -14,9 +14,9 @@
 
 #![allow(clippy::too_many_arguments)]
 
-use super::boundary::{
-    arg_out, arg_ref, destroy, full_size, guard_value, required_versioned_out, requires, versioned,
-};
+#[cfg(feature = "wrinkle")]
+use super::boundary::required_versioned_out;
+use super::boundary::{arg_out, arg_ref, destroy, full_size, guard_value, requires, versioned};
 use super::common::{guard, PleatProgressFn, PleatStatus};
 use super::mesh::PleatMesh;
 use crate::{Error, Result};
