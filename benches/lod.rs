@@ -25,11 +25,15 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::time::Instant;
 
 use meshopt::{SimplifyOptions, VertexDataAdapter};
 use pleat::lowpoly::{generate, hausdorff_to_input, LodParams};
-use pleat::mesh::{ExactWeld, MeshReport, TriMesh};
+use pleat::mesh::{ExactWeld, TriMesh};
+
+#[path = "common/lod_sweep.rs"]
+mod lod_sweep;
+
+use lod_sweep::{corpus_dir, floor_seconds, mean, median, mesh_files, timed};
 
 /// Screen sizes of the comparison.
 const SCREEN_SIZES: [f64; 3] = [50.0, 100.0, 200.0];
@@ -78,26 +82,10 @@ struct Case {
     meshopt: Outcome,
 }
 
-fn corpus_dir() -> Option<PathBuf> {
-    let cands = [
-        std::env::var("PLEAT_MESHES").ok().map(PathBuf::from),
-        Some(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes")),
-        Some(PathBuf::from("/work/shared/meshes")),
-    ];
-    cands.into_iter().flatten().find(|p| p.is_dir())
-}
-
 /// Mesh files of the corpus, sorted, matching the optional name filter.
 fn corpus_files(dir: &Path, filter: Option<&str>) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map(|rd| rd.filter_map(|e| e.ok().map(|e| e.path())).collect())
-        .unwrap_or_default();
-    files.retain(|p| {
-        let ext = p.extension().and_then(|e| e.to_str()).unwrap_or("");
-        ["obj", "ply", "off", "stl"].contains(&ext.to_ascii_lowercase().as_str())
-            && filter.is_none_or(|f| p.to_string_lossy().contains(f))
-    });
-    files.sort();
+    let mut files = mesh_files(dir, &["obj", "ply", "off", "stl"]).unwrap_or_default();
+    files.retain(|p| filter.is_none_or(|f| p.to_string_lossy().contains(f)));
     files
 }
 
@@ -109,11 +97,11 @@ fn load_average() -> String {
 
 /// MeshReport flags, plus meshcheck's when `PLEAT_MESHCHECK` is set.
 fn validity(m: &TriMesh, tag: &str) -> Validity {
-    let r = MeshReport::compute(m);
+    let v = lod_sweep::Validity::of(m);
     Validity {
-        watertight: r.is_watertight,
-        manifold: r.is_manifold && r.consistently_oriented,
-        self_intersection_free: r.self_intersection_free == Some(true),
+        watertight: v.watertight,
+        manifold: v.manifold,
+        self_intersection_free: v.self_intersection_free,
         meshcheck: meshcheck(m, tag),
     }
 }
@@ -149,27 +137,24 @@ fn run_pleat(mesh: &TriMesh, n_p: f64, tag: &str) -> Outcome {
         measure_floor: true,
         ..LodParams::default()
     };
-    let t0 = Instant::now();
-    let c0 = pleat::report::process_cpu_seconds();
-    let r = generate(mesh, &params, &mut |_| true);
-    let mut seconds = t0.elapsed().as_secs_f64();
-    let mut cpu_seconds = pleat::report::process_cpu_seconds() - c0;
-    match r {
-        Ok((out, stats)) => {
-            // The floor is measured for this table, not part of the bake.
-            seconds -= stats.stage_seconds("floor");
-            cpu_seconds -= stats.get_metric("floor_cpu_seconds").unwrap_or(0.0);
-            Outcome {
-                status: "ok".into(),
-                method: "pleat".into(),
-                faces: out.triangle_count(),
-                seconds,
-                cpu_seconds,
-                hd_rel: hausdorff_to_input(&out, mesh) / mesh.bbox_diagonal(),
-                floor_rel: stats.get_metric("hausdorff_floor_rel").unwrap_or(f64::NAN),
-                valid: validity(&out, tag),
-            }
-        }
+    let mut run = timed(|| generate(mesh, &params, &mut |_| true));
+    if let Ok((_, stats)) = &run.value {
+        let (wall, cpu) = floor_seconds(stats);
+        run.seconds -= wall;
+        run.cpu_seconds -= cpu;
+    }
+    let (seconds, cpu_seconds) = (run.seconds, run.cpu_seconds);
+    match run.value {
+        Ok((out, stats)) => Outcome {
+            status: "ok".into(),
+            method: "pleat".into(),
+            faces: out.triangle_count(),
+            seconds,
+            cpu_seconds,
+            hd_rel: hausdorff_to_input(&out, mesh) / mesh.bbox_diagonal(),
+            floor_rel: stats.get_metric("hausdorff_floor_rel").unwrap_or(f64::NAN),
+            valid: validity(&out, tag),
+        },
         Err(e) => Outcome {
             status: format!("error: {e}"),
             seconds,
@@ -225,11 +210,9 @@ fn meshopt_to(mesh: &TriMesh, target: usize) -> (TriMesh, &'static str) {
 
 /// meshopt at pleat's face count.
 fn run_meshopt(mesh: &TriMesh, target: usize, tag: &str) -> Outcome {
-    let t0 = Instant::now();
-    let c0 = pleat::report::process_cpu_seconds();
-    let (out, method) = meshopt_to(mesh, target);
-    let seconds = t0.elapsed().as_secs_f64();
-    let cpu_seconds = pleat::report::process_cpu_seconds() - c0;
+    let run = timed(|| meshopt_to(mesh, target));
+    let (seconds, cpu_seconds) = (run.seconds, run.cpu_seconds);
+    let (out, method) = run.value;
     if out.triangle_count() == 0 {
         return Outcome {
             status: "error: no triangles left".into(),
@@ -355,23 +338,6 @@ fn write_csv(cases: &[Case]) -> PathBuf {
     path
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len().max(1) as f64
-}
-
 /// Share of `cases` whose outcome (selected by `pick`) satisfies `pred`, as "k/n (p%)".
 fn rate(cases: &[&Case], pick: fn(&Case) -> &Outcome, pred: fn(&Outcome) -> bool) -> String {
     let k = cases.iter().filter(|c| pred(pick(c))).count();
@@ -432,7 +398,7 @@ fn print_summary(cases: &[Case]) {
                     String::new()
                 },
                 mean(&hd),
-                median(secs),
+                median(&secs),
             );
         }
         let both: Vec<&&Case> = at
@@ -450,20 +416,20 @@ fn print_summary(cases: &[Case]) {
         println!(
             "  time pleat/meshopt: median {:.1}x  (meshopt needed simplify_sloppy in {sloppy} \
              cases)",
-            median(ratios)
+            median(&ratios)
         );
-        let pleat_secs = median(
-            at.iter()
-                .filter(|c| ok(&c.pleat))
-                .map(|c| c.pleat.seconds)
-                .collect(),
-        );
-        let pleat_cpu = median(
-            at.iter()
-                .filter(|c| ok(&c.pleat))
-                .map(|c| c.pleat.cpu_seconds)
-                .collect(),
-        );
+        let pleat_secs: Vec<f64> = at
+            .iter()
+            .filter(|c| ok(&c.pleat))
+            .map(|c| c.pleat.seconds)
+            .collect();
+        let pleat_secs = median(&pleat_secs);
+        let pleat_cpu: Vec<f64> = at
+            .iter()
+            .filter(|c| ok(&c.pleat))
+            .map(|c| c.pleat.cpu_seconds)
+            .collect();
+        let pleat_cpu = median(&pleat_cpu);
         println!(
             "  pleat median CPU seconds {pleat_cpu:.2} (an upper bound of the wall time on an \
              unloaded machine)"

@@ -14,6 +14,9 @@ use pleat::Stats;
 #[path = "../tests/common/shapes.rs"]
 mod shapes;
 
+#[path = "common/lod_sweep.rs"]
+mod lod_sweep;
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let opt = |name: &str, default: usize| {
@@ -112,30 +115,16 @@ fn run(name: &str, mesh: &TriMesh) -> MeshReport {
     r
 }
 
-/// The `large_*` meshes of the shared corpus, when present (`$PLEAT_MESHES`, else
-/// `../shared/meshes`, else `../../shared/meshes` from the crate root).
+/// The `large_*` meshes of the shared corpus, when present ([`lod_sweep::corpus_dir`]).
 fn corpus(repeat: usize) {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let candidates = [
-        std::env::var_os("PLEAT_MESHES").map(std::path::PathBuf::from),
-        Some(root.join("../shared/meshes")),
-        Some(root.join("../../shared/meshes")),
-    ];
-    let Some(dir) = candidates.into_iter().flatten().find(|d| d.is_dir()) else {
+    let Some(dir) = lod_sweep::corpus_dir() else {
         println!("corpus: ../shared/meshes not found (set PLEAT_MESHES), skipped");
         return;
     };
-    let Ok(entries) = std::fs::read_dir(&dir) else {
+    let Ok(mut files) = lod_sweep::mesh_files(&dir, &lod_sweep::MESH_EXTENSIONS) else {
         return;
     };
-    let mut files: Vec<_> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.file_name()
-                .is_some_and(|n| n.to_string_lossy().starts_with("large_"))
-        })
-        .collect();
-    files.sort();
+    files.retain(|p| lod_sweep::file_name(p).starts_with("large_"));
     for f in files {
         let t0 = Instant::now();
         let mesh = match pleat::mesh::io::read_mesh(&f) {

@@ -596,8 +596,8 @@ PleatStatus pleat_mesh_copy_edges(const struct PleatMesh *mesh,
                                   size_t edge_capacity);
 
 // The default interpolation parameters (50 guide frames, 4 sub-steps, 200 iterations,
-// c_scale 1000, tolerance 1e-6, exact Hessian), with `struct_size` set. Available in every
-// build.
+// c_scale 1000, tolerance 1e-6, trust-region Newton–CG with the exact Hessian,
+// `PLEAT_INTERP_HESSIAN_TRUST_REGION`), with `struct_size` set. Available in every build.
 struct PleatWrinkleInterpParams pleat_wrinkle_interp_params_default(void);
 
 // Interpolates between keyframe `a` (t = 0) and keyframe `b` (t = 1) (dissertation §3.4):

@@ -84,7 +84,9 @@ fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
 }
 
 /// The panic fence: runs `f` on pleat's thread pool, catches panics, maps errors to statuses and
-/// records the message. Every `extern "C"` function that can fail goes through here.
+/// records the message. Every `extern "C"` function that can fail goes through here or through
+/// [`guard_progress`] (the same fence with a progress relay); both end in `status_of`. The
+/// arguments are checked inside `f` with the helpers of `ffi::boundary`.
 pub(crate) fn guard(f: impl FnOnce() -> crate::Result<()>) -> PleatStatus {
     status_of(catch_unwind(AssertUnwindSafe(|| with_pool(f))))
 }
@@ -103,7 +105,8 @@ fn status_of(result: std::thread::Result<crate::Result<()>>) -> PleatStatus {
 }
 
 /// Records that this build was compiled without the cargo feature `feature` and returns
-/// `PLEAT_STATUS_UNSUPPORTED` (for entry points whose capability was left out).
+/// `PLEAT_STATUS_UNSUPPORTED` (for entry points whose capability was left out; the one
+/// message of the `requires!` macro).
 #[allow(dead_code)] // used only by builds that leave a capability out
 pub(crate) fn unsupported(feature: &str) -> PleatStatus {
     set_last_error(&format!(
@@ -191,7 +194,7 @@ pub extern "C" fn pleat_set_thread_count(n: u32) -> PleatStatus {
 /// Number of worker threads the next pleat call will use (≥ 1).
 #[no_mangle]
 pub extern "C" fn pleat_thread_count() -> u32 {
-    catch_unwind(|| with_pool(rayon::current_num_threads) as u32).unwrap_or(1)
+    super::boundary::guard_value(1, || with_pool(rayon::current_num_threads) as u32)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -322,6 +325,7 @@ enum Msg {
 /// invoked on the calling thread: without a custom pool `f` runs on the calling thread; with a
 /// pool set by `pleat_set_thread_count`, `f` runs on a pool worker while the calling thread
 /// relays each progress report to `cb` and sends its answer back; the worker waits for it.
+#[cfg_attr(not(any(feature = "lod", feature = "wrinkle")), allow(dead_code))]
 pub(crate) fn guard_progress(
     cb: PleatProgressFn,
     user_data: *mut std::ffi::c_void,

@@ -4,7 +4,8 @@
 //! undirected edges of the triangles, sorted by `(min vertex, max vertex)` and oriented from the
 //! smaller to the larger vertex index. Available in every build.
 
-use super::common::{guard, null_arg, PleatStatus};
+use super::boundary::{arg_out, guard_value};
+use super::common::{guard, PleatStatus};
 use super::mesh::{mesh_ref, PleatMesh};
 use crate::Error;
 
@@ -18,10 +19,7 @@ use crate::Error;
 /// `mesh` is NULL or a live handle.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_mesh_edge_count(mesh: *const PleatMesh) -> usize {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        mesh.as_ref().map_or(0, |m| m.mesh.edges().len())
-    }))
-    .unwrap_or(0)
+    guard_value(0, || mesh.as_ref().map_or(0, |m| m.mesh.edges().len()))
 }
 
 /// Copies the edges of `mesh` in pleat's edge numbering: edge `e` is written as the two vertex
@@ -44,9 +42,7 @@ pub unsafe extern "C" fn pleat_mesh_copy_edges(
 ) -> PleatStatus {
     guard(|| {
         let m = mesh_ref(mesh, "mesh")?;
-        if dst.is_null() {
-            return Err(null_arg("dst"));
-        }
+        arg_out(dst, "dst")?;
         let edges = m.edges();
         let n = edges.len();
         if edge_capacity < n {

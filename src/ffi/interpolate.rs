@@ -11,34 +11,17 @@
 //! `PLEAT_STATUS_UNSUPPORTED` and the counts 0.
 
 #[cfg(feature = "wrinkle")]
-use super::common::guard;
-use super::common::{null_arg, PleatProgressFn, PleatStatus};
-use super::mesh::PleatMesh;
-use super::wrinkle::PleatCwf;
+use super::boundary::{arg_out, arg_ref, guard_value};
+use super::boundary::{destroy, full_size, requires, versioned};
 #[cfg(feature = "wrinkle")]
-use super::wrinkle::{output_size, read_versioned, write_versioned};
+use super::common::{c_str_arg, guard};
+use super::common::{PleatProgressFn, PleatStatus};
+use super::mesh::PleatMesh;
+use super::wrinkle::{wrinkle_count, wrinkle_only, PleatCwf};
 #[cfg(feature = "wrinkle")]
 use crate::Error;
+#[cfg(feature = "wrinkle")]
 use crate::Result;
-
-#[cfg(not(feature = "wrinkle"))]
-use super::common::unsupported;
-
-/// Runs `$body` (a `PleatStatus` expression) when built with `wrinkle`; otherwise returns
-/// `PLEAT_STATUS_UNSUPPORTED` and marks the listed parameters used.
-macro_rules! wrinkle_only {
-    ([$($arg:expr),*] $body:expr) => {{
-        #[cfg(feature = "wrinkle")]
-        {
-            $body
-        }
-        #[cfg(not(feature = "wrinkle"))]
-        {
-            let _ = ($($arg,)*);
-            unsupported("wrinkle")
-        }
-    }};
-}
 
 /// `PleatWrinkleInterpStats::stop_reason`: the gradient norm reached the tolerance.
 pub const PLEAT_INTERP_STOP_CONVERGED: u32 = 0;
@@ -134,12 +117,45 @@ pub struct PleatWrinkleInterpStats {
 }
 
 /// The default interpolation parameters (50 guide frames, 4 sub-steps, 200 iterations,
-/// c_scale 1000, tolerance 1e-6, exact Hessian), with `struct_size` set. Available in every
-/// build.
+/// c_scale 1000, tolerance 1e-6, trust-region Newton–CG with the exact Hessian,
+/// `PLEAT_INTERP_HESSIAN_TRUST_REGION`), with `struct_size` set. Available in every build.
 #[no_mangle]
 pub extern "C" fn pleat_wrinkle_interp_params_default() -> PleatWrinkleInterpParams {
+    #[cfg(feature = "wrinkle")]
+    return PleatWrinkleInterpParams::from(&crate::wrinkle::InterpOptions::default());
+    #[cfg(not(feature = "wrinkle"))]
+    return defaults_without_wrinkle();
+}
+
+#[cfg(feature = "wrinkle")]
+impl From<&crate::wrinkle::InterpOptions> for PleatWrinkleInterpParams {
+    fn from(o: &crate::wrinkle::InterpOptions) -> Self {
+        use crate::wrinkle::HessianModel;
+        let count = |n: usize| n.min(u32::MAX as usize) as u32;
+        PleatWrinkleInterpParams {
+            struct_size: full_size::<PleatWrinkleInterpParams>(),
+            guide_frames: count(o.guide_frames),
+            substeps: count(o.substeps),
+            max_iterations: count(o.max_iterations),
+            c_scale: o.c_scale,
+            gradient_tolerance: o.gradient_tolerance,
+            hessian: match o.hessian {
+                HessianModel::Projected => PLEAT_INTERP_HESSIAN_PROJECTED,
+                HessianModel::GaussNewton => PLEAT_INTERP_HESSIAN_GAUSS_NEWTON,
+                HessianModel::Exact => PLEAT_INTERP_HESSIAN_EXACT,
+                HessianModel::TrustRegion => PLEAT_INTERP_HESSIAN_TRUST_REGION,
+            },
+            reserved: 0,
+        }
+    }
+}
+
+/// `InterpOptions::default()` as C, for builds without `wrinkle` (which have no
+/// `InterpOptions`); the test `ffi::defaults` pins it to the conversion above.
+#[cfg_attr(feature = "wrinkle", allow(dead_code))]
+pub(super) fn defaults_without_wrinkle() -> PleatWrinkleInterpParams {
     PleatWrinkleInterpParams {
-        struct_size: std::mem::size_of::<PleatWrinkleInterpParams>() as u32,
+        struct_size: full_size::<PleatWrinkleInterpParams>(),
         guide_frames: 50,
         substeps: 4,
         max_iterations: 200,
@@ -149,6 +165,13 @@ pub extern "C" fn pleat_wrinkle_interp_params_default() -> PleatWrinkleInterpPar
         reserved: 0,
     }
 }
+
+versioned!(
+    PleatWrinkleInterpParams,
+    8,
+    pleat_wrinkle_interp_params_default
+);
+versioned!(PleatWrinkleInterpStats, 8);
 
 /// Interpolates between keyframe `a` (t = 0) and keyframe `b` (t = 1) (dissertation §3.4):
 /// linear amplitude, the explicit magnitude/angle path of ω, and the phase z̃ on the guide frames
@@ -204,11 +227,9 @@ pub unsafe extern "C" fn pleat_cwf_animation_frame(
 ) -> PleatStatus {
     wrinkle_only!([anim, t, out] guard(|| {
         let an = anim_ref(anim)?;
-        if out.is_null() {
-            return Err(null_arg("out"));
-        }
+        let out = arg_out(out, "out")?;
         let cwf = an.anim.frame_at(t)?;
-        *out = Box::into_raw(Box::new(PleatCwf { cwf, knoppel: None }));
+        out.put_boxed(PleatCwf { cwf, knoppel: None });
         Ok(())
     }))
 }
@@ -219,15 +240,7 @@ pub unsafe extern "C" fn pleat_cwf_animation_frame(
 /// `anim` is NULL or live.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_cwf_animation_frame_count(anim: *const PleatCwfAnimation) -> usize {
-    #[cfg(feature = "wrinkle")]
-    {
-        anim.as_ref().map_or(0, |a| a.anim.frame_count())
-    }
-    #[cfg(not(feature = "wrinkle"))]
-    {
-        let _ = anim;
-        0
-    }
+    wrinkle_count!(anim, |a| a.anim.frame_count())
 }
 
 /// Number of guide intervals `N'` (there are `N' + 1` guide frames); 0 when `anim` is NULL or
@@ -237,15 +250,7 @@ pub unsafe extern "C" fn pleat_cwf_animation_frame_count(anim: *const PleatCwfAn
 /// `anim` is NULL or live.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_cwf_animation_guide_count(anim: *const PleatCwfAnimation) -> usize {
-    #[cfg(feature = "wrinkle")]
-    {
-        anim.as_ref().map_or(0, |a| a.anim.guide_intervals())
-    }
-    #[cfg(not(feature = "wrinkle"))]
-    {
-        let _ = anim;
-        0
-    }
+    wrinkle_count!(anim, |a| a.anim.guide_intervals())
 }
 
 /// Number of convergence-history records (the initial guess and each Newton iteration); 0 for
@@ -257,15 +262,7 @@ pub unsafe extern "C" fn pleat_cwf_animation_guide_count(anim: *const PleatCwfAn
 pub unsafe extern "C" fn pleat_cwf_animation_history_count(
     anim: *const PleatCwfAnimation,
 ) -> usize {
-    #[cfg(feature = "wrinkle")]
-    {
-        anim.as_ref().map_or(0, |a| a.history.len())
-    }
-    #[cfg(not(feature = "wrinkle"))]
-    {
-        let _ = anim;
-        0
-    }
+    wrinkle_count!(anim, |a| a.history.len())
 }
 
 /// Copies the convergence history: 2 doubles per record, `(wall seconds since the start of
@@ -285,17 +282,16 @@ pub unsafe extern "C" fn pleat_cwf_animation_copy_history(
 ) -> PleatStatus {
     wrinkle_only!([anim, dst, record_capacity] guard(|| {
         let an = anim_ref(anim)?;
-        if dst.is_null() {
-            return Err(null_arg("dst"));
-        }
+        let dst = arg_out(dst, "dst")?;
         if record_capacity < an.history.len() {
             return Err(Error::LimitExceeded(format!(
                 "dst holds {record_capacity} records, {} are needed",
                 an.history.len()
             )));
         }
-        let flat: Vec<f64> = an.history.iter().flatten().copied().collect();
-        std::ptr::copy_nonoverlapping(flat.as_ptr(), dst, flat.len());
+        for (i, &v) in an.history.iter().flatten().enumerate() {
+            dst.add(i).put(v);
+        }
         Ok(())
     }))
 }
@@ -315,7 +311,7 @@ pub unsafe extern "C" fn pleat_cwf_animation_write_file(
 ) -> PleatStatus {
     wrinkle_only!([anim, path] guard(|| {
         let an = anim_ref(anim)?;
-        let path = super::common::c_str_arg(path, "path")?;
+        let path = c_str_arg(path, "path")?;
         crate::wrinkle::write_animation(path, &an.anim)
     }))
 }
@@ -339,12 +335,10 @@ pub unsafe extern "C" fn pleat_cwf_animation_read_file(
 ) -> PleatStatus {
     wrinkle_only!([base, path, out] guard(|| {
         let m = super::mesh::mesh_ref(base, "base")?;
-        let path = super::common::c_str_arg(path, "path")?;
-        if out.is_null() {
-            return Err(null_arg("out"));
-        }
+        let path = c_str_arg(path, "path")?;
+        let out = arg_out(out, "out")?;
         let anim = crate::wrinkle::read_animation(path, m.clone())?;
-        *out = Box::into_raw(Box::new(PleatCwfAnimation { anim, history: Vec::new() }));
+        out.put_boxed(PleatCwfAnimation { anim, history: Vec::new() });
         Ok(())
     }))
 }
@@ -355,29 +349,28 @@ pub unsafe extern "C" fn pleat_cwf_animation_read_file(
 /// `anim` is NULL or a handle from pleat not yet destroyed.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_cwf_animation_destroy(anim: *mut PleatCwfAnimation) {
-    if !anim.is_null() {
-        let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            drop(Box::from_raw(anim));
-        }));
-    }
+    destroy(anim)
 }
 
 /// Borrows an animation handle, failing with InvalidArgument on NULL.
 ///
 /// # Safety
 /// `a` is NULL or live.
-#[cfg_attr(not(feature = "wrinkle"), allow(dead_code))]
+#[cfg(feature = "wrinkle")]
 unsafe fn anim_ref<'a>(a: *const PleatCwfAnimation) -> Result<&'a PleatCwfAnimation> {
-    a.as_ref().ok_or_else(|| null_arg("anim"))
+    arg_ref(a, "anim")
 }
 
 #[cfg(feature = "wrinkle")]
-mod imp {
+pub(super) mod imp {
     use super::*;
+    use crate::ffi::boundary::{check_range, read_versioned, versioned_out};
     use crate::ffi::common::guard_progress;
     use crate::wrinkle::{interpolate_with_progress, HessianModel, InterpOptions, StopReason};
 
-    fn options(p: &PleatWrinkleInterpParams) -> Result<InterpOptions> {
+    /// The Rust options of C interpolation parameters; the enum and the iteration cap are
+    /// checked here, the other ranges by `interpolate` with messages naming the field.
+    pub(in crate::ffi) fn options(p: &PleatWrinkleInterpParams) -> Result<InterpOptions> {
         let hessian = match p.hessian {
             PLEAT_INTERP_HESSIAN_PROJECTED => HessianModel::Projected,
             PLEAT_INTERP_HESSIAN_GAUSS_NEWTON => HessianModel::GaussNewton,
@@ -389,12 +382,7 @@ mod imp {
                 )))
             }
         };
-        if p.max_iterations > 1_000_000 {
-            return Err(Error::InvalidArgument(format!(
-                "params->max_iterations is {}; allowed 0 to 1000000",
-                p.max_iterations
-            )));
-        }
+        check_range(p.max_iterations, 0, 1_000_000, "params->max_iterations")?;
         // the other ranges (guide_frames, substeps, c_scale, tolerance, NaN) are checked by
         // interpolate() with messages naming the field
         Ok(InterpOptions {
@@ -429,17 +417,11 @@ mod imp {
         stats: *mut PleatWrinkleInterpStats,
     ) -> PleatStatus {
         guard_progress(progress, user_data, |relay| {
-            let ka = a.as_ref().ok_or_else(|| null_arg("a"))?;
-            let kb = b.as_ref().ok_or_else(|| null_arg("b"))?;
-            if out.is_null() {
-                return Err(null_arg("out"));
-            }
-            let stats_size = if stats.is_null() {
-                0
-            } else {
-                output_size(stats, "stats")?
-            };
-            let p = read_versioned(params, pleat_wrinkle_interp_params_default(), "params")?;
+            let ka = arg_ref(a, "a")?;
+            let kb = arg_ref(b, "b")?;
+            let out = arg_out(out, "out")?;
+            let stats = versioned_out(stats, "stats")?;
+            let p = read_versioned(params, "params")?;
             let opts = options(&p)?;
             let t0 = std::time::Instant::now();
             let (anim, report, _) = interpolate_with_progress(&ka.cwf, &kb.cwf, &opts, relay)?;
@@ -461,9 +443,9 @@ mod imp {
                 .iter()
                 .map(|r| [r.seconds, r.gradient_norm])
                 .collect();
-            *out = Box::into_raw(Box::new(PleatCwfAnimation { anim, history }));
-            if stats_size > 0 {
-                write_versioned(stats, s, stats_size);
+            out.put_boxed(PleatCwfAnimation { anim, history });
+            if let Some(stats) = stats {
+                stats.write(s);
             }
             Ok(())
         })

@@ -4,8 +4,16 @@
 //! The functions exist in every build; without the cargo feature `lod` (or `cage`) they return
 //! `PLEAT_STATUS_UNSUPPORTED`.
 
-use super::common::{fail, guard_progress, null_arg, PleatProgressFn, PleatStatus};
-use super::mesh::{emit_mesh, mesh_ref, PleatMesh};
+#[cfg(feature = "lod")]
+use super::boundary::{arg_out, arg_slice, check_flags, read_versioned, versioned_out};
+use super::boundary::{full_size, requires, versioned};
+#[cfg(feature = "lod")]
+use super::common::guard_progress;
+use super::common::{PleatProgressFn, PleatStatus};
+#[cfg(feature = "lod")]
+use super::mesh::mesh_ref;
+use super::mesh::PleatMesh;
+#[cfg(feature = "lod")]
 use crate::{Error, Result};
 
 /// `PleatLodParams::flags` bit: skip the feature-alignment step (Alg. 6).
@@ -113,8 +121,42 @@ pub struct PleatLodStats {
 /// The defaults, with `struct_size = sizeof(PleatLodParams)`.
 #[no_mangle]
 pub extern "C" fn pleat_lod_params_default() -> PleatLodParams {
+    #[cfg(feature = "lod")]
+    return PleatLodParams::from(&crate::lowpoly::LodParams::default());
+    #[cfg(not(feature = "lod"))]
+    return defaults_without_lod();
+}
+
+// Smallest sizes: through `screen_size` (params), through `rounds` (stats).
+versioned!(PleatLodParams, 16, pleat_lod_params_default);
+versioned!(PleatLodStats, 8);
+
+#[cfg(feature = "lod")]
+impl From<&crate::lowpoly::LodParams> for PleatLodParams {
+    fn from(p: &crate::lowpoly::LodParams) -> Self {
+        let flag = |on: bool, bit: u32| if on { bit } else { 0 };
+        PleatLodParams {
+            struct_size: full_size::<PleatLodParams>(),
+            max_rounds: p.max_rounds,
+            screen_size: p.screen_size,
+            target_faces: p.target_faces.map_or(0, |n| n as u64),
+            flow_ratio: p.flow_ratio,
+            epsilon: p.epsilon,
+            theta0_deg: p.theta0_deg,
+            l0: p.l0,
+            flags: flag(!p.align, PLEAT_LOD_NO_ALIGN)
+                | flag(p.measure_floor, PLEAT_LOD_MEASURE_FLOOR),
+            memory_budget_bytes: p.memory_budget_bytes,
+        }
+    }
+}
+
+/// `LodParams::default()` as C, for builds without `lod` (which have no `LodParams`); the
+/// test `ffi::defaults` pins it to the conversion above.
+#[cfg_attr(feature = "lod", allow(dead_code))]
+pub(super) fn defaults_without_lod() -> PleatLodParams {
     PleatLodParams {
-        struct_size: std::mem::size_of::<PleatLodParams>() as u32,
+        struct_size: full_size::<PleatLodParams>(),
         max_rounds: 50,
         screen_size: 200.0,
         target_faces: 0,
@@ -127,81 +169,27 @@ pub extern "C" fn pleat_lod_params_default() -> PleatLodParams {
     }
 }
 
-/// Smallest accepted `PleatLodParams::struct_size`: through `screen_size`.
-const MIN_PARAMS_SIZE: u32 = 16;
-/// Smallest accepted `PleatLodStats::struct_size`: through `rounds`.
-const MIN_STATS_SIZE: u32 = 8;
-
-/// Reads the caller's params over the defaults (NULL = defaults).
-///
-/// # Safety
-/// `p` is NULL or points to `p->struct_size` readable bytes.
-unsafe fn read_params(p: *const PleatLodParams) -> Result<PleatLodParams> {
-    let mut out = pleat_lod_params_default();
-    if p.is_null() {
-        return Ok(out);
-    }
-    let size = std::ptr::read_unaligned(p as *const u32);
-    if size < MIN_PARAMS_SIZE {
-        return Err(Error::InvalidArgument(format!(
-            "params->struct_size is {size}; set it with pleat_lod_params_default() or to \
-             sizeof(PleatLodParams)"
-        )));
-    }
-    let n = (size as usize).min(std::mem::size_of::<PleatLodParams>());
-    std::ptr::copy_nonoverlapping(p as *const u8, &mut out as *mut _ as *mut u8, n);
-    out.struct_size = std::mem::size_of::<PleatLodParams>() as u32;
-    Ok(out)
-}
-
-/// Checks a stats output's `struct_size` before any work.
-///
-/// # Safety
-/// `s` is NULL or points to at least 4 readable bytes.
-unsafe fn stats_size(s: *const PleatLodStats) -> Result<Option<u32>> {
-    if s.is_null() {
-        return Ok(None);
-    }
-    let size = std::ptr::read_unaligned(s as *const u32);
-    if size < MIN_STATS_SIZE {
-        return Err(Error::InvalidArgument(format!(
-            "stats->struct_size is {size}; set it to sizeof(PleatLodStats)"
-        )));
-    }
-    Ok(Some(size))
-}
-
-/// Copies `c` into the caller's `dst` (at most `size` bytes).
-///
-/// # Safety
-/// `dst` points to `size` writable bytes.
-unsafe fn write_stats(dst: *mut PleatLodStats, size: u32, mut c: PleatLodStats) {
-    let n = (size as usize).min(std::mem::size_of::<PleatLodStats>());
-    c.struct_size = n as u32;
-    std::ptr::copy_nonoverlapping(&c as *const PleatLodStats as *const u8, dst as *mut u8, n);
-}
-
 #[cfg(feature = "lod")]
-mod imp {
+pub(super) mod imp {
     use super::*;
     use crate::lowpoly::LodParams;
     use crate::mesh::TriMesh;
     use crate::Stats;
 
-    pub(super) fn to_rust(p: &PleatLodParams) -> Result<LodParams> {
+    /// The Rust parameters of C LOD parameters (flags and `target_faces` checked here, the
+    /// rest by the pipeline).
+    pub(in crate::ffi) fn to_rust(p: &PleatLodParams) -> Result<LodParams> {
         let target = match p.target_faces {
             0 => None,
             n => Some(usize::try_from(n).map_err(|_| {
                 Error::InvalidArgument(format!("target_faces {n} is out of range"))
             })?),
         };
-        let known = PLEAT_LOD_NO_ALIGN | PLEAT_LOD_MEASURE_FLOOR;
-        if p.flags & !known != 0 {
-            return Err(Error::InvalidArgument(format!(
-                "unknown flags {:#x}",
-                p.flags
-            )));
-        }
+        check_flags(
+            p.flags,
+            PLEAT_LOD_NO_ALIGN | PLEAT_LOD_MEASURE_FLOOR,
+            "params->flags",
+        )?;
         Ok(LodParams {
             screen_size: p.screen_size,
             target_faces: target,
@@ -275,48 +263,6 @@ mod imp {
     }
 }
 
-/// Records that this build lacks the cargo feature `feature`: `PLEAT_STATUS_UNSUPPORTED`.
-fn unsupported(feature: &str) -> PleatStatus {
-    fail(Error::Unsupported(format!(
-        "pleat was compiled without the `{feature}` feature"
-    )))
-}
-
-/// Stand-ins when the `lod` feature is off (never called: the entry points return
-/// `PLEAT_STATUS_UNSUPPORTED` first).
-#[cfg(not(feature = "lod"))]
-mod imp {
-    use super::*;
-    use crate::mesh::TriMesh;
-    use crate::Stats;
-
-    fn off() -> Error {
-        Error::Internal("the `lod` feature is not built".into())
-    }
-
-    pub(super) fn bake(
-        _: &TriMesh,
-        _: &PleatLodParams,
-        _: bool,
-        _: &mut crate::report::ProgressFn<'_>,
-    ) -> Result<(TriMesh, Stats)> {
-        Err(off())
-    }
-
-    pub(super) fn bake_chain(
-        _: &TriMesh,
-        _: &[f64],
-        _: &PleatLodParams,
-        _: &mut crate::report::ProgressFn<'_>,
-    ) -> Result<Vec<(TriMesh, Stats)>> {
-        Err(off())
-    }
-
-    pub(super) fn to_c(_: &TriMesh, _: &Stats) -> PleatLodStats {
-        PleatLodStats::default()
-    }
-}
-
 /// The shared body of `pleat_lod_generate` and `pleat_cage_generate`.
 ///
 /// # Safety
@@ -330,26 +276,27 @@ unsafe fn generate_one(
     out: *mut *mut PleatMesh,
     stats: *mut PleatLodStats,
 ) -> PleatStatus {
-    if !cfg!(feature = "lod") {
-        return unsupported("lod");
-    }
-    if cage && !cfg!(feature = "cage") {
-        return unsupported("cage");
-    }
-    guard_progress(progress, user_data, |prog| {
-        let m = mesh_ref(input, "input")?;
-        if out.is_null() {
-            return Err(null_arg("out"));
+    requires!(
+        "lod",
+        [cage, input, params, progress, user_data, out, stats],
+        {
+            if cage && !cfg!(feature = "cage") {
+                return super::common::unsupported("cage");
+            }
+            guard_progress(progress, user_data, |prog| {
+                let m = mesh_ref(input, "input")?;
+                let out = arg_out(out, "out")?;
+                let p = read_versioned(params, "params")?;
+                let stats = versioned_out(stats, "stats")?;
+                let (mesh, st) = imp::bake(m, &p, cage, prog)?;
+                if let Some(s) = stats {
+                    s.write(imp::to_c(&mesh, &st));
+                }
+                out.put_mesh(mesh);
+                Ok(())
+            })
         }
-        let p = read_params(params)?;
-        let ssize = stats_size(stats)?;
-        let (mesh, st) = imp::bake(m, &p, cage, prog)?;
-        if let Some(size) = ssize {
-            write_stats(stats, size, imp::to_c(&mesh, &st));
-        }
-        emit_mesh(out, mesh);
-        Ok(())
-    })
+    )
 }
 
 /// Bakes one LOD of `input` (any triangle soup): a watertight, manifold,
@@ -422,33 +369,39 @@ pub unsafe extern "C" fn pleat_lod_generate_chain(
     out_meshes: *mut *mut PleatMesh,
     stats: *mut PleatLodStats,
 ) -> PleatStatus {
-    if !cfg!(feature = "lod") {
-        return unsupported("lod");
-    }
-    guard_progress(progress, user_data, |prog| {
-        let m = mesh_ref(input, "input")?;
-        if screen_sizes.is_null() {
-            return Err(null_arg("screen_sizes"));
+    requires!(
+        "lod",
+        [
+            input,
+            screen_sizes,
+            count,
+            params,
+            progress,
+            user_data,
+            out_meshes,
+            stats
+        ],
+        {
+            guard_progress(progress, user_data, |prog| {
+                let m = mesh_ref(input, "input")?;
+                let sizes = arg_slice(screen_sizes, count, "screen_sizes")?;
+                let out = arg_out(out_meshes, "out_meshes")?;
+                if count == 0 || count > 64 {
+                    return Err(Error::InvalidArgument(format!(
+                        "count is {count}; give 1 to 64 screen sizes"
+                    )));
+                }
+                let p = read_versioned(params, "params")?;
+                let stats = versioned_out(stats, "stats")?;
+                let levels = imp::bake_chain(m, sizes, &p, prog)?;
+                for (i, (mesh, st)) in levels.into_iter().enumerate() {
+                    if let Some(s) = &stats {
+                        s.write_at(i, imp::to_c(&mesh, &st));
+                    }
+                    out.add(i).put_mesh(mesh);
+                }
+                Ok(())
+            })
         }
-        if out_meshes.is_null() {
-            return Err(null_arg("out_meshes"));
-        }
-        if count == 0 || count > 64 {
-            return Err(Error::InvalidArgument(format!(
-                "count is {count}; give 1 to 64 screen sizes"
-            )));
-        }
-        let sizes = std::slice::from_raw_parts(screen_sizes, count).to_vec();
-        let p = read_params(params)?;
-        let ssize = stats_size(stats)?;
-        let levels = imp::bake_chain(m, &sizes, &p, prog)?;
-        for (i, (mesh, st)) in levels.into_iter().enumerate() {
-            if let Some(size) = ssize {
-                let dst = (stats as *mut u8).add(i * size as usize) as *mut PleatLodStats;
-                write_stats(dst, size, imp::to_c(&mesh, &st));
-            }
-            emit_mesh(out_meshes.add(i), mesh);
-        }
-        Ok(())
-    })
+    )
 }

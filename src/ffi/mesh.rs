@@ -1,6 +1,7 @@
 //! `PleatMesh`: create from caller buffers, copy out, destroy.
 
-use super::common::{guard, null_arg, PleatStatus};
+use super::boundary::{arg_out, arg_ref, arg_slice, destroy, guard_value, Out};
+use super::common::{c_str_arg, guard, PleatStatus};
 use crate::mesh::TriMesh;
 use crate::{Error, Result};
 
@@ -12,26 +13,19 @@ pub struct PleatMesh {
     pub(crate) mesh: TriMesh,
 }
 
-impl PleatMesh {
-    pub(crate) fn boxed(mesh: TriMesh) -> *mut PleatMesh {
-        Box::into_raw(Box::new(PleatMesh { mesh }))
-    }
-}
-
 /// Borrows a mesh handle, failing with InvalidArgument on NULL.
 ///
 /// # Safety
 /// `m` is NULL or a live handle from pleat.
 pub(crate) unsafe fn mesh_ref<'a>(m: *const PleatMesh, name: &str) -> Result<&'a TriMesh> {
-    m.as_ref().map(|m| &m.mesh).ok_or_else(|| null_arg(name))
+    arg_ref(m, name).map(|m| &m.mesh)
 }
 
-/// Writes a new mesh handle to `out`.
-///
-/// # Safety
-/// `out` is valid for writes (checked non-NULL by the caller).
-pub(crate) unsafe fn emit_mesh(out: *mut *mut PleatMesh, mesh: TriMesh) {
-    *out = PleatMesh::boxed(mesh);
+impl Out<*mut PleatMesh> {
+    /// Hands `mesh` to the caller as a new handle.
+    pub(crate) fn put_mesh(self, mesh: TriMesh) {
+        self.put_boxed(PleatMesh { mesh });
+    }
 }
 
 fn check_stride(stride_bytes: usize, elem: usize) -> Result<usize> {
@@ -86,15 +80,9 @@ unsafe fn create<T: Copy + Into<f64>>(
     index_count: usize,
     out: *mut *mut PleatMesh,
 ) -> Result<()> {
-    if out.is_null() {
-        return Err(null_arg("out"));
-    }
-    if positions.is_null() {
-        return Err(null_arg("positions"));
-    }
-    if indices.is_null() {
-        return Err(null_arg("indices"));
-    }
+    let out = arg_out(out, "out")?;
+    arg_ref(positions, "positions")?;
+    let idx = arg_slice(indices, index_count, "indices")?;
     if vertex_count == 0 {
         return Err(Error::InvalidArgument("vertex_count is 0".into()));
     }
@@ -115,11 +103,9 @@ unsafe fn create<T: Copy + Into<f64>>(
         ));
     }
     let pos = read_xyz::<T>(positions as *const u8, vertex_count, stride)?;
-    let idx = std::slice::from_raw_parts(indices, index_count);
     let mut tris = try_vec(index_count / 3, "triangles")?;
     tris.extend(idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
-    let mesh = TriMesh::new(pos, tris)?;
-    emit_mesh(out, mesh);
+    out.put_mesh(TriMesh::new(pos, tris)?);
     Ok(())
 }
 
@@ -193,11 +179,7 @@ pub unsafe extern "C" fn pleat_mesh_create_f64(
 /// `mesh` is NULL or a handle from pleat not yet destroyed.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_mesh_destroy(mesh: *mut PleatMesh) {
-    if !mesh.is_null() {
-        let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            drop(Box::from_raw(mesh));
-        }));
-    }
+    destroy(mesh)
 }
 
 /// Number of vertices of `mesh` (0 when `mesh` is NULL).
@@ -206,7 +188,7 @@ pub unsafe extern "C" fn pleat_mesh_destroy(mesh: *mut PleatMesh) {
 /// `mesh` is NULL or a live handle.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_mesh_vertex_count(mesh: *const PleatMesh) -> usize {
-    mesh.as_ref().map_or(0, |m| m.mesh.vertex_count())
+    guard_value(0, || mesh.as_ref().map_or(0, |m| m.mesh.vertex_count()))
 }
 
 /// Number of triangles of `mesh` (0 when `mesh` is NULL). The index count is 3× this.
@@ -215,7 +197,7 @@ pub unsafe extern "C" fn pleat_mesh_vertex_count(mesh: *const PleatMesh) -> usiz
 /// `mesh` is NULL or a live handle.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_mesh_triangle_count(mesh: *const PleatMesh) -> usize {
-    mesh.as_ref().map_or(0, |m| m.mesh.triangle_count())
+    guard_value(0, || mesh.as_ref().map_or(0, |m| m.mesh.triangle_count()))
 }
 
 /// Copies the positions into a caller buffer.
@@ -230,9 +212,7 @@ unsafe fn copy_positions<T: Copy>(
     conv: impl Fn(f64) -> T,
 ) -> Result<()> {
     let m = mesh_ref(mesh, "mesh")?;
-    if dst.is_null() {
-        return Err(null_arg("dst"));
-    }
+    arg_out(dst, "dst")?;
     let stride = check_stride(stride_bytes, std::mem::size_of::<T>())?;
     let n = m.vertex_count();
     if vertex_capacity < n {
@@ -298,9 +278,7 @@ pub unsafe extern "C" fn pleat_mesh_copy_indices(
 ) -> PleatStatus {
     guard(|| {
         let m = mesh_ref(mesh, "mesh")?;
-        if dst.is_null() {
-            return Err(null_arg("dst"));
-        }
+        arg_out(dst, "dst")?;
         let n = 3 * m.triangle_count();
         if index_capacity < n {
             return Err(Error::LimitExceeded(format!(
@@ -334,12 +312,9 @@ pub unsafe extern "C" fn pleat_mesh_read_file(
     out: *mut *mut PleatMesh,
 ) -> PleatStatus {
     guard(|| {
-        let path = super::common::c_str_arg(path, "path")?;
-        if out.is_null() {
-            return Err(null_arg("out"));
-        }
-        let mesh = crate::mesh::io::read_mesh(std::path::Path::new(path))?;
-        emit_mesh(out, mesh);
+        let path = c_str_arg(path, "path")?;
+        let out = arg_out(out, "out")?;
+        out.put_mesh(crate::mesh::io::read_mesh(std::path::Path::new(path))?);
         Ok(())
     })
 }
@@ -357,7 +332,7 @@ pub unsafe extern "C" fn pleat_mesh_write_file(
 ) -> PleatStatus {
     guard(|| {
         let m = mesh_ref(mesh, "mesh")?;
-        let path = super::common::c_str_arg(path, "path")?;
+        let path = c_str_arg(path, "path")?;
         crate::mesh::io::write_mesh(std::path::Path::new(path), m)
     })
 }

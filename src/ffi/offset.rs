@@ -1,8 +1,15 @@
 //! `pleat_offset_surface`: stage 1 of the LOD pipeline as a standalone operation (ch. 4.5.1).
 
-use super::common::{guard, guard_progress, null_arg, PleatProgressFn, PleatStatus};
-use super::mesh::{emit_mesh, mesh_ref, PleatMesh};
-use super::stats::{emit_stats, PleatStats};
+#[cfg(feature = "lod")]
+use super::boundary::bool_field;
+use super::boundary::{arg_out, full_size, read_versioned, requires, versioned};
+#[cfg(feature = "lod")]
+use super::common::guard_progress;
+use super::common::{guard, PleatProgressFn, PleatStatus};
+use super::mesh::{mesh_ref, PleatMesh};
+#[cfg(feature = "lod")]
+use super::stats::emit_stats;
+use super::stats::PleatStats;
 use crate::Error;
 
 /// Parameters of `pleat_offset_surface`. Get defaults from `pleat_offset_params_default()` and
@@ -42,8 +49,48 @@ pub struct PleatOffsetParams {
 /// The default offset parameters (screen size 200, features on, θ0 = 120°, l0 = 4).
 #[no_mangle]
 pub extern "C" fn pleat_offset_params_default() -> PleatOffsetParams {
+    #[cfg(feature = "lod")]
+    return PleatOffsetParams::from(&crate::lowpoly::OffsetParams::default());
+    #[cfg(not(feature = "lod"))]
+    return defaults_without_lod();
+}
+
+// Smallest size: through `use_absolute_distance`.
+versioned!(PleatOffsetParams, 8, pleat_offset_params_default);
+
+#[cfg(feature = "lod")]
+impl From<&crate::lowpoly::OffsetParams> for PleatOffsetParams {
+    /// An absolute distance leaves `screen_size` 0; a screen size leaves `distance` 0.
+    fn from(p: &crate::lowpoly::OffsetParams) -> Self {
+        use crate::lowpoly::OffsetDistance;
+        let (absolute, screen_size, distance) = match p.distance {
+            OffsetDistance::ScreenSize(n_p) => (0, n_p, 0.0),
+            OffsetDistance::Absolute(d) => (1, 0.0, d),
+        };
+        PleatOffsetParams {
+            struct_size: full_size::<PleatOffsetParams>(),
+            use_absolute_distance: absolute,
+            screen_size,
+            distance,
+            voxel_scale: p.voxel_scale,
+            theta0_deg: p.theta0_deg,
+            l0: p.l0,
+            features: p.features as u32,
+            remove_interior: p.remove_interior as u32,
+            iso_refinement_steps: p.iso_refinement_steps,
+            memory_budget_bytes: p.memory_budget_bytes,
+            verify: p.verify as u32,
+            reserved: 0,
+        }
+    }
+}
+
+/// `OffsetParams::default()` as C, for builds without `lod` (which have no `OffsetParams`);
+/// the test `ffi::defaults` pins it to the conversion above.
+#[cfg_attr(feature = "lod", allow(dead_code))]
+pub(super) fn defaults_without_lod() -> PleatOffsetParams {
     PleatOffsetParams {
-        struct_size: std::mem::size_of::<PleatOffsetParams>() as u32,
+        struct_size: full_size::<PleatOffsetParams>(),
         use_absolute_distance: 0,
         screen_size: 200.0,
         distance: 0.0,
@@ -59,50 +106,24 @@ pub extern "C" fn pleat_offset_params_default() -> PleatOffsetParams {
     }
 }
 
-/// Reads a caller's params struct over the defaults, honouring a shorter `struct_size`.
-///
-/// # Safety
-/// `p` is NULL or points to `p->struct_size` readable bytes.
-unsafe fn read_params(p: *const PleatOffsetParams) -> crate::Result<PleatOffsetParams> {
-    let mut out = pleat_offset_params_default();
-    if p.is_null() {
-        return Ok(out);
-    }
-    let size = std::ptr::read_unaligned(p as *const u32) as usize;
-    if size < 8 {
-        return Err(Error::InvalidArgument(format!(
-            "params->struct_size is {size}; initialise params with pleat_offset_params_default()"
-        )));
-    }
-    let n = size.min(std::mem::size_of::<PleatOffsetParams>());
-    std::ptr::copy_nonoverlapping(p as *const u8, &mut out as *mut _ as *mut u8, n);
-    Ok(out)
-}
-
+/// The Rust parameters of a C struct (the `reserved` field is checked by the caller).
 #[cfg(feature = "lod")]
-fn to_rust(p: &PleatOffsetParams) -> crate::Result<crate::lowpoly::OffsetParams> {
+pub(super) fn to_rust(p: &PleatOffsetParams) -> crate::Result<crate::lowpoly::OffsetParams> {
     use crate::lowpoly::{OffsetDistance, OffsetParams};
-    let flag = |v: u32, name: &str| match v {
-        0 => Ok(false),
-        1 => Ok(true),
-        _ => Err(Error::InvalidArgument(format!(
-            "{name} must be 0 or 1, got {v}"
-        ))),
-    };
     Ok(OffsetParams {
-        distance: if flag(p.use_absolute_distance, "use_absolute_distance")? {
+        distance: if bool_field(p.use_absolute_distance, "use_absolute_distance")? {
             OffsetDistance::Absolute(p.distance)
         } else {
             OffsetDistance::ScreenSize(p.screen_size)
         },
         voxel_scale: p.voxel_scale,
-        features: flag(p.features, "features")?,
+        features: bool_field(p.features, "features")?,
         theta0_deg: p.theta0_deg,
         l0: p.l0,
-        remove_interior: flag(p.remove_interior, "remove_interior")?,
+        remove_interior: bool_field(p.remove_interior, "remove_interior")?,
         iso_refinement_steps: p.iso_refinement_steps,
         memory_budget_bytes: p.memory_budget_bytes,
-        verify: flag(p.verify, "verify")?,
+        verify: bool_field(p.verify, "verify")?,
     })
 }
 
@@ -131,38 +152,31 @@ pub unsafe extern "C" fn pleat_offset_surface(
     out: *mut *mut PleatMesh,
     out_stats: *mut *mut PleatStats,
 ) -> PleatStatus {
+    // Argument errors come before "unsupported", as they always have for this function.
     let checked = guard(|| {
         mesh_ref(mesh, "mesh")?;
-        if out.is_null() {
-            return Err(null_arg("out"));
-        }
-        let p = read_params(params)?;
-        if p.reserved != 0 {
-            return Err(Error::InvalidArgument("params->reserved must be 0".into()));
-        }
-        Ok(())
+        arg_out(out, "out")?;
+        reserved_zero(&read_versioned(params, "params")?)
     });
     if checked != PleatStatus::Ok {
         return checked;
     }
-    #[cfg(feature = "lod")]
-    {
+    requires!("lod", [progress, user_data, out_stats], {
         guard_progress(progress, user_data, |relay| {
             let m = mesh_ref(mesh, "mesh")?;
-            let p = to_rust(&read_params(params)?)?;
+            let out = arg_out(out, "out")?;
+            let p = to_rust(&read_versioned(params, "params")?)?;
             let (result, stats) = crate::lowpoly::offset_surface_with_progress(m, &p, relay)?;
-            emit_mesh(out, result);
+            out.put_mesh(result);
             emit_stats(out_stats, stats);
             Ok(())
         })
+    })
+}
+
+fn reserved_zero(p: &PleatOffsetParams) -> crate::Result<()> {
+    if p.reserved != 0 {
+        return Err(Error::InvalidArgument("params->reserved must be 0".into()));
     }
-    #[cfg(not(feature = "lod"))]
-    {
-        let _ = (progress, user_data, out_stats);
-        guard(|| {
-            Err(crate::Error::Unsupported(
-                "pleat_offset_surface needs feature `lod`".into(),
-            ))
-        })
-    }
+    Ok(())
 }

@@ -1,9 +1,9 @@
 //! `pleat_mesh_check`: the validity report of any mesh, as a versioned C struct.
 
-use super::common::{guard, null_arg, PleatStatus};
+use super::boundary::{check_flags, required_versioned_out, versioned};
+use super::common::{guard, PleatStatus};
 use super::mesh::{mesh_ref, PleatMesh};
 use crate::mesh::{MeshReport, ReportOptions};
-use crate::Error;
 
 /// `pleat_mesh_check` flag: skip the self-intersection test (the most expensive part);
 /// `self_intersections_checked` is then 0.
@@ -109,8 +109,8 @@ fn to_c(r: &MeshReport) -> PleatMeshReport {
     }
 }
 
-/// Smallest `struct_size` accepted: up to and including `is_closed`.
-const MIN_REPORT_SIZE: u32 = 8;
+// Smallest size: through `is_closed`.
+versioned!(PleatMeshReport, 8);
 
 /// Computes the validity report of `mesh` (any soup) into `*out`.
 ///
@@ -131,27 +131,14 @@ pub unsafe extern "C" fn pleat_mesh_check(
 ) -> PleatStatus {
     guard(|| {
         let m = mesh_ref(mesh, "mesh")?;
-        if out.is_null() {
-            return Err(null_arg("out"));
-        }
-        let size = std::ptr::read_unaligned(out as *const u32);
-        if size < MIN_REPORT_SIZE {
-            return Err(Error::InvalidArgument(format!(
-                "out->struct_size is {size}; set it to sizeof(PleatMeshReport)"
-            )));
-        }
+        let out = required_versioned_out(out, "out")?;
         let known = PLEAT_CHECK_SKIP_SELF_INTERSECTIONS | PLEAT_CHECK_WELD;
-        if flags & !known != 0 {
-            return Err(Error::InvalidArgument(format!("unknown flags {flags:#x}")));
-        }
+        check_flags(flags, known, "flags")?;
         let options = ReportOptions {
             self_intersections: flags & PLEAT_CHECK_SKIP_SELF_INTERSECTIONS == 0,
             weld: flags & PLEAT_CHECK_WELD != 0,
         };
-        let mut c = to_c(&MeshReport::compute_with(m, &options));
-        let n = (size as usize).min(std::mem::size_of::<PleatMeshReport>());
-        c.struct_size = n as u32;
-        std::ptr::copy_nonoverlapping(&c as *const PleatMeshReport as *const u8, out as *mut u8, n);
+        out.write(to_c(&MeshReport::compute_with(m, &options)));
         Ok(())
     })
 }

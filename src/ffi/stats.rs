@@ -1,6 +1,7 @@
 //! `PleatStats`: what a long operation measured — wall time per stage, counts, metrics (error
 //! against run time) and which guarantees independent code verified.
 
+use super::boundary::{arg_ref, destroy};
 use super::common::{guard, null_arg, PleatStatus};
 use crate::{Error, Stats};
 use std::ffi::{c_char, CString};
@@ -98,7 +99,7 @@ pub unsafe extern "C" fn pleat_stats_entry(
     value: *mut f64,
 ) -> PleatStatus {
     guard(|| {
-        let s = stats.as_ref().ok_or_else(|| null_arg("stats"))?;
+        let s = arg_ref(stats, "stats")?;
         let (offset, values) = entries(&s.stats, kind);
         let v = values.get(index).copied().ok_or_else(|| {
             Error::InvalidArgument(format!("index {index} >= {} entries", values.len()))
@@ -136,7 +137,7 @@ pub unsafe extern "C" fn pleat_stats_to_json(
     needed: *mut usize,
 ) -> PleatStatus {
     guard(|| {
-        let s = stats.as_ref().ok_or_else(|| null_arg("stats"))?;
+        let s = arg_ref(stats, "stats")?;
         let json = s.stats.to_json();
         if !needed.is_null() {
             *needed = json.len();
@@ -160,8 +161,5 @@ pub unsafe extern "C" fn pleat_stats_to_json(
 /// `stats` is NULL or a live handle not yet destroyed.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_stats_destroy(stats: *mut PleatStats) {
-    if !stats.is_null() {
-        let _ =
-            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| drop(Box::from_raw(stats))));
-    }
+    destroy(stats)
 }

@@ -14,28 +14,38 @@
 
 #![allow(clippy::too_many_arguments)]
 
-use super::common::{guard, null_arg, PleatProgressFn, PleatStatus};
+#[cfg(feature = "wrinkle")]
+use super::boundary::required_versioned_out;
+use super::boundary::{arg_out, arg_ref, destroy, full_size, guard_value, requires, versioned};
+use super::common::{guard, PleatProgressFn, PleatStatus};
 use super::mesh::PleatMesh;
 use crate::{Error, Result};
-
-#[cfg(not(feature = "wrinkle"))]
-use super::common::unsupported;
 
 /// Runs `$body` (a `PleatStatus` expression) when built with `wrinkle`; otherwise returns
 /// `PLEAT_STATUS_UNSUPPORTED` and marks the listed parameters used.
 macro_rules! wrinkle_only {
-    ([$($arg:expr),*] $body:expr) => {{
+    ([$($arg:expr),*] $body:expr) => {
+        requires!("wrinkle", [$($arg),*], $body)
+    };
+}
+pub(super) use wrinkle_only;
+
+/// A count of the live handle `$h` (`*const H`): `$e` with `$c: &H`; 0 when `$h` is NULL,
+/// on a panic, or in a build without `wrinkle`.
+macro_rules! wrinkle_count {
+    ($h:expr, |$c:ident| $e:expr) => {{
         #[cfg(feature = "wrinkle")]
         {
-            $body
+            guard_value(0, || $h.as_ref().map_or(0, |$c| $e))
         }
         #[cfg(not(feature = "wrinkle"))]
         {
-            let _ = ($($arg,)*);
-            unsupported("wrinkle")
+            let _ = $h;
+            0
         }
     }};
 }
+pub(super) use wrinkle_count;
 
 // ---------------------------------------------------------------------------------------------
 // Constants
@@ -197,85 +207,100 @@ pub struct PleatKnoppelReport {
 /// every build.
 #[no_mangle]
 pub extern "C" fn pleat_wrinkle_eval_params_default() -> PleatWrinkleEvalParams {
-    PleatWrinkleEvalParams {
-        struct_size: std::mem::size_of::<PleatWrinkleEvalParams>() as u32,
-        levels: 3,
-        flags: 0,
-        boundary: PLEAT_WRINKLE_BOUNDARY_FIXED,
-        corner_angle: std::f64::consts::FRAC_PI_6,
-        displacement_scale: 1.0,
-        max_output_triangles: 1 << 26,
-    }
+    #[cfg(feature = "wrinkle")]
+    return PleatWrinkleEvalParams::from(&crate::wrinkle::EvalOptions::default());
+    #[cfg(not(feature = "wrinkle"))]
+    return defaults_without_wrinkle().0;
 }
 
 /// The default Knöppel parameters (cotangent weights, 200 iterations, tolerance 1e-12, shift
 /// 1e-9), with `struct_size` set. Available in every build.
 #[no_mangle]
 pub extern "C" fn pleat_knoppel_params_default() -> PleatKnoppelParams {
-    PleatKnoppelParams {
-        struct_size: std::mem::size_of::<PleatKnoppelParams>() as u32,
+    #[cfg(feature = "wrinkle")]
+    return PleatKnoppelParams::from(&crate::wrinkle::KnoppelOptions::default());
+    #[cfg(not(feature = "wrinkle"))]
+    return defaults_without_wrinkle().1;
+}
+
+/// Default `PleatWrinkleEvalParams::levels`: the Rust API takes the level count as an
+/// argument of `Cwf::evaluate`, so it is the one C default without a Rust `Default`.
+const DEFAULT_EVAL_LEVELS: u32 = 3;
+
+#[cfg(feature = "wrinkle")]
+impl From<&crate::wrinkle::EvalOptions> for PleatWrinkleEvalParams {
+    /// `levels` is [`DEFAULT_EVAL_LEVELS`]; `want_z` sets `PLEAT_WRINKLE_FIELD_Z`.
+    fn from(o: &crate::wrinkle::EvalOptions) -> Self {
+        use crate::wrinkle::BoundaryRule;
+        let bit = |on: bool, b: u32| if on { b } else { 0 };
+        PleatWrinkleEvalParams {
+            struct_size: full_size::<PleatWrinkleEvalParams>(),
+            levels: DEFAULT_EVAL_LEVELS,
+            flags: bit(o.want_amplitude, PLEAT_WRINKLE_FIELD_AMPLITUDE)
+                | bit(o.want_phase, PLEAT_WRINKLE_FIELD_PHASE)
+                | bit(o.want_normals, PLEAT_WRINKLE_FIELD_NORMALS)
+                | bit(o.want_z, PLEAT_WRINKLE_FIELD_Z)
+                | bit(o.want_omega, PLEAT_WRINKLE_FIELD_OMEGA),
+            boundary: match o.subdivision.boundary {
+                BoundaryRule::Fixed => PLEAT_WRINKLE_BOUNDARY_FIXED,
+                BoundaryRule::Smooth => PLEAT_WRINKLE_BOUNDARY_SMOOTH,
+            },
+            corner_angle: o.subdivision.corner_angle,
+            displacement_scale: o.displacement_scale,
+            max_output_triangles: o.max_output_faces as u64,
+        }
+    }
+}
+
+#[cfg(feature = "wrinkle")]
+impl From<&crate::wrinkle::KnoppelOptions> for PleatKnoppelParams {
+    fn from(o: &crate::wrinkle::KnoppelOptions) -> Self {
+        use crate::wrinkle::PhaseWeights;
+        PleatKnoppelParams {
+            struct_size: full_size::<PleatKnoppelParams>(),
+            weights: match o.weights {
+                PhaseWeights::Cotan => PLEAT_PHASE_WEIGHTS_COTAN,
+                PhaseWeights::EdgeArea => PLEAT_PHASE_WEIGHTS_EDGE_AREA,
+            },
+            max_iterations: o.max_iterations.min(u32::MAX as usize) as u32,
+            reserved: 0,
+            tolerance: o.tolerance,
+            shift: o.shift,
+        }
+    }
+}
+
+/// `EvalOptions::default()` and `KnoppelOptions::default()` as C, for builds without `wrinkle`
+/// (which have no such types); the test `ffi::defaults` pins them to the conversions above.
+#[cfg_attr(feature = "wrinkle", allow(dead_code))]
+pub(super) fn defaults_without_wrinkle() -> (PleatWrinkleEvalParams, PleatKnoppelParams) {
+    let eval = PleatWrinkleEvalParams {
+        struct_size: full_size::<PleatWrinkleEvalParams>(),
+        levels: DEFAULT_EVAL_LEVELS,
+        flags: 0,
+        boundary: PLEAT_WRINKLE_BOUNDARY_FIXED,
+        corner_angle: std::f64::consts::FRAC_PI_6,
+        displacement_scale: 1.0,
+        max_output_triangles: 1 << 26,
+    };
+    let knoppel = PleatKnoppelParams {
+        struct_size: full_size::<PleatKnoppelParams>(),
         weights: PLEAT_PHASE_WEIGHTS_COTAN,
         max_iterations: 200,
         reserved: 0,
         tolerance: 1e-12,
         shift: 1e-9,
-    }
+    };
+    (eval, knoppel)
 }
 
 // ---------------------------------------------------------------------------------------------
-// Versioned structs
+// Versioned structs: every one accepts a `struct_size` down to 8 (the size field and one u32).
 
-/// Smallest accepted `struct_size` of every versioned struct (the size field and one more u32).
-const MIN_STRUCT_SIZE: u32 = 8;
-
-/// Reads a caller's versioned input struct over `default`: NULL gives `default`; otherwise the
-/// first `min(struct_size, sizeof(T))` bytes are taken from the caller.
-///
-/// # Safety
-/// `p` is NULL or points to `p->struct_size` readable bytes, the first 4 being `struct_size`.
-#[cfg_attr(not(feature = "wrinkle"), allow(dead_code))]
-pub(super) unsafe fn read_versioned<T: Copy>(p: *const T, default: T, name: &str) -> Result<T> {
-    if p.is_null() {
-        return Ok(default);
-    }
-    let size = std::ptr::read_unaligned(p as *const u32);
-    if size < MIN_STRUCT_SIZE {
-        return Err(Error::InvalidArgument(format!(
-            "{name}->struct_size is {size}; set it to sizeof the struct (get defaults from the \
-             matching *_default() function)"
-        )));
-    }
-    let mut v = default;
-    let n = (size as usize).min(std::mem::size_of::<T>());
-    // The size field itself is copied too; callers of this function ignore it.
-    std::ptr::copy_nonoverlapping(p as *const u8, &mut v as *mut T as *mut u8, n);
-    Ok(v)
-}
-
-/// Checks a caller's versioned output struct; returns the number of bytes to fill.
-///
-/// # Safety
-/// `p` is non-NULL and its first 4 bytes are readable.
-#[cfg_attr(not(feature = "wrinkle"), allow(dead_code))]
-pub(super) unsafe fn output_size<T>(p: *mut T, name: &str) -> Result<usize> {
-    let size = std::ptr::read_unaligned(p as *const u32);
-    if size < MIN_STRUCT_SIZE {
-        return Err(Error::InvalidArgument(format!(
-            "{name}->struct_size is {size}; set it to sizeof the struct"
-        )));
-    }
-    Ok((size as usize).min(std::mem::size_of::<T>()))
-}
-
-/// Writes the first `n` bytes of `v` (whose first field is `struct_size`, set to `n`) to `p`.
-///
-/// # Safety
-/// `p` is valid for `n` bytes of writes; `n ≤ size_of::<T>()`.
-#[cfg_attr(not(feature = "wrinkle"), allow(dead_code))]
-pub(super) unsafe fn write_versioned<T: Copy>(p: *mut T, mut v: T, n: usize) {
-    std::ptr::write_unaligned(&mut v as *mut T as *mut u32, n as u32);
-    std::ptr::copy_nonoverlapping(&v as *const T as *const u8, p as *mut u8, n);
-}
+versioned!(PleatWrinkleEvalParams, 8, pleat_wrinkle_eval_params_default);
+versioned!(PleatKnoppelParams, 8, pleat_knoppel_params_default);
+versioned!(PleatWrinkleEvalStats, 8);
+versioned!(PleatKnoppelReport, 8);
 
 // ---------------------------------------------------------------------------------------------
 // Creation
@@ -442,11 +467,7 @@ pub unsafe extern "C" fn pleat_cwf_write_file(
 /// `cwf` is NULL or a handle from pleat not yet destroyed.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_cwf_destroy(cwf: *mut PleatCwf) {
-    if !cwf.is_null() {
-        let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            drop(Box::from_raw(cwf));
-        }));
-    }
+    destroy(cwf)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -459,15 +480,7 @@ pub unsafe extern "C" fn pleat_cwf_destroy(cwf: *mut PleatCwf) {
 /// `cwf` is NULL or live.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_cwf_vertex_count(cwf: *const PleatCwf) -> usize {
-    #[cfg(feature = "wrinkle")]
-    {
-        cwf.as_ref().map_or(0, |c| c.cwf.amplitude().len())
-    }
-    #[cfg(not(feature = "wrinkle"))]
-    {
-        let _ = cwf;
-        0
-    }
+    wrinkle_count!(cwf, |c| c.cwf.amplitude().len())
 }
 
 /// Number of edges of the field's base mesh (the length of ω); 0 when `cwf` is NULL or the
@@ -477,15 +490,7 @@ pub unsafe extern "C" fn pleat_cwf_vertex_count(cwf: *const PleatCwf) -> usize {
 /// `cwf` is NULL or live.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_cwf_edge_count(cwf: *const PleatCwf) -> usize {
-    #[cfg(feature = "wrinkle")]
-    {
-        cwf.as_ref().map_or(0, |c| c.cwf.omega().len())
-    }
-    #[cfg(not(feature = "wrinkle"))]
-    {
-        let _ = cwf;
-        0
-    }
+    wrinkle_count!(cwf, |c| c.cwf.omega().len())
 }
 
 /// Number of triangles of the field's base mesh (a third of the length of per-corner ω); 0
@@ -495,15 +500,7 @@ pub unsafe extern "C" fn pleat_cwf_edge_count(cwf: *const PleatCwf) -> usize {
 /// `cwf` is NULL or live.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_cwf_triangle_count(cwf: *const PleatCwf) -> usize {
-    #[cfg(feature = "wrinkle")]
-    {
-        cwf.as_ref().map_or(0, |c| c.cwf.base().triangle_count())
-    }
-    #[cfg(not(feature = "wrinkle"))]
-    {
-        let _ = cwf;
-        0
-    }
+    wrinkle_count!(cwf, |c| c.cwf.base().triangle_count())
 }
 
 /// Copies ω, one double per edge in pleat's edge numbering (`pleat_mesh_copy_edges` of the base
@@ -609,10 +606,7 @@ pub unsafe extern "C" fn pleat_cwf_get_knoppel_report(
 ) -> PleatStatus {
     wrinkle_only!([cwf, out] guard(|| {
         let c = imp::cwf_ref(cwf)?;
-        if out.is_null() {
-            return Err(null_arg("out"));
-        }
-        let n = output_size(out, "out")?;
+        let out = required_versioned_out(out, "out")?;
         let Some(r) = c.knoppel else {
             return Err(Error::InvalidArgument(
                 "this field's phase was given, not computed by Knöppel's method".into(),
@@ -625,7 +619,7 @@ pub unsafe extern "C" fn pleat_cwf_get_knoppel_report(
             residual: r.residual,
             shift: r.shift,
         };
-        write_versioned(out, v, n);
+        out.write(v);
         Ok(())
     }))
 }
@@ -636,9 +630,7 @@ pub unsafe extern "C" fn pleat_cwf_get_knoppel_report(
 /// `dst` is NULL or valid for `capacity` doubles.
 #[cfg_attr(not(feature = "wrinkle"), allow(dead_code))]
 unsafe fn copy_doubles(src: &[f64], dst: *mut f64, capacity: usize, unit: &str) -> Result<()> {
-    if dst.is_null() {
-        return Err(null_arg("dst"));
-    }
+    arg_out(dst, "dst")?;
     if capacity < src.len() {
         return Err(Error::LimitExceeded(format!(
             "dst holds {capacity} values, {} are needed ({unit})",
@@ -715,10 +707,12 @@ pub unsafe extern "C" fn pleat_wrinkle_fields_count(
     fields: *const PleatWrinkleFields,
     field: u32,
 ) -> usize {
-    let (Some(f), Some((slot, comps))) = (fields.as_ref(), field_slot(field)) else {
-        return 0;
-    };
-    f.fields[slot].as_ref().map_or(0, |v| v.len() / comps)
+    guard_value(0, || {
+        let (Some(f), Some((slot, comps))) = (fields.as_ref(), field_slot(field)) else {
+            return 0;
+        };
+        f.fields[slot].as_ref().map_or(0, |v| v.len() / comps)
+    })
 }
 
 /// Copies one evaluated field into a caller buffer, element by element.
@@ -778,10 +772,8 @@ unsafe fn copy_field<T: Copy>(
     stride_bytes: usize,
     conv: impl Fn(f64) -> T,
 ) -> Result<()> {
-    let f = fields.as_ref().ok_or_else(|| null_arg("fields"))?;
-    if dst.is_null() {
-        return Err(null_arg("dst"));
-    }
+    let f = arg_ref(fields, "fields")?;
+    arg_out(dst, "dst")?;
     let (slot, comps) = field_slot(field).ok_or_else(|| {
         Error::InvalidArgument(format!(
             "field {field:#x} is not one PLEAT_WRINKLE_FIELD_* value"
@@ -829,21 +821,21 @@ unsafe fn copy_field<T: Copy>(
 /// `fields` is NULL or a handle from pleat not yet destroyed.
 #[no_mangle]
 pub unsafe extern "C" fn pleat_wrinkle_fields_destroy(fields: *mut PleatWrinkleFields) {
-    if !fields.is_null() {
-        let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            drop(Box::from_raw(fields));
-        }));
-    }
+    destroy(fields)
 }
 
 // ---------------------------------------------------------------------------------------------
 // Implementation (only with the `wrinkle` capability)
 
 #[cfg(feature = "wrinkle")]
-mod imp {
+pub(super) mod imp {
     use super::*;
+    use crate::ffi::boundary::{
+        arg_slice, check_f64, check_flags, check_range, finite_slice, non_null, read_versioned,
+        versioned_out, Out,
+    };
     use crate::ffi::common::{c_str_arg, guard_progress};
-    use crate::ffi::mesh::{emit_mesh, mesh_ref};
+    use crate::ffi::mesh::mesh_ref;
     use crate::mesh::TriMesh;
     use crate::wrinkle::{
         BoundaryRule, Complex, Cwf, EvalOptions, FrequencyField, KnoppelOptions, PhaseWeights,
@@ -855,15 +847,7 @@ mod imp {
     /// # Safety
     /// `c` is NULL or live.
     pub(super) unsafe fn cwf_ref<'a>(c: *const PleatCwf) -> Result<&'a PleatCwf> {
-        c.as_ref().ok_or_else(|| null_arg("cwf"))
-    }
-
-    unsafe fn emit(
-        out: *mut *mut PleatCwf,
-        cwf: Cwf,
-        knoppel: Option<crate::wrinkle::KnoppelReport>,
-    ) {
-        *out = Box::into_raw(Box::new(PleatCwf { cwf, knoppel }));
+        arg_ref(c, "cwf")
     }
 
     fn check_count(name: &str, got: usize, want: usize, query: &str) -> Result<()> {
@@ -880,13 +864,8 @@ mod imp {
     /// # Safety
     /// `p` is non-NULL and valid for `n` doubles.
     unsafe fn read_finite(p: *const f64, n: usize, name: &str) -> Result<Vec<f64>> {
-        let s = std::slice::from_raw_parts(p, n);
-        if let Some(i) = s.iter().position(|v| !v.is_finite()) {
-            return Err(Error::InvalidArgument(format!(
-                "{name}[{i}] is {} (NaN or infinite)",
-                s[i]
-            )));
-        }
+        let s = arg_slice(p, n, name)?;
+        finite_slice(s, name)?;
         let mut v = Vec::new();
         v.try_reserve_exact(n)
             .map_err(|_| Error::LimitExceeded(format!("cannot allocate {n} values of {name}")))?;
@@ -904,9 +883,7 @@ mod imp {
         zeta_re_im: *const f64,
         vertex_count: usize,
     ) -> Result<(Vec<f64>, Option<Vec<Complex>>)> {
-        if amplitude.is_null() {
-            return Err(null_arg("amplitude"));
-        }
+        non_null(amplitude, "amplitude")?;
         check_count(
             "vertex_count",
             vertex_count,
@@ -933,7 +910,7 @@ mod imp {
         omega: Vec<f64>,
         amplitude: Vec<f64>,
         zeta: Option<Vec<Complex>>,
-        out: *mut *mut PleatCwf,
+        out: Out<*mut PleatCwf>,
     ) -> Result<()> {
         let (cwf, report) = match zeta {
             Some(z) => (Cwf::new(base, omega, amplitude, z)?, None),
@@ -943,8 +920,10 @@ mod imp {
                 (c, Some(r))
             }
         };
-        // SAFETY: `out` was checked non-NULL by the callers before any work.
-        unsafe { emit(out, cwf, report) };
+        out.put_boxed(PleatCwf {
+            cwf,
+            knoppel: report,
+        });
         Ok(())
     }
 
@@ -959,13 +938,9 @@ mod imp {
         vertex_count: usize,
         out: *mut *mut PleatCwf,
     ) -> Result<()> {
-        if out.is_null() {
-            return Err(null_arg("out"));
-        }
+        let out = arg_out(out, "out")?;
         let m = mesh_ref(base, "base")?;
-        if omega.is_null() {
-            return Err(null_arg("omega"));
-        }
+        non_null(omega, "omega")?;
         check_count(
             "edge_count",
             edge_count,
@@ -988,13 +963,9 @@ mod imp {
         vertex_count: usize,
         out: *mut *mut PleatCwf,
     ) -> Result<()> {
-        if out.is_null() {
-            return Err(null_arg("out"));
-        }
+        let out = arg_out(out, "out")?;
         let m = mesh_ref(base, "base")?;
-        if corner_omega.is_null() {
-            return Err(null_arg("corner_omega"));
-        }
+        non_null(corner_omega, "corner_omega")?;
         check_count(
             "corner_count",
             corner_count,
@@ -1084,9 +1055,8 @@ mod imp {
             .collect()
     }
 
-    fn knoppel_options(p: *const PleatKnoppelParams) -> Result<KnoppelOptions> {
-        // SAFETY: the caller of the entry point passes NULL or a valid struct.
-        let p = unsafe { read_versioned(p, pleat_knoppel_params_default(), "params")? };
+    /// The Rust options of C Knöppel parameters, every field checked.
+    pub(in crate::ffi) fn knoppel_options(p: &PleatKnoppelParams) -> Result<KnoppelOptions> {
         let weights = match p.weights {
             PLEAT_PHASE_WEIGHTS_COTAN => PhaseWeights::Cotan,
             PLEAT_PHASE_WEIGHTS_EDGE_AREA => PhaseWeights::EdgeArea,
@@ -1096,24 +1066,17 @@ mod imp {
                 )))
             }
         };
-        if !(1..=1_000_000).contains(&p.max_iterations) {
-            return Err(Error::InvalidArgument(format!(
-                "params->max_iterations is {}; allowed 1 to 1000000",
-                p.max_iterations
-            )));
-        }
-        if !(p.tolerance.is_finite() && p.tolerance >= 0.0) {
-            return Err(Error::InvalidArgument(format!(
-                "params->tolerance is {}; must be finite and ≥ 0",
-                p.tolerance
-            )));
-        }
-        if !(p.shift.is_finite() && (0.0..1.0).contains(&p.shift)) {
-            return Err(Error::InvalidArgument(format!(
-                "params->shift is {}; must be in [0, 1)",
-                p.shift
-            )));
-        }
+        check_range(p.max_iterations, 1, 1_000_000, "params->max_iterations")?;
+        let t = p.tolerance;
+        check_f64(
+            t,
+            t.is_finite() && t >= 0.0,
+            "params->tolerance",
+            "finite and ≥ 0",
+        )?;
+        let s = p.shift;
+        let shift_ok = s.is_finite() && (0.0..1.0).contains(&s);
+        check_f64(s, shift_ok, "params->shift", "in [0, 1)")?;
         Ok(KnoppelOptions {
             weights,
             max_iterations: p.max_iterations as usize,
@@ -1134,14 +1097,10 @@ mod imp {
         params: *const PleatKnoppelParams,
         out: *mut *mut PleatCwf,
     ) -> Result<()> {
-        if out.is_null() {
-            return Err(null_arg("out"));
-        }
+        let out = arg_out(out, "out")?;
         let m = mesh_ref(base, "base")?;
-        if frequency.is_null() {
-            return Err(null_arg("frequency"));
-        }
-        let opts = knoppel_options(params)?;
+        non_null(frequency, "frequency")?;
+        let opts = knoppel_options(&read_versioned(params, "params")?)?;
         let want = match location {
             PLEAT_FREQUENCY_PER_VERTEX => m.vertex_count(),
             PLEAT_FREQUENCY_PER_FACE => m.triangle_count(),
@@ -1166,7 +1125,10 @@ mod imp {
             FrequencyField::PerFace(&k)
         };
         let (cwf, report, _) = Cwf::from_frequency_field(m.clone(), field, a, &opts)?;
-        emit(out, cwf, Some(report));
+        out.put_boxed(PleatCwf {
+            cwf,
+            knoppel: Some(report),
+        });
         Ok(())
     }
 
@@ -1179,21 +1141,19 @@ mod imp {
     ) -> Result<()> {
         let m = mesh_ref(base, "base")?;
         let path = c_str_arg(path, "path")?;
-        if out.is_null() {
-            return Err(null_arg("out"));
-        }
+        let out = arg_out(out, "out")?;
         let cwf = crate::wrinkle::read_cwf(path, m.clone())?;
-        emit(out, cwf, None);
+        out.put_boxed(PleatCwf { cwf, knoppel: None });
         Ok(())
     }
 
-    fn eval_options(p: &PleatWrinkleEvalParams, want_fields: bool) -> Result<EvalOptions> {
-        if p.flags & !ALL_FIELDS != 0 {
-            return Err(Error::InvalidArgument(format!(
-                "params->flags has unknown bits {:#x}",
-                p.flags & !ALL_FIELDS
-            )));
-        }
+    /// The Rust options of C evaluation parameters (fields only when `want_fields`), every
+    /// field checked.
+    pub(in crate::ffi) fn eval_options(
+        p: &PleatWrinkleEvalParams,
+        want_fields: bool,
+    ) -> Result<EvalOptions> {
+        check_flags(p.flags, ALL_FIELDS, "params->flags")?;
         let boundary = match p.boundary {
             PLEAT_WRINKLE_BOUNDARY_FIXED => BoundaryRule::Fixed,
             PLEAT_WRINKLE_BOUNDARY_SMOOTH => BoundaryRule::Smooth,
@@ -1203,18 +1163,11 @@ mod imp {
                 )))
             }
         };
-        if !(p.corner_angle.is_finite() && (0.0..=std::f64::consts::PI).contains(&p.corner_angle)) {
-            return Err(Error::InvalidArgument(format!(
-                "params->corner_angle is {}; must be in [0, π] radians",
-                p.corner_angle
-            )));
-        }
-        if !p.displacement_scale.is_finite() {
-            return Err(Error::InvalidArgument(format!(
-                "params->displacement_scale is {}; must be finite",
-                p.displacement_scale
-            )));
-        }
+        let a = p.corner_angle;
+        let angle_ok = a.is_finite() && (0.0..=std::f64::consts::PI).contains(&a);
+        check_f64(a, angle_ok, "params->corner_angle", "in [0, π] radians")?;
+        let d = p.displacement_scale;
+        check_f64(d, d.is_finite(), "params->displacement_scale", "finite")?;
         if p.max_output_triangles == 0 {
             return Err(Error::InvalidArgument(
                 "params->max_output_triangles is 0; must be ≥ 1".into(),
@@ -1253,15 +1206,9 @@ mod imp {
     ) -> PleatStatus {
         guard_progress(progress, user_data, |relay| {
             let c = cwf_ref(cwf)?;
-            if out_mesh.is_null() {
-                return Err(null_arg("out_mesh"));
-            }
-            let stats_size = if stats.is_null() {
-                0
-            } else {
-                output_size(stats, "stats")?
-            };
-            let p = read_versioned(params, pleat_wrinkle_eval_params_default(), "params")?;
+            let out_mesh = arg_out(out_mesh, "out_mesh")?;
+            let stats = versioned_out(stats, "stats")?;
+            let p = read_versioned(params, "params")?;
             let opts = eval_options(&p, !out_fields.is_null())?;
             let (ev, st) = c
                 .cwf
@@ -1300,12 +1247,12 @@ mod imp {
                 displacement_seconds: displacement,
             };
             // Nothing below fails: every output is written or none is.
-            emit_mesh(out_mesh, ev.mesh);
+            out_mesh.put_mesh(ev.mesh);
             if !out_fields.is_null() {
                 *out_fields = Box::into_raw(Box::new(PleatWrinkleFields { fields }));
             }
-            if stats_size > 0 {
-                write_versioned(stats, s, stats_size);
+            if let Some(stats) = stats {
+                stats.write(s);
             }
             Ok(())
         })

@@ -1,0 +1,109 @@
+//! The C defaults cannot drift from the Rust ones: for every C parameters struct, its
+//! `pleat_*_params_default()` converts back to the Rust parameters' `Default`, field by field
+//! (the Rust types derive `PartialEq`), and the copy used by builds without the capability is
+//! the same struct.
+
+use super::*;
+
+/// Bitwise equality of two `#[repr(C)]` parameter structs without padding-sensitive fields
+/// (`PartialEq` is not derived by every one of them; NaN-free defaults compare equal bitwise).
+fn same_bytes<T: Copy>(a: &T, b: &T) -> bool {
+    let n = std::mem::size_of::<T>();
+    // SAFETY: both are valid `T`s; the C parameter structs have no padding.
+    unsafe {
+        std::slice::from_raw_parts(a as *const T as *const u8, n)
+            == std::slice::from_raw_parts(b as *const T as *const u8, n)
+    }
+}
+
+#[cfg(feature = "lod")]
+#[test]
+fn lod_params_default_is_rust_default() {
+    let c = pleat_lod_params_default();
+    assert_eq!(
+        c.struct_size as usize,
+        std::mem::size_of::<PleatLodParams>()
+    );
+    let rust = lod::imp::to_rust(&c).expect("the C default is valid");
+    assert_eq!(rust, crate::lowpoly::LodParams::default());
+    assert!(same_bytes(&c, &lod::defaults_without_lod()));
+}
+
+#[cfg(feature = "lod")]
+#[test]
+fn offset_params_default_is_rust_default() {
+    let c = pleat_offset_params_default();
+    assert_eq!(
+        c.struct_size as usize,
+        std::mem::size_of::<PleatOffsetParams>()
+    );
+    let rust = offset::to_rust(&c).expect("the C default is valid");
+    assert_eq!(rust, crate::lowpoly::OffsetParams::default());
+    assert!(same_bytes(&c, &offset::defaults_without_lod()));
+}
+
+#[cfg(feature = "wrinkle")]
+#[test]
+fn wrinkle_eval_params_default_is_rust_default() {
+    let c = pleat_wrinkle_eval_params_default();
+    assert_eq!(
+        c.struct_size as usize,
+        std::mem::size_of::<PleatWrinkleEvalParams>()
+    );
+    let rust = wrinkle::imp::eval_options(&c, true).expect("the C default is valid");
+    assert_eq!(rust, crate::wrinkle::EvalOptions::default());
+    assert_eq!(c, wrinkle::defaults_without_wrinkle().0);
+}
+
+#[cfg(feature = "wrinkle")]
+#[test]
+fn knoppel_params_default_is_rust_default() {
+    let c = pleat_knoppel_params_default();
+    assert_eq!(
+        c.struct_size as usize,
+        std::mem::size_of::<PleatKnoppelParams>()
+    );
+    let rust = wrinkle::imp::knoppel_options(&c).expect("the C default is valid");
+    assert_eq!(rust, crate::wrinkle::KnoppelOptions::default());
+    assert_eq!(c, wrinkle::defaults_without_wrinkle().1);
+}
+
+#[cfg(feature = "wrinkle")]
+#[test]
+fn wrinkle_interp_params_default_is_rust_default() {
+    let c = pleat_wrinkle_interp_params_default();
+    assert_eq!(
+        c.struct_size as usize,
+        std::mem::size_of::<PleatWrinkleInterpParams>()
+    );
+    let rust = interpolate::imp::options(&c).expect("the C default is valid");
+    assert_eq!(rust, crate::wrinkle::InterpOptions::default());
+    assert_eq!(c, interpolate::defaults_without_wrinkle());
+}
+
+/// A shorter caller struct keeps the defaults past its `struct_size`; a too-short one is
+/// refused with the one message format.
+#[test]
+fn read_versioned_honours_struct_size() {
+    use super::boundary::read_versioned;
+    let mut p = pleat_lod_params_default();
+    p.struct_size = 16;
+    p.screen_size = 50.0;
+    p.flow_ratio = 0.5; // beyond 16 bytes: ignored
+                        // SAFETY: `p` is a valid struct.
+    let r = unsafe { read_versioned(&p, "params") }.unwrap();
+    assert_eq!(r.screen_size, 50.0);
+    assert_eq!(r.flow_ratio, pleat_lod_params_default().flow_ratio);
+    assert_eq!(
+        r.struct_size as usize,
+        std::mem::size_of::<PleatLodParams>()
+    );
+    p.struct_size = 4;
+    // SAFETY: as above.
+    let e = unsafe { read_versioned(&p, "params") }.unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "invalid argument: params->struct_size is 4 (at least 16 is needed); set it to \
+         sizeof(PleatLodParams), e.g. with pleat_lod_params_default()"
+    );
+}
