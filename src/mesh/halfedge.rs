@@ -63,7 +63,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use crate::mesh::trimesh::{cross, norm, sub};
+use crate::geom::{tri_normal, Vec3};
 use crate::{Error, Result};
 
 mod build;
@@ -381,28 +381,28 @@ impl HalfEdgeMesh {
     /// `(b − a) × (c − a)` of live face `f`: normal direction with length twice the area
     /// (panics on a deleted face).
     #[track_caller]
-    pub fn face_area_vector(&self, f: u32) -> [f64; 3] {
-        let [a, b, c] = self.face_positions(f);
-        cross(sub(b, a), sub(c, a))
+    pub fn face_area_vector(&self, f: u32) -> Vec3 {
+        let [a, b, c] = self.face_positions(f).map(Vec3::from);
+        tri_normal(a, b, c)
     }
 
     /// Unit normal of live face `f` (right-hand rule over its corners); `[0, 0, 0]` for a
     /// degenerate (zero-area) face. Panics on a deleted face.
     #[track_caller]
-    pub fn face_normal(&self, f: u32) -> [f64; 3] {
+    pub fn face_normal(&self, f: u32) -> Vec3 {
         let n = self.face_area_vector(f);
-        let l = norm(n);
+        let l = n.length();
         if l > 0.0 {
-            [n[0] / l, n[1] / l, n[2] / l]
+            n / l
         } else {
-            [0.0; 3]
+            Vec3::ZERO
         }
     }
 
     /// Area of live face `f` (panics on a deleted face).
     #[track_caller]
     pub fn face_area(&self, f: u32) -> f64 {
-        0.5 * norm(self.face_area_vector(f))
+        0.5 * self.face_area_vector(f).length()
     }
 
     // ----------------------------------------------------------------------------------------

@@ -295,7 +295,7 @@ fn navigation_on_tetrahedron() {
     assert_eq!(m.face_halfedge(0), m.find_halfedge(0, 2).unwrap());
     assert_eq!(m.find_halfedge(1, 1), None);
     // Face 0 = (0, 2, 1) lies in z = 0 with its normal pointing down (outwards).
-    assert_eq!(m.face_normal(0), [0., 0., -1.]);
+    assert_eq!(m.face_normal(0).to_array(), [0., 0., -1.]);
     assert!((m.face_area(0) - 0.5).abs() < 1e-15);
     let total: f64 = m.faces().map(|f| m.face_area(f)).sum();
     assert!((total - tet().surface_area()).abs() < 1e-12);
