@@ -96,7 +96,7 @@ fn sharp_edges(mesh: &HalfEdgeMesh, theta0_deg: f64) -> Vec<bool> {
             }
             let h = mesh.edge_halfedge(e);
             let n = |h: u32| mesh.face(h).and_then(|f| normals[f as usize]);
-            matches!((n(h), n(h ^ 1)), (Some(a), Some(b)) if a.dot(b) < cos_limit)
+            matches!((n(h), n(mesh.twin(h))), (Some(a), Some(b)) if a.dot(b) < cos_limit)
         })
         .collect()
 }

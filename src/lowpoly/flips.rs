@@ -108,7 +108,7 @@ fn candidates(mesh: &HalfEdgeMesh, is_feature: &[bool], sharp_only: Option<f64>)
     mesh.edges()
         .filter_map(|e| {
             let h = mesh.edge_halfedge(e);
-            let (c, d) = (opposite(mesh, h)?, opposite(mesh, h ^ 1)?);
+            let (c, d) = (opposite(mesh, h)?, opposite(mesh, mesh.twin(h))?);
             let ok = feature(c)
                 && feature(d)
                 && sharp_only.is_none_or(|cl| flip_is_sharp(mesh, h, c, d, cl));
@@ -168,13 +168,13 @@ pub(crate) fn flip_to_features(
     for q in queue {
         let h = mesh.edge_halfedge(q.edge);
         if mesh.can_flip(h).is_err()
-            || (opposite(mesh, h), opposite(mesh, h ^ 1)) != (Some(q.c), Some(q.d))
+            || (opposite(mesh, h), opposite(mesh, mesh.twin(h))) != (Some(q.c), Some(q.d))
         {
             counts.refused_topology += 1;
             continue;
         }
         let (a, b) = (mesh.origin(h), mesh.target(h));
-        let old = [mesh.face(h), mesh.face(h ^ 1)].map(|f| f.unwrap_or(u32::MAX));
+        let old = [mesh.face(h), mesh.face(mesh.twin(h))].map(|f| f.unwrap_or(u32::MAX));
         let new = [[q.c, q.d, b], [q.d, q.c, a]];
         if !flip_is_embedded(mesh, &bvh, &tris, new, old) {
             counts.refused_geometry += 1;

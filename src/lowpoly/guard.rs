@@ -399,7 +399,7 @@ impl<'a> Guard<'a> {
     fn fill_collapse(&self, h: u32, p: [f64; 3], s: &mut GuardScratch) {
         let m = &self.mesh;
         let (a, b) = (m.origin(h), m.target(h));
-        let dying = [m.face(h), m.face(h ^ 1)];
+        let dying = [m.face(h), m.face(m.twin(h))];
         let map = |v: u32| if v == b { a } else { v };
         let pos = |v: u32| if v == a { p } else { m.position(v) };
         s.m_1.clear();

@@ -179,7 +179,7 @@ fn vertex_quadrics(g: &Guard<'_>) -> Vec<Quadric> {
         let h = m.edge_halfedge(e);
         let (a, b) = (m.origin(h), m.target(h));
         let (pa, pb) = (Vec3::from(m.position(a)), Vec3::from(m.position(b)));
-        let nsum = [m.face(h), m.face(h ^ 1)]
+        let nsum = [m.face(h), m.face(m.twin(h))]
             .into_iter()
             .flatten()
             .fold(Vec3::ZERO, |s, f| s + m.face_normal(f));
@@ -612,7 +612,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         };
         let m = self.g.mesh();
         let h0 = m.edge_halfedge(e);
-        let Some(h) = [h0, h0 ^ 1]
+        let Some(h) = [h0, m.twin(h0)]
             .into_iter()
             .find(|&h| m.can_collapse(h).is_ok())
         else {
@@ -717,7 +717,7 @@ impl<'g, 'a> Pass<'g, 'a> {
     fn patches(&self, h: u32, x: Vec3) -> (Patch, Patch) {
         let m = self.g.mesh();
         let (a, b) = (m.origin(h), m.target(h));
-        let dying = [m.face(h), m.face(h ^ 1)];
+        let dying = [m.face(h), m.face(m.twin(h))];
         let mut old = Patch::default();
         let mut new = Patch::default();
         // The link condition (checked before) makes the edge's faces the only ones with both
