@@ -34,6 +34,8 @@
 //!   (folded onto each other); one shared vertex ⇒ intersect iff the edge opposite the shared
 //!   vertex in either face meets the other face; otherwise the closed triangle test.
 
+use crate::geom::{tri_normal, Vec3};
+
 /// Sign (`-1`, `0`, `+1`) of the orientation of `d` relative to the plane through `a, b, c`:
 /// `+1` when `d` lies on the side the normal `(b − a) × (c − a)` points to, i.e. the sign of
 /// `det[b − a, c − a, d − a]`. Exact (Shewchuk's adaptive `orient3d`).
@@ -280,13 +282,8 @@ fn proj(p: [f64; 3], drop: usize) -> [f64; 2] {
 /// A coordinate axis along which the projection of the non-degenerate triangle `t` keeps a
 /// non-zero exact area. Tries the axis of the largest approximate normal component first.
 fn projection_axis(t: &[[f64; 3]; 3]) -> usize {
-    let u = [t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]];
-    let v = [t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]];
-    let n = [
-        (u[1] * v[2] - u[2] * v[1]).abs(),
-        (u[2] * v[0] - u[0] * v[2]).abs(),
-        (u[0] * v[1] - u[1] * v[0]).abs(),
-    ];
+    let [a, b, c] = t.map(Vec3::from);
+    let n = tri_normal(a, b, c).abs();
     let mut order = [0usize, 1, 2];
     order.sort_by(|&i, &j| n[j].total_cmp(&n[i]));
     order
