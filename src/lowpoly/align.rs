@@ -22,39 +22,39 @@
 
 use super::flow::{local_update, record, MoveReport};
 use super::guard::Guard;
-use super::vec3::{add, cross, dot, norm, normalized, scale, sub, tri_normal, P3};
+use crate::geom::{normalized, tri_normal, Vec3};
 use crate::{Error, Result};
 
 /// Unit normals of the live faces of the guard's mesh, indexed by face id (`[0; 3]` for
 /// deleted or degenerate faces): `ñ_f / ‖ñ_f‖` of `M̃`, taken before the flow.
-pub(crate) fn reference_normals(g: &Guard<'_>) -> Vec<P3> {
+pub(crate) fn reference_normals(g: &Guard<'_>) -> Vec<Vec3> {
     let m = g.mesh();
-    let mut n = vec![[0.0; 3]; m.face_capacity()];
+    let mut n = vec![Vec3::ZERO; m.face_capacity()];
     for f in m.faces() {
-        n[f as usize] = normalized(m.face_area_vector(f)).unwrap_or([0.0; 3]);
+        n[f as usize] = normalized(m.face_area_vector(f)).unwrap_or(Vec3::ZERO);
     }
     n
 }
 
 /// The minimiser of eq. 4.5 for vertex `v`, or `None` when the ring is degenerate.
-pub(crate) fn aligned_position(g: &Guard<'_>, v: u32, reference: &[P3]) -> Option<P3> {
+pub(crate) fn aligned_position(g: &Guard<'_>, v: u32, reference: &[Vec3]) -> Option<Vec3> {
     let m = g.mesh();
-    let pv = m.position(v);
+    let pv = Vec3::from(m.position(v));
     let mut h = [[0.0f64; 3]; 3];
-    let mut rhs = [0.0; 3];
+    let mut rhs = Vec3::ZERO;
     let mut any = false;
     for out in m.outgoing(v) {
         let Some(f) = m.face(out) else { continue };
-        let b = m.position(m.target(out));
-        let c = m.position(m.target(m.next(out)));
-        let cf = crate::lowpoly::vec3::norm(tri_normal(&[pv, b, c]));
+        let b = Vec3::from(m.position(m.target(out)));
+        let c = Vec3::from(m.position(m.target(m.next(out))));
+        let cf = tri_normal(pv, b, c).length();
         let t = reference[f as usize];
-        if cf.is_nan() || cf <= 0.0 || t == [0.0; 3] {
+        if cf.is_nan() || cf <= 0.0 || t == Vec3::ZERO {
             continue;
         }
         any = true;
-        let e = sub(b, c);
-        let ee = dot(e, e);
+        let e = b - c;
+        let ee = e.dot(e);
         let w = 1.0 / (cf * cf);
         for (i, row) in h.iter_mut().enumerate() {
             for (j, x) in row.iter_mut().enumerate() {
@@ -62,8 +62,8 @@ pub(crate) fn aligned_position(g: &Guard<'_>, v: u32, reference: &[P3]) -> Optio
                 *x += w * (id - e[i] * e[j]);
             }
         }
-        let y = sub(t, scale(cross(b, c), 1.0 / cf));
-        rhs = add(rhs, scale(cross(e, y), 1.0 / cf));
+        let y = t - b.cross(c) * (1.0 / cf);
+        rhs += e.cross(y) * (1.0 / cf);
     }
     if !any {
         return None;
@@ -76,8 +76,11 @@ pub(crate) fn aligned_position(g: &Guard<'_>, v: u32, reference: &[P3]) -> Optio
 }
 
 /// Solves the 3×3 system `h x = r` by Cramer's rule; `None` when singular or non-finite.
-fn solve3(h: [[f64; 3]; 3], r: P3) -> Option<P3> {
-    let det3 = |m: [[f64; 3]; 3]| dot(m[0], cross(m[1], m[2]));
+fn solve3(h: [[f64; 3]; 3], r: Vec3) -> Option<Vec3> {
+    let det3 = |m: [[f64; 3]; 3]| {
+        let [r0, r1, r2] = m.map(Vec3::from);
+        r0.dot(r1.cross(r2))
+    };
     let d = det3(h);
     if d == 0.0 || !d.is_finite() {
         return None;
@@ -85,12 +88,12 @@ fn solve3(h: [[f64; 3]; 3], r: P3) -> Option<P3> {
     let mut x = [0.0; 3];
     for (k, xk) in x.iter_mut().enumerate() {
         let mut m = h;
-        for (row, rv) in m.iter_mut().zip(r) {
+        for (row, rv) in m.iter_mut().zip(r.to_array()) {
             row[k] = rv;
         }
         *xk = det3(m) / d;
     }
-    x.iter().all(|c| c.is_finite()).then_some(x)
+    x.iter().all(|c| c.is_finite()).then_some(Vec3::from(x))
 }
 
 /// Halvings of an alignment step that would end farther from the input than the drift cap.
@@ -98,16 +101,17 @@ pub const CAP_HALVINGS: u32 = 4;
 
 /// Shortens `d` (halving) until `p + d` is within `max(cap, dist(p))` of the input; `None`
 /// when [`CAP_HALVINGS`] halvings do not suffice.
-fn capped_step(g: &Guard<'_>, p: P3, mut d: P3, cap: f64) -> Option<P3> {
+fn capped_step(g: &Guard<'_>, p: Vec3, mut d: Vec3, cap: f64) -> Option<Vec3> {
     let input = g.input();
     // The allowance grows to the current distance only when the cap alone refuses a step.
     let mut allowed = None;
     for _ in 0..=CAP_HALVINGS {
-        let dn = input.distance(add(p, d));
-        if dn <= cap || dn <= *allowed.get_or_insert_with(|| cap.max(input.distance(p))) {
+        let dn = input.distance((p + d).to_array());
+        if dn <= cap || dn <= *allowed.get_or_insert_with(|| cap.max(input.distance(p.to_array())))
+        {
             return Some(d);
         }
-        d = scale(d, 0.5);
+        d *= 0.5;
     }
     None
 }
@@ -117,7 +121,7 @@ fn capped_step(g: &Guard<'_>, p: P3, mut d: P3, cap: f64) -> Option<P3> {
 /// farther than `max(cap, current distance)` from the input (module docs).
 pub(crate) fn align_sweep(
     g: &mut Guard<'_>,
-    reference: &[P3],
+    reference: &[Vec3],
     max_step: f64,
     cap: f64,
     keep_going: &mut dyn FnMut(f64) -> bool,
@@ -136,13 +140,13 @@ pub(crate) fn align_sweep(
             rep.stuck += 1;
             continue;
         };
-        let mut d = sub(opt, g.mesh().position(v));
-        let len = norm(d);
+        let mut d = opt - Vec3::from(g.mesh().position(v));
+        let len = d.length();
         if len > max_step {
-            d = scale(d, max_step / len);
+            d *= max_step / len;
         }
         let step = if len > 0.0 {
-            capped_step(g, g.mesh().position(v), d, cap)
+            capped_step(g, g.mesh().position(v).into(), d, cap)
         } else {
             None
         };
@@ -168,17 +172,18 @@ mod tests {
         let m = cube(1.0, 0.0);
         let input = InputModel::new(&m, false);
         let g = Guard::new(HalfEdgeMesh::from_trimesh(&m).unwrap(), &input, false);
-        let close = |a: P3, b: P3| (0..3).all(|i| (a[i] - b[i]).abs() < 1e-12);
-        let p = [0.5, 0.5, 1.1];
+        let v = Vec3::new;
+        let close = |a: Vec3, b: Vec3| (0..3).all(|i| (a[i] - b[i]).abs() < 1e-12);
+        let p = v(0.5, 0.5, 1.1);
         let cap = 0.31;
-        let d = capped_step(&g, p, [0.0, 0.0, 0.4], cap).unwrap();
-        assert!(close(d, [0.0, 0.0, 0.2]), "{d:?}");
-        let d = capped_step(&g, p, [0.0, 0.0, 0.05], cap).unwrap();
-        assert!(close(d, [0.0, 0.0, 0.05]), "{d:?}");
-        let d = capped_step(&g, p, [0.3, 0.0, 0.0], cap).unwrap();
-        assert!(close(d, [0.3, 0.0, 0.0]), "{d:?}");
-        assert!(capped_step(&g, [0.5, 0.5, 1.6], [0.0, 0.0, 0.1], cap).is_none());
-        let d = capped_step(&g, [0.5, 0.5, 1.6], [0.0, 0.0, -0.1], cap).unwrap();
-        assert!(close(d, [0.0, 0.0, -0.1]), "{d:?}");
+        let d = capped_step(&g, p, v(0.0, 0.0, 0.4), cap).unwrap();
+        assert!(close(d, v(0.0, 0.0, 0.2)), "{d:?}");
+        let d = capped_step(&g, p, v(0.0, 0.0, 0.05), cap).unwrap();
+        assert!(close(d, v(0.0, 0.0, 0.05)), "{d:?}");
+        let d = capped_step(&g, p, v(0.3, 0.0, 0.0), cap).unwrap();
+        assert!(close(d, v(0.3, 0.0, 0.0)), "{d:?}");
+        assert!(capped_step(&g, v(0.5, 0.5, 1.6), v(0.0, 0.0, 0.1), cap).is_none());
+        let d = capped_step(&g, v(0.5, 0.5, 1.6), v(0.0, 0.0, -0.1), cap).unwrap();
+        assert!(close(d, v(0.0, 0.0, -0.1)), "{d:?}");
     }
 }

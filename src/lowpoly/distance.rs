@@ -21,13 +21,12 @@
 
 use std::collections::HashMap;
 
-use parry3d_f64::bounding_volume::Aabb;
-use parry3d_f64::math::Vector;
-use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy, BvhLeafCost};
 use rayon::prelude::*;
 
-use super::geom::{add, cross, dist, dot, norm2, scale, sub, V3};
+use crate::geom::Vec3;
 use crate::mesh::TriMesh;
+use crate::spatial::closest::{closest_on_nondegenerate_triangle, closest_on_segment};
+use crate::spatial::BoxTree;
 use crate::{Error, Result};
 
 /// Points per brick edge.
@@ -42,29 +41,33 @@ pub(crate) const MAX_GRID_POINTS: u32 = 1 << 20;
 /// One primitive of the input soup, with degenerate triangles reduced to what they are.
 #[derive(Debug, Clone, Copy)]
 enum Prim {
-    Triangle([V3; 3]),
-    Segment(V3, V3),
-    Point(V3),
+    Triangle([Vec3; 3]),
+    Segment(Vec3, Vec3),
+    Point(Vec3),
 }
 
 impl Prim {
-    fn from_triangle(t: [V3; 3]) -> Prim {
+    fn from_triangle(t: [Vec3; 3]) -> Prim {
         let [a, b, c] = t;
-        let n = cross(sub(b, a), sub(c, a));
-        let l2 = norm2(sub(b, a)).max(norm2(sub(c, b))).max(norm2(sub(a, c)));
+        let n = (b - a).cross(c - a);
+        let l2 = (b - a)
+            .length_squared()
+            .max((c - b).length_squared())
+            .max((a - c).length_squared());
         if l2 == 0.0 {
             return Prim::Point(a);
         }
         // Relative sliver test: height/length below ~1e-10 is a segment for distance purposes.
-        if norm2(n) <= 1e-20 * l2 * l2 {
+        if n.length_squared() <= 1e-20 * l2 * l2 {
             let (p, q) = longest_edge(a, b, c);
             return Prim::Segment(p, q);
         }
         Prim::Triangle(t)
     }
 
-    fn aabb(&self) -> Aabb {
-        let pts: &[V3] = match self {
+    /// The primitive's box `(min, max)`.
+    fn bbox(&self) -> (Vec3, Vec3) {
+        let pts: &[Vec3] = match self {
             Prim::Triangle(t) => t,
             Prim::Segment(a, b) => &[*a, *b],
             Prim::Point(a) => std::slice::from_ref(a),
@@ -77,100 +80,24 @@ impl Prim {
                 hi[k] = hi[k].max(p[k]);
             }
         }
-        Aabb::new(to_vec(lo), to_vec(hi))
+        (lo, hi)
     }
 
-    fn closest(&self, p: V3) -> V3 {
+    fn closest(&self, p: Vec3) -> Vec3 {
         match *self {
-            Prim::Triangle([a, b, c]) => closest_on_triangle(p, a, b, c),
+            Prim::Triangle([a, b, c]) => closest_on_nondegenerate_triangle(p, a, b, c),
             Prim::Segment(a, b) => closest_on_segment(p, a, b),
             Prim::Point(a) => a,
         }
     }
 }
 
-fn longest_edge(a: V3, b: V3, c: V3) -> (V3, V3) {
+fn longest_edge(a: Vec3, b: Vec3, c: Vec3) -> (Vec3, Vec3) {
     let e = [(a, b), (b, c), (c, a)];
     let mut best = e[0];
     for &(p, q) in &e[1..] {
-        if norm2(sub(q, p)) > norm2(sub(best.1, best.0)) {
+        if (q - p).length_squared() > (best.1 - best.0).length_squared() {
             best = (p, q);
-        }
-    }
-    best
-}
-
-fn to_vec(p: V3) -> Vector {
-    Vector::new(p[0], p[1], p[2])
-}
-
-/// Closest point to `p` on segment `ab` (any `a`, `b`, including `a == b`).
-pub(crate) fn closest_on_segment(p: V3, a: V3, b: V3) -> V3 {
-    let ab = sub(b, a);
-    let l2 = norm2(ab);
-    if l2 == 0.0 {
-        return a;
-    }
-    let t = (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0);
-    add(a, scale(ab, t))
-}
-
-/// Closest point to `p` on the non-degenerate triangle `abc` (Voronoi-region walk).
-pub(crate) fn closest_on_triangle(p: V3, a: V3, b: V3, c: V3) -> V3 {
-    let ab = sub(b, a);
-    let ac = sub(c, a);
-    let ap = sub(p, a);
-    let d1 = dot(ab, ap);
-    let d2 = dot(ac, ap);
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = sub(p, b);
-    let d3 = dot(ab, bp);
-    let d4 = dot(ac, bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return add(a, scale(ab, d1 / (d1 - d3)));
-    }
-    let cp = sub(p, c);
-    let d5 = dot(ab, cp);
-    let d6 = dot(ac, cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return add(a, scale(ac, d2 / (d2 - d6)));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return add(b, scale(sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
-    }
-    let denom = va + vb + vc;
-    if denom.is_nan() || denom <= 0.0 {
-        // Only reachable through rounding on slivers: fall back to the best edge point.
-        return best_of(
-            [
-                closest_on_segment(p, a, b),
-                closest_on_segment(p, b, c),
-                closest_on_segment(p, c, a),
-            ],
-            p,
-        );
-    }
-    let v = vb / denom;
-    let w = vc / denom;
-    add(a, add(scale(ab, v), scale(ac, w)))
-}
-
-fn best_of(c: [V3; 3], p: V3) -> V3 {
-    let mut best = c[0];
-    for q in &c[1..] {
-        if norm2(sub(*q, p)) < norm2(sub(best, p)) {
-            best = *q;
         }
     }
     best
@@ -182,44 +109,38 @@ pub(crate) struct Closest {
     /// Euclidean distance from the query point.
     pub dist: f64,
     /// The closest point on the input.
-    pub point: V3,
+    pub point: Vec3,
     /// Index of the input primitive (triangle) it lies on.
     pub prim: u32,
 }
 
-impl BvhLeafCost for Closest {
-    fn cost(&self) -> f64 {
-        self.dist
-    }
-}
-
-/// Exact closest-point queries on an input soup (parry's BVH over our own primitives).
+/// Exact closest-point queries on an input soup (a `spatial::BoxTree` over our own
+/// primitives).
 pub(crate) struct InputDistance {
     prims: Vec<Prim>,
-    bvh: Bvh,
+    tree: BoxTree,
 }
 
 impl InputDistance {
     /// Builds the BVH over every triangle of `mesh` (degenerate ones as segments or points).
     pub(crate) fn new(mesh: &TriMesh) -> InputDistance {
         let prims: Vec<Prim> = (0..mesh.triangle_count())
-            .map(|t| Prim::from_triangle(mesh.triangle_positions(t)))
+            .map(|t| Prim::from_triangle(mesh.triangle_positions(t).map(Vec3::from)))
             .collect();
-        let aabbs: Vec<Aabb> = prims.iter().map(Prim::aabb).collect();
-        let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &aabbs);
-        InputDistance { prims, bvh }
+        let tree = BoxTree::new(prims.iter().map(Prim::bbox));
+        InputDistance { prims, tree }
     }
 
     /// Closest input point to `p` if it is closer than `max_dist`.
-    pub(crate) fn closest(&self, p: V3, max_dist: f64) -> Option<Closest> {
+    pub(crate) fn closest(&self, p: Vec3, max_dist: f64) -> Option<Closest> {
         self.closest_hinted(p, max_dist, None)
     }
 
     /// Distance from `p` to primitive `i`.
-    fn closest_on(&self, i: u32, p: V3) -> Option<Closest> {
+    fn closest_on(&self, i: u32, p: Vec3) -> Option<Closest> {
         let q = self.prims.get(i as usize)?.closest(p);
         Some(Closest {
-            dist: dist(p, q),
+            dist: p.distance(q),
             point: q,
             prim: i,
         })
@@ -230,7 +151,7 @@ impl InputDistance {
     /// everything farther. The result is the same as without the hint up to ties.
     pub(crate) fn closest_hinted(
         &self,
-        p: V3,
+        p: Vec3,
         max_dist: f64,
         hint: Option<u32>,
     ) -> Option<Closest> {
@@ -238,34 +159,24 @@ impl InputDistance {
             .and_then(|i| self.closest_on(i, p))
             .filter(|c| c.dist < max_dist);
         let bound = seed.map_or(max_dist, |c| c.dist);
-        let pv = to_vec(p);
-        let found = self
-            .bvh
-            .find_best(
-                bound,
-                |node, _| aabb_distance(node.mins(), node.maxs(), pv),
-                |leaf, _| self.closest_on(leaf, p),
-            )
-            .map(|(_, c)| c);
+        let found = self.tree.nearest(p, bound, |leaf| {
+            self.closest_on(leaf, p).map(|c| (c.dist, c))
+        });
         found.or(seed)
     }
 
     /// `min(f(p), max_dist)`.
-    pub(crate) fn distance_capped(&self, p: V3, max_dist: f64) -> f64 {
+    pub(crate) fn distance_capped(&self, p: Vec3, max_dist: f64) -> f64 {
         self.closest(p, max_dist).map_or(max_dist, |c| c.dist)
     }
 
     /// Exact distance from `p` to primitive `i` (brick culling).
-    fn prim_distance(&self, i: usize, p: V3) -> f64 {
-        dist(p, self.prims[i].closest(p))
+    fn prim_distance(&self, i: usize, p: Vec3) -> f64 {
+        p.distance(self.prims[i].closest(p))
     }
 
-    fn prim_aabb(&self, i: usize) -> (V3, V3) {
-        let b = self.prims[i].aabb();
-        (
-            [b.mins.x, b.mins.y, b.mins.z],
-            [b.maxs.x, b.maxs.y, b.maxs.z],
-        )
+    fn prim_aabb(&self, i: usize) -> (Vec3, Vec3) {
+        self.prims[i].bbox()
     }
 
     fn len(&self) -> usize {
@@ -273,18 +184,11 @@ impl InputDistance {
     }
 }
 
-fn aabb_distance(lo: Vector, hi: Vector, p: Vector) -> f64 {
-    let dx = (lo.x - p.x).max(p.x - hi.x).max(0.0);
-    let dy = (lo.y - p.y).max(p.y - hi.y).max(0.0);
-    let dz = (lo.z - p.z).max(p.z - hi.z).max(0.0);
-    (dx * dx + dy * dy + dz * dz).sqrt()
-}
-
 /// The regular grid: point `(i, j, k)` sits at `origin + h·(i, j, k)`, `0 ≤ i < dims[0]`, ….
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct GridSpec {
     /// Position of grid point (0, 0, 0).
-    pub origin: V3,
+    pub origin: Vec3,
     /// Voxel edge length.
     pub h: f64,
     /// Number of grid points per axis.
@@ -293,8 +197,8 @@ pub(crate) struct GridSpec {
 
 impl GridSpec {
     /// A grid covering the box `[lo, hi]` padded by `pad` on every side.
-    pub(crate) fn covering(lo: V3, hi: V3, pad: f64, h: f64) -> Result<GridSpec> {
-        let origin = sub(lo, [pad; 3]);
+    pub(crate) fn covering(lo: Vec3, hi: Vec3, pad: f64, h: f64) -> Result<GridSpec> {
+        let origin = lo - Vec3::splat(pad);
         let mut dims = [0u32; 3];
         for k in 0..3 {
             let n = ((hi[k] - lo[k] + 2.0 * pad) / h).ceil() + 2.0;
@@ -312,12 +216,12 @@ impl GridSpec {
 
     /// Position of grid point `p`.
     #[inline]
-    pub(crate) fn point(&self, p: [u32; 3]) -> V3 {
-        [
-            self.origin[0] + self.h * p[0] as f64,
-            self.origin[1] + self.h * p[1] as f64,
-            self.origin[2] + self.h * p[2] as f64,
-        ]
+    pub(crate) fn point(&self, p: [u32; 3]) -> Vec3 {
+        Vec3::new(
+            self.origin.x + self.h * p[0] as f64,
+            self.origin.y + self.h * p[1] as f64,
+            self.origin.z + self.h * p[2] as f64,
+        )
     }
 
     /// Number of bricks per axis.
@@ -494,10 +398,8 @@ fn triangle_bricks(
     for bx in range[0][0]..=range[0][1] {
         for by in range[1][0]..=range[1][1] {
             for bz in range[2][0]..=range[2][1] {
-                let c = add(
-                    spec.point([bx * BRICK, by * BRICK, bz * BRICK]),
-                    [centre_offset; 3],
-                );
+                let c =
+                    spec.point([bx * BRICK, by * BRICK, bz * BRICK]) + Vec3::splat(centre_offset);
                 if input.prim_distance(t, c) <= reach {
                     out.push(brick_key([bx, by, bz]));
                 }
@@ -576,11 +478,11 @@ fn brick_values(input: &InputDistance, spec: &GridSpec, key: u64, cap: f64) -> V
 mod tests {
     use super::*;
 
-    fn brute(mesh: &TriMesh, p: V3) -> f64 {
+    fn brute(mesh: &TriMesh, p: Vec3) -> f64 {
         (0..mesh.triangle_count())
             .map(|t| {
-                let q = Prim::from_triangle(mesh.triangle_positions(t)).closest(p);
-                dist(p, q)
+                let q = Prim::from_triangle(mesh.triangle_positions(t).map(Vec3::from)).closest(p);
+                p.distance(q)
             })
             .fold(f64::INFINITY, f64::min)
     }
@@ -611,24 +513,12 @@ mod tests {
                     .wrapping_add(1442695040888963407);
                 *c = (s >> 11) as f64 / (1u64 << 53) as f64 * 8.0 - 2.0;
             }
+            let p = Vec3::from(p);
             let exact = brute(&mesh, p);
             let got = q.closest(p, f64::INFINITY).unwrap().dist;
             assert!((exact - got).abs() < 1e-12, "{p:?}: {exact} vs {got}");
             assert!(exact.is_finite());
         }
-    }
-
-    #[test]
-    fn triangle_closest_point_regions() {
-        let (a, b, c) = ([0., 0., 0.], [1., 0., 0.], [0., 1., 0.]);
-        assert_eq!(closest_on_triangle([-1., -1., 3.], a, b, c), a);
-        assert_eq!(
-            closest_on_triangle([0.25, 0.25, 3.], a, b, c),
-            [0.25, 0.25, 0.]
-        );
-        assert_eq!(closest_on_triangle([0.5, -1., 0.], a, b, c), [0.5, 0., 0.]);
-        let p = closest_on_triangle([1., 1., 0.], a, b, c);
-        assert!(dist(p, [0.5, 0.5, 0.]) < 1e-15);
     }
 
     #[test]
@@ -647,7 +537,7 @@ mod tests {
             memory_budget: 1 << 30,
         };
         let (lo, hi) = mesh.bbox();
-        let spec = GridSpec::covering(lo, hi, d + 3.0 * h, h).unwrap();
+        let spec = GridSpec::covering(Vec3::from(lo), Vec3::from(hi), d + 3.0 * h, h).unwrap();
         let keys = band_bricks(&q, &spec, &p).unwrap();
         assert!(keys.windows(2).all(|w| w[0] < w[1]));
         let grid = evaluate_band(&q, spec, keys, &p, &mut |_| true).unwrap();
@@ -683,7 +573,7 @@ mod tests {
             memory_budget: 1 << 20,
         };
         let (lo, hi) = mesh.bbox();
-        let spec = GridSpec::covering(lo, hi, 3.0 * d, p.h).unwrap();
+        let spec = GridSpec::covering(Vec3::from(lo), Vec3::from(hi), 3.0 * d, p.h).unwrap();
         assert!(matches!(
             band_bricks(&q, &spec, &p),
             Err(Error::LimitExceeded(_))

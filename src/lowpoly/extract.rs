@@ -27,10 +27,10 @@ use rayon::prelude::*;
 
 use super::distance::{brick_coords, brick_key, DistanceGrid, GridSpec, InputDistance, BRICK};
 use super::features::{cube_geometry, CubeFlags};
-use super::geom::{add, lerp, normalized, scale, sub, V3};
 use super::mc33::tables::{CORNER_POS, EDGE_AXIS, EDGE_CORNERS};
 use super::mc33::triangulate::{fan, LocalTri};
 use super::mc33::{decide, topology, CubeTopology, Decisions};
+use crate::geom::{lerp, normalized, Vec3};
 use crate::{Error, Result};
 
 /// Clamp of the iso-point parameter away from grid points.
@@ -72,7 +72,7 @@ pub(crate) struct ExtractParams {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct PatchSet {
     /// Iso-points (ids `0..n_iso`), then feature and center vertices.
-    pub positions: Vec<V3>,
+    pub positions: Vec<Vec3>,
     /// Number of iso-points.
     pub n_iso: usize,
     /// Per patch `p`, its loop vertex ids are `loop_ids[loop_off[p]..loop_off[p + 1]]`.
@@ -221,7 +221,7 @@ impl PatchSet {
     pub(crate) fn assemble(
         &self,
         mode: &dyn Fn(usize) -> Mode,
-    ) -> (Vec<V3>, Vec<[u32; 3]>, Vec<u32>) {
+    ) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u32>) {
         let mut tris = Vec::new();
         for p in 0..self.len() {
             match mode(p) {
@@ -241,7 +241,10 @@ impl PatchSet {
                 *v = remap[*v as usize];
             }
         }
-        let pos = back.iter().map(|&v| self.positions[v as usize]).collect();
+        let pos = back
+            .iter()
+            .map(|&v| self.positions[v as usize].to_array())
+            .collect();
         (pos, tris, back)
     }
 }
@@ -355,7 +358,7 @@ pub(crate) fn extract(
     let chunk = 512;
     let (keys, mixed) = crossed_edges(&grid, p.d, chunk, &mut counts, keep_going)?;
     // Iso-points and their normals (eq. 4.3).
-    let (iso_pos, iso): (Vec<V3>, Vec<IsoNormal>) = keys
+    let (iso_pos, iso): (Vec<Vec3>, Vec<IsoNormal>) = keys
         .par_iter()
         .map(|&k| iso_point(&grid, input, k, p))
         .unzip();
@@ -509,7 +512,7 @@ fn crossed_edges(
 struct IsoNormal {
     /// Unit normal `(p − p*)/‖p − p*‖` (eq. 4.3), or the direction of increasing `f` along
     /// the edge when there is no usable closest point (`fallback`).
-    normal: V3,
+    normal: Vec3,
     /// Input primitive of the closest point (`u32::MAX` when unknown).
     prim: u32,
     /// The normal is the edge-direction fallback.
@@ -522,7 +525,7 @@ fn iso_point(
     input: &InputDistance,
     k: u64,
     p: &ExtractParams,
-) -> (V3, IsoNormal) {
+) -> (Vec3, IsoNormal) {
     let (g, a) = edge_from_key(k);
     let mut g1 = g;
     g1[a as usize] += 1;
@@ -538,7 +541,7 @@ fn iso_point(
     if p.features {
         if let Some(c) = input.closest(x, grid.cap * 2.0) {
             prim = c.prim;
-            if let Some(normal) = normalized(sub(x, c.point)) {
+            if let Some(normal) = normalized(x - c.point) {
                 let n = IsoNormal {
                     normal,
                     prim,
@@ -549,7 +552,7 @@ fn iso_point(
         }
     }
     // The direction of increasing f along the edge is a usable fallback normal.
-    let mut normal = [0.0; 3];
+    let mut normal = Vec3::ZERO;
     normal[a as usize] = if f1 > f0 { 1.0 } else { -1.0 };
     let n = IsoNormal {
         normal,
@@ -573,8 +576,8 @@ pub(crate) fn iso_parameter(f0: f64, f1: f64, d: f64) -> f64 {
 #[allow(clippy::too_many_arguments)]
 fn refine(
     input: &InputDistance,
-    x0: V3,
-    x1: V3,
+    x0: Vec3,
+    x1: Vec3,
     f0: f64,
     f1: f64,
     t0: f64,
@@ -626,7 +629,7 @@ struct CubeCtx<'a> {
     cap: f64,
     input: &'a InputDistance,
     keys: &'a [u64],
-    iso_pos: &'a [V3],
+    iso_pos: &'a [Vec3],
     iso: &'a [IsoNormal],
     p: &'a ExtractParams,
 }
@@ -639,7 +642,7 @@ struct BrickPatches {
     first_len: Vec<u8>,
     plain: Vec<LocalTri>,
     plain_len: Vec<u32>,
-    extra: Vec<V3>,
+    extra: Vec<Vec3>,
     center: Vec<u32>,
     feature: Vec<u32>,
     counts: ExtractCounts,
@@ -667,8 +670,8 @@ fn cube_patches(
     let d = ctx.p.d;
     let origin = ctx.spec.point(g);
     let mut ids = [NONE; 12];
-    let mut local = [[0.0; 3]; 12];
-    let mut normals = [[0.0; 3]; 12];
+    let mut local = [Vec3::ZERO; 12];
+    let mut normals = [Vec3::ZERO; 12];
     let mut hint = None;
     for e in 0..12 {
         let ec = EDGE_CORNERS[e];
@@ -680,23 +683,23 @@ fn cube_patches(
         };
         ids[e] = i as u32;
         let ip = ctx.iso[i];
-        local[e] = scale(sub(ctx.iso_pos[i], origin), 1.0 / h);
+        local[e] = (ctx.iso_pos[i] - origin) * (1.0 / h);
         normals[e] = ip.normal;
         if ip.prim != u32::MAX {
             hint = Some(ip.prim);
         }
     }
     let normals = ctx.p.features.then_some(&normals);
-    let project = |x: V3| -> Option<V3> {
-        let w = [
+    let project = |x: Vec3| -> Option<Vec3> {
+        let w = Vec3::new(
             origin[0] + h * x[0],
             origin[1] + h * x[1],
             origin[2] + h * x[2],
-        ];
+        );
         let c = ctx.input.closest_hinted(w, 2.0 * ctx.cap, hint)?;
-        let n = normalized(sub(w, c.point))?;
-        let y = lerp(c.point, add(c.point, n), d);
-        Some(scale(sub(y, origin), 1.0 / h))
+        let n = normalized(w - c.point)?;
+        let y = lerp(c.point, c.point + n, d);
+        Some((y - origin) * (1.0 / h))
     };
     let (patches, flags) = cube_geometry(
         topo,
@@ -706,12 +709,12 @@ fn cube_patches(
         Some(&project),
     );
     out.counts.add_flags(&flags);
-    let world = |x: V3| {
-        [
+    let world = |x: Vec3| {
+        Vec3::new(
             origin[0] + h * x[0],
             origin[1] + h * x[1],
             origin[2] + h * x[2],
-        ]
+        )
     };
     for pg in patches {
         if pg.is_annulus() {
@@ -725,7 +728,7 @@ fn cube_patches(
         out.first_len.push(pg.first_len as u8);
         out.plain.extend_from_slice(&pg.plain);
         out.plain_len.push(pg.plain.len() as u32);
-        let mut push_extra = |x: Option<V3>| match x {
+        let mut push_extra = |x: Option<Vec3>| match x {
             Some(x) => {
                 out.extra.push(world(x));
                 (out.extra.len() - 1) as u32
@@ -740,7 +743,7 @@ fn cube_patches(
 }
 
 /// Appends one brick's patches; its extra vertices go to `extra` (ids from `set.n_iso`).
-fn append(set: &mut PatchSet, extra: &mut Vec<V3>, bp: BrickPatches) {
+fn append(set: &mut PatchSet, extra: &mut Vec<Vec3>, bp: BrickPatches) {
     let base = (set.n_iso + extra.len()) as u32;
     extra.extend(bp.extra);
     let shift = |x: u32| if x == NONE { NONE } else { base + x };
@@ -761,6 +764,6 @@ fn append(set: &mut PatchSet, extra: &mut Vec<V3>, bp: BrickPatches) {
 }
 
 /// Distance from `x` to the input, for reporting (`max |f(x) − d|`).
-pub(crate) fn deviation(input: &InputDistance, x: V3, d: f64, cap: f64) -> f64 {
+pub(crate) fn deviation(input: &InputDistance, x: Vec3, d: f64, cap: f64) -> f64 {
     (input.distance_capped(x, cap) - d).abs()
 }

@@ -37,9 +37,9 @@
 //! as unresolved. Tunnels (annuli) get no feature vertex (the dissertation excludes them too);
 //! their strip is checked exactly, and replaced by two disks when it fails.
 
-use super::geom::{add, dot, normalized, scale, sub, V3};
 use super::mc33::triangulate::{fan, plain_disk, strip, LocalTri};
 use super::mc33::{CubeTopology, NO_LOOP};
+use crate::geom::{normalized, Vec3};
 
 /// Shrink of the cube for apex vertices, in units of `h`.
 pub(crate) const CUBE_MARGIN: f64 = 1e-3;
@@ -50,7 +50,7 @@ pub(crate) const REGULARIZATION: f64 = 0.01;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct HalfSpace {
     /// Outward normal.
-    pub n: V3,
+    pub n: Vec3,
     /// Offset.
     pub c: f64,
 }
@@ -59,10 +59,10 @@ pub(crate) struct HalfSpace {
 /// enumerating active sets of size 0..3 and returning the first KKT point (for a strictly
 /// convex QP it is the unique optimum). `None` when no KKT point is found (infeasible or
 /// numerically degenerate).
-pub(crate) fn solve_qp(a: [[f64; 3]; 3], b: V3, cons: &[HalfSpace]) -> Option<V3> {
+pub(crate) fn solve_qp(a: [[f64; 3]; 3], b: Vec3, cons: &[HalfSpace]) -> Option<Vec3> {
     let ainv = inverse3(a)?;
     let tol = 1e-12;
-    let feasible = |x: V3| cons.iter().all(|h| dot(h.n, x) <= h.c + tol);
+    let feasible = |x: Vec3| cons.iter().all(|h| h.n.dot(x) <= h.c + tol);
     let x0 = mul3(&ainv, b);
     if feasible(x0) {
         return Some(x0);
@@ -106,25 +106,25 @@ fn next_combination(idx: &mut [usize], m: usize) -> bool {
 /// Equality-constrained minimiser with constraints `set` active; returns `(x, λ)`.
 fn solve_active(
     ainv: &[[f64; 3]; 3],
-    b: V3,
+    b: Vec3,
     cons: &[HalfSpace],
     set: &[usize],
-) -> Option<(V3, [f64; 3])> {
+) -> Option<(Vec3, [f64; 3])> {
     let k = set.len();
-    let g: Vec<V3> = set.iter().map(|&i| cons[i].n).collect();
-    let ag: Vec<V3> = g.iter().map(|gi| mul3(ainv, *gi)).collect();
+    let g: Vec<Vec3> = set.iter().map(|&i| cons[i].n).collect();
+    let ag: Vec<Vec3> = g.iter().map(|gi| mul3(ainv, *gi)).collect();
     let ab = mul3(ainv, b);
     let mut mtx = [[0.0; 4]; 3];
     for r in 0..k {
         for c in 0..k {
-            mtx[r][c] = dot(g[r], ag[c]);
+            mtx[r][c] = g[r].dot(ag[c]);
         }
-        mtx[r][3] = dot(g[r], ab) - cons[set[r]].c;
+        mtx[r][3] = g[r].dot(ab) - cons[set[r]].c;
     }
     let lam = gauss_solve(&mut mtx, k)?;
     let mut rhs = b;
     for r in 0..k {
-        rhs = sub(rhs, scale(g[r], lam[r]));
+        rhs -= g[r] * lam[r];
     }
     Some((mul3(ainv, rhs), lam))
 }
@@ -157,8 +157,12 @@ fn gauss_solve(m: &mut [[f64; 4]; 3], k: usize) -> Option<[f64; 3]> {
     Some(x)
 }
 
-fn mul3(m: &[[f64; 3]; 3], v: V3) -> V3 {
-    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
+fn mul3(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {
+    Vec3::new(
+        Vec3::from(m[0]).dot(v),
+        Vec3::from(m[1]).dot(v),
+        Vec3::from(m[2]).dot(v),
+    )
 }
 
 fn inverse3(a: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
@@ -195,27 +199,22 @@ const DIRECTIONS: [[f64; 3]; 13] = [
 
 /// A plane strictly separating point sets `a` and `b`, as the half-space containing `a`
 /// (with the apex margin already applied) and the one containing `b`.
-pub(crate) fn separating_plane(a: &[V3], b: &[V3]) -> Option<(HalfSpace, HalfSpace)> {
-    let centroid = |s: &[V3]| {
-        scale(
-            s.iter().fold([0.0; 3], |x, p| add(x, *p)),
-            1.0 / s.len() as f64,
-        )
-    };
-    let diff = sub(centroid(b), centroid(a));
-    let mut best: Option<(f64, V3, f64, f64)> = None;
+pub(crate) fn separating_plane(a: &[Vec3], b: &[Vec3]) -> Option<(HalfSpace, HalfSpace)> {
+    let centroid = |s: &[Vec3]| s.iter().fold(Vec3::ZERO, |x, p| x + *p) * (1.0 / s.len() as f64);
+    let diff = centroid(b) - centroid(a);
+    let mut best: Option<(f64, Vec3, f64, f64)> = None;
     let extra = normalized(diff).into_iter();
     for n in DIRECTIONS
         .iter()
-        .filter_map(|d| normalized(*d))
+        .filter_map(|d| normalized(Vec3::from(*d)))
         .chain(extra)
     {
-        for n in [n, scale(n, -1.0)] {
+        for n in [n, n * -1.0] {
             let amax = a
                 .iter()
-                .map(|p| dot(n, *p))
+                .map(|p| n.dot(*p))
                 .fold(f64::NEG_INFINITY, f64::max);
-            let bmin = b.iter().map(|p| dot(n, *p)).fold(f64::INFINITY, f64::min);
+            let bmin = b.iter().map(|p| n.dot(*p)).fold(f64::INFINITY, f64::min);
             let gap = bmin - amax;
             if gap > 0.0 && best.is_none_or(|bb| gap > bb.0) {
                 best = Some((gap, n, amax, bmin));
@@ -228,7 +227,7 @@ pub(crate) fn separating_plane(a: &[V3], b: &[V3]) -> Option<(HalfSpace, HalfSpa
     Some((
         HalfSpace { n, c: mid - m },
         HalfSpace {
-            n: scale(n, -1.0),
+            n: n * -1.0,
             c: -(mid + m),
         },
     ))
@@ -237,15 +236,15 @@ pub(crate) fn separating_plane(a: &[V3], b: &[V3]) -> Option<(HalfSpace, HalfSpa
 /// The six half-spaces of the unit cube shrunk by `margin`.
 fn cube_halfspaces(margin: f64) -> [HalfSpace; 6] {
     let mut out = [HalfSpace {
-        n: [0.0; 3],
+        n: Vec3::ZERO,
         c: 0.0,
     }; 6];
     for a in 0..3 {
-        let mut n = [0.0; 3];
+        let mut n = Vec3::ZERO;
         n[a] = 1.0;
         out[2 * a] = HalfSpace { n, c: 1.0 - margin };
         out[2 * a + 1] = HalfSpace {
-            n: scale(n, -1.0),
+            n: n * -1.0,
             c: -margin,
         };
     }
@@ -260,9 +259,9 @@ pub(crate) struct PatchGeom {
     /// Number of edges of the first loop (`edges.len()` for a disk).
     pub first_len: usize,
     /// The feature vertex (eq. 4.3), local coordinates; disks only.
-    pub feature: Option<V3>,
+    pub feature: Option<Vec3>,
     /// Extra vertex needed by the template triangulation, if any (index `edges.len()`).
-    pub center: Option<V3>,
+    pub center: Option<Vec3>,
     /// Template triangulation (local indices; `edges.len()` is the center).
     pub plain: Vec<LocalTri>,
     /// Largest angle (degrees) between two iso-point normals of the patch (0 without normals).
@@ -288,7 +287,7 @@ pub(crate) struct CubeFlags {
 }
 
 /// Maps a cube-local point onto the exact iso-surface (`None` when it cannot).
-pub(crate) type Projector<'a> = &'a dyn Fn(V3) -> Option<V3>;
+pub(crate) type Projector<'a> = &'a dyn Fn(Vec3) -> Option<Vec3>;
 
 /// Geometry of all patches of one cube. `iso[e]` is the iso-point of crossed edge `e` and
 /// `normals[e]` its unit normal (eq. 4.3), both in cube-local coordinates (unit cube);
@@ -298,14 +297,14 @@ pub(crate) type Projector<'a> = &'a dyn Fn(V3) -> Option<V3>;
 /// still satisfies its polyhedron's constraints (so the embedding argument is unaffected).
 pub(crate) fn cube_geometry(
     topo: &CubeTopology,
-    iso: &[V3; 12],
-    normals: Option<&[V3; 12]>,
+    iso: &[Vec3; 12],
+    normals: Option<&[Vec3; 12]>,
     min_spread_deg: f32,
     project: Option<Projector<'_>>,
 ) -> (Vec<PatchGeom>, CubeFlags) {
     let mut flags = CubeFlags::default();
     let groups = patch_groups(topo, iso, &mut flags);
-    let pts: Vec<Vec<V3>> = groups
+    let pts: Vec<Vec<Vec3>> = groups
         .iter()
         .map(|g| g.0.iter().map(|&e| iso[e as usize]).collect())
         .collect();
@@ -360,7 +359,7 @@ pub(crate) fn cube_geometry(
 /// separated from another patch, become two disks.
 fn patch_groups(
     topo: &CubeTopology,
-    iso: &[V3; 12],
+    iso: &[Vec3; 12],
     flags: &mut CubeFlags,
 ) -> Vec<(Vec<u8>, usize)> {
     let mut groups: Vec<(Vec<u8>, usize)> = Vec::with_capacity(topo.n_patches as usize);
@@ -373,9 +372,9 @@ fn patch_groups(
             continue;
         }
         let e1 = topo.loop_edges(l1 as usize).to_vec();
-        let p0: Vec<V3> = e0.iter().map(|&e| iso[e as usize]).collect();
-        let p1: Vec<V3> = e1.iter().map(|&e| iso[e as usize]).collect();
-        let mut others: Vec<V3> = Vec::new();
+        let p0: Vec<Vec3> = e0.iter().map(|&e| iso[e as usize]).collect();
+        let p1: Vec<Vec3> = e1.iter().map(|&e| iso[e as usize]).collect();
+        let mut others: Vec<Vec3> = Vec::new();
         for q in 0..topo.n_patches as usize {
             if q != p {
                 for &l in topo.patches[q].iter().filter(|&&l| l != NO_LOOP) {
@@ -383,7 +382,7 @@ fn patch_groups(
                 }
             }
         }
-        let both: Vec<V3> = p0.iter().chain(&p1).copied().collect();
+        let both: Vec<Vec3> = p0.iter().chain(&p1).copied().collect();
         let separable = others.is_empty() || separating_plane(&both, &others).is_some();
         let mut tmp = Vec::new();
         if separable && strip(&p0, &e0, &p1, &e1, &[], &mut tmp) {
@@ -401,29 +400,26 @@ fn patch_groups(
     groups
 }
 
-fn centroid(p: &[V3]) -> V3 {
-    scale(
-        p.iter().fold([0.0; 3], |a, q| add(a, *q)),
-        1.0 / p.len() as f64,
-    )
+fn centroid(p: &[Vec3]) -> Vec3 {
+    p.iter().fold(Vec3::ZERO, |a, q| a + *q) * (1.0 / p.len() as f64)
 }
 
 /// Feature vertex and template triangulation of a disk patch. `feature` holds the normals and
 /// the least normal spread (degrees) for which the feature vertex is computed.
 fn disk_geometry(
     g: &mut PatchGeom,
-    pts: &[V3],
+    pts: &[Vec3],
     cons: &[HalfSpace],
     separated: bool,
-    feature: Option<(&[V3; 12], f32)>,
+    feature: Option<(&[Vec3; 12], f32)>,
     project: Option<Projector<'_>>,
 ) {
     let c = centroid(pts);
     let cons: &[HalfSpace] = if separated { cons } else { &cons[..6] };
-    let onto_surface = |x: V3| {
+    let onto_surface = |x: Vec3| {
         project
             .and_then(|f| f(x))
-            .filter(|y| cons.iter().all(|h| dot(h.n, *y) <= h.c))
+            .filter(|y| cons.iter().all(|h| h.n.dot(*y) <= h.c))
             .unwrap_or(x)
     };
     if let (Some((nrm, min_spread)), true) = (feature, separated) {
@@ -436,22 +432,22 @@ fn disk_geometry(
         // Template needs a center: the centroid projected into the polyhedron.
         let w = REGULARIZATION * pts.len() as f64;
         let a = [[w, 0.0, 0.0], [0.0, w, 0.0], [0.0, 0.0, w]];
-        let x = solve_qp(a, scale(c, w), cons).unwrap_or_else(|| clamp_into_cube(c));
+        let x = solve_qp(a, c * w, cons).unwrap_or_else(|| clamp_into_cube(c));
         g.center = Some(onto_surface(x));
         fan(pts.len(), &mut g.plain);
     }
 }
 
-fn clamp_into_cube(p: V3) -> V3 {
+fn clamp_into_cube(p: Vec3) -> Vec3 {
     p.map(|x| x.clamp(0.25, 0.75))
 }
 
 /// Largest angle between two of the normals of `edges`, in degrees.
-fn normal_spread(edges: &[u8], nrm: &[V3; 12]) -> f32 {
+fn normal_spread(edges: &[u8], nrm: &[Vec3; 12]) -> f32 {
     let mut min_cos = 1.0f64;
     for (i, &a) in edges.iter().enumerate() {
         for &b in &edges[i + 1..] {
-            min_cos = min_cos.min(dot(nrm[a as usize], nrm[b as usize]));
+            min_cos = min_cos.min(nrm[a as usize].dot(nrm[b as usize]));
         }
     }
     min_cos.clamp(-1.0, 1.0).acos().to_degrees() as f32
@@ -459,15 +455,15 @@ fn normal_spread(edges: &[u8], nrm: &[V3; 12]) -> f32 {
 
 /// Eq. 4.3 with Tikhonov regularisation toward the centroid `c`.
 fn feature_vertex(
-    pts: &[V3],
+    pts: &[Vec3],
     edges: &[u8],
-    nrm: &[V3; 12],
-    c: V3,
+    nrm: &[Vec3; 12],
+    c: Vec3,
     cons: &[HalfSpace],
-) -> Option<V3> {
+) -> Option<Vec3> {
     let w = REGULARIZATION * pts.len() as f64;
     let mut a = [[w, 0.0, 0.0], [0.0, w, 0.0], [0.0, 0.0, w]];
-    let mut b = scale(c, w);
+    let mut b = c * w;
     for (p, &e) in pts.iter().zip(edges) {
         let n = nrm[e as usize];
         for r in 0..3 {
@@ -475,16 +471,20 @@ fn feature_vertex(
                 a[r][s] += n[r] * n[s];
             }
         }
-        b = add(b, scale(n, dot(n, *p)));
+        b += n * n.dot(*p);
     }
     solve_qp(a, b, cons)
 }
 
 /// Exact check of a cube whose patches could not all be separated.
-fn cube_is_embedded(patches: &[PatchGeom], iso: &[V3; 12]) -> bool {
+fn cube_is_embedded(patches: &[PatchGeom], iso: &[Vec3; 12]) -> bool {
     // Point ids: iso-point of edge e is e, the center of patch k is 12 + k.
-    let mut pos: Vec<V3> = iso.to_vec();
-    pos.extend(patches.iter().map(|g| g.center.unwrap_or([0.5; 3])));
+    let mut pos: Vec<[f64; 3]> = iso.iter().map(|p| p.to_array()).collect();
+    pos.extend(
+        patches
+            .iter()
+            .map(|g| g.center.unwrap_or(Vec3::splat(0.5)).to_array()),
+    );
     let mut tris: Vec<[u32; 3]> = Vec::new();
     for (k, g) in patches.iter().enumerate() {
         let id = |i: u8| -> u32 {
@@ -525,29 +525,29 @@ mod tests {
                         + if r == c { 0.1 } else { 0.0 };
                 }
             }
-            let b: V3 = std::array::from_fn(|_| 4.0 * (rnd() - 0.5));
+            let b = Vec3::from(std::array::from_fn::<f64, 3, _>(|_| 4.0 * (rnd() - 0.5)));
             let mut cons = cube_halfspaces(0.0).to_vec();
-            let n = normalized([rnd() - 0.5, rnd() - 0.5, rnd() - 0.5]).unwrap();
+            let n = normalized(Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)).unwrap();
             cons.push(HalfSpace {
                 n,
-                c: dot(n, [0.5; 3]) + 0.1,
+                c: n.dot(Vec3::splat(0.5)) + 0.1,
             });
             let x = solve_qp(a, b, &cons).expect("feasible");
-            let f = |x: V3| 0.5 * dot(x, mul3(&a, x)) - dot(b, x);
+            let f = |x: Vec3| 0.5 * x.dot(mul3(&a, x)) - b.dot(x);
             // brute force over a grid of feasible points
             let k = 24;
             let mut best = f64::INFINITY;
             for i in 0..=k {
                 for j in 0..=k {
                     for l in 0..=k {
-                        let p = [i, j, l].map(|t| t as f64 / k as f64);
-                        if cons.iter().all(|h| dot(h.n, p) <= h.c + 1e-12) {
+                        let p = Vec3::from([i, j, l].map(|t| t as f64 / k as f64));
+                        if cons.iter().all(|h| h.n.dot(p) <= h.c + 1e-12) {
                             best = best.min(f(p));
                         }
                     }
                 }
             }
-            assert!(cons.iter().all(|h| dot(h.n, x) <= h.c + 1e-9));
+            assert!(cons.iter().all(|h| h.n.dot(x) <= h.c + 1e-9));
             assert!(f(x) <= best + 1e-9, "{} > {}", f(x), best);
         }
     }
@@ -574,19 +574,20 @@ mod tests {
         ];
         let w = 0.0;
         let mut a = [[w, 0.0, 0.0], [0.0, w, 0.0], [0.0, 0.0, w]];
-        let mut b = [0.0; 3];
+        let mut b = Vec3::ZERO;
         for (p, n) in pts.iter().zip(&nrm) {
+            let (p, n) = (Vec3::from(*p), Vec3::from(*n));
             for r in 0..3 {
                 for s in 0..3 {
                     a[r][s] += n[r] * n[s];
                 }
             }
-            b = add(b, scale(*n, dot(*n, *p)));
+            b += n * n.dot(p);
         }
         let x = solve_qp(a, b, &cube_halfspaces(CUBE_MARGIN)).unwrap();
-        assert!(super::super::geom::dist(x, [0.6; 3]) < 1e-12);
+        assert!(x.distance(Vec3::splat(0.6)) < 1e-12);
         // A corner outside the cube is clamped to the shrunk cube.
-        let b2 = add(b, [3.0, 0.0, 0.0]);
+        let b2 = b + Vec3::new(3.0, 0.0, 0.0);
         let y = solve_qp(a, b2, &cube_halfspaces(CUBE_MARGIN)).unwrap();
         assert!((y[0] - (1.0 - CUBE_MARGIN)).abs() < 1e-12);
     }

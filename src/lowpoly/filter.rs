@@ -7,7 +7,7 @@
 
 use rayon::prelude::*;
 
-use super::geom::{dot, normalized, V3};
+use crate::geom::{normalized, Vec3};
 use crate::mesh::HalfEdgeMesh;
 
 /// Marks the vertices lying on real feature curves.
@@ -80,7 +80,7 @@ fn walk_curve(
 /// apart.)
 fn sharp_edges(mesh: &HalfEdgeMesh, theta0_deg: f64) -> Vec<bool> {
     let cos_limit = (180.0 - theta0_deg).to_radians().cos();
-    let normals: Vec<Option<V3>> = (0..mesh.face_capacity() as u32)
+    let normals: Vec<Option<Vec3>> = (0..mesh.face_capacity() as u32)
         .into_par_iter()
         .map(|f| {
             mesh.is_face_live(f)
@@ -96,7 +96,7 @@ fn sharp_edges(mesh: &HalfEdgeMesh, theta0_deg: f64) -> Vec<bool> {
             }
             let h = mesh.edge_halfedge(e);
             let n = |h: u32| mesh.face(h).and_then(|f| normals[f as usize]);
-            matches!((n(h), n(h ^ 1)), (Some(a), Some(b)) if dot(a, b) < cos_limit)
+            matches!((n(h), n(mesh.twin(h))), (Some(a), Some(b)) if a.dot(b) < cos_limit)
         })
         .collect()
 }

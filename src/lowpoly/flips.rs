@@ -23,7 +23,7 @@
 
 use std::collections::HashSet;
 
-use super::geom::{dot, normalized, tri_normal, V3};
+use crate::geom::{normalized, tri_normal, Vec3};
 use crate::mesh::HalfEdgeMesh;
 use crate::spatial::{faces_intersect, is_collinear, TriangleBvh};
 
@@ -65,7 +65,7 @@ impl std::hash::Hasher for CellHasher {
 type CellSet = HashSet<[i64; 3], std::hash::BuildHasherDefault<CellHasher>>;
 
 /// Calls `f` for every cell of size `1/inv` overlapped by the box of `pts`.
-fn for_cells(pts: &[V3], inv: f64, mut f: impl FnMut([i64; 3])) {
+fn for_cells(pts: &[[f64; 3]], inv: f64, mut f: impl FnMut([i64; 3])) {
     let r: [[i64; 2]; 3] = std::array::from_fn(|k| {
         let lo = pts.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
         let hi = pts.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
@@ -89,10 +89,10 @@ fn opposite(m: &HalfEdgeMesh, h: u32) -> Option<u32> {
 /// `(d, c, a)` with cosine below `cos_limit`)?
 fn flip_is_sharp(mesh: &HalfEdgeMesh, h: u32, c: u32, d: u32, cos_limit: f64) -> bool {
     let (a, b) = (mesh.origin(h), mesh.target(h));
-    let p = |v: u32| mesh.position(v);
+    let p = |v: u32| Vec3::from(mesh.position(v));
     let n1 = normalized(tri_normal(p(c), p(d), p(b)));
     let n2 = normalized(tri_normal(p(d), p(c), p(a)));
-    matches!((n1, n2), (Some(x), Some(y)) if dot(x, y) < cos_limit)
+    matches!((n1, n2), (Some(x), Some(y)) if x.dot(y) < cos_limit)
 }
 
 /// A candidate flip: the edge and its opposite vertices when queued.
@@ -108,7 +108,7 @@ fn candidates(mesh: &HalfEdgeMesh, is_feature: &[bool], sharp_only: Option<f64>)
     mesh.edges()
         .filter_map(|e| {
             let h = mesh.edge_halfedge(e);
-            let (c, d) = (opposite(mesh, h)?, opposite(mesh, h ^ 1)?);
+            let (c, d) = (opposite(mesh, h)?, opposite(mesh, mesh.twin(h))?);
             let ok = feature(c)
                 && feature(d)
                 && sharp_only.is_none_or(|cl| flip_is_sharp(mesh, h, c, d, cl));
@@ -168,13 +168,13 @@ pub(crate) fn flip_to_features(
     for q in queue {
         let h = mesh.edge_halfedge(q.edge);
         if mesh.can_flip(h).is_err()
-            || (opposite(mesh, h), opposite(mesh, h ^ 1)) != (Some(q.c), Some(q.d))
+            || (opposite(mesh, h), opposite(mesh, mesh.twin(h))) != (Some(q.c), Some(q.d))
         {
             counts.refused_topology += 1;
             continue;
         }
         let (a, b) = (mesh.origin(h), mesh.target(h));
-        let old = [mesh.face(h), mesh.face(h ^ 1)].map(|f| f.unwrap_or(u32::MAX));
+        let old = [mesh.face(h), mesh.face(mesh.twin(h))].map(|f| f.unwrap_or(u32::MAX));
         let new = [[q.c, q.d, b], [q.d, q.c, a]];
         if !flip_is_embedded(mesh, &bvh, &tris, new, old) {
             counts.refused_geometry += 1;

@@ -13,7 +13,7 @@
 use rayon::prelude::*;
 
 use super::guard::Guard;
-use super::vec3::{add, norm, scale, sub, P3};
+use crate::geom::Vec3;
 use crate::{Error, Result};
 
 /// The safety factor of Alg. 4 line 5.
@@ -35,13 +35,13 @@ pub(crate) struct MoveReport {
 
 /// Alg. 4: tries `v + 0.95 α d` for `α = 1, 1/2, …` and applies the first the guard accepts.
 /// Returns the applied displacement length (0 when none was accepted).
-pub(crate) fn local_update(g: &mut Guard<'_>, v: u32, d: P3) -> f64 {
-    let p = g.mesh().position(v);
+pub(crate) fn local_update(g: &mut Guard<'_>, v: u32, d: Vec3) -> f64 {
+    let p = Vec3::from(g.mesh().position(v));
     let mut alpha = 1.0;
     for _ in 0..=MAX_HALVINGS {
-        let step = scale(d, SAFETY_FACTOR * alpha);
-        if g.try_move(v, add(p, step)).is_ok() {
-            return norm(step);
+        let step = d * (SAFETY_FACTOR * alpha);
+        if g.try_move(v, (p + step).to_array()).is_ok() {
+            return step.length();
         }
         alpha *= 0.5;
     }
@@ -61,17 +61,17 @@ pub(crate) fn flow_sweep(
         .filter(|&v| g.mesh().vertex_halfedge(v).is_some())
         .collect();
     let input = g.input();
-    let positions: Vec<P3> = verts.iter().map(|&v| g.mesh().position(v)).collect();
-    let targets: Vec<P3> = positions.par_iter().map(|&p| input.closest(p).0).collect();
+    let positions: Vec<[f64; 3]> = verts.iter().map(|&v| g.mesh().position(v)).collect();
+    let targets: Vec<[f64; 3]> = positions.par_iter().map(|&p| input.closest(p).0).collect();
     let mut rep = MoveReport::default();
     for (i, &v) in verts.iter().enumerate() {
         if i % 1024 == 0 && !keep_going(i as f64 / verts.len() as f64) {
             return Err(Error::Cancelled);
         }
-        let d = scale(sub(targets[i], positions[i]), r);
+        let d = (Vec3::from(targets[i]) - Vec3::from(positions[i])) * r;
         record(
             &mut rep,
-            if norm(d) > 0.0 {
+            if d.length() > 0.0 {
                 local_update(g, v, d)
             } else {
                 0.0

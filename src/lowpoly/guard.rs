@@ -32,7 +32,7 @@
 
 #[cfg(test)]
 use super::measure;
-use super::vec3::{bbox_of, dot, normalized, tri_normal, P3};
+use crate::geom::{bbox_of, normalized, tri_normal, Vec3};
 use crate::mesh::halfedge::CollapseRecord;
 use crate::mesh::HalfEdgeMesh;
 use crate::spatial::solid_angle;
@@ -47,7 +47,7 @@ pub const CONE_HALF_ANGLE: f64 = std::f64::consts::FRAC_PI_4;
 
 /// The input mesh `M_i` with the acceleration structures the loop queries.
 pub(crate) struct InputModel {
-    pub positions: Vec<P3>,
+    pub positions: Vec<[f64; 3]>,
     pub tris: Vec<[u32; 3]>,
     /// BVH over `tris` (closest points for flow and distances; cage intersection tests).
     pub bvh: TriangleBvh,
@@ -97,7 +97,7 @@ impl InputModel {
     }
 
     /// Closest input point to `p` and its distance.
-    pub fn closest(&self, p: P3) -> (P3, f64) {
+    pub fn closest(&self, p: [f64; 3]) -> ([f64; 3], f64) {
         match self
             .bvh
             .closest_point(&self.positions, &self.tris, p, f64::INFINITY)
@@ -108,13 +108,13 @@ impl InputModel {
     }
 
     /// Distance from `p` to the input.
-    pub fn distance(&self, p: P3) -> f64 {
+    pub fn distance(&self, p: [f64; 3]) -> f64 {
         self.closest(p).1
     }
 
     /// Distance from `p` to the input, given an upper bound `ub` on it (from the triangle
     /// inequality), which lets the BVH prune everything farther.
-    pub fn distance_bounded(&self, p: P3, ub: f64) -> f64 {
+    pub fn distance_bounded(&self, p: [f64; 3], ub: f64) -> f64 {
         let max = ub * (1.0 + 1e-9) + f64::MIN_POSITIVE;
         match self.bvh.closest_point(&self.positions, &self.tris, p, max) {
             Some(c) => c.distance,
@@ -123,7 +123,7 @@ impl InputModel {
     }
 
     /// Input triangle `t`'s corners.
-    pub fn triangle(&self, t: u32) -> [P3; 3] {
+    pub fn triangle(&self, t: u32) -> [[f64; 3]; 3] {
         self.tris[t as usize].map(|v| self.positions[v as usize])
     }
 }
@@ -167,7 +167,7 @@ pub(crate) struct GuardStats {
 struct NFace {
     id: u32,
     v: [u32; 3],
-    t: [P3; 3],
+    t: [[f64; 3]; 3],
 }
 
 /// Reusable buffers of one guard check. Checks of collapses take them explicitly so that
@@ -182,8 +182,8 @@ pub(crate) struct GuardScratch {
     /// Vertices of `M_e` (after the operation).
     verts: Vec<u32>,
     /// Geometry that `M_e` replaced (cage mode only).
-    old_patch: Vec<[P3; 3]>,
-    normals: Vec<P3>,
+    old_patch: Vec<[[f64; 3]; 3]>,
+    normals: Vec<Vec3>,
     cand: Vec<u32>,
 }
 
@@ -259,7 +259,7 @@ impl<'a> Guard<'a> {
     }
 
     /// Moves vertex `v` to `p` if the result passes every check; returns whether it did.
-    pub fn try_move(&mut self, v: u32, p: P3) -> Result<(), Reject> {
+    pub fn try_move(&mut self, v: u32, p: [f64; 3]) -> Result<(), Reject> {
         let old_p = self.mesh.position(v);
         let mut s = std::mem::take(&mut self.scratch);
         s.old_patch.clear();
@@ -296,7 +296,7 @@ impl<'a> Guard<'a> {
     /// uses [`check_collapse`](Self::check_collapse) and
     /// [`commit_collapse`](Self::commit_collapse), which this composes.)
     #[cfg(test)]
-    pub fn try_collapse(&mut self, h: u32, p: P3) -> Result<CollapseRecord, Reject> {
+    pub fn try_collapse(&mut self, h: u32, p: [f64; 3]) -> Result<CollapseRecord, Reject> {
         if self.mesh.can_collapse(h).is_err() {
             self.stats.checks += 1;
             self.stats.rejected_topology += 1;
@@ -319,7 +319,7 @@ impl<'a> Guard<'a> {
     pub fn check_collapse(
         &self,
         h: u32,
-        p: P3,
+        p: [f64; 3],
         s: &mut GuardScratch,
         st: &mut GuardStats,
     ) -> Result<(), Reject> {
@@ -331,7 +331,7 @@ impl<'a> Guard<'a> {
     /// `check_collapse` accepted on the current mesh — or on a mesh
     /// that differs from it only by operations outside the collapse's `M_1` whose new faces
     /// were then tested against its `M_e` (see [`patches_intersect`]).
-    pub fn commit_collapse(&mut self, h: u32, p: P3) -> CollapseRecord {
+    pub fn commit_collapse(&mut self, h: u32, p: [f64; 3]) -> CollapseRecord {
         let rec = self
             .mesh
             .collapse_edge(h, p)
@@ -396,10 +396,10 @@ impl<'a> Guard<'a> {
 
     /// Neighbourhood after collapsing `h = a→b` to `p`, read from the unchanged mesh: faces
     /// keep their ids, `b` becomes `a`, `a` sits at `p`, the faces of the edge disappear.
-    fn fill_collapse(&self, h: u32, p: P3, s: &mut GuardScratch) {
+    fn fill_collapse(&self, h: u32, p: [f64; 3], s: &mut GuardScratch) {
         let m = &self.mesh;
         let (a, b) = (m.origin(h), m.target(h));
-        let dying = [m.face(h), m.face(h ^ 1)];
+        let dying = [m.face(h), m.face(m.twin(h))];
         let map = |v: u32| if v == b { a } else { v };
         let pos = |v: u32| if v == a { p } else { m.position(v) };
         s.m_1.clear();
@@ -491,18 +491,19 @@ impl<'a> Guard<'a> {
     /// their mean direction.
     fn normal_cone_is_narrow(&self, s: &mut GuardScratch) -> bool {
         s.normals.clear();
-        let mut sum = [0.0; 3];
+        let mut sum = Vec3::ZERO;
         for f in &s.m_1 {
-            let Some(n) = normalized(tri_normal(&f.t)) else {
+            let [a, b, c] = f.t.map(Vec3::from);
+            let Some(n) = normalized(tri_normal(a, b, c)) else {
                 return false;
             };
-            sum = super::vec3::add(sum, n);
+            sum += n;
             s.normals.push(n);
         }
         let Some(axis) = normalized(sum) else {
             return false;
         };
-        s.normals.iter().all(|&n| dot(n, axis) > self.cone_cos)
+        s.normals.iter().all(|&n| n.dot(axis) > self.cone_cos)
     }
 
     /// `M_e` does not meet `M_r` (Alg. 7 with exact tests on all BVH candidates): one BVH
@@ -510,18 +511,18 @@ impl<'a> Guard<'a> {
     /// touch the operation's vertices, so their stored geometry is current.
     fn check_against_rest(&self, s: &mut GuardScratch, st: &mut GuardStats) -> Result<(), Reject> {
         let m_e = &s.m_1[..s.n_e];
-        let (lo, hi) = bbox_of(m_e.iter().flat_map(|f| f.t));
+        let (lo, hi) = bbox(m_e.iter().flat_map(|f| f.t));
         s.cand.clear();
         s.cand.extend(
             self.bvh
-                .query_box(lo, hi)
+                .query_box(lo.to_array(), hi.to_array())
                 .filter(|&g| s.excluded.binary_search(&g).is_err() && self.mesh.is_face_live(g)),
         );
         for &g in &s.cand {
             let gt = self.tris[g as usize].map(|v| self.mesh.position(v));
-            let gbox = bbox_of(gt);
+            let gbox = bbox(gt);
             for f in m_e {
-                if !boxes_overlap(bbox_of(f.t), gbox) {
+                if !boxes_overlap(bbox(f.t), gbox) {
                     continue;
                 }
                 st.exact_tests += 1;
@@ -554,13 +555,13 @@ impl<'a> Guard<'a> {
         };
         let new_patch = &s.m_1[..s.n_e];
         let old_patch = &s.old_patch;
-        let (lo, hi) = bbox_of(
+        let (lo, hi) = bbox(
             new_patch
                 .iter()
                 .flat_map(|f| f.t)
                 .chain(old_patch.iter().flatten().copied()),
         );
-        for i in pbvh.query_box(lo, hi) {
+        for i in pbvh.query_box(lo.to_array(), hi.to_array()) {
             let q = self.input.positions[pts[i as usize][0] as usize];
             let new_w: f64 = new_patch.iter().map(|f| solid_angle(f.t, q)).sum();
             let old_w: f64 = old_patch.iter().map(|t| solid_angle(*t, q)).sum();
@@ -578,13 +579,13 @@ impl<'a> Guard<'a> {
 fn check_within_m1(s: &GuardScratch, cone_ok: bool, st: &mut GuardStats) -> Result<(), Reject> {
     for i in 0..s.n_e {
         let f = &s.m_1[i];
-        let fbox = bbox_of(f.t);
+        let fbox = bbox(f.t);
         for g in &s.m_1[i + 1..] {
             let shares = g.v.iter().any(|v| f.v.contains(v));
             if shares && cone_ok {
                 continue;
             }
-            if !boxes_overlap(fbox, bbox_of(g.t)) {
+            if !boxes_overlap(fbox, bbox(g.t)) {
                 continue;
             }
             st.exact_tests += 1;
@@ -601,16 +602,20 @@ fn check_within_m1(s: &GuardScratch, cone_ok: bool, st: &mut GuardStats) -> Resu
 /// triangle–triangle tests (touching counts) decide; each patch was checked against everything
 /// else, so this is the only pair the batch's checks did not see (§4.3.3: `M_e` against the
 /// rest, with part of the rest changed by the other collapse).
-pub(crate) fn patches_intersect(a: &[[P3; 3]], b: &[[P3; 3]], st: &mut GuardStats) -> bool {
-    let (alo, ahi) = bbox_of(a.iter().flatten().copied());
-    let (blo, bhi) = bbox_of(b.iter().flatten().copied());
+pub(crate) fn patches_intersect(
+    a: &[[[f64; 3]; 3]],
+    b: &[[[f64; 3]; 3]],
+    st: &mut GuardStats,
+) -> bool {
+    let (alo, ahi) = bbox(a.iter().flatten().copied());
+    let (blo, bhi) = bbox(b.iter().flatten().copied());
     if !boxes_overlap((alo, ahi), (blo, bhi)) {
         return false;
     }
     a.iter().any(|ta| {
-        let abox = bbox_of(*ta);
+        let abox = bbox(*ta);
         b.iter().any(|tb| {
-            if !boxes_overlap(abox, bbox_of(*tb)) {
+            if !boxes_overlap(abox, bbox(*tb)) {
                 return false;
             }
             st.exact_tests += 1;
@@ -619,14 +624,23 @@ pub(crate) fn patches_intersect(a: &[[P3; 3]], b: &[[P3; 3]], st: &mut GuardStat
     })
 }
 
+/// Axis-aligned box `(min, max)` of stored positions (`geom::bbox_of`).
+pub(crate) fn bbox(points: impl IntoIterator<Item = [f64; 3]>) -> (Vec3, Vec3) {
+    bbox_of(points.into_iter().map(Vec3::from))
+}
+
 /// Closed box overlap test.
-pub(crate) fn boxes_overlap(a: (P3, P3), b: (P3, P3)) -> bool {
+pub(crate) fn boxes_overlap(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> bool {
     (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
 }
 
 /// Exact: does the closed mesh triangle `tri` meet input triangle `t` (which may be
 /// degenerate: then its edges — or its single point — are tested)?
-pub(crate) fn touches_input_triangle(tri: &[P3; 3], t: &[P3; 3], degenerate: bool) -> bool {
+pub(crate) fn touches_input_triangle(
+    tri: &[[f64; 3]; 3],
+    t: &[[f64; 3]; 3],
+    degenerate: bool,
+) -> bool {
     if !degenerate {
         return sp::triangles_intersect(tri, t);
     }

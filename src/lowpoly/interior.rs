@@ -19,14 +19,11 @@
 //! outer sheet's, not also the inner sheet's — and its leaves hold up to 32 triangles, which
 //! makes the tree about 4× smaller than the default.
 
-use parry3d_f64::bounding_volume::Aabb;
-use parry3d_f64::math::Vector;
-use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use rayon::prelude::*;
 
-use super::geom::V3;
+use crate::geom::Vec3;
 use crate::mesh::TriMesh;
-use crate::spatial::FastWindingNumber;
+use crate::spatial::{BoxTree, FastWindingNumber};
 
 #[cfg(test)]
 /// Connected components of a triangle mesh through shared vertices: `comp[t]` per triangle and
@@ -68,28 +65,28 @@ pub(crate) fn components(n_vertices: usize, tris: &[[u32; 3]]) -> (Vec<u32>, usi
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct ComponentBox {
     /// Bounding box.
-    pub lo: V3,
+    pub lo: Vec3,
     /// Bounding box.
-    pub hi: V3,
+    pub hi: Vec3,
     /// A point on the component.
-    pub sample: V3,
+    pub sample: Vec3,
 }
 
 impl ComponentBox {
     /// An empty box with sample point `sample`.
-    pub(crate) fn empty(sample: V3) -> ComponentBox {
+    pub(crate) fn empty(sample: Vec3) -> ComponentBox {
         ComponentBox {
-            lo: [f64::INFINITY; 3],
-            hi: [f64::NEG_INFINITY; 3],
+            lo: Vec3::INFINITY,
+            hi: Vec3::NEG_INFINITY,
             sample,
         }
     }
 
     /// Extends the box to contain `x`.
-    pub(crate) fn grow(&mut self, x: V3) {
-        for ((lo, hi), v) in self.lo.iter_mut().zip(self.hi.iter_mut()).zip(x) {
-            *lo = lo.min(v);
-            *hi = hi.max(v);
+    pub(crate) fn grow(&mut self, x: Vec3) {
+        for k in 0..3 {
+            self.lo[k] = self.lo[k].min(x[k]);
+            self.hi[k] = self.hi[k].max(x[k]);
         }
     }
 }
@@ -98,7 +95,7 @@ impl ComponentBox {
 /// component `c`; `triangles(c)` yields its closed triangle set (asked only for components
 /// that contain another's box, the only possible containers).
 pub(crate) fn visible_components(
-    pos: &[V3],
+    pos: &[Vec3],
     boxes: &[ComponentBox],
     triangles: &(dyn Fn(usize) -> Vec<[u32; 3]> + Sync),
 ) -> Vec<bool> {
@@ -106,14 +103,10 @@ pub(crate) fn visible_components(
     if n <= 1 {
         return vec![true; n];
     }
-    let aabbs: Vec<Aabb> = boxes
-        .iter()
-        .map(|b| Aabb::new(Vector::from(b.lo), Vector::from(b.hi)))
-        .collect();
-    let tree = Bvh::from_leaves(BvhBuildStrategy::Binned, &aabbs);
+    let tree = BoxTree::new(boxes.iter().map(|b| (b.lo, b.hi)));
     let mut inside_of: Vec<Vec<u32>> = vec![Vec::new(); n];
-    for (a, ab) in aabbs.iter().enumerate() {
-        for b in tree.intersect_aabb(ab) {
+    for (a, ab) in boxes.iter().enumerate() {
+        for b in tree.overlapping(ab.lo, ab.hi) {
             if b as usize != a && contains(&boxes[b as usize], &boxes[a]) {
                 inside_of[b as usize].push(a as u32);
             }
@@ -160,7 +153,7 @@ fn containers_largest_first(boxes: &[ComponentBox], inside_of: &[Vec<u32>]) -> V
 /// The `candidates` whose sample point is inside the closed surface `tris` (winding number
 /// of the hierarchy of Barill et al. 2018). One container's hierarchy is alive at a time.
 fn hidden_inside(
-    pos: &[V3],
+    pos: &[Vec3],
     tris: Vec<[u32; 3]>,
     boxes: &[ComponentBox],
     candidates: &[u32],
@@ -173,17 +166,21 @@ fn hidden_inside(
     candidates
         .par_iter()
         .copied()
-        .filter(|&a| fwn.winding_number(boxes[a as usize].sample).abs() > 0.5)
+        .filter(|&a| {
+            fwn.winding_number(boxes[a as usize].sample.to_array())
+                .abs()
+                > 0.5
+        })
         .collect()
 }
 
 /// The triangles `tris` (indexing `pos`) as a compact mesh, renumbered in place.
-fn component_mesh(pos: &[V3], mut tris: Vec<[u32; 3]>) -> Option<TriMesh> {
+fn component_mesh(pos: &[Vec3], mut tris: Vec<[u32; 3]>) -> Option<TriMesh> {
     let mut map = std::collections::HashMap::new();
     let mut p = Vec::new();
     for v in tris.iter_mut().flatten() {
         *v = *map.entry(*v).or_insert_with(|| {
-            p.push(pos[*v as usize]);
+            p.push(pos[*v as usize].to_array());
             (p.len() - 1) as u32
         });
     }
@@ -199,14 +196,14 @@ fn contains(outer: &ComponentBox, inner: &ComponentBox) -> bool {
 mod tests {
     use super::*;
 
-    fn cube(c: V3, r: f64, flip: bool) -> (Vec<V3>, Vec<[u32; 3]>) {
-        let p: Vec<V3> = (0..8)
+    fn cube(c: Vec3, r: f64, flip: bool) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let p: Vec<Vec3> = (0..8)
             .map(|i| {
-                [
+                Vec3::new(
                     c[0] + if i & 1 == 1 { r } else { -r },
                     c[1] + if i & 2 == 2 { r } else { -r },
                     c[2] + if i & 4 == 4 { r } else { -r },
-                ]
+                )
             })
             .collect();
         let mut t = vec![
@@ -233,8 +230,11 @@ mod tests {
 
     #[test]
     fn nested_components_are_removed() {
-        let (mut pos, mut tris) = cube([0.0; 3], 1.0, false);
-        for (c, r, flip) in [([0.0; 3], 0.5, true), ([3.0, 0.0, 0.0], 0.5, false)] {
+        let (mut pos, mut tris) = cube(Vec3::ZERO, 1.0, false);
+        for (c, r, flip) in [
+            (Vec3::ZERO, 0.5, true),
+            (Vec3::new(3.0, 0.0, 0.0), 0.5, false),
+        ] {
             let (p, t) = cube(c, r, flip);
             let base = pos.len() as u32;
             pos.extend(p);

@@ -13,7 +13,11 @@
 
 use rayon::prelude::*;
 
-use super::vec3::{for_each_sample, sample_resolution, P3};
+use crate::geom::Vec3;
+use crate::spatial::closest::{for_each_sample, sample_resolution};
+
+/// A stored point.
+type P3 = [f64; 3];
 use crate::mesh::TriMesh;
 use crate::mesh::{MeshReport, ReportOptions};
 use crate::spatial::{FastWindingNumber, TriangleBvh};
@@ -78,9 +82,10 @@ pub(crate) fn one_sided(
                 // the CGAL `compare` tool) never lands on it; its corners are sampled above.
                 return 0.0;
             }
+            let tri = tri.map(Vec3::from);
             let k = sample_resolution(&tri, spacing, max_k);
             let mut m: f64 = 0.0;
-            for_each_sample(&tri, k, true, |p| m = m.max(to.distance(p)));
+            for_each_sample(&tri, k, true, |p| m = m.max(to.distance(p.to_array())));
             m
         })
         .reduce(|| 0.0, f64::max);
@@ -102,10 +107,11 @@ pub(crate) fn one_sided_exceeds(
         if tri.iter().any(|&p| to.distance(p) > threshold) {
             return true;
         }
+        let tri = tri.map(Vec3::from);
         let k = sample_resolution(&tri, spacing, max_k);
         let mut over = false;
         for_each_sample(&tri, k, true, |p| {
-            over = over || to.distance(p) > threshold;
+            over = over || to.distance(p.to_array()) > threshold;
         });
         over
     })

@@ -18,7 +18,6 @@ pub(crate) mod features;
 mod filter;
 mod flips;
 mod flow;
-mod geom;
 pub(crate) mod guard;
 mod interior;
 pub(crate) mod mc33;
@@ -26,7 +25,6 @@ pub(crate) mod measure;
 mod offset;
 mod pipeline;
 mod simplify;
-mod vec3;
 
 pub use guard::CONE_HALF_ANGLE;
 pub use measure::{

@@ -21,7 +21,6 @@ use super::distance::{
 use super::extract::{deviation, extract, ExtractParams, Mode, PatchSet};
 use super::filter::vertices_on_real_curves;
 use super::flips::{flip_to_features, FlipCounts};
-use super::geom::V3;
 use super::interior::{visible_components, ComponentBox};
 use crate::mesh::{HalfEdgeMesh, MeshReport, ReportOptions, TriMesh};
 use crate::report::{Progress, ProgressFn, Stats};
@@ -249,7 +248,12 @@ fn distance_field(
     progress: &mut ProgressFn<'_>,
 ) -> Result<DistanceGrid> {
     let (lo, hi) = mesh.bbox();
-    let spec = GridSpec::covering(lo, hi, band_radius(band) + 2.0 * band.h, band.h)?;
+    let spec = GridSpec::covering(
+        lo.into(),
+        hi.into(),
+        band_radius(band) + 2.0 * band.h,
+        band.h,
+    )?;
     step(progress, "band", 0.02)?;
     let keys = stats.time("band", || band_bricks(input, &spec, band))?;
     let t = Instant::now();
@@ -278,6 +282,9 @@ fn distance_field(
 /// (fandisk), 209 vs 181 (homer), 980 vs 975 (truck); output sizes within 0.1%.
 const CREASE_CANDIDATE_DEG: f32 = 30.0;
 
+/// Mesh buffers (positions, triangles), as [`TriMesh::into_parts`] returns them.
+type MeshParts = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
 /// Phase 1: every feature vertex, flips (Algorithm 2), feature filtering; phase 2: real
 /// feature vertices only, flips again (§4.3.1). Without features: the MC33 templates.
 fn surface_with_features(
@@ -286,7 +293,7 @@ fn surface_with_features(
     params: &OffsetParams,
     h: f64,
     stats: &mut Stats,
-) -> Result<(Vec<V3>, Vec<[u32; 3]>)> {
+) -> Result<MeshParts> {
     let mode = |p: usize, feature: bool| match (visible[p], feature) {
         (false, _) => Mode::Skip,
         (true, false) => Mode::Template,
@@ -338,7 +345,7 @@ fn surface_with_features(
 
 /// Builds the half-edge mesh and runs Algorithm 2 with the patch set's feature vertices.
 fn flipped(
-    pos: Vec<V3>,
+    pos: Vec<[f64; 3]>,
     tris: Vec<[u32; 3]>,
     back: &[u32],
     set: &PatchSet,
@@ -403,7 +410,7 @@ fn visible_patches(set: &PatchSet, stats: &mut Stats) -> Vec<bool> {
         stats.count("components_removed", 0);
         return vec![true; set.len()];
     }
-    let mut boxes = vec![ComponentBox::empty([0.0; 3]); n];
+    let mut boxes = vec![ComponentBox::empty(crate::geom::Vec3::ZERO); n];
     let mut patches_of: Vec<Vec<u32>> = vec![Vec::new(); n];
     for (p, &c) in pcomp.iter().enumerate() {
         let b = &mut boxes[c as usize];
@@ -447,7 +454,7 @@ fn verify(out: &TriMesh, input: &InputDistance, r: Resolved, stats: &mut Stats) 
     let max_dev = out
         .positions()
         .par_iter()
-        .map(|&x| deviation(input, x, r.d, cap))
+        .map(|&x| deviation(input, x.into(), r.d, cap))
         .reduce(|| 0.0, f64::max);
     stats.metric("max_deviation_over_d", max_dev / r.d);
     stats.verify("vertices_within_h_of_offset", max_dev <= r.h);

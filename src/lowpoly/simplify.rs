@@ -40,12 +40,10 @@
 
 use rayon::prelude::*;
 
-use super::guard::{boxes_overlap, patches_intersect, Guard, GuardScratch, GuardStats};
-use super::vec3::{
-    add, bbox_of, cross, dist, dot, for_each_sample, norm, normalized, point_triangle_distance,
-    sample_resolution, scale, sub, tri_normal, P3,
-};
+use super::guard::{bbox, boxes_overlap, patches_intersect, Guard, GuardScratch, GuardStats};
+use crate::geom::{normalized, tri_normal, Vec3};
 use crate::mesh::halfedge::INVALID;
+use crate::spatial::closest::{for_each_sample, point_triangle_distance, sample_resolution};
 use crate::{Error, Result};
 
 /// Weight of an edge's virtual plane relative to `|e|²` (face planes weigh their area).
@@ -93,14 +91,14 @@ pub(crate) struct SimplifyReport {
 pub(crate) struct Quadric {
     /// Upper triangle of `A`: `a00 a01 a02 a11 a12 a22`.
     a: [f64; 6],
-    b: [f64; 3],
+    b: Vec3,
     c: f64,
 }
 
 impl Quadric {
     /// `w · (n · (x − p))²` for a unit normal `n`.
-    pub fn plane(n: P3, p: P3, w: f64) -> Quadric {
-        let d = -dot(n, p);
+    pub fn plane(n: Vec3, p: Vec3, w: f64) -> Quadric {
+        let d = -n.dot(p);
         Quadric {
             a: [
                 w * n[0] * n[0],
@@ -110,7 +108,7 @@ impl Quadric {
                 w * n[1] * n[2],
                 w * n[2] * n[2],
             ],
-            b: scale(n, w * d),
+            b: n * (w * d),
             c: w * d * d,
         }
     }
@@ -123,24 +121,24 @@ impl Quadric {
         }
         Quadric {
             a,
-            b: add(self.b, o.b),
+            b: self.b + o.b,
             c: self.c + o.c,
         }
     }
 
     /// `Q(x)`.
-    pub fn eval(&self, x: P3) -> f64 {
+    pub fn eval(&self, x: Vec3) -> f64 {
         let [a00, a01, a02, a11, a12, a22] = self.a;
-        let ax = [
+        let ax = Vec3::new(
             a00 * x[0] + a01 * x[1] + a02 * x[2],
             a01 * x[0] + a11 * x[1] + a12 * x[2],
             a02 * x[0] + a12 * x[1] + a22 * x[2],
-        ];
-        dot(x, ax) + 2.0 * dot(self.b, x) + self.c
+        );
+        x.dot(ax) + 2.0 * self.b.dot(x) + self.c
     }
 
     /// The minimiser `−A⁻¹b`, or `None` when `A` is (nearly) singular.
-    pub fn minimize(&self) -> Option<P3> {
+    pub fn minimize(&self) -> Option<Vec3> {
         let [a00, a01, a02, a11, a12, a22] = self.a;
         let c00 = a11 * a22 - a12 * a12;
         let c01 = a02 * a12 - a01 * a22;
@@ -154,12 +152,12 @@ impl Quadric {
         let c12 = a01 * a02 - a00 * a12;
         let c22 = a00 * a11 - a01 * a01;
         let b = self.b;
-        let x = [
+        let x = Vec3::new(
             -(c00 * b[0] + c01 * b[1] + c02 * b[2]) / det,
             -(c01 * b[0] + c11 * b[1] + c12 * b[2]) / det,
             -(c02 * b[0] + c12 * b[1] + c22 * b[2]) / det,
-        ];
-        x.iter().all(|c| c.is_finite()).then_some(x)
+        );
+        x.is_finite().then_some(x)
     }
 }
 
@@ -169,10 +167,10 @@ fn vertex_quadrics(g: &Guard<'_>) -> Vec<Quadric> {
     let m = g.mesh();
     let mut q = vec![Quadric::default(); m.vertex_capacity()];
     for f in m.faces() {
-        let t = m.face_positions(f);
-        let nv = tri_normal(&t);
+        let t = m.face_positions(f).map(Vec3::from);
+        let nv = tri_normal(t[0], t[1], t[2]);
         let Some(n) = normalized(nv) else { continue };
-        let fq = Quadric::plane(n, t[0], 0.5 * norm(nv));
+        let fq = Quadric::plane(n, t[0], 0.5 * nv.length());
         for v in m.face_vertices(f) {
             q[v as usize] = q[v as usize].add(&fq);
         }
@@ -180,15 +178,15 @@ fn vertex_quadrics(g: &Guard<'_>) -> Vec<Quadric> {
     for e in m.edges() {
         let h = m.edge_halfedge(e);
         let (a, b) = (m.origin(h), m.target(h));
-        let (pa, pb) = (m.position(a), m.position(b));
-        let nsum = [m.face(h), m.face(h ^ 1)]
+        let (pa, pb) = (Vec3::from(m.position(a)), Vec3::from(m.position(b)));
+        let nsum = [m.face(h), m.face(m.twin(h))]
             .into_iter()
             .flatten()
-            .fold([0.0; 3], |s, f| add(s, m.face_normal(f)));
-        let Some(pn) = normalized(cross(nsum, sub(pb, pa))) else {
+            .fold(Vec3::ZERO, |s, f| s + m.face_normal(f));
+        let Some(pn) = normalized(nsum.cross(pb - pa)) else {
             continue;
         };
-        let l2 = super::vec3::norm2(sub(pb, pa));
+        let l2 = (pb - pa).length_squared();
         let vq = Quadric::plane(pn, pa, VIRTUAL_PLANE_WEIGHT * l2);
         q[a as usize] = q[a as usize].add(&vq);
         q[b as usize] = q[b as usize].add(&vq);
@@ -197,12 +195,12 @@ fn vertex_quadrics(g: &Guard<'_>) -> Vec<Quadric> {
 }
 
 /// Optimal position and cost of collapsing edge `a–b` with combined quadric `q`.
-fn collapse_target(q: &Quadric, pa: P3, pb: P3) -> (P3, f64) {
-    let mid = scale(add(pa, pb), 0.5);
-    let len = dist(pa, pb);
+fn collapse_target(q: &Quadric, pa: Vec3, pb: Vec3) -> (Vec3, f64) {
+    let mid = (pa + pb) * 0.5;
+    let len = pa.distance(pb);
     let x = q
         .minimize()
-        .filter(|x| dist(*x, mid) <= 2.0 * len)
+        .filter(|x| x.distance(mid) <= 2.0 * len)
         .unwrap_or_else(|| {
             [pa, pb, mid]
                 .into_iter()
@@ -338,7 +336,7 @@ impl Queue {
 }
 
 /// An axis-aligned box `(min, max)`.
-type Aabb = (P3, P3);
+type Aabb = (Vec3, Vec3);
 
 /// Largest number of candidate collapses evaluated together (see [`Pass::run`]).
 const BATCH: usize = 64;
@@ -352,7 +350,7 @@ struct Pass<'g, 'a> {
     g: &'g mut Guard<'a>,
     opt: SimplifyOptions,
     quadrics: Vec<Quadric>,
-    targets: Vec<P3>,
+    targets: Vec<Vec3>,
     heap: Queue,
     /// Sampled distance to the input per face (NaN mean = not computed yet).
     face_dist: Vec<FaceDist>,
@@ -375,7 +373,7 @@ struct Accepted {
     h: u32,
     a: u32,
     b: u32,
-    x: P3,
+    x: Vec3,
     new: Patch,
     new_face_dist: Vec<FaceDist>,
 }
@@ -422,7 +420,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         let quadrics = vertex_quadrics(g);
         let m = g.mesh();
         let mut pass = Pass {
-            targets: vec![[0.0; 3]; m.edge_capacity()],
+            targets: vec![Vec3::ZERO; m.edge_capacity()],
             face_dist: vec![FaceDist::UNKNOWN; m.face_capacity()],
             vert_dist: vec![f64::NAN; m.vertex_capacity()],
             mark_w: vec![0; m.vertex_capacity()],
@@ -454,7 +452,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         let h = m.edge_halfedge(e);
         let (a, b) = (m.origin(h), m.target(h));
         let q = self.quadrics[a as usize].add(&self.quadrics[b as usize]);
-        let (target, cost) = collapse_target(&q, m.position(a), m.position(b));
+        let (target, cost) = collapse_target(&q, m.position(a).into(), m.position(b).into());
         self.targets[e as usize] = target;
         self.heap.push(Entry { cost, edge: e });
     }
@@ -476,7 +474,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         let mut pops = 0u64;
         let mut batch: Vec<u32> = Vec::with_capacity(BATCH);
         let mut deferred: Vec<Entry> = Vec::with_capacity(BATCH);
-        let mut applied: Vec<(Vec<[P3; 3]>, Aabb)> = Vec::with_capacity(BATCH);
+        let mut applied: Vec<(Vec<[[f64; 3]; 3]>, Aabb)> = Vec::with_capacity(BATCH);
         'pass: while !self.target_reached() {
             let cap = if self.g.mesh().face_count() >= BATCH_MIN_FACES {
                 BATCH
@@ -529,7 +527,7 @@ impl<'g, 'a> Pass<'g, 'a> {
                 let meets = match &ev.outcome {
                     Ok(acc) if !applied.is_empty() => {
                         let st = &mut self.g.stats;
-                        let abox = bbox_of(acc.new.tris.iter().flatten().copied());
+                        let abox = bbox(acc.new.tris.iter().flatten().copied());
                         applied.iter().any(|(p, pbox)| {
                             boxes_overlap(abox, *pbox) && patches_intersect(&acc.new.tris, p, st)
                         })
@@ -544,7 +542,7 @@ impl<'g, 'a> Pass<'g, 'a> {
                     self.scratch = s;
                 }
                 if let Ok(acc) = &ev.outcome {
-                    let abox = bbox_of(acc.new.tris.iter().flatten().copied());
+                    let abox = bbox(acc.new.tris.iter().flatten().copied());
                     applied.push((acc.new.tris.clone(), abox));
                 }
                 self.apply(ev);
@@ -614,17 +612,17 @@ impl<'g, 'a> Pass<'g, 'a> {
         };
         let m = self.g.mesh();
         let h0 = m.edge_halfedge(e);
-        let Some(h) = [h0, h0 ^ 1]
+        let Some(h) = [h0, m.twin(h0)]
             .into_iter()
             .find(|&h| m.can_collapse(h).is_ok())
         else {
             return ev;
         };
         let (a, b) = (m.origin(h), m.target(h));
-        let (pa, pb) = (m.position(a), m.position(b));
+        let (pa, pb) = (Vec3::from(m.position(a)), Vec3::from(m.position(b)));
         let mut candidates = [self.targets[e as usize]; 4];
         let mut n = 1;
-        for c in [scale(add(pa, pb), 0.5), pa, pb] {
+        for c in [(pa + pb) * 0.5, pa, pb] {
             if !candidates[..n].contains(&c) {
                 candidates[n] = c;
                 n += 1;
@@ -655,7 +653,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         h: u32,
         a: u32,
         b: u32,
-        x: P3,
+        x: Vec3,
         ev: &mut Eval,
         s: &mut GuardScratch,
     ) -> std::result::Result<Accepted, Rejection> {
@@ -670,7 +668,7 @@ impl<'g, 'a> Pass<'g, 'a> {
             return Err(Rejection::Distance);
         };
         self.g
-            .check_collapse(h, x, s, &mut ev.guard)
+            .check_collapse(h, x.to_array(), s, &mut ev.guard)
             .map_err(|_| Rejection::Guard)?;
         Ok(Accepted {
             h,
@@ -698,7 +696,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         self.g.stats.add(&ev.guard);
         match ev.outcome {
             Ok(acc) => {
-                let rec = self.g.commit_collapse(acc.h, acc.x);
+                let rec = self.g.commit_collapse(acc.h, acc.x.to_array());
                 self.commit(
                     acc.a,
                     acc.b,
@@ -716,10 +714,10 @@ impl<'g, 'a> Pass<'g, 'a> {
 
     /// The patch before (faces around `a` and `b`) and after the collapse of `h = a→b` to `x`
     /// (the surviving faces with `a`, `b` replaced by `x`), each with its face ids.
-    fn patches(&self, h: u32, x: P3) -> (Patch, Patch) {
+    fn patches(&self, h: u32, x: Vec3) -> (Patch, Patch) {
         let m = self.g.mesh();
         let (a, b) = (m.origin(h), m.target(h));
-        let dying = [m.face(h), m.face(h ^ 1)];
+        let dying = [m.face(h), m.face(m.twin(h))];
         let mut old = Patch::default();
         let mut new = Patch::default();
         // The link condition (checked before) makes the edge's faces the only ones with both
@@ -735,7 +733,7 @@ impl<'g, 'a> Pass<'g, 'a> {
                 continue;
             }
             let nvs = vs.map(|v| if v == b { a } else { v });
-            let nt = nvs.map(|v| if v == a { x } else { m.position(v) });
+            let nt = nvs.map(|v| if v == a { x.to_array() } else { m.position(v) });
             new.push(f, nvs, nt);
         }
         (old, new)
@@ -750,37 +748,41 @@ impl<'g, 'a> Pass<'g, 'a> {
     /// face lies within `(α + β) max(|x − a|, |x − b|)` of `(α + β)x + γc` on the new edge
     /// `x–c`.) Only when that bound exceeds `d` are both patches sampled (skipping the shared
     /// ring vertices, at distance 0 on both sides).
-    fn within_hausdorff(&self, a: u32, b: u32, x: P3, old: &Patch, new: &Patch) -> bool {
+    fn within_hausdorff(&self, a: u32, b: u32, x: Vec3, old: &Patch, new: &Patch) -> bool {
         let d = self.opt.d;
         let s = self.opt.spacing;
         let m = self.g.mesh();
-        if dist(x, m.position(a)).max(dist(x, m.position(b))) <= d {
+        if x.distance(m.position(a).into())
+            .max(x.distance(m.position(b).into()))
+            <= d
+        {
             return true;
         }
         // Consecutive samples are close to each other, so the triangle that was near the last
         // one is tried first.
         let hint = std::cell::Cell::new(0usize);
-        let near = |p: P3, other: &Patch| -> bool {
+        let near = |p: Vec3, other: &Patch| -> bool {
             let n = other.tris.len();
             let start = hint.get().min(n.saturating_sub(1));
             let found = (0..n)
                 .map(|i| (start + i) % n)
-                .find(|&i| point_triangle_distance(p, &other.tris[i]) <= d);
+                .find(|&i| point_triangle_distance(p, &other.tris[i].map(Vec3::from)) <= d);
             if let Some(i) = found {
                 hint.set(i);
             }
             found.is_some()
         };
-        let one_side = |from: &Patch, to: &Patch, moved: &[(u32, P3)]| -> bool {
+        let one_side = |from: &Patch, to: &Patch, moved: &[(u32, Vec3)]| -> bool {
             for &(_, p) in moved {
                 if !near(p, to) {
                     return false;
                 }
             }
             for t in &from.tris {
-                let k = sample_resolution(t, s, MAX_SAMPLE_RES);
+                let t = t.map(Vec3::from);
+                let k = sample_resolution(&t, s, MAX_SAMPLE_RES);
                 let mut ok = true;
-                for_each_sample(t, k, true, |p| ok = ok && near(p, to));
+                for_each_sample(&t, k, true, |p| ok = ok && near(p, to));
                 if !ok {
                     return false;
                 }
@@ -788,7 +790,11 @@ impl<'g, 'a> Pass<'g, 'a> {
             true
         };
         one_side(new, old, &[(a, x)])
-            && one_side(old, new, &[(a, m.position(a)), (b, m.position(b))])
+            && one_side(
+                old,
+                new,
+                &[(a, m.position(a).into()), (b, m.position(b).into())],
+            )
     }
 
     /// Distance of vertex `v` to the input, from the cache or computed (and noted in `ev`).
@@ -806,7 +812,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         let p = m.position(v);
         let ub = m
             .vertex_neighbors(v)
-            .map(|u| self.vert_dist[u as usize] + dist(p, m.position(u)))
+            .map(|u| self.vert_dist[u as usize] + Vec3::from(p).distance(Vec3::from(m.position(u))))
             .filter(|b| !b.is_nan())
             .fold(f64::INFINITY, f64::min);
         let d = if ub.is_finite() {
@@ -822,7 +828,8 @@ impl<'g, 'a> Pass<'g, 'a> {
     /// longer than the sample spacing, at its centroid. Smaller triangles use their corners
     /// only: the distance field is 1-Lipschitz and, at the offset distance, smooth at that
     /// scale, so an interior sample adds little there.
-    fn triangle_distance(&self, t: &[P3; 3], corner: [f64; 3]) -> FaceDist {
+    fn triangle_distance(&self, t: &[[f64; 3]; 3], corner: [f64; 3]) -> FaceDist {
+        let t = &t.map(Vec3::from);
         let sum = corner[0] + corner[1] + corner[2];
         let cmax = corner[0].max(corner[1]).max(corner[2]);
         if sample_resolution(t, self.opt.spacing, 2) == 1 {
@@ -831,11 +838,11 @@ impl<'g, 'a> Pass<'g, 'a> {
                 max: cmax,
             };
         }
-        let c = scale(add(add(t[0], t[1]), t[2]), 1.0 / 3.0);
+        let c = (t[0] + t[1] + t[2]) * (1.0 / 3.0);
         let ub = (0..3)
-            .map(|i| corner[i] + dist(c, t[i]))
+            .map(|i| corner[i] + c.distance(t[i]))
             .fold(f64::INFINITY, f64::min);
-        let dc = self.g.input().distance_bounded(c, ub);
+        let dc = self.g.input().distance_bounded(c.to_array(), ub);
         FaceDist {
             mean: (sum + dc) / 4.0,
             max: cmax.max(dc),
@@ -844,7 +851,7 @@ impl<'g, 'a> Pass<'g, 'a> {
 
     /// Distance of face `f` (vertices `vs`, corners `t`) to the input, from the cache or
     /// computed (and noted in `ev`).
-    fn face_distance(&self, f: u32, vs: [u32; 3], t: &[P3; 3], ev: &mut Eval) -> FaceDist {
+    fn face_distance(&self, f: u32, vs: [u32; 3], t: &[[f64; 3]; 3], ev: &mut Eval) -> FaceDist {
         let d = self.face_dist[f as usize];
         if !d.mean.is_nan() {
             return d;
@@ -867,14 +874,14 @@ impl<'g, 'a> Pass<'g, 'a> {
         &self,
         a: u32,
         b: u32,
-        x: P3,
+        x: Vec3,
         old: &Patch,
         new: &Patch,
         ev: &mut Eval,
     ) -> Option<Vec<FaceDist>> {
         let (mut old_sum, mut old_area, mut old_max) = (0.0, 0.0, 0.0f64);
         for i in 0..old.ids.len() {
-            let w = norm(tri_normal(&old.tris[i]));
+            let w = area_vector(&old.tris[i]).length();
             let fd = self.face_distance(old.ids[i], old.verts[i], &old.tris[i], ev);
             old_sum += w * fd.mean;
             old_area += w;
@@ -888,10 +895,10 @@ impl<'g, 'a> Pass<'g, 'a> {
         };
         let limit = old_mean.max(self.opt.slack) * (1.0 + 1e-9);
         let m = self.g.mesh();
-        let (pa, pb) = (m.position(a), m.position(b));
-        let ub = (self.vertex_distance(a, ev) + dist(x, pa))
-            .min(self.vertex_distance(b, ev) + dist(x, pb));
-        let dx = self.g.input().distance_bounded(x, ub);
+        let (pa, pb) = (Vec3::from(m.position(a)), Vec3::from(m.position(b)));
+        let ub = (self.vertex_distance(a, ev) + x.distance(pa))
+            .min(self.vertex_distance(b, ev) + x.distance(pb));
+        let dx = self.g.input().distance_bounded(x.to_array(), ub);
         let (mut new_sum, mut new_area) = (0.0, 0.0);
         let mut out = Vec::with_capacity(new.ids.len());
         for i in 0..new.ids.len() {
@@ -908,7 +915,7 @@ impl<'g, 'a> Pass<'g, 'a> {
             if fd.max > cap {
                 return None;
             }
-            let w = norm(tri_normal(&new.tris[i]));
+            let w = area_vector(&new.tris[i]).length();
             new_sum += w * fd.mean;
             new_area += w;
             out.push(fd);
@@ -954,11 +961,11 @@ enum Rejection {
 struct Patch {
     ids: Vec<u32>,
     verts: Vec<[u32; 3]>,
-    tris: Vec<[P3; 3]>,
+    tris: Vec<[[f64; 3]; 3]>,
 }
 
 impl Patch {
-    fn push(&mut self, f: u32, vs: [u32; 3], t: [P3; 3]) {
+    fn push(&mut self, f: u32, vs: [u32; 3], t: [[f64; 3]; 3]) {
         self.ids.push(f);
         self.verts.push(vs);
         self.tris.push(t);
@@ -973,10 +980,16 @@ fn folds_over(old: &Patch, new: &Patch) -> bool {
             .iter()
             .position(|g| g == f)
             .expect("new faces are old faces");
-        let n0 = tri_normal(&old.tris[j]);
-        let n1 = tri_normal(&new.tris[i]);
-        dot(n0, n1) <= 0.0
+        let n0 = area_vector(&old.tris[j]);
+        let n1 = area_vector(&new.tris[i]);
+        n0.dot(n1) <= 0.0
     })
+}
+
+/// `(b − a) × (c − a)` of a stored triangle.
+fn area_vector(t: &[[f64; 3]; 3]) -> Vec3 {
+    let [a, b, c] = t.map(Vec3::from);
+    tri_normal(a, b, c)
 }
 
 #[cfg(test)]
@@ -985,13 +998,14 @@ mod tests {
 
     #[test]
     fn quadric_of_three_planes_has_their_corner_as_minimiser() {
-        let q = Quadric::plane([1., 0., 0.], [1., 0., 0.], 1.0)
-            .add(&Quadric::plane([0., 1., 0.], [0., 2., 0.], 2.0))
-            .add(&Quadric::plane([0., 0., 1.], [0., 0., 3.], 0.5));
+        let v = Vec3::new;
+        let q = Quadric::plane(v(1., 0., 0.), v(1., 0., 0.), 1.0)
+            .add(&Quadric::plane(v(0., 1., 0.), v(0., 2., 0.), 2.0))
+            .add(&Quadric::plane(v(0., 0., 1.), v(0., 0., 3.), 0.5));
         let x = q.minimize().unwrap();
-        assert!(dist(x, [1., 2., 3.]) < 1e-12);
+        assert!(x.distance(v(1., 2., 3.)) < 1e-12);
         assert!(q.eval(x).abs() < 1e-12);
-        assert!((q.eval([0., 2., 3.]) - 1.0).abs() < 1e-12);
+        assert!((q.eval(v(0., 2., 3.)) - 1.0).abs() < 1e-12);
     }
 
     /// Against a sorted reference: one entry per edge, the last cost pushed wins (costs go
@@ -1035,9 +1049,9 @@ mod tests {
 
     #[test]
     fn rank_one_quadric_is_singular() {
-        let q = Quadric::plane([0., 0., 1.], [0., 0., 0.], 1.0);
+        let q = Quadric::plane(Vec3::Z, Vec3::ZERO, 1.0);
         assert!(q.minimize().is_none());
-        let (x, c) = collapse_target(&q, [0., 0., 0.], [1., 0., 0.]);
+        let (x, c) = collapse_target(&q, Vec3::ZERO, Vec3::X);
         assert_eq!(c, 0.0);
         assert_eq!(x[2], 0.0);
     }

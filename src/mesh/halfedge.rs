@@ -6,9 +6,12 @@
 //!
 //! Everything is index based: vertices, faces, edges and half-edges are `u32` ids into `Vec`
 //! storage, and [`INVALID`] (`u32::MAX`) means "none". Half-edges come in pairs: the two halves of
-//! edge `e` are `2e` and `2e + 1`, so `twin(h) = h ^ 1` and `edge(h) = h >> 1`. A half-edge with
-//! no face is a *boundary* half-edge; boundary half-edges are linked by `next`/`prev` into the
-//! boundary loops (a boundary loop runs clockwise seen from the front side of the surface).
+//! edge `e` are `2e` and `2e + 1`; that arithmetic lives only in the typed ids ([`HalfedgeId::twin`],
+//! [`HalfedgeId::edge`], [`EdgeId::halfedge`]), which also come with per-element containers
+//! ([`VertexData`], [`FaceData`], [`EdgeData`], [`HalfedgeData`]) indexable only by their own id
+//! type. A half-edge with no face is a *boundary* half-edge; boundary half-edges are linked by
+//! `next`/`prev` into the boundary loops (a boundary loop runs clockwise seen from the front side
+//! of the surface).
 //!
 //! Deleting elements (by a collapse) only marks them dead, so ids of the other elements stay
 //! valid; [`HalfEdgeMesh::garbage_collect`] compacts the storage and says where everything went.
@@ -63,16 +66,21 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use crate::mesh::trimesh::{cross, norm, sub};
+use crate::geom::{tri_normal, Vec3};
 use crate::{Error, Result};
 
 mod build;
 mod check;
+mod ids;
 mod ops;
 #[cfg(test)]
 mod tests;
 
 pub use build::Compaction;
+pub use ids::{
+    EdgeData, EdgeId, ElementId, FaceData, FaceId, HalfedgeData, HalfedgeId, IdVec, VertexData,
+    VertexId,
+};
 pub use ops::{CollapseRecord, FlipRecord, Refusal, Undo};
 
 /// The id meaning "no element" (a boundary half-edge's face, a deleted element's links, ...).
@@ -121,6 +129,24 @@ pub struct HalfEdgeMesh {
     /// operation produced (stamps come from [`fresh_stamp`] and are never reused, even across
     /// meshes and clones).
     stamp: u64,
+}
+
+/// The twin of raw half-edge id `h` ([`HalfedgeId::twin`]).
+#[inline]
+fn twin(h: u32) -> u32 {
+    HalfedgeId::new(h).twin().raw()
+}
+
+/// The edge of raw half-edge id `h` ([`HalfedgeId::edge`]).
+#[inline]
+fn edge_of(h: u32) -> u32 {
+    HalfedgeId::new(h).edge().raw()
+}
+
+/// The first half-edge of raw edge id `e` ([`EdgeId::halfedge`]).
+#[inline]
+fn halfedge_of(e: u32) -> u32 {
+    EdgeId::new(e).halfedge().raw()
 }
 
 /// A stamp never handed out before in this process.
@@ -250,7 +276,7 @@ impl HalfEdgeMesh {
     /// The live edge ids in increasing order.
     pub fn edges(&self) -> impl Iterator<Item = u32> + '_ {
         (0..self.edge_capacity() as u32)
-            .filter(|&e| self.halfedges[2 * e as usize].origin != INVALID)
+            .filter(|&e| self.halfedges[halfedge_of(e) as usize].origin != INVALID)
     }
 
     /// The live half-edge ids in increasing order.
@@ -261,22 +287,23 @@ impl HalfEdgeMesh {
     // ----------------------------------------------------------------------------------------
     // Half-edge navigation.
 
-    /// The opposite half-edge of the same edge: `h ^ 1`. Never fails (no range check).
+    /// The opposite half-edge of the same edge ([`HalfedgeId::twin`]). Never fails (no range
+    /// check).
     #[inline]
     pub fn twin(&self, h: u32) -> u32 {
-        h ^ 1
+        twin(h)
     }
 
-    /// The edge of half-edge `h`: `h >> 1`. Never fails (no range check).
+    /// The edge of half-edge `h` ([`HalfedgeId::edge`]). Never fails (no range check).
     #[inline]
     pub fn edge(&self, h: u32) -> u32 {
-        h >> 1
+        edge_of(h)
     }
 
     /// The first half-edge `2e` of edge `e` (its twin is `2e + 1`). Never fails (no range check).
     #[inline]
     pub fn edge_halfedge(&self, e: u32) -> u32 {
-        e << 1
+        halfedge_of(e)
     }
 
     /// The next half-edge in `h`'s face (or boundary loop); [`INVALID`] when `h` is deleted.
@@ -304,7 +331,7 @@ impl HalfEdgeMesh {
     #[inline]
     #[track_caller]
     pub fn target(&self, h: u32) -> u32 {
-        self.he(h ^ 1).origin
+        self.he(twin(h)).origin
     }
 
     /// The face on the left of `h`, `None` for a boundary or deleted half-edge.
@@ -327,7 +354,7 @@ impl HalfEdgeMesh {
     #[track_caller]
     pub fn is_boundary_edge(&self, e: u32) -> bool {
         let h = self.edge_halfedge(e);
-        self.is_boundary_halfedge(h) || self.is_boundary_halfedge(h ^ 1)
+        self.is_boundary_halfedge(h) || self.is_boundary_halfedge(twin(h))
     }
 
     /// The half-edge from `a` to `b`, if that edge exists. O(valence of `a`).
@@ -381,28 +408,28 @@ impl HalfEdgeMesh {
     /// `(b − a) × (c − a)` of live face `f`: normal direction with length twice the area
     /// (panics on a deleted face).
     #[track_caller]
-    pub fn face_area_vector(&self, f: u32) -> [f64; 3] {
-        let [a, b, c] = self.face_positions(f);
-        cross(sub(b, a), sub(c, a))
+    pub fn face_area_vector(&self, f: u32) -> Vec3 {
+        let [a, b, c] = self.face_positions(f).map(Vec3::from);
+        tri_normal(a, b, c)
     }
 
     /// Unit normal of live face `f` (right-hand rule over its corners); `[0, 0, 0]` for a
     /// degenerate (zero-area) face. Panics on a deleted face.
     #[track_caller]
-    pub fn face_normal(&self, f: u32) -> [f64; 3] {
+    pub fn face_normal(&self, f: u32) -> Vec3 {
         let n = self.face_area_vector(f);
-        let l = norm(n);
+        let l = n.length();
         if l > 0.0 {
-            [n[0] / l, n[1] / l, n[2] / l]
+            n / l
         } else {
-            [0.0; 3]
+            Vec3::ZERO
         }
     }
 
     /// Area of live face `f` (panics on a deleted face).
     #[track_caller]
     pub fn face_area(&self, f: u32) -> f64 {
-        0.5 * norm(self.face_area_vector(f))
+        0.5 * self.face_area_vector(f).length()
     }
 
     // ----------------------------------------------------------------------------------------
@@ -436,7 +463,7 @@ impl HalfEdgeMesh {
             }
             let h = cur;
             // twin(prev(h)) also leaves origin(h): the next outgoing half-edge counter-clockwise.
-            let n = self.halfedges[h as usize].prev ^ 1;
+            let n = twin(self.halfedges[h as usize].prev);
             cur = if n == start { INVALID } else { n };
             Some(h)
         })

@@ -1,5 +1,6 @@
 //! [`TriMesh`]: the indexed triangle mesh every pleat operation takes and returns.
 
+use crate::geom::{tri_normal, Vec3};
 use crate::{Error, Result};
 
 /// An indexed triangle mesh with `f64` positions and `u32` triangle indices.
@@ -117,10 +118,8 @@ impl TriMesh {
 
     /// Area of triangle `t` (zero for degenerate triangles).
     pub fn triangle_area(&self, t: usize) -> f64 {
-        let [a, b, c] = self.triangle_positions(t);
-        let u = sub(b, a);
-        let v = sub(c, a);
-        0.5 * norm(cross(u, v))
+        let [a, b, c] = self.triangle_positions(t).map(Vec3::from);
+        0.5 * tri_normal(a, b, c).length()
     }
 
     /// Total surface area.
@@ -246,28 +245,6 @@ fn validate(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<()> {
         )));
     }
     Ok(())
-}
-
-/// `a − b`.
-#[inline]
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-/// `a × b`.
-#[inline]
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-/// Euclidean length.
-#[inline]
-pub(crate) fn norm(a: [f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
 #[cfg(test)]

@@ -19,15 +19,13 @@ use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy, BvhNode, BvhWorkspace};
 use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
 
-use super::Point3;
-
 /// The point of a triangle set closest to a query point (see [`TriangleBvh::closest_point`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClosestPoint {
     /// Index of the triangle the closest point lies on.
     pub triangle: u32,
     /// The closest point.
-    pub point: Point3,
+    pub point: [f64; 3],
     /// Euclidean distance from the query point to `point`.
     pub distance: f64,
 }
@@ -90,7 +88,7 @@ impl std::fmt::Debug for TriangleBvh {
 
 impl TriangleBvh {
     /// Builds a tree over all `triangles` (leaf `i` is triangle `i`).
-    pub fn new(positions: &[Point3], triangles: &[[u32; 3]]) -> Self {
+    pub fn new(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Self {
         let boxes = (0..triangles.len()).map(|t| triangle_aabb(positions, triangles[t]));
         TriangleBvh {
             bvh: build_tree(boxes.collect()),
@@ -101,7 +99,7 @@ impl TriangleBvh {
 
     /// Builds a tree over the listed triangles only (each index at most once). Memory is
     /// proportional to the subset, not to the mesh.
-    pub fn from_subset(positions: &[Point3], triangles: &[[u32; 3]], subset: &[u32]) -> Self {
+    pub fn from_subset(positions: &[[f64; 3]], triangles: &[[u32; 3]], subset: &[u32]) -> Self {
         let boxes = subset
             .iter()
             .map(|&t| triangle_aabb(positions, triangles[t as usize]));
@@ -138,14 +136,14 @@ impl TriangleBvh {
     }
 
     /// The box stored for triangle `t`, as `(min, max)`, if it is in the tree.
-    pub fn triangle_box(&self, t: u32) -> Option<(Point3, Point3)> {
+    pub fn triangle_box(&self, t: u32) -> Option<([f64; 3], [f64; 3])> {
         let node = self.bvh.leaf_node(self.keys.leaf(t)?)?;
         Some((node.mins().into(), node.maxs().into()))
     }
 
     /// Recomputes every leaf box from the current positions and refits the whole tree
     /// (O(n); the tree topology is kept, so quality degrades after large motions — rebuild then).
-    pub fn refit(&mut self, positions: &[Point3], triangles: &[[u32; 3]]) {
+    pub fn refit(&mut self, positions: &[[f64; 3]], triangles: &[[u32; 3]]) {
         let leaves: Vec<u32> = self.bvh.leaves(|_| true).collect();
         for leaf in leaves {
             let t = self.keys.tri(leaf);
@@ -157,7 +155,7 @@ impl TriangleBvh {
 
     /// Recomputes the boxes of the listed triangles and of their ancestors: O(k · height), for
     /// local edits. Triangles not in the tree are ignored.
-    pub fn update(&mut self, positions: &[Point3], triangles: &[[u32; 3]], changed: &[u32]) {
+    pub fn update(&mut self, positions: &[[f64; 3]], triangles: &[[u32; 3]], changed: &[u32]) {
         let mut leaves = Vec::with_capacity(changed.len());
         for &t in changed {
             if let Some(leaf) = self
@@ -174,7 +172,7 @@ impl TriangleBvh {
     }
 
     /// Adds triangle `t` (or updates its box when already present).
-    pub fn insert(&mut self, positions: &[Point3], triangles: &[[u32; 3]], t: u32) {
+    pub fn insert(&mut self, positions: &[[f64; 3]], triangles: &[[u32; 3]], t: u32) {
         if self.contains(t) {
             self.update(positions, triangles, &[t]);
             return;
@@ -212,7 +210,7 @@ impl TriangleBvh {
     }
 
     /// The box enclosing every triangle in the tree, as `(min, max)`; `None` when empty.
-    pub fn bounds(&self) -> Option<(Point3, Point3)> {
+    pub fn bounds(&self) -> Option<([f64; 3], [f64; 3])> {
         if self.is_empty() {
             return None;
         }
@@ -232,7 +230,7 @@ impl TriangleBvh {
     }
 
     /// Triangles whose box meets the closed box `[min, max]`, in tree order (unsorted).
-    pub fn query_box(&self, min: Point3, max: Point3) -> impl Iterator<Item = u32> + '_ {
+    pub fn query_box(&self, min: [f64; 3], max: [f64; 3]) -> impl Iterator<Item = u32> + '_ {
         let query = BvhNode::leaf(Aabb::new(Vector::from(min), Vector::from(max)), 0);
         self.bvh
             .leaves(move |n: &BvhNode| n.intersects(&query))
@@ -240,7 +238,7 @@ impl TriangleBvh {
     }
 
     /// Triangles whose box meets the box of the triangle `tri` (given by its corners).
-    pub fn query_triangle(&self, tri: &[Point3; 3]) -> impl Iterator<Item = u32> + '_ {
+    pub fn query_triangle(&self, tri: &[[f64; 3]; 3]) -> impl Iterator<Item = u32> + '_ {
         let (lo, hi) = corners_box(tri);
         self.query_box(lo, hi)
     }
@@ -296,9 +294,9 @@ impl TriangleBvh {
     /// `max_distance` (pass `f64::INFINITY` for no limit). Ties are broken by tree order.
     pub fn closest_point(
         &self,
-        positions: &[Point3],
+        positions: &[[f64; 3]],
         triangles: &[[u32; 3]],
-        p: Point3,
+        p: [f64; 3],
         max_distance: f64,
     ) -> Option<ClosestPoint> {
         if self.is_empty() {
@@ -342,13 +340,13 @@ fn build_tree(boxes: Vec<Aabb>) -> Bvh {
 }
 
 /// The exact box of a triangle's corners.
-pub fn triangle_aabb(positions: &[Point3], t: [u32; 3]) -> Aabb {
+pub fn triangle_aabb(positions: &[[f64; 3]], t: [u32; 3]) -> Aabb {
     let (lo, hi) = corners_box(&t.map(|v| positions[v as usize]));
     Aabb::new(Vector::from(lo), Vector::from(hi))
 }
 
 /// `(min, max)` of three points, coordinate-wise.
-pub fn corners_box(p: &[Point3; 3]) -> (Point3, Point3) {
+pub fn corners_box(p: &[[f64; 3]; 3]) -> ([f64; 3], [f64; 3]) {
     let lo = [0, 1, 2].map(|k| p[0][k].min(p[1][k]).min(p[2][k]));
     let hi = [0, 1, 2].map(|k| p[0][k].max(p[1][k]).max(p[2][k]));
     (lo, hi)
@@ -359,7 +357,7 @@ mod tests {
     use super::*;
 
     /// A strip of `n` unit right triangles along x, plus positions.
-    fn strip(n: u32) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    fn strip(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
         let mut p = Vec::new();
         for i in 0..=n {
             p.push([i as f64, 0., 0.]);
@@ -369,7 +367,7 @@ mod tests {
         (p, t)
     }
 
-    fn brute_pairs(p: &[Point3], t: &[[u32; 3]], ids: &[u32]) -> Vec<(u32, u32)> {
+    fn brute_pairs(p: &[[f64; 3]], t: &[[u32; 3]], ids: &[u32]) -> Vec<(u32, u32)> {
         let mut out = Vec::new();
         for (k, &a) in ids.iter().enumerate() {
             for &b in &ids[k + 1..] {

@@ -1,11 +1,17 @@
-//! Spatial queries: BVH, closest points, exact triangle–triangle tests, self-intersections,
-//! winding numbers.
+//! Spatial queries: BVHs, closest points, exact triangle–triangle tests, self-intersections,
+//! winding numbers. The only module that speaks parry's types: everything else passes
+//! [`crate::geom::Vec3`] (arithmetic) or `[f64; 3]` (stored positions).
+//!
+//! May import: `crate::geom`, `crate::mesh`.
 
+mod box_tree;
 pub mod bvh;
+pub mod closest;
 pub mod self_intersect;
 pub mod tritri;
 pub mod winding;
 
+pub use box_tree::BoxTree;
 pub use bvh::{ClosestPoint, TriangleBvh};
 pub use self_intersect::{
     degenerate_faces, find_self_intersections, find_self_intersections_in, has_self_intersection,
@@ -13,7 +19,7 @@ pub use self_intersect::{
 };
 pub use tritri::{
     are_coplanar, coplanar_same_side, faces_intersect, faces_intersect_at, is_collinear, orient2d,
-    orient3d, segment_triangle_intersect, sharing, triangles_intersect, Point3, Sharing,
+    orient3d, segment_triangle_intersect, sharing, triangles_intersect, Sharing,
 };
 pub use winding::{
     solid_angle, winding_number, winding_number_in, winding_numbers, FastWindingNumber,

@@ -26,7 +26,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use super::bvh::{corners_box, TriangleBvh};
-use super::tritri::{faces_intersect, is_collinear, Point3};
+use super::tritri::{faces_intersect, is_collinear};
 use crate::mesh::{ExactWeld, TriMesh};
 use crate::Stats;
 
@@ -61,7 +61,7 @@ pub fn find_self_intersections(mesh: &TriMesh) -> SelfIntersections {
 
 /// As [`find_self_intersections`], on raw buffers (indices must be in range).
 pub fn find_self_intersections_in(
-    positions: &[Point3],
+    positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
 ) -> SelfIntersections {
     let weld = ExactWeld::compute(positions);
@@ -72,7 +72,7 @@ pub fn find_self_intersections_in(
 /// records the stages `si_prepare` (welded faces, degenerate faces), `si_bvh` (chunk trees) and
 /// `si_pairs_and_tests` (traversal with the exact test of each candidate pair) in `stats`.
 pub(crate) fn find_self_intersections_welded(
-    positions: &[Point3],
+    positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
     weld: &ExactWeld,
     stats: &mut Stats,
@@ -100,7 +100,7 @@ pub fn has_self_intersection(mesh: &TriMesh) -> bool {
 }
 
 /// As [`has_self_intersection`], on raw buffers (indices must be in range).
-pub fn has_self_intersection_in(positions: &[Point3], triangles: &[[u32; 3]]) -> bool {
+pub fn has_self_intersection_in(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> bool {
     let weld = ExactWeld::compute(positions);
     let (welded, faces, degenerate) = split_degenerate(positions, triangles, &weld);
     if !degenerate.is_empty() {
@@ -115,7 +115,7 @@ pub fn has_self_intersection_in(positions: &[Point3], triangles: &[[u32; 3]]) ->
 }
 
 /// Indices of the faces of `triangles` whose corners are exactly collinear, sorted.
-pub fn degenerate_faces(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<u32> {
+pub fn degenerate_faces(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<u32> {
     (0..triangles.len() as u32)
         .into_par_iter()
         .filter(|&f| is_degenerate(positions, triangles[f as usize]))
@@ -123,14 +123,14 @@ pub fn degenerate_faces(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<u32
 }
 
 #[inline]
-fn is_degenerate(positions: &[Point3], t: [u32; 3]) -> bool {
+fn is_degenerate(positions: &[[f64; 3]], t: [u32; 3]) -> bool {
     let [a, b, c] = t.map(|v| positions[v as usize]);
     is_collinear(a, b, c)
 }
 
 /// Exact narrow phase on welded faces.
 struct Narrow<'a> {
-    positions: &'a [Point3],
+    positions: &'a [[f64; 3]],
     welded: &'a [[u32; 3]],
 }
 
@@ -147,7 +147,7 @@ impl Narrow<'_> {
 
 /// The welded faces, the non-degenerate ones and the degenerate ones (both sorted).
 fn split_degenerate(
-    positions: &[Point3],
+    positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
     weld: &ExactWeld,
 ) -> (Vec<[u32; 3]>, Vec<u32>, Vec<u32>) {
@@ -175,7 +175,7 @@ struct ChunkedBvh {
 
 impl ChunkedBvh {
     /// About `faces.len() / chunk_faces` chunks (at least 1, at most 64).
-    fn new(positions: &[Point3], welded: &[[u32; 3]], faces: &[u32], chunk_faces: usize) -> Self {
+    fn new(positions: &[[f64; 3]], welded: &[[u32; 3]], faces: &[u32], chunk_faces: usize) -> Self {
         let chunks = (faces.len() / chunk_faces.max(1)).clamp(1, 64);
         let order = morton_order(positions, welded, faces);
         let size = order.len().div_ceil(chunks).max(1);
@@ -238,7 +238,7 @@ impl ChunkedBvh {
 }
 
 /// `faces` sorted by the Morton code (21 bits per axis) of their box centres, ties by index.
-fn morton_order(positions: &[Point3], welded: &[[u32; 3]], faces: &[u32]) -> Vec<u32> {
+fn morton_order(positions: &[[f64; 3]], welded: &[[u32; 3]], faces: &[u32]) -> Vec<u32> {
     let centre = |f: u32| {
         let (lo, hi) = corners_box(&welded[f as usize].map(|v| positions[v as usize]));
         [0, 1, 2].map(|k| 0.5 * lo[k] + 0.5 * hi[k])
@@ -286,7 +286,7 @@ fn spread(x: u64) -> u64 {
 mod tests {
     use super::*;
 
-    fn mesh(p: Vec<Point3>, t: Vec<[u32; 3]>) -> TriMesh {
+    fn mesh(p: Vec<[f64; 3]>, t: Vec<[u32; 3]>) -> TriMesh {
         TriMesh::new(p, t).unwrap()
     }
 

@@ -34,14 +34,13 @@
 //!   (folded onto each other); one shared vertex ⇒ intersect iff the edge opposite the shared
 //!   vertex in either face meets the other face; otherwise the closed triangle test.
 
-/// A point in 3D.
-pub type Point3 = [f64; 3];
+use crate::geom::{tri_normal, Vec3};
 
 /// Sign (`-1`, `0`, `+1`) of the orientation of `d` relative to the plane through `a, b, c`:
 /// `+1` when `d` lies on the side the normal `(b − a) × (c − a)` points to, i.e. the sign of
 /// `det[b − a, c − a, d − a]`. Exact (Shewchuk's adaptive `orient3d`).
 #[inline]
-pub fn orient3d(a: Point3, b: Point3, c: Point3, d: Point3) -> i8 {
+pub fn orient3d(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> i8 {
     // Fast exact path for a plane normal to a coordinate axis k (common in CAD models, where
     // Shewchuk's adaptive stages are slow for exactly coplanar points): with (b − a)_k =
     // (c − a)_k = 0, det[b − a, c − a, d − a] = (d_k − a_k) · ((b − a) × (c − a))_k, and the
@@ -66,26 +65,26 @@ pub fn orient3d(a: Point3, b: Point3, c: Point3, d: Point3) -> i8 {
 /// collinear. Exact (Shewchuk's adaptive `orient2d`).
 #[inline]
 pub fn orient2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> i8 {
-    sign(robust::orient2d(c2(a), c2(b), c2(c)))
+    sign(crate::geom::orient2d(a, b, c))
 }
 
 /// True when `a, b, c` are exactly collinear (including coincident points): the triangle is
 /// degenerate (zero area). Exact: `(b − a) × (c − a) = 0` iff its three components, which are
 /// the orientations of the three coordinate-plane projections, all vanish.
-pub fn is_collinear(a: Point3, b: Point3, c: Point3) -> bool {
+pub fn is_collinear(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> bool {
     (0..3).all(|drop| orient2d(proj(a, drop), proj(b, drop), proj(c, drop)) == 0)
 }
 
 /// True when the four points are exactly coplanar.
 #[inline]
-pub fn are_coplanar(a: Point3, b: Point3, c: Point3, d: Point3) -> bool {
+pub fn are_coplanar(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> bool {
     orient3d(a, b, c, d) == 0
 }
 
 /// For four coplanar points with `p, q, r` not collinear: true when `r` and `s` lie strictly on
 /// the same side of the line `pq` inside their common plane. This is CGAL's
 /// `coplanar_orientation(p, q, r, s) == POSITIVE`.
-pub fn coplanar_same_side(p: Point3, q: Point3, r: Point3, s: Point3) -> bool {
+pub fn coplanar_same_side(p: [f64; 3], q: [f64; 3], r: [f64; 3], s: [f64; 3]) -> bool {
     let drop = projection_axis(&[p, q, r]);
     let (p2, q2) = (proj(p, drop), proj(q, drop));
     let or = orient2d(p2, q2, proj(r, drop));
@@ -96,7 +95,7 @@ pub fn coplanar_same_side(p: Point3, q: Point3, r: Point3, s: Point3) -> bool {
 /// Exact test whether the closed segment `s` meets the closed triangle `t`.
 ///
 /// `t` must not be degenerate (see [`is_collinear`]); `s` may be a single point.
-pub fn segment_triangle_intersect(s: [Point3; 2], t: &[Point3; 3]) -> bool {
+pub fn segment_triangle_intersect(s: [[f64; 3]; 2], t: &[[f64; 3]; 3]) -> bool {
     let sp = orient3d(t[0], t[1], t[2], s[0]);
     let sq = orient3d(t[0], t[1], t[2], s[1]);
     segment_triangle_with_sides(s, t, sp, sq)
@@ -108,7 +107,7 @@ pub fn segment_triangle_intersect(s: [Point3; 2], t: &[Point3; 3]) -> bool {
 /// Both triangles must be non-degenerate (see [`is_collinear`]); the answer is unspecified
 /// otherwise. Symmetric in `a` and `b` and invariant under any permutation of either
 /// triangle's vertices.
-pub fn triangles_intersect(a: &[Point3; 3], b: &[Point3; 3]) -> bool {
+pub fn triangles_intersect(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> bool {
     let da = sides(b, a);
     if strictly_one_side(da) {
         return false;
@@ -195,7 +194,7 @@ pub fn sharing(a: [u32; 3], b: [u32; 3]) -> Sharing {
 /// - one shared vertex: intersect iff the edge of `b` opposite the shared vertex meets `a`, or
 ///   the edge of `a` opposite it meets `b`;
 /// - nothing shared: [`triangles_intersect`] (touching counts).
-pub fn faces_intersect(positions: &[Point3], a: [u32; 3], b: [u32; 3]) -> bool {
+pub fn faces_intersect(positions: &[[f64; 3]], a: [u32; 3], b: [u32; 3]) -> bool {
     let p = |v: u32| positions[v as usize];
     faces_intersect_at(a, &a.map(p), b, &b.map(p))
 }
@@ -203,7 +202,12 @@ pub fn faces_intersect(positions: &[Point3], a: [u32; 3], b: [u32; 3]) -> bool {
 /// [`faces_intersect`] with the corners given: faces `a` and `b` (vertex indices, which decide
 /// what they share) with corner positions `ta` and `tb`. Used to test a hypothetical state
 /// (a vertex at a new position) without writing it into a position buffer.
-pub fn faces_intersect_at(a: [u32; 3], ta: &[Point3; 3], b: [u32; 3], tb: &[Point3; 3]) -> bool {
+pub fn faces_intersect_at(
+    a: [u32; 3],
+    ta: &[[f64; 3]; 3],
+    b: [u32; 3],
+    tb: &[[f64; 3]; 3],
+) -> bool {
     match sharing(a, b) {
         Sharing::All => true,
         Sharing::Edge { ia, ib } => {
@@ -223,7 +227,12 @@ pub fn faces_intersect_at(a: [u32; 3], ta: &[Point3; 3], b: [u32; 3], tb: &[Poin
 /// Faces sharing exactly the vertex `ta[ia] == tb[ib]`: intersect iff the edge of `tb` opposite
 /// the shared vertex meets `ta` or the edge of `ta` opposite it meets `tb`. When `tb` lies in
 /// `ta`'s plane both tests are planar and share one projection.
-fn shared_vertex_faces_intersect(ta: &[Point3; 3], tb: &[Point3; 3], ia: usize, ib: usize) -> bool {
+fn shared_vertex_faces_intersect(
+    ta: &[[f64; 3]; 3],
+    tb: &[[f64; 3]; 3],
+    ia: usize,
+    ib: usize,
+) -> bool {
     let s_a = [ta[(ia + 1) % 3], ta[(ia + 2) % 3]];
     let s_b = [tb[(ib + 1) % 3], tb[(ib + 2) % 3]];
     let sp = orient3d(ta[0], ta[1], ta[2], s_b[0]);
@@ -255,7 +264,7 @@ fn sign(v: f64) -> i8 {
 }
 
 #[inline]
-fn c3(p: Point3) -> robust::Coord3D<f64> {
+fn c3(p: [f64; 3]) -> robust::Coord3D<f64> {
     robust::Coord3D {
         x: p[0],
         y: p[1],
@@ -263,28 +272,18 @@ fn c3(p: Point3) -> robust::Coord3D<f64> {
     }
 }
 
-#[inline]
-fn c2(p: [f64; 2]) -> robust::Coord<f64> {
-    robust::Coord { x: p[0], y: p[1] }
-}
-
 /// Drops coordinate `drop` (0 = x, 1 = y, 2 = z), keeping the other two in cyclic order so the
 /// projection's orientation equals the sign of the dropped normal component.
 #[inline]
-fn proj(p: Point3, drop: usize) -> [f64; 2] {
+fn proj(p: [f64; 3], drop: usize) -> [f64; 2] {
     [p[(drop + 1) % 3], p[(drop + 2) % 3]]
 }
 
 /// A coordinate axis along which the projection of the non-degenerate triangle `t` keeps a
 /// non-zero exact area. Tries the axis of the largest approximate normal component first.
-fn projection_axis(t: &[Point3; 3]) -> usize {
-    let u = [t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]];
-    let v = [t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]];
-    let n = [
-        (u[1] * v[2] - u[2] * v[1]).abs(),
-        (u[2] * v[0] - u[0] * v[2]).abs(),
-        (u[0] * v[1] - u[1] * v[0]).abs(),
-    ];
+fn projection_axis(t: &[[f64; 3]; 3]) -> usize {
+    let [a, b, c] = t.map(Vec3::from);
+    let n = tri_normal(a, b, c).abs();
     let mut order = [0usize, 1, 2];
     order.sort_by(|&i, &j| n[j].total_cmp(&n[i]));
     order
@@ -295,7 +294,7 @@ fn projection_axis(t: &[Point3; 3]) -> usize {
 
 /// Orientations of the three vertices of `t` against the plane of `plane`.
 #[inline]
-fn sides(plane: &[Point3; 3], t: &[Point3; 3]) -> [i8; 3] {
+fn sides(plane: &[[f64; 3]; 3], t: &[[f64; 3]; 3]) -> [i8; 3] {
     [
         orient3d(plane[0], plane[1], plane[2], t[0]),
         orient3d(plane[0], plane[1], plane[2], t[1]),
@@ -315,7 +314,7 @@ fn no_opposite_signs(s: [i8; 3]) -> bool {
 }
 
 /// Segment–triangle test given the sides `sp`, `sq` of the endpoints against `t`'s plane.
-fn segment_triangle_with_sides(s: [Point3; 2], t: &[Point3; 3], sp: i8, sq: i8) -> bool {
+fn segment_triangle_with_sides(s: [[f64; 3]; 2], t: &[[f64; 3]; 3], sp: i8, sq: i8) -> bool {
     if sp == sq && sp != 0 {
         return false; // both endpoints strictly on one side
     }
@@ -332,13 +331,13 @@ fn segment_triangle_with_sides(s: [Point3; 2], t: &[Point3; 3], sp: i8, sq: i8) 
     ])
 }
 
-fn coplanar_segment_triangle(s: [Point3; 2], t: &[Point3; 3]) -> bool {
+fn coplanar_segment_triangle(s: [[f64; 3]; 2], t: &[[f64; 3]; 3]) -> bool {
     let d = projection_axis(t);
     let t2 = [proj(t[0], d), proj(t[1], d), proj(t[2], d)];
     segment_triangle_intersect_2d([proj(s[0], d), proj(s[1], d)], &t2)
 }
 
-fn coplanar_triangles_intersect(a: &[Point3; 3], b: &[Point3; 3]) -> bool {
+fn coplanar_triangles_intersect(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> bool {
     let d = projection_axis(b);
     let a2 = [proj(a[0], d), proj(a[1], d), proj(a[2], d)];
     let b2 = [proj(b[0], d), proj(b[1], d), proj(b[2], d)];

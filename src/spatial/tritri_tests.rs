@@ -5,7 +5,7 @@
 
 use super::*;
 
-type T3 = [Point3; 3];
+type T3 = [[f64; 3]; 3];
 
 /// The 6 vertex orders of a triangle (3 rotations × 2 orientations).
 fn perms(t: &T3) -> [T3; 6] {
@@ -38,7 +38,7 @@ fn check_tt(a: T3, b: T3, expected: bool, what: &str) {
     }
 }
 
-fn check_st(s: [Point3; 2], t: T3, expected: bool, what: &str) {
+fn check_st(s: [[f64; 3]; 2], t: T3, expected: bool, what: &str) {
     for pt in perms(&t) {
         assert_eq!(
             segment_triangle_intersect(s, &pt),
@@ -512,7 +512,7 @@ fn non_degenerate(t: &[I3; 3]) -> bool {
 
 /// Maps an integer point to floats exactly, with a scale and offset that keep every value
 /// exactly representable (so the float geometry is the integer geometry, moved).
-fn to_f(p: I3, scale: f64, offset: f64) -> Point3 {
+fn to_f(p: I3, scale: f64, offset: f64) -> [f64; 3] {
     [
         p[0] as f64 * scale + offset,
         p[1] as f64 * scale - offset,
@@ -633,7 +633,7 @@ fn random_shared_vertex_pairs_match_segment_rule() {
         if !non_degenerate(&a) || !non_degenerate(&b) || a[1..].iter().any(|p| b.contains(p)) {
             continue;
         }
-        let positions: Vec<Point3> = a
+        let positions: Vec<[f64; 3]> = a
             .iter()
             .chain(&b[1..])
             .map(|&p| to_f(p, 0.5, 8.0))

@@ -20,17 +20,17 @@
 
 use rayon::prelude::*;
 
-use super::Point3;
+use crate::geom::Vec3;
 use crate::mesh::TriMesh;
 
 /// The generalized winding number of `mesh` at `p` by direct summation (see the module docs).
 /// Deterministic: triangles are summed in order.
-pub fn winding_number(mesh: &TriMesh, p: Point3) -> f64 {
+pub fn winding_number(mesh: &TriMesh, p: [f64; 3]) -> f64 {
     winding_number_in(mesh.positions(), mesh.triangles(), p)
 }
 
 /// As [`winding_number`], on raw buffers (indices must be in range).
-pub fn winding_number_in(positions: &[Point3], triangles: &[[u32; 3]], p: Point3) -> f64 {
+pub fn winding_number_in(positions: &[[f64; 3]], triangles: &[[u32; 3]], p: [f64; 3]) -> f64 {
     let sum: f64 = triangles
         .iter()
         .map(|t| solid_angle(t.map(|v| positions[v as usize]), p))
@@ -39,7 +39,7 @@ pub fn winding_number_in(positions: &[Point3], triangles: &[[u32; 3]], p: Point3
 }
 
 /// Exact winding numbers of `mesh` at many points, in parallel over the points.
-pub fn winding_numbers(mesh: &TriMesh, points: &[Point3]) -> Vec<f64> {
+pub fn winding_numbers(mesh: &TriMesh, points: &[[f64; 3]]) -> Vec<f64> {
     points
         .par_iter()
         .map(|&p| winding_number(mesh, p))
@@ -49,11 +49,12 @@ pub fn winding_numbers(mesh: &TriMesh, points: &[Point3]) -> Vec<f64> {
 /// Signed solid angle subtended at `p` by the triangle `t`, in `[−2π, 2π]`: positive when `p`
 /// lies on the side opposite the normal `(b − a) × (c − a)`, so the triangles of a closed
 /// outward-oriented surface sum to `4π` at interior points. Van Oosterom & Strackee 1983.
-pub fn solid_angle(t: [Point3; 3], p: Point3) -> f64 {
-    let [a, b, c] = t.map(|x| sub(x, p));
-    let (la, lb, lc) = (norm(a), norm(b), norm(c));
-    let num = dot(a, cross(b, c));
-    let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+pub fn solid_angle(t: [[f64; 3]; 3], p: [f64; 3]) -> f64 {
+    let p = Vec3::from(p);
+    let [a, b, c] = t.map(|x| Vec3::from(x) - p);
+    let (la, lb, lc) = (a.length(), b.length(), c.length());
+    let num = a.dot(b.cross(c));
+    let den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
     2.0 * num.atan2(den)
 }
 
@@ -61,7 +62,7 @@ pub fn solid_angle(t: [Point3; 3], p: Point3) -> f64 {
 /// many times (`&self` queries are thread-safe).
 #[derive(Debug, Clone)]
 pub struct FastWindingNumber {
-    positions: Vec<Point3>,
+    positions: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
     nodes: Vec<Node>,
     beta: f64,
@@ -73,17 +74,17 @@ const LEAF_SIZE: usize = 8;
 #[derive(Debug, Clone)]
 struct Node {
     /// Area-weighted centroid of the node's triangles (the expansion point).
-    center: Point3,
+    center: [f64; 3],
     /// Distance from `center` to the farthest corner of the node's bounding box.
     radius: f64,
     /// Total area of the node's triangles.
     area: f64,
     /// The node's bounding box.
-    lo: Point3,
+    lo: [f64; 3],
     /// The node's bounding box.
-    hi: Point3,
+    hi: [f64; 3],
     /// `Σ A_t n_t` (half the sum of the triangles' cross products).
-    normal: Point3,
+    normal: [f64; 3],
     /// `M[j][i] = Σ A_t (x_t − center)_j n_t,i` with `x_t` the triangle centroid (exact first
     /// moment of each triangle).
     moment: [[f64; 3]; 3],
@@ -135,7 +136,7 @@ impl FastWindingNumber {
         let leaf_size = leaf_size.max(1);
         let positions = mesh.positions().to_vec();
         let triangles = mesh.triangles();
-        let centroids: Vec<Point3> = triangles
+        let centroids: Vec<[f64; 3]> = triangles
             .par_iter()
             .map(|t| centroid(&positions, *t))
             .collect();
@@ -158,20 +159,20 @@ impl FastWindingNumber {
     }
 
     /// The approximate winding number at `p`.
-    pub fn winding_number(&self, p: Point3) -> f64 {
+    pub fn winding_number(&self, p: [f64; 3]) -> f64 {
         self.eval(0, p) / (4.0 * std::f64::consts::PI)
     }
 
     /// Approximate winding numbers at many points, in parallel over the points.
-    pub fn winding_numbers(&self, points: &[Point3]) -> Vec<f64> {
+    pub fn winding_numbers(&self, points: &[[f64; 3]]) -> Vec<f64> {
         points.par_iter().map(|&p| self.winding_number(p)).collect()
     }
 
     /// `4π ×` the winding number of node `n`'s triangles at `p`.
-    fn eval(&self, n: usize, p: Point3) -> f64 {
+    fn eval(&self, n: usize, p: [f64; 3]) -> f64 {
         let node = &self.nodes[n];
-        let y = sub(node.center, p);
-        let d = norm(y);
+        let y = Vec3::from(node.center) - Vec3::from(p);
+        let d = y.length();
         if d > self.beta * node.radius {
             return far_field(node, y, d);
         }
@@ -191,11 +192,11 @@ impl FastWindingNumber {
 /// `4π w ≈ F·N + ∂_j F_i M_ji + ½ ∂_j∂_k F_i S_jki` with `F(y) = y / |y|³`,
 /// `∂_j F_i = δ_ij / r³ − 3 y_i y_j / r⁵` and
 /// `∂_j∂_k F_i = −3 (δ_ij y_k + δ_ik y_j + δ_jk y_i) / r⁵ + 15 y_i y_j y_k / r⁷`.
-fn far_field(node: &Node, y: Point3, d: f64) -> f64 {
+fn far_field(node: &Node, y: Vec3, d: f64) -> f64 {
     let d2 = d * d;
     let d3 = d2 * d;
     let d5 = d3 * d2;
-    let zeroth = dot(y, node.normal) / d3;
+    let zeroth = y.dot(Vec3::from(node.normal)) / d3;
     let m = &node.moment;
     let trace = m[0][0] + m[1][1] + m[2][2];
     let mut ymy = 0.0;
@@ -236,9 +237,9 @@ fn subtree_nodes(len: usize, leaf_size: usize) -> usize {
 
 /// The mesh data the tree is built from.
 struct BuildInput<'a> {
-    positions: &'a [Point3],
+    positions: &'a [[f64; 3]],
     triangles: &'a [[u32; 3]],
-    centroids: &'a [Point3],
+    centroids: &'a [[f64; 3]],
     /// Largest leaf.
     leaf_size: usize,
 }
@@ -291,7 +292,7 @@ impl BuildInput<'_> {
         let mut weighted = [0.0; 3];
         for &t in ids {
             let an = area_normal(self.positions, self.triangles[t as usize]);
-            let area = norm(an);
+            let area = an.length();
             let c = self.centroids[t as usize];
             for k in 0..3 {
                 node.normal[k] += an[k];
@@ -312,15 +313,16 @@ impl BuildInput<'_> {
         for &t in ids {
             let tri = self.triangles[t as usize];
             let an = area_normal(self.positions, tri);
-            let r = sub(self.centroids[t as usize], node.center);
-            let corners = tri.map(|v| sub(self.positions[v as usize], node.center));
+            let center = Vec3::from(node.center);
+            let r = Vec3::from(self.centroids[t as usize]) - center;
+            let corners = tri.map(|v| Vec3::from(self.positions[v as usize]) - center);
             for j in 0..3 {
-                for (m, a) in node.moment[j].iter_mut().zip(an) {
+                for (m, a) in node.moment[j].iter_mut().zip(an.to_array()) {
                     *m += r[j] * a;
                 }
                 for k in 0..3 {
                     let rr = corners.iter().map(|q| q[j] * q[k]).sum::<f64>() + 9.0 * r[j] * r[k];
-                    for (s, a) in node.second[j][k].iter_mut().zip(an) {
+                    for (s, a) in node.second[j][k].iter_mut().zip(an.to_array()) {
                         *s += a * rr / 12.0;
                     }
                 }
@@ -352,7 +354,7 @@ fn merge(l: &Node, r: &Node, kind: NodeKind) -> Node {
         box_centre(&node)
     };
     for child in [l, r] {
-        let d = sub(child.center, node.center);
+        let d = Vec3::from(child.center) - Vec3::from(node.center);
         for j in 0..3 {
             for i in 0..3 {
                 node.moment[j][i] += child.moment[j][i] + d[j] * child.normal[i];
@@ -370,7 +372,7 @@ fn merge(l: &Node, r: &Node, kind: NodeKind) -> Node {
     node
 }
 
-fn box_centre(node: &Node) -> Point3 {
+fn box_centre(node: &Node) -> [f64; 3] {
     [0, 1, 2].map(|k| 0.5 * (node.lo[k] + node.hi[k]))
 }
 
@@ -387,7 +389,7 @@ fn box_radius(node: &Node) -> f64 {
         .sqrt()
 }
 
-fn longest_axis(centroids: &[Point3], ids: &[u32]) -> usize {
+fn longest_axis(centroids: &[[f64; 3]], ids: &[u32]) -> usize {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for &t in ids {
@@ -402,35 +404,14 @@ fn longest_axis(centroids: &[Point3], ids: &[u32]) -> usize {
 }
 
 /// `A n` of a triangle: half the cross product of two edges.
-fn area_normal(positions: &[Point3], t: [u32; 3]) -> Point3 {
-    let [a, b, c] = t.map(|v| positions[v as usize]);
-    cross(sub(b, a), sub(c, a)).map(|x| 0.5 * x)
+fn area_normal(positions: &[[f64; 3]], t: [u32; 3]) -> Vec3 {
+    let [a, b, c] = t.map(|v| Vec3::from(positions[v as usize]));
+    (b - a).cross(c - a) * 0.5
 }
 
-fn centroid(positions: &[Point3], t: [u32; 3]) -> Point3 {
+fn centroid(positions: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
     let [a, b, c] = t.map(|v| positions[v as usize]);
     [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0)
-}
-
-#[inline]
-fn sub(a: Point3, b: Point3) -> Point3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-#[inline]
-fn dot(a: Point3, b: Point3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-#[inline]
-fn cross(a: Point3, b: Point3) -> Point3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-#[inline]
-fn norm(a: Point3) -> f64 {
-    dot(a, a).sqrt()
 }
 
 #[cfg(test)]
@@ -544,7 +525,7 @@ mod tests {
     #[test]
     fn larger_leaves_stay_accurate() {
         let t = torus(96, 48);
-        let points: Vec<Point3> = (0..60)
+        let points: Vec<[f64; 3]> = (0..60)
             .map(|i| [-3.0 + 0.1 * i as f64, 0.2, 0.05 * (i % 7) as f64 - 0.15])
             .collect();
         let exact = winding_numbers(&t, &points);
@@ -560,7 +541,7 @@ mod tests {
     #[test]
     fn parallel_build_is_deterministic_and_accurate() {
         let t = torus(256, 128); // 65536 triangles: built with rayon::join
-        let points: Vec<Point3> = (0..50).map(|i| [-2.6 + 0.1 * i as f64, 0.3, 0.1]).collect();
+        let points: Vec<[f64; 3]> = (0..50).map(|i| [-2.6 + 0.1 * i as f64, 0.3, 0.1]).collect();
         let run = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)

@@ -1,9 +1,9 @@
 use super::tables::*;
 use super::triangulate::{fan, LocalTri};
 use super::*;
+use crate::geom::normalized;
+use crate::geom::{lerp, Vec3};
 use crate::lowpoly::features::{cube_geometry, CubeFlags};
-use crate::lowpoly::geom::normalized;
-use crate::lowpoly::geom::{lerp, V3};
 use crate::spatial::faces_intersect;
 use std::collections::HashMap;
 
@@ -27,12 +27,12 @@ impl Rng {
     }
 }
 
-fn corner(c: u8) -> V3 {
-    CORNER_POS[c as usize].map(f64::from)
+fn corner(c: u8) -> Vec3 {
+    Vec3::from(CORNER_POS[c as usize].map(f64::from))
 }
 
 /// Iso-point on cube edge `e` at parameter `t` from its first corner.
-fn edge_point(e: u8, t: f64) -> V3 {
+fn edge_point(e: u8, t: f64) -> Vec3 {
     let [a, b] = EDGE_CORNERS[e as usize];
     lerp(corner(a), corner(b), t)
 }
@@ -93,12 +93,12 @@ fn check_loops(dec: &Decisions, topo: &CubeTopology) {
 /// [`no_conflicts`] checks such a cube with the exact `spatial::faces_intersect`.
 pub(crate) fn triangulate_cube(
     topo: &CubeTopology,
-    iso: &[V3; 12],
-    normals: Option<&[V3; 12]>,
-) -> (Vec<[u32; 3]>, HashMap<u32, V3>, CubeFlags) {
+    iso: &[Vec3; 12],
+    normals: Option<&[Vec3; 12]>,
+) -> (Vec<[u32; 3]>, HashMap<u32, Vec3>, CubeFlags) {
     let (patches, flags) = cube_geometry(topo, iso, normals, 0.0, None);
     let mut tris = Vec::new();
-    let mut pos: HashMap<u32, V3> = HashMap::new();
+    let mut pos: HashMap<u32, Vec3> = HashMap::new();
     for e in 0..12u8 {
         pos.insert(e as u32, iso[e as usize]);
     }
@@ -129,11 +129,11 @@ pub(crate) fn triangulate_cube(
 }
 
 /// No two triangles of the cube intersect beyond what they share (exact).
-fn no_conflicts(tris: &[[u32; 3]], pos: &HashMap<u32, V3>) -> Result<(), String> {
+fn no_conflicts(tris: &[[u32; 3]], pos: &HashMap<u32, Vec3>) -> Result<(), String> {
     let mut ids: Vec<u32> = pos.keys().copied().collect();
     ids.sort_unstable();
-    let dense: Vec<V3> = (0..=ids.last().copied().unwrap_or(0))
-        .map(|i| pos.get(&i).copied().unwrap_or([f64::NAN; 3]))
+    let dense: Vec<[f64; 3]> = (0..=ids.last().copied().unwrap_or(0))
+        .map(|i| pos.get(&i).map_or([f64::NAN; 3], |p| p.to_array()))
         .collect();
     for (x, a) in tris.iter().enumerate() {
         for b in &tris[x + 1..] {
@@ -196,11 +196,15 @@ fn every_configuration_and_resolution_gives_closed_patches() {
                 .filter(|&p| topo.is_annulus(p))
                 .count();
             for round in 0..4 {
-                let iso: [V3; 12] =
+                let iso: [Vec3; 12] =
                     std::array::from_fn(|e| edge_point(e as u8, 0.02 + 0.96 * rng.unit()));
-                let nrm: [V3; 12] = std::array::from_fn(|_| {
-                    normalized([rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5])
-                        .unwrap_or([1.0, 0.0, 0.0])
+                let nrm: [Vec3; 12] = std::array::from_fn(|_| {
+                    normalized(Vec3::new(
+                        rng.unit() - 0.5,
+                        rng.unit() - 0.5,
+                        rng.unit() - 0.5,
+                    ))
+                    .unwrap_or(Vec3::X)
                 });
                 let normals = (round % 2 == 1).then_some(&nrm);
                 let (tris, pos, flags) = triangulate_cube(&topo, &iso, normals);
@@ -332,7 +336,7 @@ fn ties_resolve_to_outside_consistently() {
 }
 
 /// Iso-point of edge `e` by linear interpolation of `v` (clamped like the extractor).
-pub(crate) fn iso_from_values(v: &[f64; 8], e: u8) -> V3 {
+pub(crate) fn iso_from_values(v: &[f64; 8], e: u8) -> Vec3 {
     let [a, b] = EDGE_CORNERS[e as usize];
     let (va, vb) = (v[a as usize], v[b as usize]);
     let t = if va == vb { 0.5 } else { va / (va - vb) };
@@ -354,10 +358,14 @@ fn value_consistent_cubes_separate_and_embed() {
             }
         });
         let topo = topology(&decide(&v));
-        let iso: [V3; 12] = std::array::from_fn(|e| iso_from_values(&v, e as u8));
-        let nrm: [V3; 12] = std::array::from_fn(|_| {
-            normalized([rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5])
-                .unwrap_or([1.0, 0.0, 0.0])
+        let iso: [Vec3; 12] = std::array::from_fn(|e| iso_from_values(&v, e as u8));
+        let nrm: [Vec3; 12] = std::array::from_fn(|_| {
+            normalized(Vec3::new(
+                rng.unit() - 0.5,
+                rng.unit() - 0.5,
+                rng.unit() - 0.5,
+            ))
+            .unwrap_or(Vec3::X)
         });
         let (tris, pos, flags) = triangulate_cube(&topo, &iso, Some(&nrm));
         check_patch_surface(&topo, &tris);

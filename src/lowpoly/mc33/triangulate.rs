@@ -19,7 +19,7 @@
 //!   intersection inside the strip or with the cube's other triangles.
 
 use super::tables::edges_share_face;
-use crate::lowpoly::geom::{dist, orient2d, V3};
+use crate::geom::{orient2d, Vec3};
 use crate::spatial::{faces_intersect, is_collinear, triangles_intersect};
 
 /// A triangle as local point indices.
@@ -33,8 +33,8 @@ pub(crate) fn fan(n: usize, out: &mut Vec<LocalTri>) {
 }
 
 /// Newell normal of a closed polygon.
-pub(crate) fn newell_normal(pts: &[V3]) -> V3 {
-    let mut n = [0.0; 3];
+pub(crate) fn newell_normal(pts: &[Vec3]) -> Vec3 {
+    let mut n = Vec3::ZERO;
     for i in 0..pts.len() {
         let (u, v) = (pts[i], pts[(i + 1) % pts.len()]);
         n[0] += (u[1] - v[1]) * (u[2] + v[2]);
@@ -46,7 +46,7 @@ pub(crate) fn newell_normal(pts: &[V3]) -> V3 {
 
 /// Ear-clipping triangulation without extra vertex (see module doc); `None` when the loop's
 /// projection is not a simple polygon or no admissible ear exists.
-pub(crate) fn plain_disk(pts: &[V3], edges: &[u8], out: &mut Vec<LocalTri>) -> bool {
+pub(crate) fn plain_disk(pts: &[Vec3], edges: &[u8], out: &mut Vec<LocalTri>) -> bool {
     let n = pts.len();
     if !(3..=12).contains(&n) {
         return false;
@@ -167,15 +167,15 @@ fn segs_touch(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
 /// no chord lies on a cube face and exact tests find no degenerate triangle and no intersection
 /// within the strip or with `others` (the cube's remaining triangles, by position).
 pub(crate) fn strip(
-    a: &[V3],
+    a: &[Vec3],
     a_edges: &[u8],
-    b: &[V3],
+    b: &[Vec3],
     b_edges: &[u8],
-    others: &[[V3; 3]],
+    others: &[[[f64; 3]; 3]],
     out: &mut Vec<LocalTri>,
 ) -> bool {
     let (n, m) = (a.len(), b.len());
-    let mut cands: Vec<(f64, usize)> = (0..m).map(|s| (dist(a[0], b[s]), s)).collect();
+    let mut cands: Vec<(f64, usize)> = (0..m).map(|s| (a[0].distance(b[s]), s)).collect();
     cands.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
     let pos = |i: usize| if i < n { a[i] } else { b[i - n] };
     let edge = |i: usize| if i < n { a_edges[i] } else { b_edges[i - n] };
@@ -197,7 +197,7 @@ pub(crate) fn strip(
     false
 }
 
-fn zip(a: &[V3], b: &[V3], s: usize, out: &mut Vec<LocalTri>) {
+fn zip(a: &[Vec3], b: &[Vec3], s: usize, out: &mut Vec<LocalTri>) {
     let (n, m) = (a.len(), b.len());
     let bi = |j: usize| (s + m * 2 - j % m) % m; // j-th step backwards from s
     let (mut i, mut j) = (0usize, 0usize);
@@ -212,7 +212,7 @@ fn zip(a: &[V3], b: &[V3], s: usize, out: &mut Vec<LocalTri>) {
             (true, false) => true,
             (false, true) => false,
             (false, false) => i < n,
-            (true, true) => dist(a[(i + 1) % n], b[bi(j)]) <= dist(a[i], b[bi(j + 1)]),
+            (true, true) => a[(i + 1) % n].distance(b[bi(j)]) <= a[i].distance(b[bi(j + 1)]),
         };
         if adv_a {
             out.push([i as u8, ((i + 1) % n) as u8, (n + bi(j)) as u8]);
@@ -226,14 +226,18 @@ fn zip(a: &[V3], b: &[V3], s: usize, out: &mut Vec<LocalTri>) {
     }
 }
 
-fn strip_is_embedded(tris: &[LocalTri], pos: &dyn Fn(usize) -> V3, others: &[[V3; 3]]) -> bool {
+fn strip_is_embedded(
+    tris: &[LocalTri],
+    pos: &dyn Fn(usize) -> Vec3,
+    others: &[[[f64; 3]; 3]],
+) -> bool {
     let n = tris
         .iter()
         .flat_map(|t| t.iter())
         .map(|&i| i as usize + 1)
         .max()
         .unwrap_or(0);
-    let local: Vec<V3> = (0..n).map(pos).collect();
+    let local: Vec<[f64; 3]> = (0..n).map(|i| pos(i).to_array()).collect();
     let ids = |t: &LocalTri| t.map(u32::from);
     let geo = |t: &LocalTri| t.map(|i| local[i as usize]);
     if tris.iter().any(|t| {

@@ -1,7 +1,7 @@
 //! Building a [`HalfEdgeMesh`] from a [`TriMesh`] (with manifoldness checks), converting back,
 //! and compacting storage.
 
-use super::{fresh_stamp, HalfEdge, HalfEdgeMesh, INVALID};
+use super::{edge_of, fresh_stamp, halfedge_of, twin, HalfEdge, HalfEdgeMesh, INVALID};
 use crate::mesh::TriMesh;
 use crate::{Error, Result};
 
@@ -194,7 +194,7 @@ fn pair_corners(idx: &CornerIndex) -> Result<Pairing> {
         }
         let e = edge_count;
         edge_count += 1;
-        corner_he[c as usize] = 2 * e;
+        corner_he[c as usize] = halfedge_of(e);
         if opposite == INVALID {
             boundary_corners.push(c);
         } else if idx.vertex(c, 2) == idx.vertex(opposite, 2) {
@@ -205,7 +205,7 @@ fn pair_corners(idx: &CornerIndex) -> Result<Pairing> {
                 idx.vertex(c, 2)
             )));
         } else {
-            corner_he[opposite as usize] = 2 * e + 1;
+            corner_he[opposite as usize] = twin(halfedge_of(e));
         }
     }
     Ok(Pairing {
@@ -231,7 +231,7 @@ fn halfedge_records(idx: &CornerIndex, p: &Pairing) -> Vec<HalfEdge> {
         }
     }
     for &c in &p.boundary_corners {
-        let bh = p.corner_he[c as usize] ^ 1;
+        let bh = twin(p.corner_he[c as usize]);
         he[bh as usize].origin = idx.target(c);
     }
     he
@@ -246,7 +246,7 @@ fn vertex_outgoing(idx: &CornerIndex, p: &Pairing, vertex_count: usize) -> Resul
         if v_out[b as usize] != INVALID {
             return Err(non_manifold_vertex(idx, b));
         }
-        v_out[b as usize] = p.corner_he[c as usize] ^ 1;
+        v_out[b as usize] = twin(p.corner_he[c as usize]);
     }
     for (v, out) in v_out.iter_mut().enumerate() {
         if *out == INVALID {
@@ -263,7 +263,7 @@ fn vertex_outgoing(idx: &CornerIndex, p: &Pairing, vertex_count: usize) -> Resul
 /// and at most one out).
 fn link_boundary(idx: &CornerIndex, p: &Pairing, v_out: &[u32], he: &mut [HalfEdge]) {
     for &c in &p.boundary_corners {
-        let bh = p.corner_he[c as usize] ^ 1;
+        let bh = twin(p.corner_he[c as usize]);
         let n = v_out[idx.origin(c) as usize];
         he[bh as usize].next = n;
         he[n as usize].prev = bh;
@@ -283,7 +283,7 @@ fn check_single_fans(idx: &CornerIndex, v_out: &[u32], he: &[HalfEdge]) -> Resul
         let mut h = start;
         loop {
             seen += 1;
-            h = he[h as usize].prev ^ 1;
+            h = twin(he[h as usize].prev);
             if h == start || seen > expected {
                 break;
             }
@@ -385,10 +385,12 @@ impl HalfEdgeMesh {
                 .step_by(2)
                 .map(|x| x.origin != INVALID),
         );
-        let halfedges: Vec<u32> = (0..self.halfedges.len())
-            .map(|h| match edges[h / 2] {
+        let halfedges: Vec<u32> = (0..self.halfedges.len() as u32)
+            .map(|h| match edges[edge_of(h) as usize] {
                 INVALID => INVALID,
-                e => 2 * e + (h as u32 & 1),
+                // The same half of the new edge as `h` is of its old edge.
+                e if halfedge_of(edge_of(h)) == h => halfedge_of(e),
+                e => twin(halfedge_of(e)),
             })
             .collect();
         let map = |m: &[u32], x: u32| if x == INVALID { INVALID } else { m[x as usize] };

@@ -1,6 +1,6 @@
 //! [`HalfEdgeMesh::check_invariants`]: a full O(mesh) consistency check.
 
-use super::{HalfEdge, HalfEdgeMesh, INVALID};
+use super::{edge_of, halfedge_of, twin, HalfEdge, HalfEdgeMesh, INVALID};
 use crate::{Error, Result};
 
 fn bug(msg: String) -> Error {
@@ -54,7 +54,7 @@ impl HalfEdgeMesh {
         let (nh, nv, nf) = (self.halfedges.len(), self.v_out.len(), self.f_he.len());
         for h in 0..nh as u32 {
             let x = self.halfedges[h as usize];
-            let t = self.halfedges[(h ^ 1) as usize];
+            let t = self.halfedges[twin(h) as usize];
             if x.origin == INVALID {
                 ensure!(x == HalfEdge::DELETED, "deleted half-edge {h} has links");
                 ensure!(
@@ -95,7 +95,7 @@ impl HalfEdgeMesh {
             );
             ensure!(n.face == x.face, "next({h}) lies in another face");
             if x.face == INVALID {
-                ensure!(t.face != INVALID, "edge {} has no face", h >> 1);
+                ensure!(t.face != INVALID, "edge {} has no face", edge_of(h));
             } else {
                 ensure!(
                     (x.face as usize) < nf && self.f_he[x.face as usize] != INVALID,
@@ -144,8 +144,8 @@ impl HalfEdgeMesh {
             );
         }
         for e in self.edges() {
-            let h = 2 * e;
-            if let (Some(c), Some(d)) = (self.opposite_vertex(h), self.opposite_vertex(h ^ 1)) {
+            let h = halfedge_of(e);
+            if let (Some(c), Some(d)) = (self.opposite_vertex(h), self.opposite_vertex(twin(h))) {
                 ensure!(
                     c != d,
                     "the two faces of edge {e} have the same three vertices"
@@ -214,7 +214,7 @@ impl HalfEdgeMesh {
                 ensure!(
                     seen_from[t] != v,
                     "two edges join vertices {v} and {t} (one of them is edge {})",
-                    h >> 1
+                    edge_of(h)
                 );
                 seen_from[t] = v;
             }

@@ -3,7 +3,9 @@
 
 use std::fmt;
 
-use super::{check_finite, fresh_stamp, HalfEdge, HalfEdgeMesh, INVALID};
+use super::{
+    check_finite, edge_of, fresh_stamp, halfedge_of, twin, HalfEdge, HalfEdgeMesh, INVALID,
+};
 use crate::{Error, Result};
 
 /// Why a local operation is topologically not allowed (returned by
@@ -200,8 +202,9 @@ impl<'a> Editor<'a> {
     }
 
     fn delete_edge(&mut self, e: u32) {
-        *self.he_mut(2 * e) = HalfEdge::DELETED;
-        *self.he_mut(2 * e + 1) = HalfEdge::DELETED;
+        let h = halfedge_of(e);
+        *self.he_mut(h) = HalfEdge::DELETED;
+        *self.he_mut(twin(h)) = HalfEdge::DELETED;
         self.m.n_edges -= 1;
     }
 
@@ -276,7 +279,7 @@ impl HalfEdgeMesh {
         if !self.is_halfedge_live(h) {
             return Err(Refusal::Deleted);
         }
-        let o = h ^ 1;
+        let o = twin(h);
         let (a, b) = (self.origin(h), self.origin(o));
         let (c, d) = (self.opposite_vertex(h), self.opposite_vertex(o));
         let interior = c.is_some() && d.is_some();
@@ -287,7 +290,7 @@ impl HalfEdgeMesh {
         match (c, d) {
             (Some(c), Some(d)) => self.check_not_tetrahedron(a, b, c, d)?,
             (Some(x), None) | (None, Some(x)) => self.check_not_lone_triangle(a, b, x)?,
-            (None, None) => unreachable!("live edge {} has no face", h >> 1),
+            (None, None) => unreachable!("live edge {} has no face", edge_of(h)),
         }
         self.check_collapse_valences([a, b], valences, c, d, interior)
     }
@@ -323,7 +326,7 @@ impl HalfEdgeMesh {
         d: u32,
     ) -> std::result::Result<(), Refusal> {
         if let Some(cd) = self.find_halfedge(c, d) {
-            let (x, y) = (self.opposite_vertex(cd), self.opposite_vertex(cd ^ 1));
+            let (x, y) = (self.opposite_vertex(cd), self.opposite_vertex(twin(cd)));
             if (x == Some(a) && y == Some(b)) || (x == Some(b) && y == Some(a)) {
                 return Err(Refusal::Tetrahedron);
             }
@@ -336,7 +339,7 @@ impl HalfEdgeMesh {
     fn check_not_lone_triangle(&self, a: u32, b: u32, x: u32) -> std::result::Result<(), Refusal> {
         let on_boundary = |u: u32| {
             self.find_halfedge(u, x)
-                .is_some_and(|h| self.is_boundary_edge(h >> 1))
+                .is_some_and(|h| self.is_boundary_edge(edge_of(h)))
         };
         if on_boundary(a) && on_boundary(b) {
             Err(Refusal::IsolatedTriangle)
@@ -404,7 +407,7 @@ impl HalfEdgeMesh {
     }
 
     pub(super) fn apply_collapse(&mut self, h: u32, p: [f64; 3]) -> CollapseRecord {
-        let o = h ^ 1;
+        let o = twin(h);
         let (a, b) = (self.origin(h), self.origin(o));
         let around_b: Vec<u32> = self.outgoing(b).collect();
         let (fl, fr) = (self.face(h), self.face(o));
@@ -416,25 +419,25 @@ impl HalfEdgeMesh {
         if let Some(f) = fl {
             // Face a→b→c: edge b–c (h1 and its twin t1) goes, h2 = c→a takes t1's place.
             let (h1, h2) = (ed.m.next(h), ed.m.prev(h));
-            let (t1, c) = (h1 ^ 1, ed.m.origin(h2));
+            let (t1, c) = (twin(h1), ed.m.origin(h2));
             ed.replace_in_loop(t1, h2);
             if ed.m.v_out[c as usize] == t1 {
                 ed.set_out(c, h2);
             }
             removed_faces.push(f);
-            merged_edges.push([h1 >> 1, h2 >> 1]);
-            a_start = h2 ^ 1;
+            merged_edges.push([edge_of(h1), edge_of(h2)]);
+            a_start = twin(h2);
         }
         if let Some(f) = fr {
             // Face b→a→d: edge d–b (o2 and its twin t2) goes, o1 = a→d takes t2's place.
             let (o1, o2) = (ed.m.next(o), ed.m.prev(o));
-            let (t2, d) = (o2 ^ 1, ed.m.origin(o2));
+            let (t2, d) = (twin(o2), ed.m.origin(o2));
             ed.replace_in_loop(t2, o1);
             if ed.m.v_out[d as usize] == o2 {
-                ed.set_out(d, o1 ^ 1);
+                ed.set_out(d, twin(o1));
             }
             removed_faces.push(f);
-            merged_edges.push([o2 >> 1, o1 >> 1]);
+            merged_edges.push([edge_of(o2), edge_of(o1)]);
             a_start = o1;
         }
         // A boundary side of the edge: splice it out of its boundary loop.
@@ -450,7 +453,7 @@ impl HalfEdgeMesh {
         for &f in &removed_faces {
             ed.delete_face(f);
         }
-        ed.delete_edge(h >> 1);
+        ed.delete_edge(edge_of(h));
         for &[gone, _] in &merged_edges {
             ed.delete_edge(gone);
         }
@@ -458,7 +461,7 @@ impl HalfEdgeMesh {
         ed.fix_outgoing(a, a_start);
         ed.set_position(a, p);
         let undo = ed.finish();
-        let mut removed_edges = vec![h >> 1];
+        let mut removed_edges = vec![edge_of(h)];
         removed_edges.extend(merged_edges.iter().map(|m| m[0]));
         CollapseRecord {
             kept_vertex: a,
@@ -482,7 +485,7 @@ impl HalfEdgeMesh {
         if !self.is_halfedge_live(h) {
             return Err(Refusal::Deleted);
         }
-        let o = h ^ 1;
+        let o = twin(h);
         let (Some(c), Some(d)) = (self.opposite_vertex(h), self.opposite_vertex(o)) else {
             return Err(Refusal::BoundaryEdge);
         };
@@ -523,7 +526,7 @@ impl HalfEdgeMesh {
     }
 
     pub(super) fn apply_flip(&mut self, h: u32) -> FlipRecord {
-        let o = h ^ 1;
+        let o = twin(h);
         let (h1, h2) = (self.next(h), self.prev(h)); // b→c, c→a
         let (o1, o2) = (self.next(o), self.prev(o)); // a→d, d→b
         let (a, b) = (self.origin(h), self.origin(o));
@@ -553,7 +556,7 @@ impl HalfEdgeMesh {
             ed.set_out(b, h1);
         }
         FlipRecord {
-            edge: h >> 1,
+            edge: edge_of(h),
             old_vertices: [a, b],
             new_vertices: [c, d],
             faces: [fl, fr],

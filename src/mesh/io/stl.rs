@@ -21,7 +21,7 @@ use std::io::{BufWriter, Read, Write};
 
 use super::text::{is_space, parse_f64, show};
 use super::{build_mesh, capped, parse_error, push_vertex, read_error};
-use crate::mesh::trimesh::{cross, norm, sub};
+use crate::geom::{tri_normal, Vec3};
 use crate::mesh::TriMesh;
 use crate::{Error, Result};
 
@@ -130,10 +130,10 @@ pub(crate) fn first_beyond_f32(mesh: &TriMesh) -> Option<usize> {
 }
 
 fn unit_normal(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f64; 3] {
-    let n = cross(sub(b, a), sub(c, a));
-    let len = norm(n);
+    let n = tri_normal(Vec3::from(a), Vec3::from(b), Vec3::from(c));
+    let len = n.length();
     if len > 0.0 && len.is_finite() {
-        n.map(|x| x / len)
+        (n / len).to_array()
     } else {
         [0.0; 3]
     }
