@@ -442,7 +442,7 @@ mod imp {
             let p = read_versioned(params, pleat_wrinkle_interp_params_default(), "params")?;
             let opts = options(&p)?;
             let t0 = std::time::Instant::now();
-            let (anim, report, _) = interpolate_with_progress(&ka.cwf, &kb.cwf, &opts, relay)?;
+            let (anim, report) = interpolate_with_progress(&ka.cwf, &kb.cwf, &opts, relay)?;
             let s = PleatWrinkleInterpStats {
                 struct_size: 0,
                 iterations: report.iterations.min(u32::MAX as usize) as u32,

@@ -2,7 +2,7 @@
 
 use super::common::{guard, null_arg, PleatStatus};
 use super::mesh::{mesh_ref, PleatMesh};
-use crate::mesh::{MeshReport, ReportOptions};
+use crate::verify::{MeshReport, ReportOptions};
 use crate::Error;
 
 /// `pleat_mesh_check` flag: skip the self-intersection test (the most expensive part);

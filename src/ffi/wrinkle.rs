@@ -613,7 +613,7 @@ pub unsafe extern "C" fn pleat_cwf_get_knoppel_report(
             return Err(null_arg("out"));
         }
         let n = output_size(out, "out")?;
-        let Some(r) = c.knoppel else {
+        let Some(r) = &c.knoppel else {
             return Err(Error::InvalidArgument(
                 "this field's phase was given, not computed by Knöppel's method".into(),
             ));
@@ -846,8 +846,8 @@ mod imp {
     use crate::ffi::mesh::{emit_mesh, mesh_ref};
     use crate::mesh::TriMesh;
     use crate::wrinkle::{
-        BoundaryRule, Complex, Cwf, EvalOptions, FrequencyField, KnoppelOptions, PhaseWeights,
-        SubdivisionOptions,
+        BoundaryRule, Complex, Cwf, EvalOptions, EvalStage, FrequencyField, KnoppelOptions,
+        PhaseWeights, SubdivisionOptions,
     };
 
     /// Borrows a field handle, failing with InvalidArgument on NULL.
@@ -938,7 +938,7 @@ mod imp {
         let (cwf, report) = match zeta {
             Some(z) => (Cwf::new(base, omega, amplitude, z)?, None),
             None => {
-                let (c, r, _) =
+                let (c, r) =
                     Cwf::from_one_form(base, omega, amplitude, &KnoppelOptions::default())?;
                 (c, Some(r))
             }
@@ -1165,7 +1165,7 @@ mod imp {
         } else {
             FrequencyField::PerFace(&k)
         };
-        let (cwf, report, _) = Cwf::from_frequency_field(m.clone(), field, a, &opts)?;
+        let (cwf, report) = Cwf::from_frequency_field(m.clone(), field, a, &opts)?;
         emit(out, cwf, Some(report));
         Ok(())
     }
@@ -1281,15 +1281,8 @@ mod imp {
                     .map(flatten3),
                 ev.omega.filter(|_| keep(PLEAT_WRINKLE_FIELD_OMEGA)),
             ];
-            let subdivision: f64 = (1..=p.levels)
-                .filter_map(|k| st.get_metric(&format!("level {k} seconds")))
-                .sum();
-            let displacement = st
-                .stages
-                .iter()
-                .filter(|s| s.0 == "displace")
-                .map(|s| s.1)
-                .sum();
+            let subdivision = st.subdivision_seconds();
+            let displacement = st.stages.seconds(EvalStage::Displace);
             let s = PleatWrinkleEvalStats {
                 struct_size: 0,
                 levels: p.levels,

@@ -86,13 +86,13 @@ pub fn keyframe_pair(mesh: &TriMesh, kind: PairKind, wavelengths: f64) -> Result
         }
     };
     let opts = KnoppelOptions::default();
-    let (a, _, _) = Cwf::from_frequency_field(
+    let (a, _) = Cwf::from_frequency_field(
         mesh.clone(),
         FrequencyField::PerVertex(&k0),
         vec![a0; n],
         &opts,
     )?;
-    let (b, _, _) =
+    let (b, _) =
         Cwf::from_frequency_field(mesh.clone(), FrequencyField::PerVertex(&k1), amp1, &opts)?;
     Ok((a, b))
 }

@@ -30,7 +30,9 @@ use faer::{Mat, Side};
 
 use super::complex::Complex;
 use super::cwf::barycentric_areas;
+use super::report::CwfStage;
 use super::topology::{cross, dot, norm, sub, Topology};
+use crate::report::StageTimes;
 use crate::{Error, Result};
 
 /// Edge weights of the connection Laplacian.
@@ -70,7 +72,7 @@ impl Default for KnoppelOptions {
 }
 
 /// What the Knöppel phase solve did.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct KnoppelReport {
     /// Smallest generalized eigenvalue `λ = z^H L z / z^H M z` found (the largest of these
     /// over the mesh's connected components, each of which is solved independently).
@@ -81,6 +83,9 @@ pub struct KnoppelReport {
     pub residual: f64,
     /// The shift σ used.
     pub shift: f64,
+    /// Wall seconds of building the CWF (`validate`, `knoppel`), filled by
+    /// [`Cwf::from_one_form`](super::Cwf::from_one_form).
+    pub stages: StageTimes<CwfStage>,
 }
 
 /// Knöppel et al. 2015 phase `z̃` (unit per vertex) for the one-form `omega` (EdgeList
@@ -112,6 +117,7 @@ pub(crate) fn knoppel_phase(
         iterations: 0,
         residual: f64::INFINITY,
         shift: sigma,
+        stages: StageTimes::default(),
     };
     for it in 1..=opts.max_iterations.max(1) {
         let mut rhs = Mat::<f64>::from_fn(2 * n, 1, |i, _| mass[i / 2] * u[i]);
@@ -138,6 +144,7 @@ pub(crate) fn knoppel_phase(
             iterations: it,
             residual,
             shift: sigma,
+            stages: StageTimes::default(),
         };
         if residual < opts.tolerance || (change < opts.tolerance * 1e-3 && it > 2) {
             break;

@@ -2,10 +2,10 @@
 //!
 //! Bakes every mesh of a folder at every screen size `n_p` with [`pleat::lowpoly::generate`]
 //! (or [`pleat::cage::generate`] with `--cage`), checks each output independently with
-//! [`MeshReport`] (and the cage checks of [`pleat::cage::check`]), and writes
+//! [`MeshReport`] (and the cage checks of [`pleat::verify::check_cage`]), and writes
 //! - `lod_bench.csv`: one row per (mesh, `n_p`) with faces, wall seconds, per-stage seconds,
 //!   the sampled two-sided Hausdorff distance relative to the bounding-box diagonal `l`
-//!   ([`pleat::lowpoly::hausdorff_to_input`]: vertices plus a barycentric grid of spacing
+//!   ([`pleat::verify::hausdorff_to_input`]: vertices plus a barycentric grid of spacing
 //!   `l / 400`), the validity flags, and a `status` column (`ok`, or why the case failed);
 //! - `lod_bench.svg`: Hausdorff/l against seconds, both log scale, one polyline per mesh
 //!   (points in `n_p` order) and the mean over the meshes.
@@ -19,9 +19,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use pleat::lowpoly::{LodReport, LodStage};
 use pleat::mesh::io::read_mesh;
-use pleat::mesh::{MeshReport, TriMesh};
-use pleat::Stats;
+use pleat::mesh::TriMesh;
+use pleat::report::Stage as _;
+use pleat::verify::MeshReport;
 
 use super::{progress_bar, EXIT_FAILED, EXIT_INPUT};
 
@@ -86,7 +88,7 @@ struct Row {
     rounds: u64,
     faces_offset: u64,
     reruns_exact: u64,
-    stages: Vec<(String, f64)>,
+    stages: Vec<(LodStage, f64)>,
 }
 
 impl Row {
@@ -104,15 +106,15 @@ impl Row {
     }
 }
 
-/// Stage columns of the CSV (seconds from `Stats::stages`).
-const STAGES: [&str; 7] = [
-    "offset",
-    "simplify",
-    "flow",
-    "align",
-    "convergence",
-    "verify",
-    "measure",
+/// Stage columns of the CSV (seconds from `LodReport::stages`), named `<stage name>_s`.
+const STAGES: [LodStage; 7] = [
+    LodStage::Offset,
+    LodStage::Simplify,
+    LodStage::Flow,
+    LodStage::Align,
+    LodStage::Convergence,
+    LodStage::Verify,
+    LodStage::Measure,
 ];
 
 /// Mesh file extensions the sweep picks up.
@@ -301,8 +303,8 @@ fn parse_csv(text: &str) -> Result<(Vec<Row>, bool), String> {
         let flag = |i: usize| get(i) == "true";
         let mut stages = Vec::new();
         for st in STAGES {
-            if let Some(i) = col(&format!("{st}_s")) {
-                stages.push((st.to_string(), num(i)));
+            if let Some(i) = col(&format!("{}_s", st.name())) {
+                stages.push((st, num(i)));
             }
         }
         rows.push(Row {
@@ -463,8 +465,8 @@ fn bake_case(
     };
     fill_from_output(&mut row, mesh, &out, &stats, cage);
     // The floor measurement is for the table, not part of a bake: keep it out of the times.
-    row.seconds -= stats.stage_seconds("floor");
-    row.cpu_seconds -= stats.get_metric("floor_cpu_seconds").unwrap_or(0.0);
+    row.seconds -= stats.stages.seconds(LodStage::Floor);
+    row.cpu_seconds -= stats.floor.map_or(0.0, |f| f.cpu_seconds);
     (row, Some(out))
 }
 
@@ -474,7 +476,7 @@ fn bake_mesh(
     params: &pleat::lowpoly::LodParams,
     cage: bool,
     prog: &mut pleat::report::ProgressFn<'_>,
-) -> pleat::Result<(TriMesh, Stats)> {
+) -> pleat::Result<(TriMesh, LodReport)> {
     #[cfg(feature = "cage")]
     if cage {
         return pleat::cage::generate(mesh, params, prog);
@@ -484,18 +486,17 @@ fn bake_mesh(
 }
 
 /// Counts, error, stage times from the stats; validity from independent checks of `out`.
-fn fill_from_output(row: &mut Row, input: &TriMesh, out: &TriMesh, stats: &Stats, cage: bool) {
+fn fill_from_output(row: &mut Row, input: &TriMesh, out: &TriMesh, stats: &LodReport, cage: bool) {
     row.status = "ok".into();
     row.faces_out = out.triangle_count();
-    row.hausdorff_over_l = stats.get_metric("hausdorff_rel").unwrap_or(f64::NAN);
-    let metric = |k: &str| stats.get_metric(k).unwrap_or(f64::NAN);
-    row.in_to_out_over_l = metric("hausdorff_in_to_out_rel");
-    row.out_to_in_over_l = metric("hausdorff_out_to_in_rel");
-    row.floor_over_l = metric("hausdorff_floor_rel");
-    row.rounds = stats.get_count("rounds").unwrap_or(0);
-    row.faces_offset = stats.get_count("faces_offset").unwrap_or(0);
-    row.reruns_exact = stats.get_count("reruns_exact").unwrap_or(0);
-    row.stages = stats.stages.clone();
+    row.hausdorff_over_l = stats.hausdorff_rel;
+    row.in_to_out_over_l = stats.hausdorff_in_to_out_rel;
+    row.out_to_in_over_l = stats.hausdorff_out_to_in_rel;
+    row.floor_over_l = stats.floor.map_or(f64::NAN, |f| f.rel);
+    row.rounds = stats.rounds;
+    row.faces_offset = stats.faces_offset;
+    row.reruns_exact = stats.reruns_exact;
+    row.stages = stats.stages.iter().collect();
     let r = MeshReport::compute(out);
     row.watertight = r.is_watertight;
     row.manifold = r.is_manifold && r.consistently_oriented;
@@ -508,16 +509,10 @@ fn fill_from_output(row: &mut Row, input: &TriMesh, out: &TriMesh, stats: &Stats
     }
 }
 
-/// `(encloses, untouched)` from [`pleat::cage::check`].
-#[cfg(feature = "cage")]
+/// `(encloses, untouched)` from [`pleat::verify::check_cage`].
 fn cage_flags(out: &TriMesh, input: &TriMesh) -> (bool, bool) {
-    let c = pleat::cage::check(out, input);
+    let c = pleat::verify::check_cage(out, input);
     (c.encloses, c.untouched)
-}
-
-#[cfg(not(feature = "cage"))]
-fn cage_flags(_out: &TriMesh, _input: &TriMesh) -> (bool, bool) {
-    (false, false)
 }
 
 fn panic_message(p: &Box<dyn std::any::Any + Send>) -> String {
@@ -577,7 +572,7 @@ fn csv_text(rows: &[Row], cage: bool) -> String {
     }
     s.push_str(",rounds,faces_offset,reruns_exact");
     for st in STAGES {
-        let _ = write!(s, ",{st}_s");
+        let _ = write!(s, ",{}_s", st.name());
     }
     s.push('\n');
     for r in rows {
