@@ -11,8 +11,14 @@
 
 use std::path::{Path, PathBuf};
 
+// The keyframe pairs shared with `pleat bench wrinkle` (benchmark code, not library API); the
+// SVG plot in it is used by the CLI only.
+#[allow(dead_code)]
+#[path = "../src/bin/pleat/interp_bench.rs"]
+mod interp_bench;
+
+use interp_bench::{keyframe_pair, PairKind};
 use pleat::mesh::io::read_mesh;
-use pleat::wrinkle::interp_bench::{keyframe_pair, PairKind};
 use pleat::wrinkle::{interpolate, HessianModel, InterpOptions};
 
 fn env_usize(name: &str, default: usize) -> usize {

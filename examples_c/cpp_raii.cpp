@@ -1,8 +1,12 @@
-// The C++ RAII wrapper: create, copy out, errors as exceptions, moves.
+// The C++ RAII wrapper (bindings/cpp/pleat.hpp) over every capability of the C API: meshes,
+// the validity report, LODs, LOD chains, cages, offset surfaces with stats, wrinkle fields and
+// their interpolation; errors as exceptions, moves, progress and cancellation.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
+#include <unistd.h>
 #include "pleat.hpp"
 
 static int failures = 0, checks = 0;
@@ -79,10 +83,54 @@ static void wrinkles(const pleat::Mesh &base) {
     } catch (const std::runtime_error &err) {
         EXPECT(std::string(err.what()) == "from the callback");
     }
+    // per-corner omega round trip, float copy into an interleaved buffer
+    std::vector<double> corners = cwf.corner_omega();
+    EXPECT(corners.size() == 12 && cwf.triangle_count() == 4);
+    pleat::Cwf from_corners = pleat::Cwf::from_corner_omega(base, corners, amp, zeta);
+    EXPECT(std::fabs(from_corners.omega()[5] - omega[5]) < 1e-14);
+    std::vector<float> interleaved(4 * fine.vertex_count(), -1.0f);
+    fields.copy(PLEAT_WRINKLE_FIELD_NORMALS, interleaved.data(), fine.vertex_count(), 16);
+    EXPECT(interleaved[3] == -1.0f && std::fabs(interleaved[0]) <= 1.0f);
+
+    // interpolation between two keyframes: frames, history, files
+    std::vector<double> amp_b(base.vertex_count(), 0.1);
+    pleat::Cwf key_b = pleat::Cwf::from_edge_omega(base, omega, amp_b, zeta);
+    PleatWrinkleInterpParams ip = pleat_wrinkle_interp_params_default();
+    ip.guide_frames = 2;
+    ip.substeps = 2;
+    ip.max_iterations = 20;
+    PleatWrinkleInterpStats is{};
+    is.struct_size = sizeof is;
+    pleat::Animation anim = cwf.interpolate(key_b, ip, &is);
+    EXPECT(anim.frame_count() == 5 && anim.guide_count() == 2);
+    EXPECT(anim.history().size() == 2 * (is.iterations + 1));
+    EXPECT(std::fabs(anim.frame(0.5).amplitude()[0] - 0.075) < 1e-12);
+    EXPECT(anim.frame(1.0).amplitude() == amp_b);
+    const char *tmp = std::getenv("TMPDIR");
+    const std::string path = std::string(tmp && *tmp ? tmp : "/tmp") + "/pleat_cpp_raii_" +
+                             std::to_string(getpid()) + ".cwfa";
+    anim.write(path);
+    pleat::Animation back = pleat::Animation::read(base, path);
+    std::remove(path.c_str());
+    EXPECT(back.frame_count() == 5 && back.frame(0.25).zeta() == anim.frame(0.25).zeta());
+    try {
+        anim.frame(2.0);
+        EXPECT(false);
+    } catch (const pleat::Error &err) {
+        EXPECT(err.status() == PLEAT_STATUS_INVALID_ARGUMENT);
+    }
+    try {
+        cwf.knoppel_report();  // zeta was given: no solve, no report
+        EXPECT(false);
+    } catch (const pleat::Error &err) {
+        EXPECT(err.status() == PLEAT_STATUS_INVALID_ARGUMENT);
+    }
+
     // Knoppel's phase (zeta omitted), moves, and a size mistake
     pleat::Cwf knoppel = pleat::Cwf::from_edge_omega(base, omega, amp);
     pleat::Cwf moved = std::move(knoppel);
     EXPECT(!knoppel && moved && moved.zeta().size() == 8);
+    EXPECT(moved.knoppel_report().iterations >= 1);
     try {
         omega.pop_back();
         pleat::Cwf::from_edge_omega(base, omega, amp, zeta);
@@ -93,7 +141,81 @@ static void wrinkles(const pleat::Mesh &base) {
     }
 }
 
+// pleat::Mesh::lod / lod_chain / cage / offset on a unit cube, checked by the validity report.
+static void lods() {
+    const float p[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
+    const uint32_t t[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                          1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+    pleat::Mesh cube = pleat::Mesh::from_arrays(p, 8, t, 36);
+    if (!pleat::has_feature("lod")) {
+        try {
+            cube.lod(10.0);
+            EXPECT(false);
+        } catch (const pleat::Error &err) {
+            EXPECT(err.status() == PLEAT_STATUS_UNSUPPORTED);
+        }
+        return;
+    }
+    PleatLodStats stats = pleat::lod_stats();
+    int calls = 0;
+    pleat::Mesh lod = cube.lod(pleat::lod_params(10.0), &stats, [&](const char *, double f) {
+        calls++;
+        return f >= 0.0 && f <= 1.0;
+    });
+    PleatMeshReport r = lod.report();
+    EXPECT(r.is_watertight && r.self_intersection_free && r.consistently_oriented);
+    EXPECT(stats.watertight && stats.face_count == lod.triangle_count() && calls > 0);
+    // positions into an interleaved buffer (xyz + one float of padding per vertex)
+    std::vector<float> interleaved(4 * lod.vertex_count(), 7.0f);
+    lod.copy_positions(interleaved.data(), lod.vertex_count(), 16);
+    EXPECT(interleaved[3] == 7.0f && interleaved[0] == lod.positions_f32()[0]);
+
+    std::vector<PleatLodStats> chain_stats;
+    std::vector<pleat::Mesh> chain = cube.lod_chain({10.0, 5.0}, pleat::lod_params(), &chain_stats);
+    EXPECT(chain.size() == 2 && chain_stats.size() == 2 && chain[1].report().is_watertight);
+    EXPECT(chain_stats[0].offset_distance < chain_stats[1].offset_distance);
+
+    if (pleat::has_feature("cage")) {
+        PleatLodStats cs = pleat::lod_stats();
+        pleat::Mesh cage = cube.cage(pleat::lod_params(10.0), &cs);
+        EXPECT(cs.encloses_input == 1 && cage.report().is_watertight);
+    }
+
+    PleatOffsetParams op = pleat_offset_params_default();
+    op.screen_size = 10.0;
+    pleat::Stats ostats;
+    pleat::Mesh off = cube.offset(op, &ostats);
+    EXPECT(off.report(PLEAT_CHECK_SKIP_SELF_INTERSECTIONS).is_watertight);
+    EXPECT(ostats.count(PLEAT_STATS_KIND_STAGE) > 0 && ostats.total_seconds() > 0.0);
+    EXPECT(ostats.value(PLEAT_STATS_KIND_VERIFIED, "watertight") == 1.0);
+    EXPECT(ostats.json().find("\"verified\"") != std::string::npos);
+
+    // cancel, an exception from the callback, and a bad parameter
+    try {
+        cube.lod(pleat::lod_params(10.0), nullptr, [](const char *, double) { return false; });
+        EXPECT(false);
+    } catch (const pleat::Error &err) {
+        EXPECT(err.status() == PLEAT_STATUS_CANCELLED);
+    }
+    try {
+        cube.cage(pleat::lod_params(10.0), nullptr, [](const char *, double) -> bool {
+            throw std::runtime_error("from the callback");
+        });
+        EXPECT(false);
+    } catch (const std::runtime_error &err) {
+        EXPECT(std::string(err.what()) == "from the callback");
+    }
+    try {
+        cube.lod(-1.0);
+        EXPECT(false);
+    } catch (const pleat::Error &err) {
+        EXPECT(err.status() == PLEAT_STATUS_INVALID_ARGUMENT && !pleat::last_error().empty());
+        std::printf("  ok: negative screen size -> %s\n", err.what());
+    }
+}
+
 int main() {
+    EXPECT(pleat::abi_version() == PLEAT_ABI_VERSION && !pleat::version().empty());
     const double p[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
     const uint32_t t[] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2};
     pleat::Mesh m = pleat::Mesh::from_arrays(p, 4, t, 12);
@@ -116,7 +238,9 @@ int main() {
         EXPECT(e.status() == PLEAT_STATUS_IO);
         std::printf("  ok: missing file -> %s\n", e.what());
     }
+    EXPECT(moved.report().is_watertight && moved.report().total_genus == 0);
     wrinkles(moved);
+    lods();
     std::printf("cpp_raii: %d passed, %d failed\n", checks - failures, failures);
     return failures == 0 ? 0 : 1;
 }

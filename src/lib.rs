@@ -6,8 +6,8 @@
 //! - `lod`: any triangle soup in, a watertight, manifold, self-intersection-free low-poly mesh
 //!   out that is indistinguishable from the input at a given screen size (dissertation ch. 4).
 //! - `cage`: the same, strictly enclosing the input without touching it (ch. 4.5.2).
-//! - `wrinkle`: complex wrinkle fields — evaluation, interpolation, design (ch. 3);
-//!   `tfw`: tension-field wrinkle statics (ch. 2).
+//! - `wrinkle`: complex wrinkle fields — evaluation, interpolation, design (ch. 3); brings the
+//!   numerics module [`solve`] (sparse Cholesky, inverse iteration, Krylov; faer).
 //! - `cli`: the `pleat` command-line tool; `io-gltf`: glTF 2.0 reading and writing.
 //!
 //! The mesh core ([`mesh`], [`spatial`]) and the independent verifier ([`verify`]) are always
@@ -41,8 +41,9 @@ pub mod cage;
 #[cfg(feature = "wrinkle")]
 pub mod wrinkle;
 
-#[cfg(feature = "tfw")]
-pub mod tfw;
+// Numerics (faer): built with the features that need it.
+#[cfg(feature = "wrinkle")]
+pub mod solve;
 
 pub mod ffi;
 

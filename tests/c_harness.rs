@@ -25,9 +25,6 @@ fn features() -> Vec<&'static str> {
     if cfg!(feature = "wrinkle") {
         f.push("wrinkle");
     }
-    if cfg!(feature = "tfw") {
-        f.push("tfw");
-    }
     if cfg!(feature = "io-gltf") {
         f.push("io-gltf");
     }

@@ -1,7 +1,11 @@
 // pleat.hpp — header-only C++17 RAII wrappers over the C API in pleat.h.
 //
+// Covers the whole C API: meshes (arrays, files, validity report), LODs, LOD chains, cages,
+// offset surfaces with their stats, wrinkle fields (creation, copy-out, Knoppel report,
+// evaluation with fields) and wrinkle animations (interpolation, frames, history, files).
 // Every failing call throws pleat::Error carrying the PleatStatus and pleat's message.
-// Handles are move-only and released in destructors.
+// Handles are move-only and released in destructors. Progress callbacks return false to
+// cancel; an exception thrown by one comes out of the call that ran it.
 #ifndef PLEAT_HPP
 #define PLEAT_HPP
 
@@ -35,11 +39,122 @@ inline void check(PleatStatus s) {
     if (s != PLEAT_STATUS_OK) throw Error(s, pleat_last_error());
 }
 
-/// Library version string.
+/// Library version string (`major.minor.patch`, Cargo.toml's).
 inline std::string version() { return pleat_version(); }
+
+/// The C ABI version of the loaded library; compare with PLEAT_ABI_VERSION.
+inline uint32_t abi_version() noexcept { return pleat_abi_version(); }
+
+/// True when the library was built with capability `name` ("lod", "cage", "wrinkle", ...).
+inline bool has_feature(const char *name) noexcept { return pleat_has_feature(name) != 0; }
+
+/// The message of the last failed pleat call on this thread ("" after a success).
+inline std::string last_error() { return pleat_last_error(); }
 
 /// Sets pleat's worker thread count (0 = all cores).
 inline void set_thread_count(uint32_t n) { check(pleat_set_thread_count(n)); }
+
+/// Worker threads the next call will use (>= 1).
+inline uint32_t thread_count() noexcept { return pleat_thread_count(); }
+
+/// Progress callback of long operations: called on the calling thread with the stage name and
+/// the fraction done; return false to cancel (the call then throws pleat::Error with
+/// PLEAT_STATUS_CANCELLED). An exception it throws cancels the call and is rethrown from it.
+using Progress = std::function<bool(const char *stage, double fraction)>;
+
+namespace detail {
+/// Adapts a pleat::Progress to PleatProgressFn + user_data and carries its exception out.
+class ProgressRelay {
+  public:
+    explicit ProgressRelay(const Progress &fn) : fn_(&fn) {}
+    PleatProgressFn callback() const noexcept { return *fn_ ? &ProgressRelay::call : nullptr; }
+    void *user_data() noexcept { return this; }
+    /// Rethrows the callback's exception, else throws pleat::Error for a failing status.
+    void finish(PleatStatus s) const {
+        if (error_) std::rethrow_exception(error_);
+        check(s);
+    }
+
+  private:
+    static int32_t call(void *user, const PleatProgress *info) {
+        auto *self = static_cast<ProgressRelay *>(user);
+        try {
+            return (*self->fn_)(info->stage, info->fraction) ? 0 : 1;
+        } catch (...) {
+            self->error_ = std::current_exception();
+            return 1;
+        }
+    }
+    const Progress *fn_;
+    std::exception_ptr error_;
+};
+}  // namespace detail
+
+/// Default LOD/cage parameters (the dissertation's) with `screen_size` set.
+inline PleatLodParams lod_params(double screen_size = 200.0) noexcept {
+    PleatLodParams p = pleat_lod_params_default();
+    p.screen_size = screen_size;
+    return p;
+}
+
+/// A PleatLodStats ready to be filled (`struct_size` set).
+inline PleatLodStats lod_stats() noexcept {
+    PleatLodStats s{};
+    s.struct_size = sizeof s;
+    return s;
+}
+
+/// Statistics of one long operation (wraps PleatStats*): per-stage seconds, counts, metrics
+/// and verified guarantees, by kind and index or as JSON.
+class Stats {
+  public:
+    Stats() = default;
+    explicit Stats(PleatStats *raw) noexcept : raw_(raw) {}
+    Stats(const Stats &) = delete;
+    Stats &operator=(const Stats &) = delete;
+    Stats(Stats &&o) noexcept : raw_(std::exchange(o.raw_, nullptr)) {}
+    Stats &operator=(Stats &&o) noexcept {
+        if (this != &o) {
+            pleat_stats_destroy(raw_);
+            raw_ = std::exchange(o.raw_, nullptr);
+        }
+        return *this;
+    }
+    ~Stats() { pleat_stats_destroy(raw_); }
+
+    /// Number of entries of `kind` (PLEAT_STATS_KIND_*).
+    size_t count(PleatStatsKind kind) const noexcept { return pleat_stats_count(raw_, kind); }
+    /// Entry `index` of `kind`: (name, value); seconds, a count, a metric or 1/0.
+    std::pair<std::string, double> entry(PleatStatsKind kind, size_t index) const {
+        const char *name = nullptr;
+        double value = 0.0;
+        check(pleat_stats_entry(raw_, kind, index, &name, &value));
+        return {name, value};
+    }
+    /// The value of the entry of `kind` called `name`; throws INVALID_ARGUMENT when absent.
+    double value(PleatStatsKind kind, const std::string &name) const {
+        for (size_t i = 0; i < count(kind); i++) {
+            auto e = entry(kind, i);
+            if (e.first == name) return e.second;
+        }
+        throw Error(PLEAT_STATUS_INVALID_ARGUMENT, "no stats entry named " + name);
+    }
+    /// Total wall-clock seconds over all stages.
+    double total_seconds() const noexcept { return pleat_stats_total_seconds(raw_); }
+    /// The stats as one JSON object ({"stages":…,"counts":…,"metrics":…,"verified":…}).
+    std::string json() const {
+        size_t needed = 0;
+        check(pleat_stats_to_json(raw_, nullptr, 0, &needed));
+        std::string s(needed + 1, '\0');
+        check(pleat_stats_to_json(raw_, &s[0], s.size(), nullptr));
+        s.resize(needed);
+        return s;
+    }
+    explicit operator bool() const noexcept { return raw_ != nullptr; }
+
+  private:
+    PleatStats *raw_ = nullptr;
+};
 
 /// An owned, immutable triangle mesh (wraps PleatMesh*).
 class Mesh {
@@ -109,6 +224,76 @@ class Mesh {
         return e;
     }
 
+    /// Positions as packed xyz floats (rounded to nearest).
+    std::vector<float> positions_f32() const {
+        std::vector<float> p(3 * vertex_count() + 3);
+        check(pleat_mesh_copy_positions_f32(raw_, p.data(), vertex_count(), 0));
+        p.resize(3 * vertex_count());
+        return p;
+    }
+    /// Copies the positions into a caller's (possibly interleaved) vertex buffer: xyz floats
+    /// every `stride_bytes` (0 = packed); bytes in between are left untouched.
+    void copy_positions(float *dst, size_t vertex_capacity, size_t stride_bytes = 0) const {
+        check(pleat_mesh_copy_positions_f32(raw_, dst, vertex_capacity, stride_bytes));
+    }
+    /// As copy_positions with doubles.
+    void copy_positions(double *dst, size_t vertex_capacity, size_t stride_bytes = 0) const {
+        check(pleat_mesh_copy_positions_f64(raw_, dst, vertex_capacity, stride_bytes));
+    }
+
+    /// Validity report, pleat_mesh_check (PLEAT_CHECK_* flags: skip self-intersections,
+    /// weld first).
+    PleatMeshReport report(uint32_t flags = 0) const {
+        PleatMeshReport r{};
+        r.struct_size = sizeof r;
+        check(pleat_mesh_check(raw_, flags, &r));
+        return r;
+    }
+
+    /// One LOD for `params.screen_size` pixels (see pleat::lod_params); fills `*stats` when
+    /// non-null. Watertight, manifold, self-intersection-free.
+    Mesh lod(const PleatLodParams &params, PleatLodStats *stats = nullptr,
+             const Progress &progress = {}) const {
+        return bake(&pleat_lod_generate, params, stats, progress);
+    }
+    /// One LOD for `screen_size` pixels with the default parameters.
+    Mesh lod(double screen_size) const { return lod(lod_params(screen_size)); }
+    /// A cage: like lod, but enclosing this mesh without touching it
+    /// (`stats->encloses_input` is the verification).
+    Mesh cage(const PleatLodParams &params, PleatLodStats *stats = nullptr,
+              const Progress &progress = {}) const {
+        return bake(&pleat_cage_generate, params, stats, progress);
+    }
+    /// One LOD per screen size, in the order given; coarser levels start from finer results.
+    /// `params.screen_size`/`target_faces` are ignored; `*stats` is resized and filled.
+    std::vector<Mesh> lod_chain(const std::vector<double> &screen_sizes,
+                                const PleatLodParams &params = lod_params(),
+                                std::vector<PleatLodStats> *stats = nullptr,
+                                const Progress &progress = {}) const {
+        std::vector<PleatMesh *> raw(screen_sizes.size() + 1, nullptr);
+        if (stats) stats->assign(screen_sizes.size() + 1, lod_stats());
+        detail::ProgressRelay relay(progress);
+        relay.finish(pleat_lod_generate_chain(raw_, screen_sizes.data(), screen_sizes.size(),
+                                              &params, relay.callback(), relay.user_data(),
+                                              raw.data(), stats ? stats->data() : nullptr));
+        if (stats) stats->pop_back();
+        std::vector<Mesh> out;
+        out.reserve(screen_sizes.size());
+        for (size_t i = 0; i < screen_sizes.size(); i++) out.emplace_back(raw[i]);
+        return out;
+    }
+    /// The d-offset surface (LOD stage 1); `*stats` receives its PleatStats when non-null.
+    Mesh offset(const PleatOffsetParams &params = pleat_offset_params_default(),
+                Stats *stats = nullptr, const Progress &progress = {}) const {
+        PleatMesh *m = nullptr;
+        PleatStats *st = nullptr;
+        detail::ProgressRelay relay(progress);
+        relay.finish(pleat_offset_surface(raw_, &params, relay.callback(), relay.user_data(), &m,
+                                          stats ? &st : nullptr));
+        if (stats) *stats = Stats(st);
+        return Mesh(m);
+    }
+
     /// The underlying handle (still owned by this object).
     const PleatMesh *get() const noexcept { return raw_; }
     /// Gives up ownership of the handle.
@@ -116,6 +301,17 @@ class Mesh {
     explicit operator bool() const noexcept { return raw_ != nullptr; }
 
   private:
+    using BakeFn = PleatStatus (*)(const PleatMesh *, const PleatLodParams *, PleatProgressFn,
+                                   void *, PleatMesh **, PleatLodStats *);
+    Mesh bake(BakeFn fn, const PleatLodParams &params, PleatLodStats *stats,
+              const Progress &progress) const {
+        PleatMesh *m = nullptr;
+        PleatLodStats local = lod_stats();
+        detail::ProgressRelay relay(progress);
+        relay.finish(fn(raw_, &params, relay.callback(), relay.user_data(), &m,
+                        stats ? stats : &local));
+        return Mesh(m);
+    }
     PleatMesh *raw_ = nullptr;
 };
 
@@ -151,11 +347,18 @@ class WrinkleFields {
         v.resize(comps * n);
         return v;
     }
+    /// Copies the field as floats into a caller buffer, one element every `stride_bytes`
+    /// (0 = packed), e.g. straight into an interleaved vertex buffer.
+    void copy(uint32_t field, float *dst, size_t element_capacity, size_t stride_bytes = 0) const {
+        check(pleat_wrinkle_fields_copy_f32(raw_, field, dst, element_capacity, stride_bytes));
+    }
     explicit operator bool() const noexcept { return raw_ != nullptr; }
 
   private:
     PleatWrinkleFields *raw_ = nullptr;
 };
+
+class Animation;
 
 /// A complex wrinkle field on a base mesh (wraps PleatCwf*): omega per edge of
 /// `base.edges()`, amplitude and unit phase zeta (re, im) per vertex. Needs the "wrinkle"
@@ -244,6 +447,26 @@ class Cwf {
         v.pop_back();
         return v;
     }
+    size_t triangle_count() const noexcept { return pleat_cwf_triangle_count(raw_); }
+    /// omega per triangle corner (3 per triangle, corner i to i+1).
+    std::vector<double> corner_omega() const {
+        std::vector<double> v(3 * triangle_count() + 1);
+        check(pleat_cwf_copy_corner_omega(raw_, v.data(), 3 * triangle_count()));
+        v.pop_back();
+        return v;
+    }
+    /// Report of the Knoppel phase solve; INVALID_ARGUMENT when zeta was given, not solved.
+    PleatKnoppelReport knoppel_report() const {
+        PleatKnoppelReport r{};
+        r.struct_size = sizeof r;
+        check(pleat_cwf_get_knoppel_report(raw_, &r));
+        return r;
+    }
+    /// The animation from this keyframe (t = 0) to `other` (t = 1) on the same base mesh.
+    Animation interpolate(
+        const Cwf &other,
+        const PleatWrinkleInterpParams &params = pleat_wrinkle_interp_params_default(),
+        PleatWrinkleInterpStats *stats = nullptr, const Progress &progress = {}) const;
 
     /// The wrinkled mesh after `levels` Loop refinements (other parameters at their defaults).
     Mesh evaluate(uint32_t levels = 3) const {
@@ -256,28 +479,12 @@ class Cwf {
     /// (pleat::Error with PLEAT_STATUS_CANCELLED). An exception it throws is rethrown here.
     Mesh evaluate(const PleatWrinkleEvalParams &params, WrinkleFields *fields = nullptr,
                   PleatWrinkleEvalStats *stats = nullptr,
-                  const std::function<bool(const char *, double)> &keep_going = {}) const {
-        struct Relay {
-            const std::function<bool(const char *, double)> *fn;
-            std::exception_ptr error;
-        } relay{&keep_going, nullptr};
-        PleatProgressFn cb = nullptr;
-        if (keep_going)
-            cb = [](void *user, const PleatProgress *info) -> int32_t {
-                Relay *r = static_cast<Relay *>(user);
-                try {
-                    return (*r->fn)(info->stage, info->fraction) ? 0 : 1;
-                } catch (...) {
-                    r->error = std::current_exception();
-                    return 1;
-                }
-            };
+                  const Progress &keep_going = {}) const {
+        detail::ProgressRelay relay(keep_going);
         PleatMesh *m = nullptr;
         PleatWrinkleFields *f = nullptr;
-        PleatStatus s = pleat_cwf_evaluate(raw_, &params, cb, &relay, &m, fields ? &f : nullptr,
-                                           stats);
-        if (relay.error) std::rethrow_exception(relay.error);
-        check(s);
+        relay.finish(pleat_cwf_evaluate(raw_, &params, relay.callback(), relay.user_data(), &m,
+                                        fields ? &f : nullptr, stats));
         if (fields) *fields = WrinkleFields(f);
         return Mesh(m);
     }
@@ -293,6 +500,69 @@ class Cwf {
     }
     PleatCwf *raw_ = nullptr;
 };
+
+/// A wrinkle animation between two keyframes (wraps PleatCwfAnimation*): the field at any
+/// t in [0, 1]. Made by Cwf::interpolate or Animation::read.
+class Animation {
+  public:
+    Animation() = default;
+    explicit Animation(PleatCwfAnimation *raw) noexcept : raw_(raw) {}
+    Animation(const Animation &) = delete;
+    Animation &operator=(const Animation &) = delete;
+    Animation(Animation &&o) noexcept : raw_(std::exchange(o.raw_, nullptr)) {}
+    Animation &operator=(Animation &&o) noexcept {
+        if (this != &o) {
+            pleat_cwf_animation_destroy(raw_);
+            raw_ = std::exchange(o.raw_, nullptr);
+        }
+        return *this;
+    }
+    ~Animation() { pleat_cwf_animation_destroy(raw_); }
+
+    /// Reads a .cwfa file written for `base`.
+    static Animation read(const Mesh &base, const std::string &path) {
+        PleatCwfAnimation *a = nullptr;
+        check(pleat_cwf_animation_read_file(base.get(), path.c_str(), &a));
+        return Animation(a);
+    }
+    /// Writes the .cwfa file (lossless).
+    void write(const std::string &path) const {
+        check(pleat_cwf_animation_write_file(raw_, path.c_str()));
+    }
+    /// Playback frames (guide_frames * substeps + 1); frame i is at t = i / (count - 1).
+    size_t frame_count() const noexcept { return pleat_cwf_animation_frame_count(raw_); }
+    /// Guide intervals N'.
+    size_t guide_count() const noexcept { return pleat_cwf_animation_guide_count(raw_); }
+    /// The field at time t in [0, 1] (0 and 1 reproduce the keyframes exactly).
+    Cwf frame(double t) const {
+        PleatCwf *c = nullptr;
+        check(pleat_cwf_animation_frame(raw_, t, &c));
+        return Cwf(c);
+    }
+    /// Convergence history: (seconds, normalized gradient norm) pairs, flattened.
+    std::vector<double> history() const {
+        size_t n = pleat_cwf_animation_history_count(raw_);
+        std::vector<double> v(2 * n + 1);
+        check(pleat_cwf_animation_copy_history(raw_, v.data(), n));
+        v.resize(2 * n);
+        return v;
+    }
+    const PleatCwfAnimation *get() const noexcept { return raw_; }
+    explicit operator bool() const noexcept { return raw_ != nullptr; }
+
+  private:
+    PleatCwfAnimation *raw_ = nullptr;
+};
+
+inline Animation Cwf::interpolate(const Cwf &other, const PleatWrinkleInterpParams &params,
+                                  PleatWrinkleInterpStats *stats,
+                                  const Progress &progress) const {
+    PleatCwfAnimation *a = nullptr;
+    detail::ProgressRelay relay(progress);
+    relay.finish(pleat_cwf_interpolate(raw_, other.raw_, &params, relay.callback(),
+                                       relay.user_data(), &a, stats));
+    return Animation(a);
+}
 
 }  // namespace pleat
 

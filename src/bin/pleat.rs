@@ -16,6 +16,9 @@ use std::process::ExitCode;
 #[cfg(feature = "lod")]
 #[path = "pleat/bench_lod.rs"]
 mod bench_lod;
+#[cfg(feature = "wrinkle")]
+#[path = "pleat/interp_bench.rs"]
+mod interp_bench;
 
 #[derive(Parser)]
 #[command(
@@ -593,9 +596,9 @@ fn offset(
 #[cfg(feature = "wrinkle")]
 mod wrinkle_cmd {
     use super::{BenchCommand, WrinkleCommand, EXIT_INPUT};
+    use crate::interp_bench::{keyframe_pair, svg_plot, PairKind, Series};
     use pleat::mesh::io::{read_mesh, write_mesh};
     use pleat::mesh::TriMesh;
-    use pleat::wrinkle::interp_bench::{keyframe_pair, svg_plot, PairKind, Series};
     use pleat::wrinkle::{
         interpolate_with_progress, read_animation, read_cwf, write_animation, write_cwf,
         BoundaryRule, Complex, Cwf, EvalOptions, FrequencyField, InterpOptions, KnoppelOptions,

@@ -252,8 +252,8 @@ pub extern "C" fn pleat_abi_version() -> u32 {
     PLEAT_ABI_VERSION
 }
 
-/// 1 when this build includes the capability `name` ("lod", "cage", "wrinkle", "tfw",
-/// "io-gltf"), 0 otherwise or when `name` is NULL or unknown.
+/// 1 when this build includes the capability `name` ("lod", "cage", "wrinkle", "io-gltf"), 0
+/// otherwise or when `name` is NULL or unknown.
 ///
 /// # Safety
 /// `name` is NULL or a NUL-terminated string.
@@ -262,11 +262,10 @@ pub unsafe extern "C" fn pleat_has_feature(name: *const c_char) -> u32 {
     let Ok(name) = c_str_arg(name, "name") else {
         return 0;
     };
-    const BUILT: [(&str, bool); 5] = [
+    const BUILT: [(&str, bool); 4] = [
         ("lod", cfg!(feature = "lod")),
         ("cage", cfg!(feature = "cage")),
         ("wrinkle", cfg!(feature = "wrinkle")),
-        ("tfw", cfg!(feature = "tfw")),
         ("io-gltf", cfg!(feature = "io-gltf")),
     ];
     let on = BUILT.iter().any(|&(n, built)| n == name && built);

@@ -36,7 +36,6 @@ use std::path::Path;
 
 use super::complex::Complex;
 use super::cwf::Cwf;
-use super::interpolate::check_time;
 use super::io::connectivity_hash;
 use crate::mesh::TriMesh;
 use crate::{Error, Result};
@@ -377,4 +376,13 @@ impl<'a> Tokens<'a> {
         self.keyword(kw)?;
         self.number::<usize>(kw)
     }
+}
+
+/// `Ok` when `t ∈ [0, 1]`; an invalid-argument error otherwise (NaN included). Shared by
+/// [`CwfAnimation::frame_at`] and the keyframe blends of [`interpolate`](mod@super::interpolate).
+pub(crate) fn check_time(t: f64) -> Result<()> {
+    if !(0.0..=1.0).contains(&t) {
+        return crate::invalid_arg!("t = {t} is outside [0, 1]");
+    }
+    Ok(())
 }

@@ -3,10 +3,12 @@
 //! its soft-compatibility energies (eqs. 3.5, 3.6) and the compatible/residual split of ω
 //! (eq. 3.17).
 
+use super::areas::barycentric_areas;
 use super::complex::Complex;
 use super::knoppel::{knoppel_phase, KnoppelOptions, KnoppelReport};
 use super::report::CwfStage;
-use super::topology::{cross, norm, sub, Topology};
+use super::topology::Topology;
+use crate::geom::Vec3;
 use crate::mesh::TriMesh;
 use crate::report::StageTimes;
 use crate::{Error, Result};
@@ -245,30 +247,14 @@ pub(crate) fn wrap_to_pi(x: f64) -> f64 {
     r
 }
 
-/// `(A_kl per edge, A_j per vertex)`: a third of each incident triangle's area.
-pub(crate) fn barycentric_areas(topo: &Topology, x: &[[f64; 3]]) -> (Vec<f64>, Vec<f64>) {
-    let mut edge = vec![0.0; topo.n_edges()];
-    let mut vertex = vec![0.0; topo.n_vertices];
-    for (f, t) in topo.faces.iter().enumerate() {
-        let o = x[t[0] as usize];
-        let third = norm(cross(sub(x[t[1] as usize], o), sub(x[t[2] as usize], o))) / 6.0;
-        for c in 0..3 {
-            edge[topo.face_edges[f][c] as usize] += third;
-            vertex[t[c] as usize] += third;
-        }
-    }
-    (edge, vertex)
-}
-
 /// `ω` on the EdgeList edges of `base` from per-vertex or per-face wave vectors.
 pub fn one_form_from_vectors(base: &TriMesh, frequency: FrequencyField<'_>) -> Result<Vec<f64>> {
     let el = base.edges();
     let x = base.positions();
     let edge_vec = |e: usize| {
         let [a, b] = el.edges[e].0;
-        sub(x[b as usize], x[a as usize])
+        Vec3::from(x[b as usize]) - Vec3::from(x[a as usize])
     };
-    let dot3 = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
     match frequency {
         FrequencyField::PerVertex(v) => {
             check_len("frequency (one per vertex)", v.len(), base.vertex_count())?;
@@ -277,7 +263,7 @@ pub fn one_form_from_vectors(base: &TriMesh, frequency: FrequencyField<'_>) -> R
                 .map(|e| {
                     let [a, b] = el.edges[e].0;
                     let (va, vb) = (v[a as usize], v[b as usize]);
-                    0.5 * dot3([va[0] + vb[0], va[1] + vb[1], va[2] + vb[2]], edge_vec(e))
+                    0.5 * (Vec3::from(va) + Vec3::from(vb)).dot(edge_vec(e))
                 })
                 .collect())
         }
@@ -288,7 +274,7 @@ pub fn one_form_from_vectors(base: &TriMesh, frequency: FrequencyField<'_>) -> R
             let mut count = vec![0u32; el.len()];
             for (f, fe) in el.face_edges.iter().enumerate() {
                 for &e in fe.iter().filter(|&&e| e != u32::MAX) {
-                    sum[e as usize] += dot3(v[f], edge_vec(e as usize));
+                    sum[e as usize] += Vec3::from(v[f]).dot(edge_vec(e as usize));
                     count[e as usize] += 1;
                 }
             }

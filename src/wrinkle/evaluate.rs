@@ -29,7 +29,8 @@ use super::subdivide::{
     apply_s0, apply_s1, apply_z, check_output_size, face_gradients, vertex_rules, BoundaryRule,
     SubdivisionOptions, VertexRule, ZContext,
 };
-use super::topology::{add, cross, norm, scale, sub, Topology};
+use super::topology::Topology;
+use crate::geom::{normalized, tri_normal, Vec3};
 use crate::mesh::TriMesh;
 use crate::report::{Progress, ProgressFn, StageTimes};
 use crate::Result;
@@ -287,7 +288,7 @@ fn finish(level: Level<'_>, faces: Vec<[u32; 3]>, opts: &EvalOptions) -> Evaluat
         .par_iter()
         .zip(&level.z)
         .zip(&normals)
-        .map(|((&p, z), &n)| add(p, scale(n, s * z.re)))
+        .map(|((&p, z), &n)| (Vec3::from(p) + Vec3::from(n) * (s * z.re)).to_array())
         .collect();
     let phase = opts
         .want_phase
@@ -307,26 +308,18 @@ fn finish(level: Level<'_>, faces: Vec<[u32; 3]>, opts: &EvalOptions) -> Evaluat
 /// Unit area-weighted vertex normals (sum of `(x1 − x0) × (x2 − x0)` over incident triangles);
 /// zero for vertices whose triangles cancel or have no area.
 pub(crate) fn vertex_normals(x: &[[f64; 3]], faces: &[[u32; 3]]) -> Vec<[f64; 3]> {
-    let face_n: Vec<[f64; 3]> = faces
+    let p = |v: u32| Vec3::from(x[v as usize]);
+    let face_n: Vec<Vec3> = faces
         .par_iter()
-        .map(|t| {
-            let o = x[t[0] as usize];
-            cross(sub(x[t[1] as usize], o), sub(x[t[2] as usize], o))
-        })
+        .map(|t| tri_normal(p(t[0]), p(t[1]), p(t[2])))
         .collect();
-    let mut acc = vec![[0.0; 3]; x.len()];
+    let mut acc = vec![Vec3::ZERO; x.len()];
     for (t, n) in faces.iter().zip(&face_n) {
         for &v in t {
-            acc[v as usize] = add(acc[v as usize], *n);
+            acc[v as usize] += *n;
         }
     }
-    acc.par_iter_mut().for_each(|n| {
-        let l = norm(*n);
-        *n = if l > 0.0 && l.is_finite() {
-            scale(*n, 1.0 / l)
-        } else {
-            [0.0; 3]
-        };
-    });
-    acc
+    acc.par_iter()
+        .map(|&n| normalized(n).unwrap_or(Vec3::ZERO).to_array())
+        .collect()
 }

@@ -87,19 +87,20 @@
 
 use std::time::Instant;
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, Side};
 use rayon::prelude::*;
 
-use super::animation::CwfAnimation;
+use super::animation::{check_time, CwfAnimation};
+use super::areas::barycentric_areas;
 use super::complex::Complex;
-use super::cwf::{barycentric_areas, Cwf};
+use super::cwf::Cwf;
 use super::omega_path::OmegaPath;
 use super::report::InterpStage;
-use super::spacetime::{dot, steihaug, sym_matvec_into, FrameBlocks};
-use crate::report::{Progress, ProgressFn, StageTimes};
+use super::spacetime::FrameBlocks;
+use crate::report::{Progress, ProgressFn, StageTimes, StatEntries};
+use crate::solve::{
+    assemble, dot_n, entry_index, steihaug, sym_matvec_lower_into, Cholesky, CholeskyAnalysis,
+    Entry, Parallelism, SparseMatrix,
+};
 use crate::{Error, Result};
 
 /// Hessian model of the phase solve (see the [module docs](self)).
@@ -234,6 +235,32 @@ impl InterpReport {
     }
 }
 
+impl InterpReport {
+    /// Total wall seconds over the stages.
+    pub fn total_seconds(&self) -> f64 {
+        self.stages.total()
+    }
+
+    /// The report as named entries (`g_ave`, `c`, `final gradient norm`, `E_smooth`,
+    /// `E_compat`, `E_unit`; counts `iterations`, `factorizations`, `cg iterations`,
+    /// `unknowns`).
+    pub fn entries(&self) -> StatEntries {
+        let mut e = StatEntries::default();
+        self.stages.write_entries(&mut e);
+        e.metric_entry("g_ave", self.g_ave);
+        e.metric_entry("c", self.c);
+        e.metric_entry("final gradient norm", self.final_gradient_norm());
+        e.metric_entry("E_smooth", self.smooth_energy);
+        e.metric_entry("E_compat", self.compat_energy);
+        e.metric_entry("E_unit", self.unit_energy);
+        e.count_entry("iterations", self.iterations as u64);
+        e.count_entry("factorizations", self.factorizations as u64);
+        e.count_entry("cg iterations", self.cg_iterations as u64);
+        e.count_entry("unknowns", self.unknowns as u64);
+        e
+    }
+}
+
 /// Interpolates between keyframes `a` (t = 0) and `b` (t = 1) on the same base mesh. See the
 /// [module docs](self). Errors with [`Error::InvalidArgument`] when the keyframes' base meshes
 /// differ (connectivity, or a position by more than 1e-9 of the bounding-box diagonal) or an
@@ -323,13 +350,6 @@ pub fn linear_interpolation(a: &Cwf, b: &Cwf, t: f64) -> Result<Cwf> {
         .zip(b.zeta())
         .map(|(&x, &y)| Complex::new(lerp(x.re, y.re), lerp(x.im, y.im)));
     Ok(a.with_fields(omega.collect(), amp.collect(), zeta.collect()))
-}
-
-pub(crate) fn check_time(t: f64) -> Result<()> {
-    if !(0.0..=1.0).contains(&t) {
-        return crate::invalid_arg!("t = {t} is outside [0, 1]");
-    }
-    Ok(())
 }
 
 fn check_options(o: &InterpOptions) -> Result<()> {
@@ -802,7 +822,7 @@ impl Problem {
             let pre = blocks.factor(|_, _| [0.0; 3])?;
             factorizations += self.n_frames - 1;
             let kv = |v: &[f64], y: &mut [f64]| blocks.k_matvec(v, y);
-            let tol = 1e-6 * dot(&g, &g).sqrt();
+            let tol = 1e-6 * dot_n(&g, &g).sqrt();
             let st = steihaug(&g, &kv, &|r| pre.apply(r), f64::INFINITY, tol, MAX_CG);
             cg_iterations += st.iterations;
             x = to_complex(&st.step);
@@ -837,7 +857,7 @@ impl Problem {
             let apply = |r: &[f64]| pre.apply(r);
             let hv = |v: &[f64], y: &mut [f64]| self.hess_vec(&blocks, &x, v, y);
             // first radius: the M-norm of the preconditioned steepest-descent step
-            let first_radius = *first.get_or_insert_with(|| dot(&g, &apply(&g)).sqrt());
+            let first_radius = *first.get_or_insert_with(|| dot_n(&g, &apply(&g)).sqrt());
             let mut radius = delta.unwrap_or(first_radius);
             // inexact Newton forcing term (superlinear near the solution)
             let tol = gnorm * gnorm.sqrt().min(0.5);
@@ -847,7 +867,7 @@ impl Problem {
                 last_cg = st.iterations;
                 let mut hs = vec![0.0; g.len()];
                 hv(&st.step, &mut hs);
-                let predicted = -(dot(&g, &st.step) + 0.5 * dot(&st.step, &hs));
+                let predicted = -(dot_n(&g, &st.step) + 0.5 * dot_n(&st.step, &hs));
                 let trial: Vec<Complex> = x
                     .iter()
                     .zip(st.step.chunks_exact(2))
@@ -978,15 +998,15 @@ fn normalize_unknowns(x: &mut [Complex]) {
 /// The constant quadratic part `K` (lower triangle, CSC), the slots of the 2×2 diagonal blocks
 /// and the cached symbolic factorization.
 struct Hessian {
-    k: SparseColMat<usize, f64>,
+    k: SparseMatrix,
     /// Per unknown vertex: value slots of `(2u,2u)`, `(2u+1,2u)`, `(2u+1,2u+1)`.
     diag_slots: Vec<[usize; 3]>,
     /// Mean of K's diagonal (the damping unit).
     diag_mean: f64,
-    symbolic: SymbolicLlt<usize>,
+    analysis: CholeskyAnalysis,
     factorizations: usize,
     /// The last successful factorization, reused as a preconditioner (see `lagged_solve`).
-    last: Option<Llt<usize, f64>>,
+    last: Option<Cholesky>,
 }
 
 impl Hessian {
@@ -994,9 +1014,7 @@ impl Hessian {
         let nu = p.n_unknown();
         let k = assemble_k(p)?;
         let slot = |r: usize, c: usize| -> usize {
-            let cp = k.symbolic().col_ptr();
-            let rows = &k.symbolic().row_idx()[cp[c]..cp[c + 1]];
-            cp[c] + rows.binary_search(&r).expect("diagonal block in pattern")
+            entry_index(&k, r, c).expect("diagonal block in pattern")
         };
         let diag_slots: Vec<[usize; 3]> = (0..nu)
             .map(|u| {
@@ -1013,26 +1031,19 @@ impl Hessian {
             .map(|s| vals[s[0]] + vals[s[2]])
             .sum::<f64>()
             / (2 * nu).max(1) as f64;
-        let symbolic = SymbolicLlt::try_new(k.symbolic(), Side::Lower)
-            .map_err(|e| Error::Numerical(format!("symbolic Cholesky analysis failed: {e:?}")))?;
+        let analysis = CholeskyAnalysis::new(&k)?;
         Ok(Hessian {
             k,
             diag_slots,
             diag_mean: if diag_mean > 0.0 { diag_mean } else { 1.0 },
-            symbolic,
+            analysis,
             factorizations: 0,
             last: None,
         })
     }
 
     /// `K + D(x) + μ·mean(diag K)·I` (lower triangle).
-    fn assemble(
-        &self,
-        p: &Problem,
-        x: &[Complex],
-        mu: f64,
-        model: HessianModel,
-    ) -> SparseColMat<usize, f64> {
+    fn assemble(&self, p: &Problem, x: &[Complex], mu: f64, model: HessianModel) -> SparseMatrix {
         let mut h = self.k.clone();
         let vals = h.val_mut();
         for (u, s) in self.diag_slots.iter().enumerate() {
@@ -1067,12 +1078,8 @@ impl Hessian {
         for _ in 0..40 {
             let h = self.assemble(p, x, *mu, model);
             self.factorizations += 1;
-            if let Ok(llt) =
-                Llt::try_new_with_symbolic(self.symbolic.clone(), h.as_ref(), Side::Lower)
-            {
-                let mut b = Mat::<f64>::from_fn(rhs.len(), 1, |i, _| rhs[i]);
-                llt.solve_in_place(&mut b);
-                let d: Vec<f64> = (0..rhs.len()).map(|i| b[(i, 0)]).collect();
+            if let Ok(llt) = self.analysis.factor(&h, Parallelism::Global) {
+                let d = llt.solve(&rhs);
                 if d.iter().all(|v| v.is_finite()) {
                     self.last = Some(llt);
                     return Ok(to_complex(&d));
@@ -1087,14 +1094,13 @@ impl Hessian {
 }
 
 /// The constant quadratic part `K` of the spacetime Hessian (lower triangle, CSC).
-fn assemble_k(p: &Problem) -> Result<SparseColMat<usize, f64>> {
+fn assemble_k(p: &Problem) -> Result<SparseMatrix> {
     let nu = p.n_unknown();
-    let mut t: Vec<Triplet<usize, usize, f64>> = Vec::new();
+    let mut t: Vec<Entry> = Vec::new();
     for n in 1..p.n_frames {
         push_frame_triplets(p, n, (n - 1) * p.n_v, true, &mut t);
     }
-    SparseColMat::<usize, f64>::try_new_from_triplets(2 * nu, 2 * nu, &t)
-        .map_err(|e| Error::Numerical(format!("assembling the interpolation Hessian: {e:?}")))
+    assemble(2 * nu, &t, "the interpolation Hessian")
 }
 
 /// Appends frame `n`'s entries of `K` (lower triangle) with its first unknown vertex at
@@ -1106,32 +1112,32 @@ fn push_frame_triplets(
     n: usize,
     base: usize,
     time_coupling: bool,
-    t: &mut Vec<Triplet<usize, usize, f64>>,
+    t: &mut Vec<Entry>,
 ) {
     for j in 0..p.n_v {
         let u = base + j;
         let d = 4.0 * p.w_smooth[j];
-        t.push(Triplet::new(2 * u, 2 * u, d));
-        t.push(Triplet::new(2 * u + 1, 2 * u, 0.0));
-        t.push(Triplet::new(2 * u + 1, 2 * u + 1, d));
+        t.push(Entry::new(2 * u, 2 * u, d));
+        t.push(Entry::new(2 * u + 1, 2 * u, 0.0));
+        t.push(Entry::new(2 * u + 1, 2 * u + 1, d));
         if time_coupling && n + 1 < p.n_frames {
             let v = u + p.n_v;
             let o = -2.0 * p.w_smooth[j];
-            t.push(Triplet::new(2 * v, 2 * u, o));
-            t.push(Triplet::new(2 * v + 1, 2 * u + 1, o));
+            t.push(Entry::new(2 * v, 2 * u, o));
+            t.push(Entry::new(2 * v + 1, 2 * u + 1, o));
         }
     }
     for (e, &[k, l]) in p.edges.iter().enumerate() {
         let (uk, ul) = (base + k as usize, base + l as usize);
         let w2 = 2.0 * p.w_compat[e];
         for uu in [uk, ul] {
-            t.push(Triplet::new(2 * uu, 2 * uu, w2));
-            t.push(Triplet::new(2 * uu + 1, 2 * uu + 1, w2));
+            t.push(Entry::new(2 * uu, 2 * uu, w2));
+            t.push(Entry::new(2 * uu + 1, 2 * uu + 1, w2));
         }
         // block (l, k) = −2w [t], [t] = [[c, −s], [s, c]]; l > k so it is lower
         let r = p.rot[n][e];
         for (a, q, v) in [(0, 0, r.re), (0, 1, -r.im), (1, 0, r.im), (1, 1, r.re)] {
-            t.push(Triplet::new(2 * ul + a, 2 * uk + q, -w2 * v));
+            t.push(Entry::new(2 * ul + a, 2 * uk + q, -w2 * v));
         }
     }
 }
@@ -1143,25 +1149,17 @@ fn to_complex(d: &[f64]) -> Vec<Complex> {
 }
 
 /// `y = H v` for `H` stored as its lower triangle (CSC).
-fn sym_matvec(h: &SparseColMat<usize, f64>, v: &[f64]) -> Vec<f64> {
+fn sym_matvec(h: &SparseMatrix, v: &[f64]) -> Vec<f64> {
     let mut y = vec![0.0; v.len()];
-    sym_matvec_into(h, v, &mut y);
+    sym_matvec_lower_into(h, v, &mut y);
     y
 }
 
 /// Preconditioned CG on `H d = b` with a stale factorization as preconditioner. `None` when it
 /// does not reach a relative residual of 1e-8 within 12 steps or meets non-positive curvature
 /// (`H` indefinite): the caller then factorizes.
-fn lagged_solve(
-    h: &SparseColMat<usize, f64>,
-    pre: &Llt<usize, f64>,
-    b: &[f64],
-) -> Option<Vec<f64>> {
-    let apply_pre = |r: &[f64]| -> Vec<f64> {
-        let mut m = Mat::<f64>::from_fn(r.len(), 1, |i, _| r[i]);
-        pre.solve_in_place(&mut m);
-        (0..r.len()).map(|i| m[(i, 0)]).collect()
-    };
+fn lagged_solve(h: &SparseMatrix, pre: &Cholesky, b: &[f64]) -> Option<Vec<f64>> {
+    let apply_pre = |r: &[f64]| -> Vec<f64> { pre.solve(r) };
     let dotv = |a: &[f64], c: &[f64]| a.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
     let bnorm = dotv(b, b).sqrt();
     if bnorm == 0.0 {
@@ -1276,7 +1274,7 @@ mod tests {
             .collect();
         let mut y1 = vec![0.0; v.len()];
         let mut y2 = vec![0.0; v.len()];
-        sym_matvec_into(&k, &v, &mut y1);
+        sym_matvec_lower_into(&k, &v, &mut y1);
         blocks.k_matvec(&v, &mut y2);
         let err = y1
             .iter()

@@ -23,16 +23,16 @@
 //! (on a compatible ω the smallest eigenvalue is 0); when the factorization still fails, σ is
 //! multiplied by 100, up to 4 times.
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, Side};
-
+use super::areas::barycentric_areas;
 use super::complex::Complex;
-use super::cwf::barycentric_areas;
 use super::report::CwfStage;
-use super::topology::{cross, dot, norm, sub, Topology};
-use crate::report::StageTimes;
+use super::topology::Topology;
+use crate::geom::Vec3;
+use crate::report::{StageTimes, StatEntries};
+use crate::solve::{
+    assemble, inverse_iteration, Cholesky, CholeskyAnalysis, Entry, InverseIterationParams,
+    Parallelism, ShiftSchedule, ShiftedProblem,
+};
 use crate::{Error, Result};
 
 /// Edge weights of the connection Laplacian.
@@ -88,6 +88,24 @@ pub struct KnoppelReport {
     pub stages: StageTimes<CwfStage>,
 }
 
+impl KnoppelReport {
+    /// Total wall seconds over the stages.
+    pub fn total_seconds(&self) -> f64 {
+        self.stages.total()
+    }
+
+    /// The report as named entries (metrics `knoppel eigenvalue`, `knoppel residual`; count
+    /// `knoppel iterations`).
+    pub fn entries(&self) -> StatEntries {
+        let mut e = StatEntries::default();
+        self.stages.write_entries(&mut e);
+        e.metric_entry("knoppel eigenvalue", self.eigenvalue);
+        e.metric_entry("knoppel residual", self.residual);
+        e.count_entry("knoppel iterations", self.iterations as u64);
+        e
+    }
+}
+
 /// Knöppel et al. 2015 phase `z̃` (unit per vertex) for the one-form `omega` (EdgeList
 /// orientation) on the mesh of `topo` with positions `x`. See the [module docs](self).
 pub(crate) fn knoppel_phase(
@@ -103,53 +121,38 @@ pub(crate) fn knoppel_phase(
         PhaseWeights::EdgeArea => edge_area,
     };
     let mass = floored(&vertex_area);
-    let (llt, sigma) = factor_shifted(topo, &w, omega, &mass, opts.shift)?;
-    let apply_l = |u: &[f64]| connection_laplacian_apply(topo, &w, omega, u);
+    // the real form: both reals of vertex j carry its mass and its component
+    let mass2: Vec<f64> = (0..2 * n).map(|i| mass[i / 2]).collect();
+    let llt = factor_shifted(topo, &w, omega, &mass2, opts.shift)?;
+    let sigma = llt.info().shift;
     let (comp, n_comp) = components(topo);
-    let mut u: Vec<f64> = (0..2 * n)
+    let problem = ShiftedProblem {
+        shifted: &llt,
+        apply_a: |u: &[f64]| connection_laplacian_apply(topo, &w, omega, u),
+        mass: &mass2,
+        groups: &(0..2 * n).map(|i| comp[i / 2]).collect::<Vec<u32>>(),
+        n_groups: n_comp,
+        scale: max_ratio(topo, &w, &mass),
+    };
+    let start: Vec<f64> = (0..2 * n)
         .map(|i| if i % 2 == 0 { 1.0 } else { 0.5 })
         .collect();
-    normalize_m(&mut u, &mass, &comp, n_comp);
-    let scale = max_ratio(topo, &w, &mass);
-    let mut lambda = vec![f64::INFINITY; n_comp];
-    let mut report = KnoppelReport {
-        eigenvalue: 0.0,
-        iterations: 0,
-        residual: f64::INFINITY,
+    let params = InverseIterationParams {
+        max_iterations: opts.max_iterations,
+        tolerance: opts.tolerance,
+    };
+    let (u, info) = inverse_iteration(&problem, start, &params)?;
+    let report = KnoppelReport {
+        eigenvalue: info
+            .eigenvalues
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max),
+        iterations: info.iterations,
+        residual: info.residual,
         shift: sigma,
         stages: StageTimes::default(),
     };
-    for it in 1..=opts.max_iterations.max(1) {
-        let mut rhs = Mat::<f64>::from_fn(2 * n, 1, |i, _| mass[i / 2] * u[i]);
-        llt.solve_in_place(&mut rhs);
-        u = (0..2 * n).map(|i| rhs[(i, 0)]).collect();
-        if !u.iter().all(|v| v.is_finite()) {
-            return Err(Error::Numerical(
-                "inverse iteration produced a non-finite vector".into(),
-            ));
-        }
-        normalize_m(&mut u, &mass, &comp, n_comp);
-        let lu = apply_l(&u);
-        let new_lambda = rayleigh_quotients(&u, &lu, &comp, n_comp);
-        let residual = residual_m(&lu, &u, &new_lambda, &mass, &comp) / scale;
-        let change = new_lambda
-            .iter()
-            .zip(&lambda)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max)
-            / scale;
-        lambda = new_lambda;
-        report = KnoppelReport {
-            eigenvalue: lambda.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            iterations: it,
-            residual,
-            shift: sigma,
-            stages: StageTimes::default(),
-        };
-        if residual < opts.tolerance || (change < opts.tolerance * 1e-3 && it > 2) {
-            break;
-        }
-    }
     Ok((normalize_per_vertex(&u), report))
 }
 
@@ -172,59 +175,47 @@ fn connection_laplacian_apply(topo: &Topology, w: &[f64], omega: &[f64], u: &[f6
     out
 }
 
-/// Assembles `L_ω + σM` (real form) and factors it, raising σ when it is not numerically PD.
+/// Assembles `L_ω` (real form) and factors `L_ω + σM` with
+/// `σ = shift · max_j(L_jj / M_j)`, multiplying σ by 100 (up to 4 times) while it is not
+/// numerically positive definite. `mass2` is `M`'s diagonal in the real form.
 fn factor_shifted(
     topo: &Topology,
     w: &[f64],
     omega: &[f64],
-    mass: &[f64],
+    mass2: &[f64],
     shift: f64,
-) -> Result<(Llt<usize, f64>, f64)> {
+) -> Result<Cholesky> {
     let n = topo.n_vertices;
-    let mut sigma = shift.max(1e-15) * max_ratio(topo, w, mass);
-    let off = off_diagonal_triplets(topo, w, omega);
+    let mass: Vec<f64> = mass2.iter().step_by(2).copied().collect();
+    let mut t = off_diagonal_triplets(topo, w, omega);
     let mut diag = vec![0.0; n];
     for (e, &[k, l]) in topo.edges.iter().enumerate() {
         diag[k as usize] += w[e];
         diag[l as usize] += w[e];
     }
-    let mut symbolic: Option<SymbolicLlt<usize>> = None;
-    for _ in 0..5 {
-        let mut t = off.clone();
-        for j in 0..n {
-            let d = diag[j] + sigma * mass[j];
-            t.push(Triplet::new(2 * j, 2 * j, d));
-            t.push(Triplet::new(2 * j + 1, 2 * j + 1, d));
-        }
-        let a = SparseColMat::<usize, f64>::try_new_from_triplets(2 * n, 2 * n, &t)
-            .map_err(|e| Error::Numerical(format!("assembling the connection Laplacian: {e:?}")))?;
-        let sym = match &symbolic {
-            Some(s) => s.clone(),
-            None => {
-                let s = SymbolicLlt::try_new(a.symbolic(), Side::Lower).map_err(|e| {
-                    Error::Numerical(format!("symbolic Cholesky analysis failed: {e:?}"))
-                })?;
-                symbolic = Some(s.clone());
-                s
-            }
-        };
-        if let Ok(llt) = Llt::try_new_with_symbolic(sym, a.as_ref(), Side::Lower) {
-            return Ok((llt, sigma));
-        }
-        sigma *= 100.0;
+    for (j, &d) in diag.iter().enumerate() {
+        t.push(Entry::new(2 * j, 2 * j, d));
+        t.push(Entry::new(2 * j + 1, 2 * j + 1, d));
     }
-    Err(Error::Numerical(
-        "the shifted connection Laplacian is not positive definite (is the mesh degenerate?)"
-            .into(),
-    ))
+    let a = assemble(2 * n, &t, "the connection Laplacian")?;
+    let schedule = ShiftSchedule {
+        initial: shift.max(1e-15) * max_ratio(topo, w, &mass),
+        growth: 100.0,
+        max_attempts: 5,
+    };
+    CholeskyAnalysis::new(&a)?
+        .factor_with_growing_shift(&a, mass2, schedule, Parallelism::Global)
+        .map_err(|_| {
+            Error::Numerical(
+                "the shifted connection Laplacian is not positive definite (is the mesh \
+                 degenerate?)"
+                    .into(),
+            )
+        })
 }
 
 /// Off-diagonal 2×2 blocks: `H_lk = −w e^{iω_kl}`, `H_kl = −w e^{−iω_kl}`.
-fn off_diagonal_triplets(
-    topo: &Topology,
-    w: &[f64],
-    omega: &[f64],
-) -> Vec<Triplet<usize, usize, f64>> {
+fn off_diagonal_triplets(topo: &Topology, w: &[f64], omega: &[f64]) -> Vec<Entry> {
     let mut t = Vec::with_capacity(8 * topo.n_edges() + 2 * topo.n_vertices);
     for (e, &[k, l]) in topo.edges.iter().enumerate() {
         let (k, l) = (k as usize, l as usize);
@@ -232,8 +223,8 @@ fn off_diagonal_triplets(
         let (a, b) = (-w[e] * c, -w[e] * s);
         // block (l, k) of a + ib: [[a, −b], [b, a]]; block (k, l) is its transpose
         for (r, q, v) in [(0, 0, a), (0, 1, -b), (1, 0, b), (1, 1, a)] {
-            t.push(Triplet::new(2 * l + r, 2 * k + q, v));
-            t.push(Triplet::new(2 * k + q, 2 * l + r, v));
+            t.push(Entry::new(2 * l + r, 2 * k + q, v));
+            t.push(Entry::new(2 * k + q, 2 * l + r, v));
         }
     }
     t
@@ -293,43 +284,6 @@ fn components(topo: &Topology) -> (Vec<u32>, usize) {
     (comp, count as usize)
 }
 
-/// Scales each component of `u` to unit M-norm.
-fn normalize_m(u: &mut [f64], mass: &[f64], comp: &[u32], n_comp: usize) {
-    let mut n2 = vec![0.0; n_comp];
-    for (i, v) in u.iter().enumerate() {
-        n2[comp[i / 2] as usize] += mass[i / 2] * v * v;
-    }
-    let s: Vec<f64> = n2.iter().map(|x| 1.0 / x.sqrt()).collect();
-    for (i, v) in u.iter_mut().enumerate() {
-        let f = s[comp[i / 2] as usize];
-        if f.is_finite() {
-            *v *= f;
-        }
-    }
-}
-
-/// Per component, `u_cᵀ L u_c` (u is M-normalized per component).
-fn rayleigh_quotients(u: &[f64], lu: &[f64], comp: &[u32], n_comp: usize) -> Vec<f64> {
-    let mut q = vec![0.0; n_comp];
-    for (i, (a, b)) in u.iter().zip(lu).enumerate() {
-        q[comp[i / 2] as usize] += a * b;
-    }
-    q
-}
-
-/// `‖L u − λ M u‖_{M⁻¹}` with each component's own `λ`.
-fn residual_m(lu: &[f64], u: &[f64], lambda: &[f64], mass: &[f64], comp: &[u32]) -> f64 {
-    lu.iter()
-        .zip(u)
-        .enumerate()
-        .map(|(i, (l, v))| {
-            let r = l - lambda[comp[i / 2] as usize] * mass[i / 2] * v;
-            r * r / mass[i / 2]
-        })
-        .sum::<f64>()
-        .sqrt()
-}
-
 fn normalize_per_vertex(u: &[f64]) -> Vec<Complex> {
     let z: Vec<Complex> = u
         .chunks_exact(2)
@@ -360,11 +314,11 @@ pub(crate) fn cotan_weights(topo: &Topology, x: &[[f64; 3]]) -> Vec<f64> {
     let mut w = vec![0.0; topo.n_edges()];
     for (f, t) in topo.faces.iter().enumerate() {
         for s in 0..3 {
-            let o = x[t[(s + 2) % 3] as usize];
-            let a = sub(x[t[s] as usize], o);
-            let b = sub(x[t[(s + 1) % 3] as usize], o);
-            let c = norm(cross(a, b));
-            let cot = if c > 0.0 { dot(a, b) / c } else { 0.0 };
+            let o = Vec3::from(x[t[(s + 2) % 3] as usize]);
+            let a = Vec3::from(x[t[s] as usize]) - o;
+            let b = Vec3::from(x[t[(s + 1) % 3] as usize]) - o;
+            let c = a.cross(b).length();
+            let cot = if c > 0.0 { a.dot(b) / c } else { 0.0 };
             w[topo.face_edges[f][s] as usize] += 0.5 * cot;
         }
     }

@@ -37,10 +37,10 @@
 //! ```
 
 pub mod animation;
+mod areas;
 mod complex;
 pub mod cwf;
 pub mod evaluate;
-pub mod interp_bench;
 pub mod interpolate;
 pub mod io;
 pub mod knoppel;

@@ -35,7 +35,8 @@
 //! `cE_opt` unit consistent"); the integral without the division would make `c` depend on the
 //! mesh's size.
 
-use super::topology::{cross, dot, norm, scale, sub, Topology};
+use super::topology::Topology;
+use crate::geom::{tri_normal, Vec3};
 
 /// Per face corner: how its tangent vector moves from keyframe 0 to keyframe 1.
 #[derive(Debug, Clone, Copy)]
@@ -43,9 +44,9 @@ enum Corner {
     /// Magnitude/angle interpolation (B.38, B.43).
     Rotate {
         /// `û⁰`.
-        u_hat: [f64; 3],
+        u_hat: Vec3,
         /// `n̂_f × û⁰`.
-        u_perp: [f64; 3],
+        u_perp: Vec3,
         /// `Δ = φ¹ − φ⁰` in (−π, π].
         delta: f64,
         /// `a⁰|u⁰|²`, `a¹|u¹|²`.
@@ -63,7 +64,7 @@ pub(crate) struct OmegaPath {
     corners: Vec<[Corner; 3]>,
     omega: [Vec<f64>; 2],
     /// Edge vectors `x_max − x_min`, one per edge.
-    edge_vec: Vec<[f64; 3]>,
+    edge_vec: Vec<Vec3>,
     /// `f⁰`, `f¹` per face corner (0 where undefined), for the weights.
     f_corner: Vec<[[f64; 2]; 3]>,
 }
@@ -90,7 +91,7 @@ impl OmegaPath {
                 let u1 = corner_vector(topo, x, omega1, f, c);
                 let m = topo.faces[f][c] as usize;
                 let (am0, am1) = (a0[m], a1[m]);
-                fc[c] = [am0 * dot(u0, u0), am1 * dot(u1, u1)];
+                fc[c] = [am0 * u0.dot(u0), am1 * u1.dot(u1)];
                 cs[c] = corner_path(u0, u1, normal, [am0, am1]);
             }
             corners.push(cs);
@@ -99,7 +100,7 @@ impl OmegaPath {
         let edge_vec = topo
             .edges
             .iter()
-            .map(|&[a, b]| sub(x[b as usize], x[a as usize]))
+            .map(|&[a, b]| Vec3::from(x[b as usize]) - Vec3::from(x[a as usize]))
             .collect();
         OmegaPath {
             corners,
@@ -120,12 +121,12 @@ impl OmegaPath {
         let mut sum = vec![0.0; topo.n_edges()];
         let mut count = vec![0u32; topo.n_edges()];
         for (f, cs) in self.corners.iter().enumerate() {
-            let u: [Option<[f64; 3]>; 3] = std::array::from_fn(|c| corner_at(&cs[c], t));
+            let u: [Option<Vec3>; 3] = std::array::from_fn(|c| corner_at(&cs[c], t));
             for s in 0..3 {
                 let e = topo.face_edges[f][s] as usize;
                 let lin = (1.0 - t) * self.omega[0][e] + t * self.omega[1][e];
                 for c in [s, (s + 1) % 3] {
-                    sum[e] += u[c].map_or(lin, |u| dot(u, self.edge_vec[e]));
+                    sum[e] += u[c].map_or(lin, |u| u.dot(self.edge_vec[e]));
                     count[e] += 1;
                 }
             }
@@ -185,55 +186,50 @@ impl OmegaPath {
 }
 
 /// Unit normal of face `f` (zero for a degenerate face).
-fn face_unit_normal(topo: &Topology, x: &[[f64; 3]], f: usize) -> [f64; 3] {
-    let t = topo.faces[f];
-    let n = cross(
-        sub(x[t[1] as usize], x[t[0] as usize]),
-        sub(x[t[2] as usize], x[t[0] as usize]),
-    );
-    let l = norm(n);
+fn face_unit_normal(topo: &Topology, x: &[[f64; 3]], f: usize) -> Vec3 {
+    let p = topo.faces[f].map(|v| Vec3::from(x[v as usize]));
+    let n = tri_normal(p[0], p[1], p[2]);
+    let l = n.length();
+    // not `geom::normalized`: an infinite length is scaled (to zero or NaN) here, not rejected
     if l > 0.0 {
-        scale(n, 1.0 / l)
+        n * (1.0 / l)
     } else {
-        [0.0; 3]
+        Vec3::ZERO
     }
 }
 
 /// The tangent vector `u_{f,c}` of B.51–B.52 at corner `c` of face `f` (zero when the triangle
 /// is degenerate).
-fn corner_vector(topo: &Topology, x: &[[f64; 3]], omega: &[f64], f: usize, c: usize) -> [f64; 3] {
+fn corner_vector(topo: &Topology, x: &[[f64; 3]], omega: &[f64], f: usize, c: usize) -> Vec3 {
     let t = topo.faces[f];
     let (m, k, l) = (t[c], t[(c + 1) % 3], t[(c + 2) % 3]);
-    let e1 = sub(x[k as usize], x[m as usize]);
-    let e2 = sub(x[l as usize], x[m as usize]);
+    let xm = Vec3::from(x[m as usize]);
+    let e1 = Vec3::from(x[k as usize]) - xm;
+    let e2 = Vec3::from(x[l as usize]) - xm;
     // ω along m → k (slot c) and along m → l (slot c + 2 runs l → m, so negate it)
     let w1 = topo.omega_from(omega, topo.face_edges[f][c] as usize, m);
     let w2 = -topo.omega_from(omega, topo.face_edges[f][(c + 2) % 3] as usize, l);
-    let (g11, g12, g22) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
+    let (g11, g12, g22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
     let det = g11 * g22 - g12 * g12;
     if det.is_nan() || det <= 1e-14 * g11 * g22 {
-        return [0.0; 3];
+        return Vec3::ZERO;
     }
     let cx = (g22 * w1 - g12 * w2) / det;
     let cy = (g11 * w2 - g12 * w1) / det;
-    [
-        cx * e1[0] + cy * e2[0],
-        cx * e1[1] + cy * e2[1],
-        cx * e1[2] + cy * e2[2],
-    ]
+    e1 * cx + e2 * cy
 }
 
 /// Classifies one corner: rotation when both amplitudes and both vectors are non-zero and the
 /// face has a normal, linear fallback otherwise.
-fn corner_path(u0: [f64; 3], u1: [f64; 3], normal: [f64; 3], a: [f64; 2]) -> Corner {
-    let (l0, l1) = (norm(u0), norm(u1));
-    let usable = a[0] > 0.0 && a[1] > 0.0 && l0 > 0.0 && l1 > 0.0 && norm(normal) > 0.0;
+fn corner_path(u0: Vec3, u1: Vec3, normal: Vec3, a: [f64; 2]) -> Corner {
+    let (l0, l1) = (u0.length(), u1.length());
+    let usable = a[0] > 0.0 && a[1] > 0.0 && l0 > 0.0 && l1 > 0.0 && normal.length() > 0.0;
     if !(usable && l0.is_finite() && l1.is_finite()) {
         return Corner::Linear;
     }
-    let u_hat = scale(u0, 1.0 / l0);
-    let u_perp = cross(normal, u_hat);
-    let delta = dot(cross(u0, u1), normal).atan2(dot(u0, u1));
+    let u_hat = u0 * (1.0 / l0);
+    let u_perp = normal.cross(u_hat);
+    let delta = u0.cross(u1).dot(normal).atan2(u0.dot(u1));
     Corner::Rotate {
         u_hat,
         u_perp,
@@ -245,7 +241,7 @@ fn corner_path(u0: [f64; 3], u1: [f64; 3], normal: [f64; 3], a: [f64; 2]) -> Cor
 
 /// `u^t` of a corner, or `None` for the linear fallback.
 #[inline]
-fn corner_at(c: &Corner, t: f64) -> Option<[f64; 3]> {
+fn corner_at(c: &Corner, t: f64) -> Option<Vec3> {
     match *c {
         Corner::Linear => None,
         Corner::Rotate {
@@ -259,11 +255,7 @@ fn corner_at(c: &Corner, t: f64) -> Option<[f64; 3]> {
             let at = (1.0 - t) * a[0] + t * a[1];
             let mag = (ft / at).sqrt();
             let (s, co) = (t * delta).sin_cos();
-            Some([
-                mag * (co * u_hat[0] + s * u_perp[0]),
-                mag * (co * u_hat[1] + s * u_perp[1]),
-                mag * (co * u_hat[2] + s * u_perp[2]),
-            ])
+            Some((u_hat * co + u_perp * s) * mag)
         }
     }
 }

@@ -34,52 +34,27 @@
 //!
 //! # Steihaug–Toint CG
 //!
-//! [`steihaug`] minimizes the quadratic model `gᵀs + ½ sᵀHs` over `‖s‖_M ≤ Δ` with
+//! [`steihaug`](crate::solve::steihaug) minimizes the quadratic model `gᵀs + ½ sᵀHs` over `‖s‖_M ≤ Δ` with
 //! preconditioned CG (Steihaug 1983; Nocedal & Wright, *Numerical Optimization*, Alg. 7.2 with
 //! the `M`-norm recurrences of Gould, Lucidi, Roma & Toint 1999). `H` is the *exact* Hessian:
 //! where CG meets negative curvature (near phase singularities `E_unit` is concave) it follows
 //! that direction to the trust-region boundary instead of damping it away, which is what the
 //! Levenberg–Marquardt damping of the direct solver could not do.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky};
-use faer::sparse::{SparseColMat, Triplet};
-use faer::{Conj, MatMut, Par, Side};
 use rayon::prelude::*;
 
+use crate::solve::{
+    assemble, entry_index, is_out_of_memory, sym_matvec_lower_into, Cholesky, CholeskyAnalysis,
+    Entry, Parallelism, SolveScratch, SparseMatrix,
+};
 use crate::{Error, Result};
-
-/// `H v` for a symmetric `H` given as its lower triangle (CSC), `y` overwritten.
-pub(super) fn sym_matvec_into(h: &SparseColMat<usize, f64>, v: &[f64], y: &mut [f64]) {
-    let cp = h.symbolic().col_ptr();
-    let ri = h.symbolic().row_idx();
-    let val = h.val();
-    y.iter_mut().for_each(|x| *x = 0.0);
-    for j in 0..v.len() {
-        let mut acc = 0.0;
-        for k in cp[j]..cp[j + 1] {
-            let (i, a) = (ri[k], val[k]);
-            y[i] += a * v[j];
-            if i != j {
-                acc += a * v[i];
-            }
-        }
-        y[j] += acc;
-    }
-}
-
-/// Euclidean dot product.
-pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
 
 /// The frame blocks `B_n` without their `E_unit` part, sharing one sparsity pattern.
 pub(super) struct FrameBlocks {
     /// `2V`: reals per frame.
     size: usize,
     /// `K`'s part of `B_n` per unknown frame (lower triangle, identical patterns).
-    blocks: Vec<SparseColMat<usize, f64>>,
+    blocks: Vec<SparseMatrix>,
     /// Per vertex: value slots of `(2j,2j)`, `(2j+1,2j)`, `(2j+1,2j+1)` in every block.
     diag_slots: Vec<[usize; 3]>,
     /// `2 w_s,j` per vertex: minus the time off-diagonal of `H` (both reals of vertex `j`).
@@ -87,7 +62,8 @@ pub(super) struct FrameBlocks {
     /// Added to every diagonal entry when factoring: `1e-10 ×` the mean diagonal of `K`, so a
     /// block stays definite where `E_smooth`'s weight vanishes and the connection is flat.
     shift: f64,
-    symbolic: SymbolicCholesky<usize>,
+    /// The symbolic analysis of the common pattern.
+    analysis: CholeskyAnalysis,
 }
 
 impl FrameBlocks {
@@ -98,15 +74,12 @@ impl FrameBlocks {
         n_v: usize,
         n_unknown_frames: usize,
         coupling: Vec<f64>,
-        frame_triplets: impl Fn(usize) -> Vec<Triplet<usize, usize, f64>> + Sync,
+        frame_triplets: impl Fn(usize) -> Vec<Entry> + Sync,
     ) -> Result<FrameBlocks> {
         let size = 2 * n_v;
         let blocks = (1..=n_unknown_frames)
             .into_par_iter()
-            .map(|n| {
-                SparseColMat::<usize, f64>::try_new_from_triplets(size, size, &frame_triplets(n))
-                    .map_err(|e| Error::Numerical(format!("assembling a frame block: {e:?}")))
-            })
+            .map(|n| assemble(size, &frame_triplets(n), "a frame block"))
             .collect::<Result<Vec<_>>>()?;
         let first = blocks
             .first()
@@ -121,11 +94,8 @@ impl FrameBlocks {
             ));
         }
         let slot = |r: usize, c: usize| -> Result<usize> {
-            let cp = pattern.col_ptr();
-            let rows = &pattern.row_idx()[cp[c]..cp[c + 1]];
-            rows.binary_search(&r)
-                .map(|k| cp[c] + k)
-                .map_err(|_| Error::Numerical("frame block misses a diagonal entry".into()))
+            entry_index(first, r, c)
+                .ok_or_else(|| Error::Numerical("frame block misses a diagonal entry".into()))
         };
         let diag_slots = (0..n_v)
             .map(|j| {
@@ -136,13 +106,7 @@ impl FrameBlocks {
                 ])
             })
             .collect::<Result<Vec<_>>>()?;
-        let symbolic = factorize_symbolic_cholesky(
-            pattern,
-            Side::Lower,
-            Default::default(),
-            Default::default(),
-        )
-        .map_err(|e| Error::Numerical(format!("symbolic Cholesky analysis failed: {e:?}")))?;
+        let analysis = CholeskyAnalysis::new(first)?;
         let diag_sum: f64 = blocks
             .iter()
             .flat_map(|b| {
@@ -162,7 +126,7 @@ impl FrameBlocks {
             blocks,
             diag_slots,
             coupling,
-            symbolic,
+            analysis,
         })
     }
 
@@ -171,7 +135,7 @@ impl FrameBlocks {
         let s = self.size;
         let m = self.blocks.len();
         y.par_chunks_mut(s).enumerate().for_each(|(i, yi)| {
-            sym_matvec_into(&self.blocks[i], &v[i * s..(i + 1) * s], yi);
+            sym_matvec_lower_into(&self.blocks[i], &v[i * s..(i + 1) * s], yi);
             for nb in [i.wrapping_sub(1), i + 1] {
                 if nb < m {
                     let vn = &v[nb * s..(nb + 1) * s];
@@ -203,24 +167,17 @@ impl FrameBlocks {
                     vals[s[2]] += u[2] + self.shift;
                 }
                 // small blocks: sequential kernels, the frames themselves run in parallel
-                let sym = &self.symbolic;
-                let req = sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
-                let mut buf = MemBuffer::try_new(req)
-                    .map_err(|_| Error::Numerical("out of memory factoring a frame".into()))?;
-                let mut vals = vec![0.0; sym.len_val()];
-                sym.factorize_numeric_llt(
-                    &mut vals,
-                    b.as_ref(),
-                    Side::Lower,
-                    LltRegularization::default(),
-                    Par::Seq,
-                    MemStack::new(&mut buf),
-                    Default::default(),
-                )
-                .map_err(|e| {
-                    Error::Numerical(format!("a frame block is not positive definite: {e:?}"))
-                })?;
-                Ok(vals)
+                self.analysis
+                    .factor(&b, Parallelism::Sequential)
+                    .map_err(|e| {
+                        if is_out_of_memory(&e) {
+                            Error::Numerical("out of memory factoring a frame".into())
+                        } else {
+                            Error::Numerical(format!(
+                                "a frame block is not positive definite: {e:?}"
+                            ))
+                        }
+                    })
             })
             .collect::<Result<Vec<_>>>()?;
         Ok(TimeGaussSeidel {
@@ -233,8 +190,8 @@ impl FrameBlocks {
 /// The symmetric block Gauss–Seidel preconditioner `M = (D + L) D⁻¹ (D + Lᵀ)` (module docs).
 pub(super) struct TimeGaussSeidel<'a> {
     blocks: &'a FrameBlocks,
-    /// Cholesky factor values per frame (pattern: `blocks.symbolic`).
-    factors: Vec<Vec<f64>>,
+    /// Cholesky factor per frame (sequential kernels; analysis: `blocks.analysis`).
+    factors: Vec<Cholesky>,
 }
 
 impl TimeGaussSeidel<'_> {
@@ -261,7 +218,7 @@ impl TimeGaussSeidel<'_> {
                 || self.solve_buffer(),
                 |buf, (i, ti)| {
                     self.add_neighbours(odd_y, i, ti);
-                    self.solve_frame(i, ti, MemStack::new(buf));
+                    self.factors[i].solve_in_place_with(ti, buf);
                 },
             );
         y.par_chunks_mut(s)
@@ -297,175 +254,12 @@ impl TimeGaussSeidel<'_> {
                 || self.solve_buffer(),
                 |buf, (i, yi)| {
                     extra(i, yi);
-                    self.solve_frame(i, yi, MemStack::new(buf));
+                    self.factors[i].solve_in_place_with(yi, buf);
                 },
             );
     }
 
-    fn solve_buffer(&self) -> MemBuffer {
-        MemBuffer::new(
-            self.blocks
-                .symbolic
-                .solve_in_place_scratch::<f64>(1, Par::Seq),
-        )
-    }
-
-    fn solve_frame(&self, n: usize, x: &mut [f64], stack: &mut MemStack) {
-        let len = x.len();
-        LltRef::new(&self.blocks.symbolic, &self.factors[n]).solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(x, len, 1),
-            Par::Seq,
-            stack,
-        );
-    }
-}
-
-/// What [`steihaug`] returns.
-pub(super) struct TrustStep {
-    /// The step `s`.
-    pub step: Vec<f64>,
-    /// `‖s‖_M`.
-    pub m_norm: f64,
-    /// The step ends on the trust-region boundary (negative curvature or a long step).
-    pub on_boundary: bool,
-    /// CG iterations done.
-    pub iterations: usize,
-}
-
-/// Approximately minimizes `gᵀs + ½ sᵀHs` subject to `‖s‖_M ≤ Δ` by Steihaug–Toint CG
-/// preconditioned with `M` (`precond` applies `M⁻¹`, `hess` applies `H`). Stops when the
-/// model's gradient `‖g + Hs‖₂ ≤ tol`, at the boundary, on negative curvature (followed to the
-/// boundary), or after `max_iter` iterations. The returned step always decreases the model
-/// unless `g = 0`.
-pub(super) fn steihaug(
-    g: &[f64],
-    hess: &dyn Fn(&[f64], &mut [f64]),
-    precond: &dyn Fn(&[f64]) -> Vec<f64>,
-    delta: f64,
-    tol: f64,
-    max_iter: usize,
-) -> TrustStep {
-    let n = g.len();
-    let mut s = vec![0.0; n];
-    let mut r = g.to_vec();
-    let mut y = precond(&r);
-    let mut d: Vec<f64> = y.iter().map(|v| -v).collect();
-    let mut ry = dot(&r, &y);
-    // M-norm recurrences: ⟨s,Ms⟩, ⟨s,Md⟩, ⟨d,Md⟩
-    let (mut sms, mut smd, mut dmd) = (0.0, 0.0, ry);
-    let mut hd = vec![0.0; n];
-    let to_boundary = |s: &mut Vec<f64>, d: &[f64], sms: f64, smd: f64, dmd: f64| {
-        // τ ≥ 0 with ‖s + τ d‖_M = Δ
-        let disc = (smd * smd + dmd * (delta * delta - sms)).max(0.0);
-        let tau = if dmd > 0.0 {
-            (-smd + disc.sqrt()) / dmd
-        } else {
-            0.0
-        };
-        for (si, di) in s.iter_mut().zip(d) {
-            *si += tau * di;
-        }
-    };
-    if dot(&r, &r).sqrt() <= tol || ry <= 0.0 {
-        return TrustStep {
-            step: s,
-            m_norm: 0.0,
-            on_boundary: false,
-            iterations: 0,
-        };
-    }
-    for it in 0..max_iter {
-        hess(&d, &mut hd);
-        let dhd = dot(&d, &hd);
-        // negative curvature (followed to the boundary) or a step leaving the region
-        let alpha = ry / dhd;
-        let sms_next = sms + 2.0 * alpha * smd + alpha * alpha * dmd;
-        if dhd.is_nan() || dhd <= 0.0 || sms_next >= delta * delta {
-            to_boundary(&mut s, &d, sms, smd, dmd);
-            return TrustStep {
-                step: s,
-                m_norm: delta,
-                on_boundary: true,
-                iterations: it + 1,
-            };
-        }
-        for i in 0..n {
-            s[i] += alpha * d[i];
-            r[i] += alpha * hd[i];
-        }
-        if dot(&r, &r).sqrt() <= tol {
-            return TrustStep {
-                step: s,
-                m_norm: sms_next.sqrt(),
-                on_boundary: false,
-                iterations: it + 1,
-            };
-        }
-        y = precond(&r);
-        let ry_next = dot(&r, &y);
-        let beta = ry_next / ry;
-        ry = ry_next;
-        smd = beta * (smd + alpha * dmd);
-        dmd = ry + beta * beta * dmd;
-        sms = sms_next;
-        for i in 0..n {
-            d[i] = -y[i] + beta * d[i];
-        }
-    }
-    TrustStep {
-        step: s,
-        m_norm: sms.sqrt(),
-        on_boundary: false,
-        iterations: max_iter,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A 1-D Laplacian-like SPD system: unconstrained CG (huge Δ) solves it; a small Δ stops on
-    /// the boundary with ‖s‖_M = Δ.
-    #[test]
-    fn steihaug_solves_spd_and_respects_radius() {
-        let n = 20;
-        let hess = |v: &[f64], y: &mut [f64]| {
-            for i in 0..n {
-                y[i] = 3.0 * v[i]
-                    - if i > 0 { v[i - 1] } else { 0.0 }
-                    - if i + 1 < n { v[i + 1] } else { 0.0 };
-            }
-        };
-        let pre = |r: &[f64]| r.iter().map(|x| x / 3.0).collect::<Vec<_>>();
-        let g: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
-        let st = steihaug(&g, &hess, &pre, 1e9, 1e-12, 200);
-        assert!(!st.on_boundary);
-        let mut hs = vec![0.0; n];
-        hess(&st.step, &mut hs);
-        let res: f64 = hs.iter().zip(&g).map(|(a, b)| (a + b).powi(2)).sum::<f64>();
-        assert!(res.sqrt() < 1e-10, "residual {res}");
-        let small = steihaug(&g, &hess, &pre, 0.1, 1e-12, 200);
-        assert!(small.on_boundary);
-        let mnorm = (small.step.iter().map(|x| 3.0 * x * x).sum::<f64>()).sqrt();
-        assert!((mnorm - 0.1).abs() < 1e-9, "‖s‖_M = {mnorm}");
-    }
-
-    /// On an indefinite model CG follows the negative-curvature direction to the boundary and
-    /// the model decreases.
-    #[test]
-    fn steihaug_follows_negative_curvature() {
-        let hess = |v: &[f64], y: &mut [f64]| {
-            y[0] = -v[0];
-            y[1] = 2.0 * v[1];
-        };
-        let pre = |r: &[f64]| r.to_vec();
-        let g = [0.5, 1.0];
-        let st = steihaug(&g, &hess, &pre, 2.0, 1e-12, 10);
-        assert!(st.on_boundary);
-        let s = &st.step;
-        let model = g[0] * s[0] + g[1] * s[1] + 0.5 * (-s[0] * s[0] + 2.0 * s[1] * s[1]);
-        assert!(model < -0.5, "model {model}");
-        assert!(((s[0] * s[0] + s[1] * s[1]).sqrt() - 2.0).abs() < 1e-9);
+    fn solve_buffer(&self) -> SolveScratch {
+        self.blocks.analysis.solve_scratch(Parallelism::Sequential)
     }
 }

@@ -69,7 +69,8 @@
 use rayon::prelude::*;
 
 use super::complex::Complex;
-use super::topology::{add, cross, dot, norm, scale, sub, Topology, NONE};
+use super::topology::{Topology, NONE};
+use crate::geom::{normalized, tri_normal, Vec3};
 use crate::mesh::TriMesh;
 use crate::{Error, Result};
 
@@ -182,11 +183,11 @@ impl Blend for f64 {
 impl Blend for [f64; 3] {
     #[inline]
     fn axpy(self, w: f64, x: [f64; 3]) -> [f64; 3] {
-        add(self, scale(x, w))
+        (Vec3::from(self) + Vec3::from(x) * w).to_array()
     }
     #[inline]
     fn times(self, w: f64) -> [f64; 3] {
-        scale(self, w)
+        (Vec3::from(self) * w).to_array()
     }
 }
 
@@ -448,9 +449,9 @@ pub(crate) fn face_gradients(topo: &Topology, x: &[[f64; 3]], omega: &[f64]) -> 
             let fe = topo.face_edges[f];
             let w = [0, 1, 2].map(|c| topo.omega_from(omega, fe[c] as usize, t[c]));
             let g = [0, 1, 2].map(|c| {
-                let o = x[t[c] as usize];
-                let e1 = sub(x[t[(c + 1) % 3] as usize], o);
-                let e2 = sub(x[t[(c + 2) % 3] as usize], o);
+                let o = Vec3::from(x[t[c] as usize]);
+                let e1 = Vec3::from(x[t[(c + 1) % 3] as usize]) - o;
+                let e2 = Vec3::from(x[t[(c + 2) % 3] as usize]) - o;
                 // ω(c→c+1) = w[c]; ω(c→c+2) = −ω(c+2→c) = −w[c+2]
                 corner_gradient(e1, e2, w[c], -w[(c + 2) % 3])
                     .unwrap_or_else(|| ring_gradient(topo, x, omega, t[c]))
@@ -464,13 +465,13 @@ pub(crate) fn face_gradients(topo: &Topology, x: &[[f64; 3]], omega: &[f64]) -> 
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct FaceField {
     w: [f64; 3],
-    g: [[f64; 3]; 3],
+    g: [Vec3; 3],
 }
 
 /// Solves `g·e1 = r1, g·e2 = r2` for `g = x e1 + y e2` (eq. B.52); `None` when the Gram
 /// matrix is numerically singular.
-fn corner_gradient(e1: [f64; 3], e2: [f64; 3], r1: f64, r2: f64) -> Option<[f64; 3]> {
-    let (a, b, c) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
+fn corner_gradient(e1: Vec3, e2: Vec3, r1: f64, r2: f64) -> Option<Vec3> {
+    let (a, b, c) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
     let det = a * c - b * b;
     let tr = a + c;
     if det.is_nan() || det <= 1e-12 * tr * tr {
@@ -478,25 +479,24 @@ fn corner_gradient(e1: [f64; 3], e2: [f64; 3], r1: f64, r2: f64) -> Option<[f64;
     }
     let x = (c * r1 - b * r2) / det;
     let y = (a * r2 - b * r1) / det;
-    Some(add(scale(e1, x), scale(e2, y)))
+    Some(e1 * x + e2 * y)
 }
 
 /// Least-squares tangent gradient of ω at vertex `v`: `g = argmin Σ_u (g·(x_u − x_v) − ω(v→u))²`
 /// over the edges at `v`, with `g` in the plane orthogonal to the area-weighted vertex normal.
 /// A rank-deficient system is solved along its dominant direction only; no value blows up.
-fn ring_gradient(topo: &Topology, x: &[[f64; 3]], omega: &[f64], v: u32) -> [f64; 3] {
-    let o = x[v as usize];
-    let mut n = [0.0; 3];
+fn ring_gradient(topo: &Topology, x: &[[f64; 3]], omega: &[f64], v: u32) -> Vec3 {
+    let o = Vec3::from(x[v as usize]);
+    let mut n = Vec3::ZERO;
     for &k in topo.vert_corners.row(v as usize) {
-        let t = topo.faces[k as usize / 3];
-        let p = x[t[0] as usize];
-        n = add(n, cross(sub(x[t[1] as usize], p), sub(x[t[2] as usize], p)));
+        let p = topo.faces[k as usize / 3].map(|u| Vec3::from(x[u as usize]));
+        n += tri_normal(p[0], p[1], p[2]);
     }
     let (t1, t2) = tangent_basis(n);
     let (mut a, mut b, mut c, mut r1, mut r2) = (0.0, 0.0, 0.0, 0.0, 0.0);
     for &e in topo.vert_edges.row(v as usize) {
-        let d = sub(x[topo.other_end(e as usize, v) as usize], o);
-        let (p, q) = (dot(d, t1), dot(d, t2));
+        let d = Vec3::from(x[topo.other_end(e as usize, v) as usize]) - o;
+        let (p, q) = (d.dot(t1), d.dot(t2));
         let w = topo.omega_from(omega, e as usize, v);
         a += p * p;
         b += p * q;
@@ -505,25 +505,16 @@ fn ring_gradient(topo: &Topology, x: &[[f64; 3]], omega: &[f64], v: u32) -> [f64
         r2 += q * w;
     }
     let (s1, s2) = solve_sym2_robust(a, b, c, r1, r2);
-    add(scale(t1, s1), scale(t2, s2))
+    t1 * s1 + t2 * s2
 }
 
 /// An orthonormal pair spanning the plane orthogonal to `n` (any pair when `n = 0`).
-fn tangent_basis(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
-    let l = norm(n);
-    let n = if l > 0.0 && l.is_finite() {
-        scale(n, 1.0 / l)
-    } else {
-        [0.0, 0.0, 1.0]
-    };
-    let helper = if n[0].abs() < 0.6 {
-        [1.0, 0.0, 0.0]
-    } else {
-        [0.0, 1.0, 0.0]
-    };
-    let t1 = cross(n, helper);
-    let t1 = scale(t1, 1.0 / norm(t1));
-    (t1, cross(n, t1))
+fn tangent_basis(n: Vec3) -> (Vec3, Vec3) {
+    let n = normalized(n).unwrap_or(Vec3::Z);
+    let helper = if n.x.abs() < 0.6 { Vec3::X } else { Vec3::Y };
+    let t1 = n.cross(helper);
+    let t1 = t1 * (1.0 / t1.length());
+    (t1, n.cross(t1))
 }
 
 /// Solves `[[a, b], [b, c]] s = r` for symmetric PSD input; along the dominant eigenvector only
@@ -582,16 +573,15 @@ impl ZContext<'_> {
     }
 
     /// Eq. B.49: `ω(P)(d)` at barycentric coordinates `b` in face `f`.
-    fn omega_at(&self, f: usize, b: [f64; 3], d: [f64; 3]) -> f64 {
+    fn omega_at(&self, f: usize, b: [f64; 3], d: Vec3) -> f64 {
         let g = &self.faces[f].g;
-        b[0] * dot(g[0], d) + b[1] * dot(g[1], d) + b[2] * dot(g[2], d)
+        b[0] * g[0].dot(d) + b[1] * g[1].dot(d) + b[2] * g[2].dot(d)
     }
 
-    fn position(&self, f: usize, b: [f64; 3]) -> [f64; 3] {
+    fn position(&self, f: usize, b: [f64; 3]) -> Vec3 {
         let t = self.topo.faces[f];
-        let p = scale(self.x[t[0] as usize], b[0]);
-        let p = add(p, scale(self.x[t[1] as usize], b[1]));
-        add(p, scale(self.x[t[2] as usize], b[2]))
+        let x = |c: usize| Vec3::from(self.x[t[c] as usize]);
+        x(0) * b[0] + x(1) * b[1] + x(2) * b[2]
     }
 
     /// `z(P) e^{iω(P)(target − P)}` for `P` at barycentric `b` in `f` (projected displacement);
@@ -604,7 +594,7 @@ impl ZContext<'_> {
             return Complex::ZERO;
         }
         let p = self.position(f, b);
-        let psi = self.omega_at(f, b, sub(target, p));
+        let psi = self.omega_at(f, b, Vec3::from(target) - p);
         self.vote_with_phase(f, b, psi)
     }
 
@@ -642,12 +632,13 @@ impl ZContext<'_> {
         }
         let t = topo.faces[f];
         let d = topo.faces[g as usize][(topo.edge_face_slot[e][1 - k] as usize + 2) % 3];
-        let [a, b, c] = [t[s], t[(s + 1) % 3], t[(s + 2) % 3]].map(|v| self.x[v as usize]);
-        let dc = unfold(a, b, c, self.x[d as usize]);
+        let [a, b, c] =
+            [t[s], t[(s + 1) % 3], t[(s + 2) % 3]].map(|v| Vec3::from(self.x[v as usize]));
+        let dc = unfold(a, b, c, Vec3::from(self.x[d as usize]));
         let mut bc = [0.375; 3];
         bc[(s + 2) % 3] = 0.25;
         // P₁* − P₀ = (d* − c)/4; the text's step is half of it.
-        let psi = self.omega_at(f, bc, scale(dc, 0.125));
+        let psi = self.omega_at(f, bc, dc * 0.125);
         self.vote_with_phase(f, bc, psi)
     }
 
@@ -710,30 +701,30 @@ pub(crate) struct FaceVotes {
 /// the line `ab`: `d* − c = (s_d − s_c) ê + (h_d + h_c) n̂`, `n̂` the unit in-plane normal of `ab`
 /// pointing away from `c`. Degenerate pieces fall back gracefully: a zero-length `ab` gives
 /// `d − c`, and a zero-height `abc` takes `n̂` towards `d`.
-fn unfold(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> [f64; 3] {
-    let ab = sub(b, a);
-    let len = norm(ab);
+fn unfold(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> Vec3 {
+    let ab = b - a;
+    let len = ab.length();
     if len == 0.0 || !len.is_finite() {
-        return sub(d, c);
+        return d - c;
     }
-    let axis = scale(ab, 1.0 / len);
-    let split = |q: [f64; 3]| {
-        let r = sub(q, a);
-        let s = dot(r, axis);
-        let perp = sub(r, scale(axis, s));
-        (s, perp, norm(perp))
+    let axis = ab * (1.0 / len);
+    let split = |q: Vec3| {
+        let r = q - a;
+        let s = r.dot(axis);
+        let perp = r - axis * s;
+        (s, perp, perp.length())
     };
     let (sc, pc, hc) = split(c);
     let (sd, pd, hd) = split(d);
     let tiny = 1e-300;
     let away_c = if hc > tiny {
-        scale(pc, -1.0 / hc)
+        pc * (-1.0 / hc)
     } else if hd > tiny {
-        scale(pd, 1.0 / hd)
+        pd * (1.0 / hd)
     } else {
-        [0.0; 3]
+        Vec3::ZERO
     };
-    add(scale(axis, sd - sc), scale(away_c, hd + hc))
+    axis * (sd - sc) + away_c * (hd + hc)
 }
 
 /// All odd and even z values of the next level. `fine_x` are the S0 positions of the next level.
@@ -930,25 +921,31 @@ mod tests {
 
     #[test]
     fn gradient_of_linear_function() {
-        let k = [0.3, -1.7, 0.0];
-        let e1 = [1.0, 0.2, 0.0];
-        let e2 = [-0.4, 0.9, 0.0];
-        let g = corner_gradient(e1, e2, dot(k, e1), dot(k, e2)).unwrap();
-        assert!(norm(sub(g, k)) < 1e-14);
+        let k = Vec3::new(0.3, -1.7, 0.0);
+        let e1 = Vec3::new(1.0, 0.2, 0.0);
+        let e2 = Vec3::new(-0.4, 0.9, 0.0);
+        let g = corner_gradient(e1, e2, k.dot(e1), k.dot(e2)).unwrap();
+        assert!((g - k).length() < 1e-14);
         // degenerate: collinear edges are refused; the robust 2×2 solve stays finite
-        assert!(corner_gradient(e1, scale(e1, 2.0), 1.0, 2.0).is_none());
+        assert!(corner_gradient(e1, e1 * 2.0, 1.0, 2.0).is_none());
         let (s1, s2) = solve_sym2_robust(1.0, 2.0, 4.0, 1.0, 2.0);
         assert!((s1 + 2.0 * s2 - 1.0).abs() < 1e-15 && (2.0 * s1 - s2).abs() < 1e-15);
     }
 
     #[test]
     fn unfolding_is_identity_on_flat_diamond() {
-        let (a, b, c, d) = ([0.0; 3], [1.0, 0.1, 0.0], [0.3, 0.8, 0.0], [0.6, -0.7, 0.0]);
-        assert!(norm(sub(unfold(a, b, c, d), sub(d, c))) < 1e-15);
-        assert!(norm(sub(unfold(b, a, d, c), sub(c, d))) < 1e-15);
+        let v = Vec3::from_array;
+        let (a, b, c, d) = (
+            Vec3::ZERO,
+            v([1.0, 0.1, 0.0]),
+            v([0.3, 0.8, 0.0]),
+            v([0.6, -0.7, 0.0]),
+        );
+        assert!((unfold(a, b, c, d) - (d - c)).length() < 1e-15);
+        assert!((unfold(b, a, d, c) - (c - d)).length() < 1e-15);
         // folded 90°: the unfolded distance is the intrinsic one
-        let d = [0.5, 0.0, -0.7];
-        let dc = unfold(a, [1.0, 0.0, 0.0], [0.5, 0.7, 0.0], d);
-        assert!(norm(sub(dc, [0.0, -1.4, 0.0])) < 1e-15);
+        let d = v([0.5, 0.0, -0.7]);
+        let dc = unfold(a, v([1.0, 0.0, 0.0]), v([0.5, 0.7, 0.0]), d);
+        assert!((dc - v([0.0, -1.4, 0.0])).length() < 1e-15);
     }
 }

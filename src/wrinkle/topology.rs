@@ -7,6 +7,7 @@
 //! the refined triangles (edges sorted by `(min, max)` vertex, oriented min → max). So a
 //! one-form on any level follows the one documented edge convention of the C ABI.
 
+use crate::geom::Vec3;
 use crate::mesh::{EdgeList, TriMesh};
 use crate::{Error, Result};
 
@@ -560,44 +561,10 @@ fn edge_ranks(vert_edges: &Csr, edges: &[[u32; 2]]) -> Vec<[u32; 2]> {
 /// Interior angle of triangle `t` at its corner holding `v`.
 fn corner_angle(p: &[[f64; 3]], t: [u32; 3], v: u32) -> f64 {
     let c = t.iter().position(|&x| x == v).unwrap_or(0);
-    let o = p[t[c] as usize];
-    let a = sub(p[t[(c + 1) % 3] as usize], o);
-    let b = sub(p[t[(c + 2) % 3] as usize], o);
-    norm(cross(a, b)).atan2(dot(a, b))
-}
-
-#[inline]
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-#[inline]
-pub(crate) fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-
-#[inline]
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline]
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-#[inline]
-pub(crate) fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
+    let o = Vec3::from(p[t[c] as usize]);
+    let a = Vec3::from(p[t[(c + 1) % 3] as usize]) - o;
+    let b = Vec3::from(p[t[(c + 2) % 3] as usize]) - o;
+    a.cross(b).length().atan2(a.dot(b))
 }
 
 #[cfg(test)]

@@ -1,25 +1,48 @@
-"""pleat — ctypes bindings for Blender/Maya/Houdini scripts.
+"""pleat — LODs by screen size, cages and complex wrinkle fields, from Python.
 
-Loads the pleat shared library from ``$PLEAT_LIBRARY`` (a file path), else from this package's
-directory, else from the system loader path (``libpleat.so.0`` / ``libpleat.so``). No
-dependencies; numpy arrays are accepted wherever a sequence of numbers is, and results are
-plain lists (or numpy arrays when numpy is importable and ``as_numpy=True``).
+A ctypes binding of pleat's C ABI (``include/pleat.h``) with numpy arrays in and out: data
+crosses the boundary as whole buffers, never element by element. ``pip install
+./bindings/python`` bundles the shared library in the package, so ``import pleat`` needs no
+environment variable. Works in Blender, Maya and Houdini's Python as in plain CPython.
 
+    import numpy as np
     import pleat
-    m = pleat.Mesh.read("bunny.obj")
-    print(m.vertex_count, m.triangle_count)
-    r = m.check()            # dict with the validity report (when the library has it)
 
-    # complex wrinkle fields (when has_feature("wrinkle")): omega per edge of m.edges()
-    w = pleat.Cwf.plane_wave(m, k=(9, 4, 2), amplitude=0.01)
-    wrinkled = w.evaluate(levels=3)                        # a Mesh
-    mesh, f = w.evaluate_fields(["phase", "normals"], 3)   # plus per-vertex fields
+    mesh = pleat.Mesh.read("bunny.obj")               # or Mesh.from_arrays(V, F)
+    lod = mesh.lod(screen_size=50)                     # watertight, manifold, no self-intersections
+    print(lod.triangle_count, lod.stats["hausdorff_relative"])
+    V, F = lod.positions(), lod.triangles()            # (n, 3) float64, (m, 3) uint32
+    chain = mesh.lod_chain([200, 50, 12])              # several screen sizes, one call
+    report = lod.check()                               # validity report (dict)
+
+    w = pleat.Cwf.plane_wave(mesh, k=(9, 4, 2), amplitude=0.01)     # wrinkle fields
+    wrinkled = w.evaluate(levels=3)
+
+Which library is loaded, first found wins (``pleat.library_path()`` tells):
+
+1. ``$PLEAT_LIBRARY``, a path to a ``libpleat.so`` — an explicit choice beats an implicit one,
+   so a developer can test a fresh ``cargo build`` against the installed package;
+2. the library bundled next to this file by ``pip install``;
+3. the system's (``libpleat.so.0`` as installed by ``packaging/install.sh``).
+
+The loaded library must have the C ABI version this module was written for
+(``ABI_VERSION``), else the import fails with a message naming the file.
 """
 
 import ctypes as _c
+import ctypes.util as _cutil
+import json as _json
 import os as _os
 
-__all__ = ["Mesh", "Cwf", "PleatError", "version", "set_thread_count", "has_feature"]
+import numpy as _np
+
+__all__ = [
+    "ABI_VERSION", "Mesh", "Cwf", "Animation", "PleatError", "version", "abi_version",
+    "has_feature", "set_thread_count", "thread_count", "library_path",
+]
+
+#: The C ABI version (``PLEAT_ABI_VERSION`` of pleat.h) this module's declarations match.
+ABI_VERSION = 1
 
 _STATUS = {
     0: "OK", 1: "INVALID_ARGUMENT", 2: "INVALID_MESH", 3: "IO", 4: "PARSE", 5: "NUMERICAL",
@@ -28,251 +51,361 @@ _STATUS = {
 
 
 class PleatError(RuntimeError):
-    """A pleat call failed; ``status`` is the C status name, the message is pleat's."""
+    """A pleat call failed. ``status`` is the C status name (``"INVALID_MESH"``, ...),
+    ``code`` its number (``PLEAT_STATUS_*``); the message is pleat's."""
 
-    def __init__(self, status, message):
-        super().__init__(f"{_STATUS.get(status, status)}: {message}")
-        self.status = _STATUS.get(status, str(status))
+    def __init__(self, code, message):
+        super().__init__(f"{_STATUS.get(code, code)}: {message}")
+        self.code = int(code)
+        self.status = _STATUS.get(code, str(code))
+
+
+# --- loading -------------------------------------------------------------------------------
+
+_HERE = _os.path.dirname(_os.path.abspath(__file__))
+_BUNDLED = ("libpleat.so", "libpleat.so.0", "libpleat.dylib", "pleat.dll")
+
+
+def _candidates():
+    """Library paths or names to try, in the order documented in the module doc."""
+    env = _os.environ.get("PLEAT_LIBRARY")
+    if env:
+        return [("$PLEAT_LIBRARY", env)]
+    out = [("bundled", _os.path.join(_HERE, n)) for n in _BUNDLED
+           if _os.path.exists(_os.path.join(_HERE, n))]
+    system = _cutil.find_library("pleat")
+    out += [("system", n) for n in ("libpleat.so.0", system) if n]
+    return out
 
 
 def _load():
-    cands = []
-    if _os.environ.get("PLEAT_LIBRARY"):
-        cands.append(_os.environ["PLEAT_LIBRARY"])
-    here = _os.path.dirname(_os.path.abspath(__file__))
-    cands += [_os.path.join(here, n) for n in ("libpleat.so.0", "libpleat.so", "libpleat.dylib", "pleat.dll")]
-    cands += ["libpleat.so.0", "libpleat.so"]
     errors = []
-    for c in cands:
+    for origin, path in _candidates():
         try:
-            return _c.CDLL(c)
+            lib = _c.CDLL(path)
         except OSError as e:
-            errors.append(f"{c}: {e}")
-    raise ImportError("cannot load the pleat library; set PLEAT_LIBRARY. Tried:\n  " + "\n  ".join(errors))
+            errors.append(f"{origin} {path}: {e}")
+            continue
+        lib.pleat_abi_version.restype = _c.c_uint32
+        abi = lib.pleat_abi_version()
+        if abi != ABI_VERSION:
+            raise ImportError(f"{path} ({origin}) has C ABI version {abi}; this pleat module "
+                              f"needs {ABI_VERSION}")
+        return lib, path
+    raise ImportError("cannot load the pleat library (reinstall the package with pip, or set "
+                      "PLEAT_LIBRARY to a libpleat.so). Tried:\n  " + "\n  ".join(errors))
 
 
-_lib = _load()
+_lib, _path = _load()
 _P = _c.c_void_p
 _sz = _c.c_size_t
 _st = _c.c_int32
+_u32 = _c.c_uint32
+_D = _c.POINTER(_c.c_double)
+_F = _c.POINTER(_c.c_float)
+_U = _c.POINTER(_c.c_uint32)
+_PP = _c.POINTER(_P)
 
 
 def _sig(name, restype, *args):
     f = getattr(_lib, name)
     f.restype = restype
     f.argtypes = list(args)
-    return f
 
 
-_sig("pleat_version", _c.c_char_p)
-_sig("pleat_last_error", _c.c_char_p)
-_sig("pleat_set_thread_count", _st, _c.c_uint32)
-_sig("pleat_has_feature", _c.c_uint32, _c.c_char_p)
-_sig("pleat_mesh_create_f64", _st, _c.POINTER(_c.c_double), _sz, _sz, _c.POINTER(_c.c_uint32), _sz, _c.POINTER(_P))
-_sig("pleat_mesh_destroy", None, _P)
-_sig("pleat_mesh_vertex_count", _sz, _P)
-_sig("pleat_mesh_triangle_count", _sz, _P)
-_sig("pleat_mesh_copy_positions_f64", _st, _P, _c.POINTER(_c.c_double), _sz, _sz)
-_sig("pleat_mesh_copy_indices", _st, _P, _c.POINTER(_c.c_uint32), _sz)
-_sig("pleat_mesh_read_file", _st, _c.c_char_p, _c.POINTER(_P))
-_sig("pleat_mesh_write_file", _st, _P, _c.c_char_p)
+def _struct(name, fields):
+    """A ctypes Structure with ``fields`` as (name, ctype) pairs."""
+    return type(name, (_c.Structure,), {"_fields_": fields})
 
 
-class _Report(_c.Structure):
-    _fields_ = [("struct_size", _c.c_uint32), ("is_closed", _c.c_uint32)] + [
-        (n, _c.c_uint64) for n in (
-            "vertex_count", "referenced_vertex_count", "triangle_count", "edge_count",
-            "component_count", "boundary_edge_count", "nonmanifold_edge_count",
-            "nonmanifold_vertex_count", "degenerate_face_count", "duplicate_face_count",
-            "misoriented_edge_count", "self_intersecting_pair_count")
-    ] + [("total_genus", _c.c_int64), ("euler_characteristic", _c.c_int64)] + [
-        (n, _c.c_uint32) for n in (
-            "is_edge_manifold", "is_manifold", "is_watertight", "consistently_oriented",
-            "self_intersections_checked", "self_intersection_free")
-    ] + [("surface_area", _c.c_double), ("signed_volume", _c.c_double),
-         ("bbox_diagonal", _c.c_double), ("bbox_min", _c.c_double * 3), ("bbox_max", _c.c_double * 3)]
+def _f64s(*names):
+    return [(n, _c.c_double) for n in names]
 
 
-_sig("pleat_mesh_check", _st, _P, _c.c_uint32, _c.POINTER(_Report))
-_sig("pleat_mesh_edge_count", _sz, _P)
-_sig("pleat_mesh_copy_edges", _st, _P, _c.POINTER(_c.c_uint32), _sz)
+def _u32s(*names):
+    return [(n, _c.c_uint32) for n in names]
 
 
-class _EvalParams(_c.Structure):
-    _fields_ = [("struct_size", _c.c_uint32), ("levels", _c.c_uint32), ("flags", _c.c_uint32),
-                ("boundary", _c.c_uint32), ("corner_angle", _c.c_double),
-                ("displacement_scale", _c.c_double), ("max_output_triangles", _c.c_uint64)]
+def _u64s(*names):
+    return [(n, _c.c_uint64) for n in names]
 
 
-class _EvalStats(_c.Structure):
-    _fields_ = [("struct_size", _c.c_uint32), ("levels", _c.c_uint32),
-                ("vertex_count", _c.c_uint64), ("triangle_count", _c.c_uint64),
-                ("total_seconds", _c.c_double), ("subdivision_seconds", _c.c_double),
-                ("displacement_seconds", _c.c_double)]
-
-
-class _KnoppelParams(_c.Structure):
-    _fields_ = [("struct_size", _c.c_uint32), ("weights", _c.c_uint32),
-                ("max_iterations", _c.c_uint32), ("reserved", _c.c_uint32),
-                ("tolerance", _c.c_double), ("shift", _c.c_double)]
-
-
-class _KnoppelReport(_c.Structure):
-    _fields_ = [("struct_size", _c.c_uint32), ("iterations", _c.c_uint32),
-                ("eigenvalue", _c.c_double), ("residual", _c.c_double), ("shift", _c.c_double)]
-
-
-class _Progress(_c.Structure):
-    _fields_ = [("stage", _c.c_char_p), ("fraction", _c.c_double)]
-
-
+_Progress = _struct("PleatProgress", [("stage", _c.c_char_p), ("fraction", _c.c_double)])
 _PROGRESS_FN = _c.CFUNCTYPE(_c.c_int32, _c.c_void_p, _c.POINTER(_Progress))
-_D = _c.POINTER(_c.c_double)
-_sig("pleat_wrinkle_eval_params_default", _EvalParams)
-_sig("pleat_knoppel_params_default", _KnoppelParams)
-_sig("pleat_cwf_create", _st, _P, _D, _sz, _D, _D, _sz, _c.POINTER(_P))
-_sig("pleat_cwf_create_from_corner_omega", _st, _P, _D, _sz, _D, _D, _sz, _c.POINTER(_P))
-_sig("pleat_cwf_create_from_frequency", _st, _P, _D, _sz, _c.c_uint32, _D, _sz,
-     _c.POINTER(_KnoppelParams), _c.POINTER(_P))
-_sig("pleat_cwf_read_file", _st, _P, _c.c_char_p, _c.POINTER(_P))
-_sig("pleat_cwf_write_file", _st, _P, _c.c_char_p)
-_sig("pleat_cwf_destroy", None, _P)
-_sig("pleat_cwf_vertex_count", _sz, _P)
-_sig("pleat_cwf_edge_count", _sz, _P)
-_sig("pleat_cwf_triangle_count", _sz, _P)
-_sig("pleat_cwf_copy_omega", _st, _P, _D, _sz)
-_sig("pleat_cwf_copy_corner_omega", _st, _P, _D, _sz)
-_sig("pleat_cwf_copy_amplitude", _st, _P, _D, _sz)
-_sig("pleat_cwf_copy_zeta", _st, _P, _D, _sz)
-_sig("pleat_cwf_get_knoppel_report", _st, _P, _c.POINTER(_KnoppelReport))
-_sig("pleat_cwf_evaluate", _st, _P, _c.POINTER(_EvalParams), _PROGRESS_FN, _c.c_void_p,
-     _c.POINTER(_P), _c.POINTER(_P), _c.POINTER(_EvalStats))
-_sig("pleat_wrinkle_fields_count", _sz, _P, _c.c_uint32)
-_sig("pleat_wrinkle_fields_copy", _st, _P, _c.c_uint32, _D, _sz, _sz)
-_sig("pleat_wrinkle_fields_destroy", None, _P)
 
-# PLEAT_WRINKLE_FIELD_* bits and doubles per element
+_LodParams = _struct("PleatLodParams", _u32s("struct_size", "max_rounds") + _f64s("screen_size")
+                     + _u64s("target_faces") + _f64s("flow_ratio", "epsilon", "theta0_deg")
+                     + _u32s("l0", "flags") + _u64s("memory_budget_bytes"))
+_LodStats = _struct("PleatLodStats", _u32s("struct_size", "rounds")
+                    + _u64s("face_count", "vertex_count", "start_face_count", "collapse_count")
+                    + _f64s("seconds_total", "seconds_offset", "seconds_simplify", "seconds_flow",
+                            "seconds_align", "seconds_verify", "offset_distance", "hausdorff",
+                            "hausdorff_relative")
+                    + _u32s("watertight", "manifold", "self_intersection_free", "encloses_input",
+                            "exact_rerun", "target_met")
+                    + _f64s("hausdorff_in_to_out_relative", "hausdorff_out_to_in_relative",
+                            "hausdorff_floor_relative"))
+_OffsetParams = _struct("PleatOffsetParams", _u32s("struct_size", "use_absolute_distance")
+                        + _f64s("screen_size", "distance", "voxel_scale", "theta0_deg")
+                        + _u32s("l0", "features", "remove_interior", "iso_refinement_steps")
+                        + _u64s("memory_budget_bytes") + _u32s("verify", "reserved"))
+_Report = _struct("PleatMeshReport", _u32s("struct_size", "is_closed")
+                  + _u64s("vertex_count", "referenced_vertex_count", "triangle_count", "edge_count",
+                          "component_count", "boundary_edge_count", "nonmanifold_edge_count",
+                          "nonmanifold_vertex_count", "degenerate_face_count",
+                          "duplicate_face_count", "misoriented_edge_count",
+                          "self_intersecting_pair_count")
+                  + [("total_genus", _c.c_int64), ("euler_characteristic", _c.c_int64)]
+                  + _u32s("is_edge_manifold", "is_manifold", "is_watertight",
+                          "consistently_oriented", "self_intersections_checked",
+                          "self_intersection_free")
+                  + _f64s("surface_area", "signed_volume", "bbox_diagonal")
+                  + [("bbox_min", _c.c_double * 3), ("bbox_max", _c.c_double * 3)])
+_EvalParams = _struct("PleatWrinkleEvalParams", _u32s("struct_size", "levels", "flags", "boundary")
+                      + _f64s("corner_angle", "displacement_scale")
+                      + _u64s("max_output_triangles"))
+_EvalStats = _struct("PleatWrinkleEvalStats", _u32s("struct_size", "levels")
+                     + _u64s("vertex_count", "triangle_count")
+                     + _f64s("total_seconds", "subdivision_seconds", "displacement_seconds"))
+_KnoppelParams = _struct("PleatKnoppelParams", _u32s("struct_size", "weights", "max_iterations",
+                                                     "reserved") + _f64s("tolerance", "shift"))
+_KnoppelReport = _struct("PleatKnoppelReport", _u32s("struct_size", "iterations")
+                         + _f64s("eigenvalue", "residual", "shift"))
+_InterpParams = _struct("PleatWrinkleInterpParams",
+                        _u32s("struct_size", "guide_frames", "substeps", "max_iterations")
+                        + _f64s("c_scale", "gradient_tolerance") + _u32s("hessian", "reserved"))
+_InterpStats = _struct("PleatWrinkleInterpStats",
+                       _u32s("struct_size", "iterations", "stop_reason", "factorizations")
+                       + _f64s("total_seconds", "final_gradient_norm", "smooth_energy",
+                               "compat_energy", "unit_energy", "g_ave", "c"))
+
+_PROGRESS_ARGS = (_PROGRESS_FN, _c.c_void_p)
+for _name, _res, _args in [
+    ("pleat_version", _c.c_char_p, ()),
+    ("pleat_abi_version", _u32, ()),
+    ("pleat_last_error", _c.c_char_p, ()),
+    ("pleat_last_error_message", _st, (_c.c_char_p, _sz, _c.POINTER(_sz))),
+    ("pleat_set_thread_count", _st, (_u32,)),
+    ("pleat_thread_count", _u32, ()),
+    ("pleat_has_feature", _u32, (_c.c_char_p,)),
+    # meshes
+    ("pleat_mesh_create_f32", _st, (_F, _sz, _sz, _U, _sz, _PP)),
+    ("pleat_mesh_create_f64", _st, (_D, _sz, _sz, _U, _sz, _PP)),
+    ("pleat_mesh_destroy", None, (_P,)),
+    ("pleat_mesh_vertex_count", _sz, (_P,)),
+    ("pleat_mesh_triangle_count", _sz, (_P,)),
+    ("pleat_mesh_copy_positions_f32", _st, (_P, _F, _sz, _sz)),
+    ("pleat_mesh_copy_positions_f64", _st, (_P, _D, _sz, _sz)),
+    ("pleat_mesh_copy_indices", _st, (_P, _U, _sz)),
+    ("pleat_mesh_edge_count", _sz, (_P,)),
+    ("pleat_mesh_copy_edges", _st, (_P, _U, _sz)),
+    ("pleat_mesh_read_file", _st, (_c.c_char_p, _PP)),
+    ("pleat_mesh_write_file", _st, (_P, _c.c_char_p)),
+    ("pleat_mesh_check", _st, (_P, _u32, _c.POINTER(_Report))),
+    # LOD, cage, offset, stats
+    ("pleat_lod_params_default", _LodParams, ()),
+    ("pleat_lod_generate", _st, (_P, _c.POINTER(_LodParams)) + _PROGRESS_ARGS
+     + (_PP, _c.POINTER(_LodStats))),
+    ("pleat_cage_generate", _st, (_P, _c.POINTER(_LodParams)) + _PROGRESS_ARGS
+     + (_PP, _c.POINTER(_LodStats))),
+    ("pleat_lod_generate_chain", _st, (_P, _D, _sz, _c.POINTER(_LodParams)) + _PROGRESS_ARGS
+     + (_PP, _c.POINTER(_LodStats))),
+    ("pleat_offset_params_default", _OffsetParams, ()),
+    ("pleat_offset_surface", _st, (_P, _c.POINTER(_OffsetParams)) + _PROGRESS_ARGS + (_PP, _PP)),
+    ("pleat_stats_to_json", _st, (_P, _c.c_char_p, _sz, _c.POINTER(_sz))),
+    ("pleat_stats_destroy", None, (_P,)),
+    # wrinkle fields
+    ("pleat_wrinkle_eval_params_default", _EvalParams, ()),
+    ("pleat_knoppel_params_default", _KnoppelParams, ()),
+    ("pleat_cwf_create", _st, (_P, _D, _sz, _D, _D, _sz, _PP)),
+    ("pleat_cwf_create_from_corner_omega", _st, (_P, _D, _sz, _D, _D, _sz, _PP)),
+    ("pleat_cwf_create_from_frequency", _st, (_P, _D, _sz, _u32, _D, _sz,
+                                              _c.POINTER(_KnoppelParams), _PP)),
+    ("pleat_cwf_read_file", _st, (_P, _c.c_char_p, _PP)),
+    ("pleat_cwf_write_file", _st, (_P, _c.c_char_p)),
+    ("pleat_cwf_destroy", None, (_P,)),
+    ("pleat_cwf_vertex_count", _sz, (_P,)),
+    ("pleat_cwf_edge_count", _sz, (_P,)),
+    ("pleat_cwf_triangle_count", _sz, (_P,)),
+    ("pleat_cwf_copy_omega", _st, (_P, _D, _sz)),
+    ("pleat_cwf_copy_corner_omega", _st, (_P, _D, _sz)),
+    ("pleat_cwf_copy_amplitude", _st, (_P, _D, _sz)),
+    ("pleat_cwf_copy_zeta", _st, (_P, _D, _sz)),
+    ("pleat_cwf_get_knoppel_report", _st, (_P, _c.POINTER(_KnoppelReport))),
+    ("pleat_cwf_evaluate", _st, (_P, _c.POINTER(_EvalParams)) + _PROGRESS_ARGS
+     + (_PP, _PP, _c.POINTER(_EvalStats))),
+    ("pleat_wrinkle_fields_count", _sz, (_P, _u32)),
+    ("pleat_wrinkle_fields_copy", _st, (_P, _u32, _D, _sz, _sz)),
+    ("pleat_wrinkle_fields_copy_f32", _st, (_P, _u32, _F, _sz, _sz)),
+    ("pleat_wrinkle_fields_destroy", None, (_P,)),
+    # wrinkle animation
+    ("pleat_wrinkle_interp_params_default", _InterpParams, ()),
+    ("pleat_cwf_interpolate", _st, (_P, _P, _c.POINTER(_InterpParams)) + _PROGRESS_ARGS
+     + (_PP, _c.POINTER(_InterpStats))),
+    ("pleat_cwf_animation_frame", _st, (_P, _c.c_double, _PP)),
+    ("pleat_cwf_animation_frame_count", _sz, (_P,)),
+    ("pleat_cwf_animation_guide_count", _sz, (_P,)),
+    ("pleat_cwf_animation_history_count", _sz, (_P,)),
+    ("pleat_cwf_animation_copy_history", _st, (_P, _D, _sz)),
+    ("pleat_cwf_animation_write_file", _st, (_P, _c.c_char_p)),
+    ("pleat_cwf_animation_read_file", _st, (_P, _c.c_char_p, _PP)),
+    ("pleat_cwf_animation_destroy", None, (_P,)),
+]:
+    _sig(_name, _res, *_args)
+
+# The parameter defaults carry the library's sizeof: a layout mismatch fails the import.
+for _fn, _cls in [("pleat_lod_params_default", _LodParams),
+                  ("pleat_offset_params_default", _OffsetParams),
+                  ("pleat_wrinkle_eval_params_default", _EvalParams),
+                  ("pleat_knoppel_params_default", _KnoppelParams),
+                  ("pleat_wrinkle_interp_params_default", _InterpParams)]:
+    if getattr(_lib, _fn)().struct_size != _c.sizeof(_cls):
+        raise ImportError(f"{_path}: {_cls.__name__} is {getattr(_lib, _fn)().struct_size} bytes "
+                          f"in the library, {_c.sizeof(_cls)} in this module")
+
+# PLEAT_LOD_* flags, PLEAT_CHECK_* flags, PLEAT_WRINKLE_FIELD_* bits and doubles per element.
+_LOD_NO_ALIGN, _LOD_MEASURE_FLOOR = 1, 2
+_CHECK_SKIP_SELF_INTERSECTIONS, _CHECK_WELD = 1, 2
 _FIELDS = {"amplitude": (1, 1), "phase": (2, 1), "normals": (4, 3), "z": (8, 2),
            "smooth_positions": (16, 3), "omega": (32, 1)}
+_HESSIAN = {"projected": 0, "gauss_newton": 1, "exact": 2, "trust_region": 3}
+_STOP = {0: "converged", 1: "iteration_cap", 2: "stalled", 3: "identical_keyframes",
+         4: "no_unknowns"}
 
 
 def _check(status):
     if status != 0:
-        raise PleatError(status, _lib.pleat_last_error().decode("utf-8", "replace"))
+        raise PleatError(status, last_error())
+
+
+def last_error():
+    """The message of the last failed pleat call on this thread ('' after a success)."""
+    return _lib.pleat_last_error().decode("utf-8", "replace")
 
 
 def version():
-    """The library version string."""
+    """The library version (``major.minor.patch``, Cargo.toml's; also the package version)."""
     return _lib.pleat_version().decode()
 
 
+def abi_version():
+    """The C ABI version of the loaded library (equals ``ABI_VERSION``, checked at import)."""
+    return int(_lib.pleat_abi_version())
+
+
+def library_path():
+    """The path (or system name) of the loaded shared library."""
+    return _path
+
+
 def set_thread_count(n):
-    """Worker threads for later calls (0 = all cores); results do not depend on it."""
+    """Worker threads for later calls (0 = one per core); results do not depend on it."""
     _check(_lib.pleat_set_thread_count(int(n)))
 
 
+def thread_count():
+    """Worker threads the next call will use (>= 1)."""
+    return int(_lib.pleat_thread_count())
+
+
 def has_feature(name):
-    """True when this build of the library includes capability ``name`` (lod, cage, wrinkle, ...)."""
+    """True when this build of the library includes capability ``name`` ("lod", "cage",
+    "wrinkle", "tfw", "io-gltf"); without it those calls raise PleatError UNSUPPORTED."""
     return bool(_lib.pleat_has_feature(name.encode()))
 
 
-def _flat(seq, ctype):
-    try:  # numpy fast path without importing numpy ourselves
-        flat = seq.reshape(-1).tolist()
-    except AttributeError:
-        flat = [x for row in seq for x in (row if hasattr(row, "__len__") else (row,))]
-    return (ctype * len(flat))(*flat), len(flat)
+# --- helpers -------------------------------------------------------------------------------
+
+def _ptr(a, ctype):
+    """ctypes pointer to the data of the contiguous numpy array ``a`` (kept alive by caller)."""
+    return a.ctypes.data_as(_c.POINTER(ctype))
 
 
-class Mesh:
-    """An immutable triangle mesh owned by pleat."""
+def _doubles(values, n, what):
+    """``values`` as a contiguous float64 array of exactly ``n`` elements (any shape)."""
+    a = _np.ascontiguousarray(values, dtype=_np.float64).reshape(-1)
+    if a.size != n:
+        raise PleatError(1, f"{what}: {a.size} values given, {n} needed")
+    return a if n else _np.zeros(1)
+
+
+def _indices(values, what):
+    """``values`` as a contiguous uint32 array; integers outside [0, 2^32) are an error."""
+    a = _np.asarray(values)
+    if a.dtype != _np.uint32:
+        if a.size and a.dtype.kind not in "iu":
+            raise PleatError(1, f"{what}: integer indices needed, got {a.dtype}")
+        if a.size and (a.min() < 0 or a.max() > 0xFFFFFFFF):
+            raise PleatError(1, f"{what}: indices must be in [0, 2^32)")
+    return _np.ascontiguousarray(a, dtype=_np.uint32).reshape(-1)
+
+
+def _zeta(zeta, n):
+    """Unit phases as 2n float64 (re, im): complex array (n,) or float array (n, 2); None."""
+    if zeta is None:
+        return None
+    z = _np.asarray(zeta)
+    if _np.iscomplexobj(z):
+        z = _np.stack([z.real, z.imag], axis=-1)
+    return _doubles(z, 2 * n, "zeta (one complex or (re, im) per vertex)")
+
+
+def _as_dict(struct, skip=("struct_size",), flags=()):
+    """A ctypes struct as a dict; fields named in ``flags`` become bool, arrays tuples."""
+    out = {}
+    for name, _ in struct._fields_:
+        if name in skip:
+            continue
+        v = getattr(struct, name)
+        if name in flags:
+            v = bool(v)
+        elif hasattr(v, "__len__"):
+            v = tuple(v)
+        out[name] = v
+    return out
+
+
+class _Relay:
+    """Turns ``progress(stage, fraction) -> truthy to cancel`` into a C callback; an exception
+    raised by it cancels the call and is re-raised by ``finish``."""
+
+    def __init__(self, progress):
+        self.progress = progress
+        self.error = None
+        self.fn = _PROGRESS_FN(self._call) if progress else _PROGRESS_FN()
+
+    def _call(self, _user, info):
+        try:
+            stage = info.contents.stage.decode("utf-8", "replace")
+            return 1 if self.progress(stage, info.contents.fraction) else 0
+        except BaseException as e:  # noqa: BLE001 - re-raised by finish()
+            self.error = e
+            return 1
+
+    def finish(self, status):
+        if self.error is not None:
+            raise self.error
+        _check(status)
+
+
+class _Handle:
+    """Owner of one pleat handle, released by ``close()``, ``with`` or garbage collection."""
+
+    _destroy = None
 
     def __init__(self, handle):
-        self._h = _P(handle) if not isinstance(handle, _P) else handle
-
-    @classmethod
-    def from_arrays(cls, positions, triangles):
-        """From xyz positions (n×3 or flat 3n) and triangle indices (m×3 or flat 3m)."""
-        p, npos = _flat(positions, _c.c_double)
-        t, nidx = _flat(triangles, _c.c_uint32)
-        h = _P()
-        _check(_lib.pleat_mesh_create_f64(p, npos // 3 if npos % 3 == 0 else npos, 0, t, nidx, _c.byref(h)))
-        return cls(h)
-
-    @classmethod
-    def read(cls, path):
-        """Reads obj/ply/off/stl/glb/gltf."""
-        h = _P()
-        _check(_lib.pleat_mesh_read_file(_os.fsencode(path), _c.byref(h)))
-        return cls(h)
-
-    def write(self, path):
-        """Writes a mesh file; format by extension."""
-        _check(_lib.pleat_mesh_write_file(self._h, _os.fsencode(path)))
-
-    @property
-    def vertex_count(self):
-        return _lib.pleat_mesh_vertex_count(self._h)
-
-    @property
-    def triangle_count(self):
-        return _lib.pleat_mesh_triangle_count(self._h)
-
-    def positions(self):
-        """List of (x, y, z) tuples."""
-        n = self.vertex_count
-        buf = (_c.c_double * (3 * n))()
-        _check(_lib.pleat_mesh_copy_positions_f64(self._h, buf, n, 0))
-        return [tuple(buf[3 * i:3 * i + 3]) for i in range(n)]
-
-    def triangles(self):
-        """List of (a, b, c) index tuples."""
-        n = self.triangle_count
-        buf = (_c.c_uint32 * (3 * n))()
-        _check(_lib.pleat_mesh_copy_indices(self._h, buf, 3 * n))
-        return [tuple(buf[3 * i:3 * i + 3]) for i in range(n)]
-
-    @property
-    def edge_count(self):
-        """Number of unique edges: the length of per-edge data such as wrinkle omega."""
-        return _lib.pleat_mesh_edge_count(self._h)
-
-    def edges(self):
-        """List of (a, b) with a < b, in pleat's edge numbering (sorted by (a, b)); per-edge
-        values such as omega are integrated from a to b."""
-        n = self.edge_count
-        buf = (_c.c_uint32 * max(1, 2 * n))()
-        _check(_lib.pleat_mesh_copy_edges(self._h, buf, n))
-        return [(buf[2 * i], buf[2 * i + 1]) for i in range(n)]
-
-    def check(self, self_intersections=True, weld=False):
-        """Validity report as a dict (same fields as PleatMeshReport; yes/no fields as bool)."""
-        r = _Report()
-        r.struct_size = _c.sizeof(_Report)
-        flags = (0 if self_intersections else 1) | (2 if weld else 0)
-        _check(_lib.pleat_mesh_check(self._h, flags, _c.byref(r)))
-        out = {}
-        for name, ctype in _Report._fields_:
-            v = getattr(r, name)
-            if name == "struct_size":
-                continue
-            if ctype is _c.c_uint32:
-                v = bool(v)
-            elif hasattr(v, "__len__"):
-                v = tuple(v)
-            out[name] = v
-        return out
+        self._h = handle if isinstance(handle, _P) else _P(handle)
 
     def close(self):
-        """Releases the mesh now (also done when garbage-collected)."""
+        """Releases the handle now (also done when garbage-collected); idempotent."""
         if self._h:
-            _lib.pleat_mesh_destroy(self._h)
+            getattr(_lib, self._destroy)(self._h)
             self._h = _P()
 
     def __del__(self):
         try:
             self.close()
-        except Exception:
+        except Exception:  # noqa: BLE001 - interpreter shutdown
             pass
 
     def __enter__(self):
@@ -282,80 +415,281 @@ class Mesh:
         self.close()
 
 
-def _doubles(seq, n, what):
-    buf, got = _flat(seq, _c.c_double)
-    if got != n:
-        raise PleatError(1, f"{what}: {got} values given, {n} needed")
-    return buf
+# --- meshes, LODs, cages, offsets ----------------------------------------------------------
+
+_LOD_KEYS = ("max_rounds", "target_faces", "flow_ratio", "epsilon", "theta0_deg", "l0",
+             "memory_budget_bytes")
+_LOD_STATS_FLAGS = ("watertight", "manifold", "self_intersection_free", "encloses_input",
+                    "exact_rerun", "target_met")
+_REPORT_FLAGS = ("is_closed", "is_edge_manifold", "is_manifold", "is_watertight",
+                 "consistently_oriented", "self_intersections_checked", "self_intersection_free")
 
 
-def _zeta_buf(zeta, n):
-    if zeta is None:
-        return None
-    flat = []
-    for z in zeta:
-        if isinstance(z, complex):
-            flat += [z.real, z.imag]
+def _lod_params(screen_size, align=True, measure_floor=False, **kw):
+    """PleatLodParams from the defaults and keyword overrides (names of the C fields)."""
+    p = _lib.pleat_lod_params_default()
+    unknown = set(kw) - set(_LOD_KEYS)
+    if unknown:
+        raise TypeError(f"unknown LOD parameter(s) {sorted(unknown)}; known: "
+                        f"{sorted(_LOD_KEYS + ('align', 'measure_floor'))}")
+    if screen_size is not None:
+        p.screen_size = float(screen_size)
+    for k, v in kw.items():
+        setattr(p, k, float(v) if k in ("flow_ratio", "epsilon", "theta0_deg") else int(v))
+    p.flags = (0 if align else _LOD_NO_ALIGN) | (_LOD_MEASURE_FLOOR if measure_floor else 0)
+    return p
+
+
+def _new_lod_stats(count=1):
+    stats = (_LodStats * count)()
+    for s in stats:
+        s.struct_size = _c.sizeof(_LodStats)
+    return stats
+
+
+class Mesh(_Handle):
+    """An immutable indexed triangle mesh owned by pleat (any soup). Meshes made by an
+    operation (``lod``, ``cage``, ``offset``, ``Cwf.evaluate``) carry its report in ``stats``
+    (a dict; None otherwise)."""
+
+    _destroy = "pleat_mesh_destroy"
+
+    def __init__(self, handle, stats=None):
+        super().__init__(handle)
+        self.stats = stats
+
+    @classmethod
+    def from_arrays(cls, positions, triangles):
+        """From positions (n×3, or flat 3n) and triangle indices (m×3, or flat 3m).
+        float32 positions are passed as floats (an (n, 3) view whose rows are strided, such
+        as a column slice of an interleaved vertex buffer, is used without a copy); anything
+        else is converted to float64."""
+        pos = _np.asarray(positions)
+        if pos.ndim == 1:
+            pos = pos.reshape(-1, 3)
+        if pos.ndim != 2 or pos.shape[1] != 3:
+            raise PleatError(1, f"positions: shape {pos.shape}, expected (n, 3)")
+        tri = _indices(triangles, "triangles")
+        h = _P()
+        if pos.dtype == _np.float32 and pos.strides[1] == 4 and pos.strides[0] >= 12:
+            _check(_lib.pleat_mesh_create_f32(_ptr(pos, _c.c_float), pos.shape[0],
+                                              pos.strides[0], _ptr(tri, _c.c_uint32), tri.size,
+                                              _c.byref(h)))
         else:
-            flat += [float(z[0]), float(z[1])]
-    return _doubles(flat, 2 * n, "zeta (one complex or (re, im) per vertex)")
+            pos = _np.ascontiguousarray(pos, dtype=_np.float64)
+            _check(_lib.pleat_mesh_create_f64(_ptr(pos, _c.c_double), pos.shape[0], 0,
+                                              _ptr(tri, _c.c_uint32), tri.size, _c.byref(h)))
+        return cls(h)
+
+    @classmethod
+    def read(cls, path):
+        """Reads .obj, .ply, .off, .stl, .glb/.gltf (the soup as stored)."""
+        h = _P()
+        _check(_lib.pleat_mesh_read_file(_os.fsencode(path), _c.byref(h)))
+        return cls(h)
+
+    def write(self, path):
+        """Writes a mesh file; the format follows the extension (.obj/.ply lossless)."""
+        _check(_lib.pleat_mesh_write_file(self._h, _os.fsencode(path)))
+
+    @property
+    def vertex_count(self):
+        """Number of vertices."""
+        return int(_lib.pleat_mesh_vertex_count(self._h))
+
+    @property
+    def triangle_count(self):
+        """Number of triangles."""
+        return int(_lib.pleat_mesh_triangle_count(self._h))
+
+    @property
+    def edge_count(self):
+        """Number of unique edges: the length of per-edge data such as wrinkle omega."""
+        return int(_lib.pleat_mesh_edge_count(self._h))
+
+    def positions(self, dtype=_np.float64):
+        """Vertex positions, an (n, 3) array of float64 (exact) or float32 (rounded)."""
+        n = self.vertex_count
+        if _np.dtype(dtype) == _np.float32:
+            out = _np.empty((max(n, 1), 3), dtype=_np.float32)
+            _check(_lib.pleat_mesh_copy_positions_f32(self._h, _ptr(out, _c.c_float), n, 0))
+        else:
+            out = _np.empty((max(n, 1), 3), dtype=_np.float64)
+            _check(_lib.pleat_mesh_copy_positions_f64(self._h, _ptr(out, _c.c_double), n, 0))
+        return out[:n]
+
+    def triangles(self):
+        """Triangle indices, an (m, 3) uint32 array."""
+        n = self.triangle_count
+        out = _np.empty((max(n, 1), 3), dtype=_np.uint32)
+        _check(_lib.pleat_mesh_copy_indices(self._h, _ptr(out, _c.c_uint32), 3 * n))
+        return out[:n]
+
+    def edges(self):
+        """Edges in pleat's numbering, an (e, 2) uint32 array with a < b, sorted by (a, b);
+        per-edge values such as omega are integrated from a to b."""
+        n = self.edge_count
+        out = _np.empty((max(n, 1), 2), dtype=_np.uint32)
+        _check(_lib.pleat_mesh_copy_edges(self._h, _ptr(out, _c.c_uint32), n))
+        return out[:n]
+
+    def check(self, self_intersections=True, weld=False):
+        """Validity report as a dict: the fields of PleatMeshReport (counts as int, yes/no as
+        bool, bbox_min/bbox_max as tuples). ``weld`` merges exactly coincident vertices first."""
+        r = _Report()
+        r.struct_size = _c.sizeof(_Report)
+        flags = (0 if self_intersections else _CHECK_SKIP_SELF_INTERSECTIONS) | \
+            (_CHECK_WELD if weld else 0)
+        _check(_lib.pleat_mesh_check(self._h, flags, _c.byref(r)))
+        return _as_dict(r, flags=_REPORT_FLAGS)
+
+    def _bake(self, fn, screen_size, progress, kw):
+        p = _lod_params(screen_size, **kw)
+        stats = _new_lod_stats()
+        relay, out = _Relay(progress), _P()
+        st = fn(self._h, _c.byref(p), relay.fn, None, _c.byref(out), stats)
+        relay.finish(st)
+        return Mesh(out, _as_dict(stats[0], flags=_LOD_STATS_FLAGS))
+
+    def lod(self, screen_size=200.0, progress=None, **params):
+        """One LOD for ``screen_size`` pixels covering the bounding-box diagonal: a
+        watertight, manifold, self-intersection-free Mesh within about diag/screen_size of
+        this one, with ``stats`` (PleatLodStats as a dict). ``params``: ``target_faces``,
+        ``max_rounds``, ``flow_ratio``, ``epsilon``, ``theta0_deg``, ``l0``,
+        ``memory_budget_bytes`` (C field names and defaults), ``align=False`` to skip the
+        feature alignment, ``measure_floor=True`` for ``hausdorff_floor_relative``.
+        ``progress(stage, fraction)`` is called on this thread; return True to cancel
+        (PleatError CANCELLED); an exception it raises comes out of this call."""
+        return self._bake(_lib.pleat_lod_generate, screen_size, progress, params)
+
+    def cage(self, screen_size=200.0, progress=None, **params):
+        """A cage: like ``lod`` but strictly enclosing this mesh without touching it
+        (``stats["encloses_input"]`` is the independent verification)."""
+        return self._bake(_lib.pleat_cage_generate, screen_size, progress, params)
+
+    def lod_chain(self, screen_sizes, progress=None, **params):
+        """One LOD per screen size (list of Mesh, in the order given); coarser levels start
+        from the next finer result, so a chain costs little more than its finest level.
+        ``params`` as ``lod`` (``target_faces`` is ignored)."""
+        sizes = _doubles(screen_sizes, _np.size(screen_sizes), "screen_sizes")
+        n = int(_np.size(screen_sizes))
+        p = _lod_params(None, **params)
+        stats = _new_lod_stats(max(n, 1))
+        outs = (_P * max(n, 1))()
+        relay = _Relay(progress)
+        st = _lib.pleat_lod_generate_chain(self._h, _ptr(sizes, _c.c_double), n, _c.byref(p),
+                                           relay.fn, None, outs, stats)
+        relay.finish(st)
+        return [Mesh(_P(outs[i]), _as_dict(stats[i], flags=_LOD_STATS_FLAGS)) for i in range(n)]
+
+    def offset(self, screen_size=200.0, distance=None, progress=None, features=True,
+               remove_interior=True, verify=True, **params):
+        """The watertight, manifold, self-intersection-free d-offset surface (LOD stage 1),
+        d = diag/screen_size, or ``distance`` in model units when given. ``params``:
+        ``voxel_scale``, ``theta0_deg``, ``l0``, ``iso_refinement_steps``,
+        ``memory_budget_bytes``. ``stats`` is pleat's JSON stats object as a dict
+        (stages, counts, metrics, verified)."""
+        p = _lib.pleat_offset_params_default()
+        p.screen_size = float(screen_size)
+        if distance is not None:
+            p.use_absolute_distance, p.distance = 1, float(distance)
+        p.features, p.remove_interior, p.verify = int(bool(features)), \
+            int(bool(remove_interior)), int(bool(verify))
+        known = ("voxel_scale", "theta0_deg", "l0", "iso_refinement_steps", "memory_budget_bytes")
+        for k, v in params.items():
+            if k not in known:
+                raise TypeError(f"unknown offset parameter {k!r}; known: {list(known)}")
+            setattr(p, k, float(v) if k in ("voxel_scale", "theta0_deg") else int(v))
+        relay, out, stats = _Relay(progress), _P(), _P()
+        st = _lib.pleat_offset_surface(self._h, _c.byref(p), relay.fn, None, _c.byref(out),
+                                       _c.byref(stats))
+        relay.finish(st)
+        try:
+            return Mesh(out, _stats_json(stats))
+        finally:
+            _lib.pleat_stats_destroy(stats)
+
+    def __repr__(self):
+        return f"<pleat.Mesh {self.vertex_count} vertices, {self.triangle_count} triangles>"
 
 
-class Cwf:
+def _stats_json(stats):
+    """A PleatStats handle as the dict of its JSON form."""
+    need = _sz()
+    _check(_lib.pleat_stats_to_json(stats, None, 0, _c.byref(need)))
+    buf = _c.create_string_buffer(need.value + 1)
+    _check(_lib.pleat_stats_to_json(stats, buf, len(buf), None))
+    return _json.loads(buf.value.decode("utf-8"))
+
+
+# --- wrinkle fields ------------------------------------------------------------------------
+
+class Cwf(_Handle):
     """A complex wrinkle field on a base Mesh: omega per edge (the order of ``base.edges()``,
-    integrated from the smaller to the larger vertex), amplitude and unit phase zeta per vertex.
-    Needs a library built with the ``wrinkle`` capability (else PleatError UNSUPPORTED)."""
+    integrated from the smaller to the larger vertex, radians), amplitude and unit phase zeta
+    per vertex. Needs a library with the ``wrinkle`` capability (else PleatError
+    UNSUPPORTED). Immutable."""
 
-    def __init__(self, handle):
-        self._h = _P(handle) if not isinstance(handle, _P) else handle
+    _destroy = "pleat_cwf_destroy"
 
     @classmethod
     def from_arrays(cls, base, omega, amplitude, zeta=None):
-        """omega: one value per edge of base.edges(); amplitude: one per vertex (>= 0);
-        zeta: one complex (or (re, im)) per vertex, or None for Knoppel's phase from omega."""
+        """omega: one value per edge of ``base.edges()``; amplitude: one per vertex (>= 0);
+        zeta: complex (n,) or float (n, 2) per vertex, or None for Knoppel's phase from omega."""
         nv, ne = base.vertex_count, base.edge_count
+        om, am, ze = _doubles(omega, ne, "omega"), _doubles(amplitude, nv, "amplitude"), \
+            _zeta(zeta, nv)
         h = _P()
-        _check(_lib.pleat_cwf_create(base._h, _doubles(omega, ne, "omega"), ne,
-                                     _doubles(amplitude, nv, "amplitude"), _zeta_buf(zeta, nv),
-                                     nv, _c.byref(h)))
+        _check(_lib.pleat_cwf_create(base._h, _ptr(om, _c.c_double), ne, _ptr(am, _c.c_double),
+                                     None if ze is None else _ptr(ze, _c.c_double), nv,
+                                     _c.byref(h)))
         return cls(h)
 
     @classmethod
     def from_corner_omega(cls, base, corner_omega, amplitude, zeta=None):
-        """corner_omega: 3 values per triangle, value i integrated from corner i to corner i+1;
-        must be antisymmetric across shared edges. Otherwise as from_arrays."""
+        """corner_omega: (m, 3) or 3m values, value i of triangle t integrated from its corner
+        i to corner i+1; opposite across shared edges. Otherwise as ``from_arrays``."""
         nv, nc = base.vertex_count, 3 * base.triangle_count
+        co, am, ze = _doubles(corner_omega, nc, "corner_omega"), \
+            _doubles(amplitude, nv, "amplitude"), _zeta(zeta, nv)
         h = _P()
         _check(_lib.pleat_cwf_create_from_corner_omega(
-            base._h, _doubles(corner_omega, nc, "corner_omega"), nc,
-            _doubles(amplitude, nv, "amplitude"), _zeta_buf(zeta, nv), nv, _c.byref(h)))
+            base._h, _ptr(co, _c.c_double), nc, _ptr(am, _c.c_double),
+            None if ze is None else _ptr(ze, _c.c_double), nv, _c.byref(h)))
         return cls(h)
 
     @classmethod
     def from_frequency(cls, base, vectors, amplitude, per_face=False, weights="cotan",
-                       max_iterations=None):
-        """Wave vectors (x, y, z; radians per length unit), one per vertex (or per triangle
-        with per_face=True); zeta by Knoppel et al. 2015 (weights "cotan" or "edge_area")."""
+                       max_iterations=None, tolerance=None, shift=None):
+        """Wave vectors (k, 3) in radians per length unit, one per vertex (or per triangle
+        with ``per_face=True``); zeta by Knoppel et al. 2015 (``weights`` "cotan" or
+        "edge_area"); ``knoppel_report()`` tells how the solve went."""
         nv = base.vertex_count
         n = base.triangle_count if per_face else nv
         p = _lib.pleat_knoppel_params_default()
         p.weights = {"cotan": 0, "edge_area": 1}[weights]
         if max_iterations is not None:
             p.max_iterations = int(max_iterations)
+        if tolerance is not None:
+            p.tolerance = float(tolerance)
+        if shift is not None:
+            p.shift = float(shift)
+        vec, am = _doubles(vectors, 3 * n, "vectors"), _doubles(amplitude, nv, "amplitude")
         h = _P()
         _check(_lib.pleat_cwf_create_from_frequency(
-            base._h, _doubles(vectors, 3 * n, "vectors"), n, 1 if per_face else 0,
-            _doubles(amplitude, nv, "amplitude"), nv, _c.byref(p), _c.byref(h)))
+            base._h, _ptr(vec, _c.c_double), n, 1 if per_face else 0, _ptr(am, _c.c_double), nv,
+            _c.byref(p), _c.byref(h)))
         return cls(h)
 
     @classmethod
     def plane_wave(cls, base, k, amplitude):
-        """The global wave exp(i k.x): omega_ab = k.x_b - k.x_a, zeta = exp(i k.x)."""
-        import cmath
-        phase = [sum(kc * xc for kc, xc in zip(k, x)) for x in base.positions()]
-        omega = [phase[b] - phase[a] for a, b in base.edges()]
-        a = amplitude if hasattr(amplitude, "__len__") else [amplitude] * base.vertex_count
-        return cls.from_arrays(base, omega, a, [cmath.exp(1j * t) for t in phase])
+        """The global wave exp(i k.x): omega_ab = k.x_b - k.x_a, zeta = exp(i k.x);
+        ``amplitude`` a number or one per vertex."""
+        phase = base.positions() @ _np.asarray(k, dtype=_np.float64)
+        e = base.edges().astype(_np.intp)
+        omega = phase[e[:, 1]] - phase[e[:, 0]]
+        amp = _np.broadcast_to(_np.asarray(amplitude, dtype=_np.float64), phase.shape)
+        return cls.from_arrays(base, omega, amp, _np.exp(1j * phase))
 
     @classmethod
     def read(cls, base, path):
@@ -370,124 +704,181 @@ class Cwf:
 
     @property
     def vertex_count(self):
-        return _lib.pleat_cwf_vertex_count(self._h)
+        """Vertices of the base mesh."""
+        return int(_lib.pleat_cwf_vertex_count(self._h))
 
     @property
     def edge_count(self):
-        return _lib.pleat_cwf_edge_count(self._h)
+        """Edges of the base mesh (the length of omega)."""
+        return int(_lib.pleat_cwf_edge_count(self._h))
 
-    def _copy(self, fn, n):
-        buf = (_c.c_double * max(1, n))()
-        _check(fn(self._h, buf, n))
-        return list(buf[:n])
+    @property
+    def triangle_count(self):
+        """Triangles of the base mesh."""
+        return int(_lib.pleat_cwf_triangle_count(self._h))
+
+    def _copy(self, fn, n, per=1):
+        out = _np.empty(max(per * n, 1), dtype=_np.float64)
+        _check(fn(self._h, _ptr(out, _c.c_double), n))
+        return out[:per * n]
 
     def omega(self):
-        """omega per edge of base.edges() (radians)."""
+        """omega per edge of ``base.edges()`` (radians), float64 array."""
         return self._copy(_lib.pleat_cwf_copy_omega, self.edge_count)
 
     def corner_omega(self):
-        """omega per triangle corner (3 per triangle, corner i to i+1)."""
+        """omega per triangle corner, an (m, 3) array (corner i to i+1)."""
         return self._copy(_lib.pleat_cwf_copy_corner_omega,
-                          3 * _lib.pleat_cwf_triangle_count(self._h))
+                          3 * self.triangle_count).reshape(-1, 3)
 
     def amplitude(self):
-        """Amplitude per vertex."""
+        """Amplitude per vertex, float64 array."""
         return self._copy(_lib.pleat_cwf_copy_amplitude, self.vertex_count)
 
     def zeta(self):
-        """Unit phase per vertex, as complex numbers."""
-        n = self.vertex_count
-        buf = (_c.c_double * max(1, 2 * n))()
-        _check(_lib.pleat_cwf_copy_zeta(self._h, buf, n))
-        return [complex(buf[2 * i], buf[2 * i + 1]) for i in range(n)]
+        """Unit phase per vertex, complex128 array (0 at a singularity)."""
+        return self._copy(_lib.pleat_cwf_copy_zeta, self.vertex_count, 2).view(_np.complex128)
 
     def knoppel_report(self):
-        """dict (iterations, eigenvalue, residual, shift) of the phase solve; PleatError when
-        the phase was given rather than computed."""
+        """dict (iterations, eigenvalue, residual, shift) of the phase solve; PleatError
+        INVALID_ARGUMENT when the phase was given rather than computed."""
         r = _KnoppelReport()
         r.struct_size = _c.sizeof(r)
         _check(_lib.pleat_cwf_get_knoppel_report(self._h, _c.byref(r)))
-        return {n: getattr(r, n) for n, _ in _KnoppelReport._fields_ if n != "struct_size"}
+        return _as_dict(r)
 
-    def _evaluate(self, fields, levels, displacement_scale, smooth_boundary, progress,
-                  max_output_triangles):
+    def _evaluate(self, fields, levels, displacement_scale, smooth_boundary, corner_angle,
+                  progress, max_output_triangles):
         p = _lib.pleat_wrinkle_eval_params_default()
         p.levels = int(levels)
         p.displacement_scale = float(displacement_scale)
         p.boundary = 1 if smooth_boundary else 0
+        if corner_angle is not None:
+            p.corner_angle = float(corner_angle)
         if max_output_triangles is not None:
             p.max_output_triangles = int(max_output_triangles)
         for f in fields:
             if f not in _FIELDS:
                 raise PleatError(1, f"unknown field {f!r}; known: {sorted(_FIELDS)}")
             p.flags |= _FIELDS[f][0]
-        raised = []
-
-        def relay(_user, info):
-            try:
-                stage = info.contents.stage.decode("utf-8", "replace")
-                return 1 if progress(stage, info.contents.fraction) else 0
-            except BaseException as e:  # noqa: BLE001 - re-raised after the call
-                raised.append(e)
-                return 1
-        cb = _PROGRESS_FN(relay) if progress else _PROGRESS_FN()
-        mesh, out_fields = _P(), _P()
+        relay, mesh, out_fields = _Relay(progress), _P(), _P()
         stats = _EvalStats()
         stats.struct_size = _c.sizeof(stats)
-        st = _lib.pleat_cwf_evaluate(self._h, _c.byref(p), cb, None, _c.byref(mesh),
+        st = _lib.pleat_cwf_evaluate(self._h, _c.byref(p), relay.fn, None, _c.byref(mesh),
                                      _c.byref(out_fields) if fields else None, _c.byref(stats))
-        if raised:
-            raise raised[0]
-        _check(st)
+        relay.finish(st)
         result = {}
         try:
             for f in fields:
                 bit, comps = _FIELDS[f]
                 n = _lib.pleat_wrinkle_fields_count(out_fields, bit)
-                buf = (_c.c_double * max(1, comps * n))()
-                _check(_lib.pleat_wrinkle_fields_copy(out_fields, bit, buf, n, 0))
-                if comps == 1:
-                    result[f] = list(buf[:n])
-                elif comps == 2:
-                    result[f] = [complex(buf[2 * i], buf[2 * i + 1]) for i in range(n)]
-                else:
-                    result[f] = [tuple(buf[3 * i:3 * i + 3]) for i in range(n)]
+                buf = _np.empty((max(n, 1), comps), dtype=_np.float64)
+                _check(_lib.pleat_wrinkle_fields_copy(out_fields, bit, _ptr(buf, _c.c_double),
+                                                      n, 0))
+                buf = buf[:n]
+                result[f] = buf[:, 0].copy() if comps == 1 else \
+                    buf.view(_np.complex128)[:, 0].copy() if comps == 2 else buf
         finally:
-            if out_fields:
-                _lib.pleat_wrinkle_fields_destroy(out_fields)
-        result["stats"] = {n: getattr(stats, n) for n, _ in _EvalStats._fields_
-                           if n != "struct_size"}
-        return Mesh(mesh), result
+            _lib.pleat_wrinkle_fields_destroy(out_fields)
+        return Mesh(mesh, _as_dict(stats)), result
 
-    def evaluate(self, levels=3, displacement_scale=1.0, smooth_boundary=False, progress=None,
-                 max_output_triangles=None):
-        """The wrinkled Mesh after ``levels`` Loop refinements. ``progress(stage, fraction)``
-        is called after each level; return True from it to cancel (PleatError CANCELLED)."""
-        return self._evaluate((), levels, displacement_scale, smooth_boundary, progress,
-                              max_output_triangles)[0]
+    def evaluate(self, levels=3, displacement_scale=1.0, smooth_boundary=False, corner_angle=None,
+                 progress=None, max_output_triangles=None):
+        """The wrinkled Mesh after ``levels`` Loop refinements, with ``stats``
+        (PleatWrinkleEvalStats). ``progress(stage, fraction)`` is called after each level;
+        return True to cancel (PleatError CANCELLED)."""
+        return self._evaluate((), levels, displacement_scale, smooth_boundary, corner_angle,
+                              progress, max_output_triangles)[0]
 
     def evaluate_fields(self, fields, levels=3, displacement_scale=1.0, smooth_boundary=False,
-                        progress=None, max_output_triangles=None):
-        """(Mesh, dict): the wrinkled mesh and the requested per-vertex fields, any of
-        "amplitude", "phase" (radians), "normals", "z" (complex), "smooth_positions",
-        "omega" (per edge of the output mesh's edges()); the dict also has "stats"."""
+                        corner_angle=None, progress=None, max_output_triangles=None):
+        """(Mesh, dict of arrays): the wrinkled mesh and the requested fields: "amplitude",
+        "phase" (radians), "omega" (per edge of the output's ``edges()``) as (n,) float64;
+        "z" as (n,) complex128; "normals", "smooth_positions" as (n, 3) float64."""
         return self._evaluate(tuple(fields), levels, displacement_scale, smooth_boundary,
-                              progress, max_output_triangles)
+                              corner_angle, progress, max_output_triangles)
 
-    def close(self):
-        """Releases the field now (also done when garbage-collected)."""
-        if self._h:
-            _lib.pleat_cwf_destroy(self._h)
-            self._h = _P()
+    def interpolate(self, other, guide_frames=None, substeps=None, max_iterations=None,
+                    c_scale=None, gradient_tolerance=None, hessian=None, progress=None):
+        """The Animation from this keyframe (t = 0) to ``other`` (t = 1) on the same base mesh
+        (dissertation §3.4). Unset parameters keep the C defaults (50 guide frames, 4
+        substeps, 200 iterations, c_scale 1000, tolerance 1e-6, hessian "trust_region"; also
+        "projected", "gauss_newton", "exact"). ``progress`` is called after each Newton
+        iteration; True cancels."""
+        p = _lib.pleat_wrinkle_interp_params_default()
+        for name, v in (("guide_frames", guide_frames), ("substeps", substeps),
+                        ("max_iterations", max_iterations)):
+            if v is not None:
+                setattr(p, name, int(v))
+        if c_scale is not None:
+            p.c_scale = float(c_scale)
+        if gradient_tolerance is not None:
+            p.gradient_tolerance = float(gradient_tolerance)
+        if hessian is not None:
+            p.hessian = _HESSIAN[hessian]
+        stats = _InterpStats()
+        stats.struct_size = _c.sizeof(stats)
+        relay, out = _Relay(progress), _P()
+        st = _lib.pleat_cwf_interpolate(self._h, other._h, _c.byref(p), relay.fn, None,
+                                        _c.byref(out), _c.byref(stats))
+        relay.finish(st)
+        d = _as_dict(stats)
+        d["stop_reason"] = _STOP.get(d["stop_reason"], d["stop_reason"])
+        return Animation(out, d)
 
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:
-            pass
+    def __repr__(self):
+        return f"<pleat.Cwf on {self.vertex_count} vertices, {self.edge_count} edges>"
 
-    def __enter__(self):
-        return self
 
-    def __exit__(self, *exc):
-        self.close()
+class Animation(_Handle):
+    """A wrinkle animation between two keyframes (``Cwf.interpolate`` or ``Animation.read``):
+    ``frame(t)`` gives the field at any t in [0, 1]. ``stats`` holds the solve's report
+    (None when read from a file). Immutable."""
+
+    _destroy = "pleat_cwf_animation_destroy"
+
+    def __init__(self, handle, stats=None):
+        super().__init__(handle)
+        self.stats = stats
+
+    @classmethod
+    def read(cls, base, path):
+        """Reads a .cwfa file written for ``base``."""
+        h = _P()
+        _check(_lib.pleat_cwf_animation_read_file(base._h, _os.fsencode(path), _c.byref(h)))
+        return cls(h)
+
+    def write(self, path):
+        """Writes the .cwfa text file (lossless)."""
+        _check(_lib.pleat_cwf_animation_write_file(self._h, _os.fsencode(path)))
+
+    @property
+    def frame_count(self):
+        """Playback frames, guide_frames * substeps + 1; frame i is at t = i / (count - 1)."""
+        return int(_lib.pleat_cwf_animation_frame_count(self._h))
+
+    @property
+    def guide_count(self):
+        """Guide intervals N' (there are N' + 1 guide frames)."""
+        return int(_lib.pleat_cwf_animation_guide_count(self._h))
+
+    def frame(self, t):
+        """The wrinkle field (Cwf) at time t in [0, 1]; 0 and 1 give the keyframes exactly."""
+        h = _P()
+        _check(_lib.pleat_cwf_animation_frame(self._h, float(t), _c.byref(h)))
+        return Cwf(h)
+
+    def frames(self):
+        """Every playback frame, in order (a generator of Cwf)."""
+        n = self.frame_count
+        for i in range(n):
+            yield self.frame(i / (n - 1) if n > 1 else 0.0)
+
+    def history(self):
+        """Convergence history, a (k, 2) array of (wall seconds since the start, normalized
+        gradient norm): error against run time. Empty for an animation read from a file."""
+        n = int(_lib.pleat_cwf_animation_history_count(self._h))
+        out = _np.empty((max(n, 1), 2), dtype=_np.float64)
+        _check(_lib.pleat_cwf_animation_copy_history(self._h, _ptr(out, _c.c_double), n))
+        return out[:n]
+

@@ -1,149 +1,135 @@
-"""Tests of the ctypes bindings; run by tests/c_harness.rs with PLEAT_LIBRARY set.
-Prints 'N passed, N failed'."""
+"""Mesh basics of the Python package: arrays in and out, files, errors, the validity report.
+
+Run with pytest (``python -m pytest bindings/python/tests``). Run as a script it runs the
+whole directory with pytest against the source tree (``tests/c_harness.rs`` does that with
+``PLEAT_LIBRARY`` pointing at the freshly built library); without numpy or pytest it says so
+and exits 0."""
 import math
 import os
 import sys
-import tempfile
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
+if __name__ == "__main__":
+    here = os.path.dirname(os.path.abspath(__file__))
+    sys.path.insert(0, os.path.dirname(here))
+    try:
+        import numpy  # noqa: F401
+        import pytest
+    except ImportError as e:
+        print(f"SKIPPED: Python binding tests need numpy and pytest ({e}); "
+              "pip install numpy pytest, or run .ci/packaging.sh")
+        sys.exit(0)
+    sys.exit(pytest.main(["-q", "-p", "no:cacheprovider", here]))
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
 import pleat  # noqa: E402
-
-passed = failed = 0
-
-
-def check(cond, what):
-    global passed, failed
-    if cond:
-        passed += 1
-    else:
-        failed += 1
-        print("FAILED:", what)
+from conftest import CUBE_F, CUBE_V, TET_F, TET_V, grid_arrays, two_boxes  # noqa: E402
 
 
-P = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)]
-T = [(0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2)]
-m = pleat.Mesh.from_arrays(P, T)
-check(m.vertex_count == 4 and m.triangle_count == 4, "counts")
-check(m.triangles() == T, "triangles round trip")
-check(m.positions()[1] == (1.0, 0.0, 0.0), "positions round trip")
-with tempfile.TemporaryDirectory() as d:
-    f = os.path.join(d, "t.ply")
-    m.write(f)
-    check(pleat.Mesh.read(f).triangles() == T, "ply round trip")
-try:
-    pleat.Mesh.from_arrays([(0, 0, math.nan), (1, 0, 0), (0, 1, 0)], [(0, 1, 2)])
-    check(False, "NaN accepted")
-except pleat.PleatError as e:
-    check(e.status == "INVALID_MESH", "NaN status")
-try:
-    pleat.Mesh.read("/no/such/file.obj")
-    check(False, "missing file accepted")
-except pleat.PleatError as e:
-    check(e.status == "IO" and "file.obj" in str(e), "missing file status")
-r = m.check()
-check(r["is_watertight"] and r["total_genus"] == 0 and r["component_count"] == 1, "check closed tet")
-check(abs(r["surface_area"] - (1.5 + 3 ** 0.5 / 2)) < 1e-12, "area")
-check(pleat.version().count(".") == 2, "version")
-check(pleat.has_feature("lod") in (True, False), "has_feature")
-m.close()
-m.close()
+def test_version_and_library():
+    assert pleat.version().count(".") == 2
+    assert pleat.abi_version() == pleat.ABI_VERSION == 1
+    assert os.path.exists(pleat.library_path()) or pleat.library_path().startswith("libpleat")
+    assert pleat.has_feature("lod") in (True, False)
+    assert not pleat.has_feature("no-such-capability")
+    assert pleat.thread_count() >= 1
 
 
-def grid(n):
-    P = [(i / (n - 1), j / (n - 1), 0.0) for j in range(n) for i in range(n)]
-    T = []
-    for j in range(n - 1):
-        for i in range(n - 1):
-            a = j * n + i
-            T += [(a, a + 1, a + n + 1), (a, a + n + 1, a + n)]
-    return pleat.Mesh.from_arrays(P, T)
-
-
-def wrap(x):
-    return x - 2 * math.pi * math.floor(x / (2 * math.pi) + 0.5)
-
-
-g = grid(5)
-E = g.edges()
-check(len(E) == g.edge_count == 4 * 5 * 2 + 16, "edge count")
-check(E == sorted(E) and all(a < b for a, b in E) and E[:3] == [(0, 1), (0, 5), (0, 6)], "edge order")
-K = (7.0, 3.0, 0.0)
-if pleat.has_feature("wrinkle"):
-    w = pleat.Cwf.plane_wave(g, K, 0.02)
-    check(w.vertex_count == 25 and w.edge_count == len(E), "cwf counts")
-    check(all(abs(abs(z) - 1) < 1e-15 for z in w.zeta()) and w.amplitude() == [0.02] * 25, "cwf copy-out")
-    out = w.evaluate(levels=2)
-    check(out.triangle_count == 32 * 16, "evaluate triangle count")
-    mesh, f = w.evaluate_fields(["phase", "smooth_positions", "z", "normals"], levels=2)
-    err = max(abs(wrap(ph - (K[0] * x[0] + K[1] * x[1]))) for ph, x in zip(f["phase"], f["smooth_positions"]))
-    check(err < 1e-9, f"plane wave phase exact after refinement ({err:.2e})")
-    check(len(f["z"]) == mesh.vertex_count and f["normals"][0] == (0.0, 0.0, 1.0), "fields")
-    check(f["stats"]["triangle_count"] == 512 and f["stats"]["levels"] == 2, "eval stats")
-    # per-corner omega gives the same field
-    X = g.positions()
-    corners = [K[0] * (X[t[(i + 1) % 3]][0] - X[t[i]][0]) + K[1] * (X[t[(i + 1) % 3]][1] - X[t[i]][1])
-               for t in g.triangles() for i in range(3)]
-    wc = pleat.Cwf.from_corner_omega(g, corners, [0.02] * 25, w.zeta())
-    check(max(abs(a - b) for a, b in zip(wc.omega(), w.omega())) < 1e-14, "corner omega")
-    check(max(abs(a - b) for a, b in zip(wc.corner_omega(), corners)) < 1e-14, "corner omega out")
-    bad = list(corners)
-    bad[1] += 0.1
+def test_package_version_matches_library():
     try:
-        pleat.Cwf.from_corner_omega(g, bad, [0.02] * 25)
-        check(False, "antisymmetry violation accepted")
-    except pleat.PleatError as e:
-        check(e.status == "INVALID_ARGUMENT" and "antisymmetric" in str(e), "antisymmetry status")
-    # Knoppel from wave vectors
-    wk = pleat.Cwf.from_frequency(g, [K] * 25, [0.02] * 25)
-    r = wk.knoppel_report()
-    check(r["iterations"] >= 1 and r["eigenvalue"] < 1e-6, "knoppel report")
-    # files
-    with tempfile.TemporaryDirectory() as d:
-        path = os.path.join(d, "w.cwf")
-        w.write(path)
-        back = pleat.Cwf.read(g, path)
-        check(back.omega() == w.omega() and back.zeta() == w.zeta(), "cwf round trip")
-        try:
-            pleat.Cwf.read(grid(4), path)
-            check(False, "cwf for another base accepted")
-        except pleat.PleatError as e:
-            check(e.status == "INVALID_ARGUMENT", "cwf base mismatch")
-    # progress and cancellation
-    seen = []
-    w.evaluate(levels=3, progress=lambda stage, frac: seen.append((stage, frac)))
-    check(len(seen) == 4 and seen[-1] == ("displace", 1.0), f"progress calls {seen}")
-    try:
-        w.evaluate(levels=3, progress=lambda stage, frac: True)
-        check(False, "cancel ignored")
-    except pleat.PleatError as e:
-        check(e.status == "CANCELLED", "cancel status")
+        from importlib.metadata import PackageNotFoundError, version
+        meta = version("pleat")
+    except (ImportError, PackageNotFoundError):
+        pytest.skip("pleat is not installed as a distribution (source tree)")
+    assert meta == pleat.version()
 
-    def boom(stage, frac):
-        raise KeyError("from the callback")
-    try:
-        w.evaluate(levels=2, progress=boom)
-        check(False, "callback exception swallowed")
-    except KeyError:
-        check(True, "callback exception")
-    # misuse
-    for call, status in [
-        (lambda: pleat.Cwf.from_arrays(g, [0.0] * 3, [0.02] * 25), "INVALID_ARGUMENT"),
-        (lambda: pleat.Cwf.from_arrays(g, [math.nan] * len(E), [0.02] * 25), "INVALID_ARGUMENT"),
-        (lambda: w.evaluate(levels=30), "LIMIT_EXCEEDED"),
-        (lambda: pleat.Cwf.from_arrays(pleat.Mesh.from_arrays(P + [(1, 1, 1)], T + [(0, 1, 4)]),
-                                       [0.0] * 8, [0.1] * 5), "INVALID_MESH"),
-    ]:
-        try:
-            call()
-            check(False, f"misuse accepted, expected {status}")
-        except pleat.PleatError as e:
-            check(e.status == status, f"{e.status} != {status}: {e}")
-    w.close()
-else:
-    try:
-        pleat.Cwf.from_arrays(g, [0.0] * len(E), [0.0] * 25)
-        check(False, "wrinkle call in a build without it")
-    except pleat.PleatError as e:
-        check(e.status == "UNSUPPORTED", "unsupported status")
-print(f"python bindings: {passed} passed, {failed} failed")
-sys.exit(1 if failed else 0)
+
+def test_arrays_round_trip(tet):
+    assert (tet.vertex_count, tet.triangle_count, tet.edge_count) == (4, 4, 6)
+    P, T = tet.positions(), tet.triangles()
+    assert P.dtype == np.float64 and P.shape == (4, 3) and np.array_equal(P, TET_V)
+    assert T.dtype == np.uint32 and T.shape == (4, 3) and np.array_equal(T, TET_F)
+    assert tet.positions(np.float32).dtype == np.float32
+    E = tet.edges()
+    assert E.shape == (6, 2) and np.all(E[:, 0] < E[:, 1]) and E[0].tolist() == [0, 1]
+
+
+def test_float32_interleaved_buffer_without_copy():
+    # an interleaved vertex buffer: xyz + uv per vertex (5 floats, stride 20 bytes)
+    buf = np.zeros((4, 5), dtype=np.float32)
+    buf[:, :3] = TET_V
+    buf[:, 3:] = 7.0
+    m = pleat.Mesh.from_arrays(buf[:, :3], TET_F.astype(np.int64))
+    assert np.array_equal(m.positions(), TET_V)
+
+
+def test_flat_inputs(tet):
+    m = pleat.Mesh.from_arrays(TET_V.ravel().tolist(), TET_F.ravel().tolist())
+    assert np.array_equal(m.triangles(), tet.triangles())
+
+
+def test_files_round_trip(tmp_path, cube):
+    path = tmp_path / "cube.ply"
+    cube.write(path)
+    back = pleat.Mesh.read(path)
+    assert np.array_equal(back.positions(), CUBE_V) and np.array_equal(back.triangles(), CUBE_F)
+
+
+def test_errors_carry_status_and_message():
+    with pytest.raises(pleat.PleatError) as e:
+        pleat.Mesh.from_arrays([(0, 0, math.nan), (1, 0, 0), (0, 1, 0)], [(0, 1, 2)])
+    assert e.value.status == "INVALID_MESH" and e.value.code == 2
+    with pytest.raises(pleat.PleatError) as e:
+        pleat.Mesh.read("/no/such/file.obj")
+    assert e.value.status == "IO" and "file.obj" in str(e.value)
+    with pytest.raises(pleat.PleatError) as e:
+        pleat.Mesh.from_arrays(TET_V, [(0, 1, 9)])
+    assert e.value.status == "INVALID_MESH"
+    with pytest.raises(pleat.PleatError) as e:
+        pleat.Mesh.from_arrays(TET_V, [(0, 1, -1)])
+    assert e.value.status == "INVALID_ARGUMENT"
+    with pytest.raises(pleat.PleatError):
+        pleat.Mesh.from_arrays(np.zeros((4, 2)), TET_F)
+    # errors raised by the binding itself leave the C library's last error alone
+    assert "references a vertex" in pleat.last_error()
+
+
+def test_check_report(tet):
+    r = tet.check()
+    assert r["is_watertight"] is True and r["total_genus"] == 0 and r["component_count"] == 1
+    assert abs(r["surface_area"] - (1.5 + 3 ** 0.5 / 2)) < 1e-12
+    assert r["bbox_min"] == (0.0, 0.0, 0.0) and r["bbox_max"] == (1.0, 1.0, 1.0)
+    soup = pleat.Mesh.from_arrays(*two_boxes())
+    r = soup.check()
+    assert r["component_count"] == 2 and r["self_intersections_checked"]
+    assert r["self_intersecting_pair_count"] > 0 and not r["self_intersection_free"]
+    r = soup.check(self_intersections=False)
+    assert not r["self_intersections_checked"] and r["self_intersecting_pair_count"] == 0
+    open_grid = pleat.Mesh.from_arrays(*grid_arrays(4))
+    r = open_grid.check()
+    assert not r["is_closed"] and r["boundary_edge_count"] == 12 and r["total_genus"] == -1
+
+
+def test_weld():
+    # the tetrahedron with every triangle on its own vertices: closed only after welding
+    V = TET_V[TET_F.ravel()]
+    F = np.arange(12, dtype=np.uint32).reshape(4, 3)
+    m = pleat.Mesh.from_arrays(V, F)
+    assert not m.check()["is_closed"] and m.check(weld=True)["is_watertight"]
+
+
+def test_close_is_idempotent_and_context_manager():
+    with pleat.Mesh.from_arrays(TET_V, TET_F) as m:
+        assert m.triangle_count == 4
+    m.close()
+    assert m.triangle_count == 0
+
+
+def test_threads():
+    n = pleat.thread_count()
+    pleat.set_thread_count(1)
+    assert pleat.thread_count() == 1
+    pleat.set_thread_count(0)
+    assert pleat.thread_count() >= 1
+    assert n >= 1

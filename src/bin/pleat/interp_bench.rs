@@ -1,14 +1,17 @@
 //! Keyframe pairs and plotting for the interpolation benchmark (`pleat bench wrinkle`,
 //! `benches/wrinkle_interp.rs`): the dissertation's kinds of edits (§3.4.2, Table B.1) on any
 //! base mesh, and a dependency-free SVG line plot.
+//!
+//! Not part of the library's API: the CLI includes this file as a module, and the bench includes
+//! the same file with `#[path = "../src/bin/pleat/interp_bench.rs"]`, so it exists once. It uses
+//! only the library's public API.
 
 use std::fmt::Write as _;
 
-use super::cwf::{Cwf, FrequencyField};
-use super::knoppel::KnoppelOptions;
-use super::topology::{cross, dot, norm, scale, sub};
-use crate::mesh::TriMesh;
-use crate::Result;
+use pleat::geom::{tri_normal, Vec3};
+use pleat::mesh::TriMesh;
+use pleat::wrinkle::{Cwf, FrequencyField, KnoppelOptions};
+use pleat::Result;
 
 /// The kind of keyframe pair.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -47,45 +50,34 @@ pub fn keyframe_pair(mesh: &TriMesh, kind: PairKind, wavelengths: f64) -> Result
     let diag = mesh.bbox_diagonal();
     let kmag = 2.0 * std::f64::consts::PI * wavelengths / diag;
     let normals = vertex_normals(mesh);
-    let k0: Vec<[f64; 3]> = normals
+    let k0: Vec<Vec3> = normals
         .iter()
         .map(|&n| {
-            let d = [1.0, 0.0, 0.0];
-            scale(sub(d, scale(n, dot(d, n))), kmag)
+            let d = Vec3::X;
+            (d - n * d.dot(n)) * kmag
         })
         .collect();
-    let turned: Vec<[f64; 3]> = k0
-        .iter()
-        .zip(&normals)
-        .map(|(&k, &n)| cross(n, k))
-        .collect();
+    let turned: Vec<Vec3> = k0.iter().zip(&normals).map(|(&k, &n)| n.cross(k)).collect();
     let n = mesh.vertex_count();
     let a0 = 0.005 * diag;
     let (k1, amp1) = match kind {
         PairKind::GlobalRotation => (turned, vec![a0; n]),
-        PairKind::FrequencyTripled => (
-            k0.iter().map(|&k| scale(k, 3.0)).collect(),
-            vec![a0 / 3.0; n],
-        ),
+        PairKind::FrequencyTripled => (k0.iter().map(|&k| k * 3.0).collect(), vec![a0 / 3.0; n]),
         PairKind::LocalRotation => {
-            let c = mesh.positions()[0];
+            let c = Vec3::from(mesh.positions()[0]);
             let r = 0.25 * diag;
             let k1 = (0..n)
                 .map(|j| {
-                    let d = norm(sub(mesh.positions()[j], c)) / r;
+                    let d = (Vec3::from(mesh.positions()[j]) - c).length() / r;
                     let w = smoothstep(1.0 - (d - 0.6) / 0.4);
-                    let v = scale(k0[j], 1.0 - w);
-                    [
-                        v[0] + w * turned[j][0],
-                        v[1] + w * turned[j][1],
-                        v[2] + w * turned[j][2],
-                    ]
+                    k0[j] * (1.0 - w) + turned[j] * w
                 })
                 .collect();
             (k1, vec![a0; n])
         }
     };
     let opts = KnoppelOptions::default();
+    let (k0, k1) = (to_arrays(&k0), to_arrays(&k1));
     let (a, _) = Cwf::from_frequency_field(
         mesh.clone(),
         FrequencyField::PerVertex(&k0),
@@ -97,34 +89,33 @@ pub fn keyframe_pair(mesh: &TriMesh, kind: PairKind, wavelengths: f64) -> Result
     Ok((a, b))
 }
 
+fn to_arrays(v: &[Vec3]) -> Vec<[f64; 3]> {
+    v.iter().map(|k| k.to_array()).collect()
+}
+
 fn smoothstep(x: f64) -> f64 {
     let x = x.clamp(0.0, 1.0);
     x * x * (3.0 - 2.0 * x)
 }
 
 /// Area-weighted unit vertex normals (zero where undefined).
-fn vertex_normals(m: &TriMesh) -> Vec<[f64; 3]> {
-    let x = m.positions();
-    let mut acc = vec![[0.0; 3]; m.vertex_count()];
+fn vertex_normals(m: &TriMesh) -> Vec<Vec3> {
+    let x = |v: u32| Vec3::from(m.positions()[v as usize]);
+    let mut acc = vec![Vec3::ZERO; m.vertex_count()];
     for t in m.triangles() {
-        let f = cross(
-            sub(x[t[1] as usize], x[t[0] as usize]),
-            sub(x[t[2] as usize], x[t[0] as usize]),
-        );
+        let f = tri_normal(x(t[0]), x(t[1]), x(t[2]));
         for &v in t {
-            let a = &mut acc[v as usize];
-            a[0] += f[0];
-            a[1] += f[1];
-            a[2] += f[2];
+            acc[v as usize] += f;
         }
     }
     acc.iter()
         .map(|&a| {
-            let l = norm(a);
+            let l = a.length();
+            // not `geom::normalized`: an infinite length is scaled here, not rejected
             if l > 0.0 {
-                scale(a, 1.0 / l)
+                a * (1.0 / l)
             } else {
-                [0.0; 3]
+                Vec3::ZERO
             }
         })
         .collect()

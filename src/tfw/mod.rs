@@ -1,1 +1,0 @@
-//! Tension-field wrinkles (dissertation ch. 2).
