@@ -9,11 +9,11 @@
 //!    baseline does); when it stops above `max(1.05 F, F + 4)` (it never changes topology),
 //!    `meshopt::simplify_sloppy` to `F` instead (recorded in the `meshopt_method` column).
 //!
-//! Both outputs are measured with the same function, [`pleat::lowpoly::hausdorff_to_input`]:
+//! Both outputs are measured with the same function, [`pleat::verify::hausdorff_to_input`]:
 //! two-sided sampled Hausdorff distance, every vertex plus a barycentric grid of spacing
 //! `l / 400` on every triangle (`l` = input bbox diagonal, ≤ 32 subdivisions per edge), exact
 //! closest points by BVH; reported relative to `l`. Validity (watertight, manifold and
-//! consistently oriented, self-intersection-free) comes from `pleat::mesh::MeshReport`, and
+//! consistently oriented, self-intersection-free) comes from `pleat::verify::MeshReport`, and
 //! also from the CGAL checker when `PLEAT_MESHCHECK` names its binary.
 //!
 //! Times are wall seconds measured in this process (pleat's include its own final
@@ -27,8 +27,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use meshopt::{SimplifyOptions, VertexDataAdapter};
-use pleat::lowpoly::{generate, hausdorff_to_input, LodParams};
+use pleat::lowpoly::{generate, LodParams};
 use pleat::mesh::{ExactWeld, TriMesh};
+use pleat::verify::hausdorff_to_input;
 
 #[path = "common/lod_sweep.rs"]
 mod lod_sweep;
@@ -152,7 +153,7 @@ fn run_pleat(mesh: &TriMesh, n_p: f64, tag: &str) -> Outcome {
             seconds,
             cpu_seconds,
             hd_rel: hausdorff_to_input(&out, mesh) / mesh.bbox_diagonal(),
-            floor_rel: stats.get_metric("hausdorff_floor_rel").unwrap_or(f64::NAN),
+            floor_rel: stats.floor.map_or(f64::NAN, |f| f.rel),
             valid: validity(&out, tag),
         },
         Err(e) => Outcome {

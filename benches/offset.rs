@@ -11,6 +11,7 @@ use std::time::Instant;
 
 use pleat::lowpoly::{offset_surface_with_progress, OffsetDistance, OffsetParams};
 use pleat::mesh::TriMesh;
+use pleat::report::Stage as _;
 
 fn corpus_dir() -> Option<PathBuf> {
     let cands = [
@@ -72,7 +73,7 @@ fn child(path: &Path, np: f64) {
         Ok((out, stats)) => {
             let total = t.elapsed().as_secs_f64();
             if trace {
-                for (n, c) in &stats.counts {
+                for (n, c) in &stats.entries().counts {
                     eprintln!("  {n:<24} {c}");
                 }
             }
@@ -80,13 +81,13 @@ fn child(path: &Path, np: f64) {
             let stages: Vec<String> = stats
                 .stages
                 .iter()
-                .map(|(n, s)| format!("{n}={s:.3}"))
+                .map(|(n, s)| format!("{}={s:.3}", n.name()))
                 .collect();
             println!(
                 "OK {total:.3} {} {} {} {cpu:.3} {}",
                 peak_rss_bytes(),
                 out.triangle_count(),
-                stats.get_metric("peak_memory_bytes").unwrap_or(0.0) as u64,
+                stats.peak_memory_bytes,
                 stages.join(",")
             );
         }

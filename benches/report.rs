@@ -8,8 +8,9 @@
 
 use std::time::Instant;
 
-use pleat::mesh::{MeshReport, ReportOptions, TriMesh};
-use pleat::Stats;
+use pleat::mesh::TriMesh;
+use pleat::report::{Stage as _, StageTimes};
+use pleat::verify::{MeshReport, ReportOptions};
 
 #[path = "../tests/common/shapes.rs"]
 mod shapes;
@@ -96,14 +97,13 @@ fn winding(mesh: &TriMesh) {
 
 /// Times one full report and prints its phases.
 fn run(name: &str, mesh: &TriMesh) -> MeshReport {
-    let mut stats = Stats::default();
+    let mut stats = StageTimes::default();
     let t0 = Instant::now();
     let r = MeshReport::compute_timed(mesh, &ReportOptions::default(), &mut stats);
     let total = t0.elapsed().as_secs_f64();
     let phases: Vec<String> = stats
-        .stages
         .iter()
-        .map(|(n, s)| format!("{n} {s:.3}"))
+        .map(|(n, s)| format!("{} {s:.3}", n.name()))
         .collect();
     println!(
         "{name}: {} triangles, total {total:.3} s [{}]; watertight {}, self-intersecting pairs {:?}",

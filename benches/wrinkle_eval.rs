@@ -9,7 +9,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use pleat::mesh::TriMesh;
-use pleat::wrinkle::{Complex, Cwf, EvalOptions, FrequencyField, KnoppelOptions};
+use pleat::report::Stage as _;
+use pleat::wrinkle::{
+    Complex, Cwf, EvalOptions, EvalStage, FrequencyField, KnoppelOptions, LevelPart,
+};
 
 const MAX_FACES: usize = 1_100_000;
 const REPEATS: usize = 3;
@@ -28,8 +31,8 @@ fn main() {
         let t = best_time(&cwf, 5, 2);
         println!("knight level 5, 2 threads: {t:.4} s wall");
         let (_, stats) = in_pool(1, || cwf.evaluate(5, &EvalOptions::default()).unwrap());
-        for (n, s) in &stats.stages {
-            println!("  {n:32} {s:.4}");
+        for (n, s) in stats.stages.iter() {
+            println!("  {:32} {s:.4}", n.name());
         }
         return;
     }
@@ -93,7 +96,7 @@ fn corpus(dir: &Path) {
         let stages: Vec<String> = stats
             .stages
             .iter()
-            .map(|(n, s)| format!("{n} {s:.4}"))
+            .map(|(n, s)| format!("{} {s:.4}", n.name()))
             .collect();
         println!(
             "{name:28} stages at level {} (2 threads): {}",
@@ -167,7 +170,7 @@ fn swirl_cwf(mesh: TriMesh) -> pleat::Result<Cwf> {
         .collect();
     let n = mesh.vertex_count();
     let t = Instant::now();
-    let (cwf, rep, _) = Cwf::from_frequency_field(
+    let (cwf, rep) = Cwf::from_frequency_field(
         mesh,
         FrequencyField::PerVertex(&v),
         vec![0.004 * diag; n],
@@ -308,11 +311,11 @@ fn zero_amplitude_regions(dir: &Path) {
         let c = Cwf::new(b.clone(), w.clone(), amp, z.clone()).unwrap();
         let t = best_time(&c, 5, 1);
         let (_, stats) = in_pool(1, || c.evaluate(5, &EvalOptions::default()).unwrap());
-        let part = |p: &str| {
+        let part = |p: LevelPart| {
             stats
                 .stages
                 .iter()
-                .filter(|(n, _)| n.ends_with(p))
+                .filter(|(n, _)| matches!(n, EvalStage::Level(_, part) if *part == p))
                 .map(|(_, s)| s)
                 .sum::<f64>()
         };
@@ -320,8 +323,8 @@ fn zero_amplitude_regions(dir: &Path) {
             "  zero on {:>3.0}% of base vertices: {t:.4} s (z {:.4} s, rest {:.4} s); base faces with \
              non-zero amplitude in their neighbourhood: {:.0}%",
             100.0 * frac,
-            part(": z"),
-            stats.total_seconds() - part(": z"),
+            part(LevelPart::Z),
+            stats.total_seconds() - part(LevelPart::Z),
             100.0 * active as f64 / b.triangle_count() as f64
         );
     }

@@ -103,7 +103,7 @@ fn main() {
                 ..Default::default()
             };
             let t0 = std::time::Instant::now();
-            let (_, r, _) = interpolate(&a, &b, &opts).expect("interpolate");
+            let (_, r) = interpolate(&a, &b, &opts).expect("interpolate");
             let secs = t0.elapsed().as_secs_f64();
             times.push(secs);
             println!(
@@ -126,7 +126,7 @@ fn main() {
                 ] {
                     let o = InterpOptions { hessian: h, ..opts };
                     let t0 = std::time::Instant::now();
-                    let (_, r, _) = interpolate(&a, &b, &o).expect("interpolate");
+                    let (_, r) = interpolate(&a, &b, &o).expect("interpolate");
                     println!(
                         "{name:28} {:>6} {:16} {:>14} {:>6} {:>6} {:>6} {:>10.2e} {:>9.2}  ({h:?})",
                         mesh.vertex_count(),

@@ -13,23 +13,29 @@
 //! The offset surface encloses the input at distance `d`, and each accepted operation keeps
 //! both properties, so the result encloses every input vertex (and, as nothing touches, every
 //! input point). The input may be any soup: non-manifold, open, self-intersecting.
-//! The result is verified independently: [`crate::mesh::MeshReport`] for Pro.III, an exact
+//! The result is verified independently, at the end of every bake, by `crate::verify` (code
+//! that shares nothing with the guard): [`crate::verify::MeshReport`] for Pro.III, an exact
 //! surface–surface test against the input, and hierarchical winding numbers (Barill et al.
-//! 2018) of every input vertex (`Stats::verified` entry `cage_encloses_without_touching`).
+//! 2018) of every input vertex ([`LodReport::verified`]`.cage_encloses_without_touching`).
+//!
+//! May import: `crate::lowpoly`, `crate::verify`, `crate::mesh`, `crate::report`,
+//! `crate::error`.
 
-use crate::lowpoly::{run, run_chain, LodParams, Mode};
+use crate::lowpoly::{run, run_chain, LodParams, LodReport, Mode};
 use crate::mesh::TriMesh;
 use crate::report::ProgressFn;
-use crate::{Result, Stats};
+use crate::Result;
+
+pub use crate::verify::CageCheck;
 
 /// Bakes a cage of `input` at `params.screen_size` (offset `d = l / n_p`; a larger screen size
-/// gives a tighter cage with more faces). Same parameters, statistics, progress and errors as
+/// gives a tighter cage with more faces). Same parameters, report, progress and errors as
 /// [`crate::lowpoly::generate`].
 pub fn generate(
     input: &TriMesh,
     params: &LodParams,
     progress: &mut ProgressFn<'_>,
-) -> Result<(TriMesh, Stats)> {
+) -> Result<(TriMesh, LodReport)> {
     run(input, params, Mode::Cage, progress)
 }
 
@@ -41,36 +47,13 @@ pub fn generate_chain(
     screen_sizes: &[f64],
     params: &LodParams,
     progress: &mut ProgressFn<'_>,
-) -> Result<Vec<(TriMesh, Stats)>> {
+) -> Result<Vec<(TriMesh, LodReport)>> {
     run_chain(input, screen_sizes, params, Mode::Cage, progress)
-}
-
-/// Result of [`check`]: the two cage properties, tested independently of the guard.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct CageCheck {
-    /// No cage triangle touches or intersects an input triangle (exact tests on BVH
-    /// candidates; touching counts as contact).
-    pub untouched: bool,
-    /// Every referenced input vertex has winding number above 1/2 with respect to the cage
-    /// (hierarchical fast winding numbers, Barill et al. 2018).
-    pub encloses: bool,
-}
-
-impl CageCheck {
-    /// Both properties hold.
-    pub fn is_cage(&self) -> bool {
-        self.untouched && self.encloses
-    }
 }
 
 /// Checks that `cage` encloses every vertex of `input` and touches none of its triangles —
 /// the verification the pipeline runs on its own output, usable on any mesh (benchmarks,
-/// tests, other cage generators).
+/// tests, other cage generators). Same as [`crate::verify::check_cage`].
 pub fn check(cage: &TriMesh, input: &TriMesh) -> CageCheck {
-    let model = crate::lowpoly::guard::InputModel::new(input, false);
-    let (untouched, encloses) = crate::lowpoly::measure::verify_cage(cage, &model);
-    CageCheck {
-        untouched,
-        encloses,
-    }
+    crate::verify::check_cage(cage, input)
 }

@@ -10,7 +10,8 @@
 //!   numerics module [`solve`] (sparse Cholesky, inverse iteration, Krylov; faer).
 //! - `cli`: the `pleat` command-line tool; `io-gltf`: glTF 2.0 reading and writing.
 //!
-//! The mesh core ([`mesh`], [`spatial`]) is always present.
+//! The mesh core ([`mesh`], [`spatial`]) and the independent verifier ([`verify`]) are always
+//! present.
 //!
 //! ```
 //! use pleat::mesh::TriMesh;
@@ -29,6 +30,7 @@ pub mod geom;
 pub mod mesh;
 pub mod report;
 pub mod spatial;
+pub mod verify;
 
 #[cfg(feature = "lod")]
 pub mod lowpoly;
@@ -46,4 +48,4 @@ pub mod solve;
 pub mod ffi;
 
 pub use error::{Error, Result};
-pub use report::{Progress, Stats};
+pub use report::Progress;

@@ -86,7 +86,7 @@ fn lod_chain_writes_one_valid_file_per_screen_size() {
     for n in ["25", "50"] {
         let f = dir.join(format!("lod_{n}.obj"));
         let m = pleat::mesh::io::read_mesh(&f).unwrap();
-        let r = pleat::mesh::MeshReport::compute(&m);
+        let r = pleat::verify::MeshReport::compute(&m);
         assert!(r.is_watertight && r.self_intersection_free == Some(true));
         assert!(m.triangle_count() < torus.triangle_count());
     }

@@ -581,3 +581,76 @@ fn cycles_are_found() {
         vec![vec![m("a"), m("b")], vec![m("c"), m("d"), m("e")]]
     );
 }
+
+/// The layer map of the crate (README "Layout and layers"): which top-level modules each
+/// top-level module may import. Lower layers never import higher ones; `ffi` and the crate root
+/// (`lib.rs`, which only declares modules and re-exports) sit on top. A new top-level module
+/// must be added here, with the layers it may use.
+const LAYERS: &[(&str, &[&str])] = &[
+    ("geom", &[]),
+    ("error", &[]),
+    ("report", &["geom", "error"]),
+    ("mesh", &["geom", "error", "report"]),
+    ("spatial", &["geom", "error", "report", "mesh"]),
+    ("verify", &["geom", "error", "report", "mesh", "spatial"]),
+    ("solve", &["error", "report"]),
+    (
+        "lowpoly",
+        &["geom", "error", "report", "mesh", "spatial", "verify"],
+    ),
+    (
+        "cage",
+        &[
+            "geom", "error", "report", "mesh", "spatial", "verify", "lowpoly",
+        ],
+    ),
+    ("wrinkle", &["geom", "error", "report", "mesh", "solve"]),
+    (
+        "bake",
+        &[
+            "geom", "error", "report", "mesh", "spatial", "verify", "lowpoly", "cage",
+        ],
+    ),
+    ("ffi", &["*"]),
+];
+
+#[test]
+fn modules_import_only_lower_layers() {
+    let mods = modules();
+    let allowed: BTreeMap<&str, &[&str]> = LAYERS.iter().copied().collect();
+    let mut bad = Vec::new();
+    for (m, file) in &mods {
+        let Some(top) = m.get(1) else { continue }; // the crate root re-exports everything
+        let Some(may) = allowed.get(top.as_str()) else {
+            bad.push(format!(
+                "{}: top-level module `{top}` is not in LAYERS",
+                show(&mods, m)
+            ));
+            continue;
+        };
+        if may.contains(&"*") {
+            continue;
+        }
+        let src = std::fs::read_to_string(file).expect("readable source");
+        for p in references(m, &src) {
+            let Some(t) = resolve(&mods, &p) else {
+                continue;
+            };
+            let Some(to) = t.get(1) else { continue }; // crate-root re-exports (Error, Result)
+            if to != top && !may.contains(&to.as_str()) {
+                bad.push(format!(
+                    "{} imports {} (layer `{to}`)",
+                    show(&mods, m),
+                    p.join("::")
+                ));
+            }
+        }
+    }
+    bad.sort();
+    bad.dedup();
+    assert!(
+        bad.is_empty(),
+        "imports against the layer map:\n{}",
+        bad.join("\n")
+    );
+}

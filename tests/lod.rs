@@ -7,9 +7,10 @@ mod meshcheck;
 #[path = "common/shapes.rs"]
 mod shapes;
 
-use pleat::lowpoly::{generate, generate_chain, LodParams};
-use pleat::mesh::{MeshReport, TriMesh};
-use pleat::{Error, Stats};
+use pleat::lowpoly::{generate, generate_chain, LodParams, LodReport};
+use pleat::mesh::TriMesh;
+use pleat::verify::MeshReport;
+use pleat::Error;
 
 fn params(np: f64) -> LodParams {
     LodParams {
@@ -18,7 +19,7 @@ fn params(np: f64) -> LodParams {
     }
 }
 
-fn bake(m: &TriMesh, p: &LodParams, cage: bool) -> pleat::Result<(TriMesh, Stats)> {
+fn bake(m: &TriMesh, p: &LodParams, cage: bool) -> pleat::Result<(TriMesh, LodReport)> {
     let mut prog = |_: pleat::Progress<'_>| true;
     if cage {
         #[cfg(feature = "cage")]
@@ -28,9 +29,9 @@ fn bake(m: &TriMesh, p: &LodParams, cage: bool) -> pleat::Result<(TriMesh, Stats
 }
 
 /// Pro.III checked by code independent of the pipeline, plus the pipeline's own record.
-fn assert_valid(out: &TriMesh, s: &Stats, what: &str) {
+fn assert_valid(out: &TriMesh, s: &LodReport, what: &str) {
     assert!(
-        s.verified.iter().all(|v| v.1),
+        s.verified.all_hold(),
         "{what}: verification failed {:?}",
         s.verified
     );
@@ -46,8 +47,8 @@ fn assert_valid(out: &TriMesh, s: &Stats, what: &str) {
     meshcheck::assert_valid(out, what);
 }
 
-fn rel_hausdorff(s: &Stats) -> f64 {
-    s.get_metric("hausdorff_rel").unwrap()
+fn rel_hausdorff(s: &LodReport) -> f64 {
+    s.hausdorff_rel
 }
 
 #[test]
@@ -102,12 +103,11 @@ fn error_split_and_floor_match_a_buried_sphere() {
     assert_valid(&out, &s, "buried sphere");
     let l = soup.bbox_diagonal();
     let d = l / np;
-    let m = |k: &str| s.get_metric(k).unwrap_or_else(|| panic!("no {k}"));
     let (h, hio, hoi, floor) = (
-        m("hausdorff_rel"),
-        m("hausdorff_in_to_out_rel"),
-        m("hausdorff_out_to_in_rel"),
-        m("hausdorff_floor_rel"),
+        s.hausdorff_rel,
+        s.hausdorff_in_to_out_rel,
+        s.hausdorff_out_to_in_rel,
+        s.floor.expect("floor measured").rel,
     );
     assert_eq!(h, hio.max(hoi));
     // The icosphere's vertices are on the sphere, its faces inside by ≤ 2% of the radius.
@@ -119,7 +119,7 @@ fn error_split_and_floor_match_a_buried_sphere() {
     assert!(hio * l > 0.45, "the buried sphere cannot be reached: {hio}");
     assert!(hoi < 3.0 * d / l, "output to input {hoi} over 3d");
     let (_, s2) = bake(&soup, &params(np), false).unwrap();
-    assert!(s2.get_metric("hausdorff_floor_rel").is_none());
+    assert!(s2.floor.is_none());
 }
 
 /// An open box (no lid, walls of zero thickness): its offset has an inner wall facing a
@@ -139,7 +139,7 @@ fn open_container_output_stays_near_its_walls() {
         let (out, s) = bake(&cup, &params(np), false).unwrap();
         let what = format!("open box n_p={np}");
         assert_valid(&out, &s, &what);
-        let hoi = s.get_metric("hausdorff_out_to_in_rel").unwrap();
+        let hoi = s.hausdorff_out_to_in_rel;
         assert!(hoi < 3.0 / np, "{what}: output to input {hoi} over 3d/l");
     }
 }
@@ -156,7 +156,7 @@ fn hausdorff_ignores_the_inside_of_zero_area_triangles() {
     let mut tris = cube.triangles().to_vec();
     tris.push([a, a, b]);
     let needle = TriMesh::new(cube.positions().to_vec(), tris).unwrap();
-    assert_eq!(pleat::lowpoly::hausdorff_to_input(&cube, &needle), 0.0);
+    assert_eq!(pleat::verify::hausdorff_to_input(&cube, &needle), 0.0);
 }
 
 #[test]
@@ -174,7 +174,7 @@ fn face_target_is_met() {
             n <= target && n + 10 >= target,
             "{n} faces for target {target}"
         );
-        assert_eq!(s.get_count("target_met"), Some(1));
+        assert!(s.target_met);
     }
 }
 
@@ -188,9 +188,7 @@ fn cages_enclose_and_do_not_touch() {
     ] {
         let (out, s) = bake(&m, &params(50.0), true).unwrap();
         assert_valid(&out, &s, &format!("{name} cage"));
-        assert!(s
-            .verified
-            .contains(&("cage_encloses_without_touching".into(), true)));
+        assert_eq!(s.verified.cage_encloses_without_touching, Some(true));
         let fwn = pleat::spatial::FastWindingNumber::new(&out);
         for w in fwn.winding_numbers(m.positions()) {
             assert!(
@@ -216,7 +214,7 @@ fn chain_levels_are_valid_and_coarser() {
             rel_hausdorff(s)
         );
     }
-    assert_eq!(levels[1].1.get_count("chain_level"), Some(0));
+    assert_eq!(levels[1].1.chain_level, Some(0));
     assert!(levels[0].0.triangle_count() <= levels[2].0.triangle_count());
     assert!(levels[2].0.triangle_count() <= levels[1].0.triangle_count());
 }
@@ -310,7 +308,7 @@ fn output_does_not_depend_on_thread_count() {
     };
     for (np, cage) in [(100.0, false), (200.0, false), (100.0, true)] {
         let (one, stats) = run(1, np, cage);
-        assert!(stats.get_count("faces_offset").unwrap() >= 2048);
+        assert!(stats.faces_offset >= 2048);
         for n in [2, 3] {
             assert_eq!(
                 one,

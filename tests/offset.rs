@@ -1,6 +1,6 @@
 //! Integration tests of `lowpoly::offset_surface` on synthetic soups generated here, plus the
 //! shared corpus when it is present. Every guarantee is checked by code independent of this
-//! stage: `MeshReport` (run by the stage's verification, recorded in `Stats::verified`) and the
+//! stage: `MeshReport` (run by the stage's verification, recorded in `OffsetReport::verified`) and the
 //! edge/vertex check and brute-force distances of this file.
 
 use std::collections::HashMap;
@@ -8,9 +8,10 @@ use std::collections::HashMap;
 #[path = "common/meshcheck.rs"]
 mod meshcheck;
 
+use pleat::lowpoly::OffsetReport;
 use pleat::lowpoly::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};
 use pleat::mesh::TriMesh;
-use pleat::{Error, Stats};
+use pleat::Error;
 
 type V3 = [f64; 3];
 
@@ -375,26 +376,21 @@ fn max_deviation_over_d(input: &TriMesh, out: &TriMesh, d: f64, cap: usize) -> f
         .fold(0.0, f64::max)
 }
 
-fn verified(stats: &Stats, name: &str) -> bool {
-    stats.verified.iter().any(|(n, ok)| n == name && *ok)
-}
-
 /// Runs the offset, checks the guarantees, returns the mesh, stats and max deviation / d.
 fn run_and_check(
     name: &str,
     input: &TriMesh,
     params: &OffsetParams,
     sample: usize,
-) -> (TriMesh, Stats, f64) {
+) -> (TriMesh, OffsetReport, f64) {
     let (out, stats) = offset_surface(input, params).unwrap_or_else(|e| panic!("{name}: {e}"));
     edge_and_vertex_check(&out).unwrap_or_else(|e| panic!("{name}: {e}"));
     assert!(
-        verified(&stats, "watertight") && verified(&stats, "manifold"),
+        stats.verified.watertight == Some(true) && stats.verified.manifold == Some(true),
         "{name}: {:?}",
         stats.verified
     );
-    let d = stats.get_metric("d").unwrap();
-    let h = stats.get_metric("h").unwrap();
+    let (d, h) = (stats.d, stats.h);
     let dev = max_deviation_over_d(input, &out, d, sample);
     assert!(
         dev * d <= h * (1.0 + 1e-9),
@@ -404,8 +400,8 @@ fn run_and_check(
     eprintln!(
         "{name:<28} {:>8} tris, {:>3} components kept ({} removed), max |f−d|/d = {dev:.4}, {:.3} s",
         out.triangle_count(),
-        stats.get_count("components").unwrap_or(1) - stats.get_count("components_removed").unwrap_or(0),
-        stats.get_count("components_removed").unwrap_or(0),
+        stats.interior.map_or(1, |i| i.components - i.components_removed),
+        stats.interior.map_or(0, |i| i.components_removed),
         stats.total_seconds()
     );
     (out, stats, dev)
@@ -458,7 +454,7 @@ fn tree_of_hundreds_of_cylinders_and_quads() {
     assert!(mesh.triangle_count() > 4000);
     for n in [50.0, 200.0] {
         let (_, stats, _) = run_and_check("tree", &mesh, &np(n), 1500);
-        assert_eq!(stats.get_count("cells_unresolved"), Some(0));
+        assert_eq!(stats.extraction.cells_unresolved, 0);
     }
 }
 
@@ -467,8 +463,8 @@ fn ten_thousand_components() {
     let mesh = many_components(10_000);
     let (out, stats, _) = run_and_check("10^4 components", &mesh, &np(150.0), 300);
     // Separated tetrahedra stay separate: one outer shell each.
-    let kept =
-        stats.get_count("components").unwrap() - stats.get_count("components_removed").unwrap();
+    let interior = stats.interior.expect("interior removal ran");
+    let kept = interior.components - interior.components_removed;
     assert_eq!(kept, 10_000);
     assert!(out.triangle_count() > 10_000);
 }
@@ -531,8 +527,8 @@ fn sharp_features_and_normal_error() {
             let (out, st, _) = run_and_check(name, &input, &p, 2000);
             eprintln!(
                 "  flips {:?}, feature vertices kept {:?}",
-                st.get_count("flips"),
-                st.get_count("feature_vertices_kept")
+                st.features.map(|f| f.flips),
+                st.features.map(|f| f.feature_vertices_kept)
             );
             err.push(normal_error(&input, &out));
         }

@@ -3,11 +3,12 @@
 //! folded-over neighbours, duplicate faces, unwelded seams, degenerate faces, coplanar overlap,
 //! 10⁴ components; plus brute-force and thread-count determinism checks.
 
-use pleat::mesh::{MeshReport, ReportOptions, TriMesh};
+use pleat::mesh::TriMesh;
 use pleat::spatial::{
     faces_intersect, find_self_intersections, has_self_intersection, is_collinear,
     self_intersections,
 };
+use pleat::verify::{MeshReport, ReportOptions};
 
 type P = [f64; 3];
 

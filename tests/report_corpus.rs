@@ -30,8 +30,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use pleat::mesh::io::read_mesh;
-use pleat::mesh::{MeshReport, ReportOptions};
-use pleat::Stats;
+use pleat::report::StageTimes;
+use pleat::verify::{MeshReport, ReportOptions};
 
 /// Keys compared exactly between our JSON and meshcheck's.
 const EXACT_KEYS: &[&str] = &[
@@ -110,7 +110,7 @@ fn corpus_agrees_with_meshcheck_and_manifest() {
                 .expect("run meshcheck")
         });
         let mesh = read_mesh(&path).unwrap_or_else(|e| panic!("{e}"));
-        let mut stats = Stats::default();
+        let mut stats = StageTimes::default();
         let report = MeshReport::compute_timed(&mesh, &ReportOptions::default(), &mut stats);
         let ours = report.to_json();
         let mut problems = compare_with_manifest(&report, row);
@@ -141,7 +141,7 @@ fn corpus_agrees_with_meshcheck_and_manifest() {
             yn(report.is_manifold),
             yn(report.self_intersection_free == Some(true)),
             report.n_self_intersecting_pairs.unwrap_or(0),
-            stats.total_seconds(),
+            stats.total(),
             verdict
         ));
         failures.extend(problems.into_iter().map(|p| format!("{name}: {p}")));

@@ -362,7 +362,7 @@ fn progress_reports_and_cancels() {
     assert_eq!(e.mesh.triangle_count(), 32 * 64);
     assert_eq!(seen.len(), 4);
     assert!(seen.windows(2).all(|w| w[0].1 < w[1].1) && seen[3].1 == 1.0);
-    assert_eq!(stats.get_count("level 3 faces"), Some(2048));
+    assert_eq!(stats.levels[2].faces, 2048);
     let err = cwf
         .evaluate_with_progress(3, &EvalOptions::default(), &mut |p| p.stage != "level 2")
         .unwrap_err();

@@ -177,7 +177,7 @@ fn print_report(name: &str, r: &InterpReport, seconds: f64) {
 
 fn run(a: &Cwf, b: &Cwf, opts: &InterpOptions, name: &str) -> (CwfAnimation, InterpReport) {
     let t0 = std::time::Instant::now();
-    let (anim, report, _) = interpolate(a, b, opts).unwrap();
+    let (anim, report) = interpolate(a, b, opts).unwrap();
     print_report(name, &report, t0.elapsed().as_secs_f64());
     (anim, report)
 }
@@ -330,8 +330,7 @@ fn temporal_coherence_beats_per_frame_knoppel() {
             let t = i as f64 / n as f64;
             let w = explicit_omega(a, b, t).unwrap();
             let amp = vec![0.01; m.vertex_count()];
-            let (c, _, _) =
-                Cwf::from_one_form(m.clone(), w, amp, &KnoppelOptions::default()).unwrap();
+            let (c, _) = Cwf::from_one_form(m.clone(), w, amp, &KnoppelOptions::default()).unwrap();
             c.zeta().to_vec()
         })
         .collect();
@@ -453,14 +452,14 @@ fn stability_closed_mesh_and_incompatible_keyframes() {
     let ka = vec![[6.0, 0.0, 0.0]; n];
     let kb = vec![[0.0, 0.0, 6.0]; n];
     let opts = KnoppelOptions::default();
-    let (a, _, _) = Cwf::from_frequency_field(
+    let (a, _) = Cwf::from_frequency_field(
         m.clone(),
         FrequencyField::PerVertex(&ka),
         vec![0.01; n],
         &opts,
     )
     .unwrap();
-    let (b, _, _) = Cwf::from_frequency_field(
+    let (b, _) = Cwf::from_frequency_field(
         m.clone(),
         FrequencyField::PerVertex(&kb),
         vec![0.01; n],

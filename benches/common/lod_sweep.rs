@@ -13,8 +13,12 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use pleat::mesh::{MeshReport, TriMesh};
-use pleat::Stats;
+#[cfg(feature = "lod")]
+use pleat::lowpoly::{LodReport, LodStage};
+use pleat::mesh::TriMesh;
+#[cfg(feature = "lod")]
+use pleat::report::Stage as _;
+use pleat::verify::MeshReport;
 
 // ---------------------------------------------------------------------------------------------
 // Corpus
@@ -81,10 +85,11 @@ pub fn timed<T>(f: impl FnOnce() -> T) -> Timed<T> {
 
 /// Wall and CPU seconds of the error-floor measurement (`LodParams::measure_floor`) in a bake's
 /// stats: it is for the tables, not part of a bake, so sweeps subtract it from the times.
-pub fn floor_seconds(stats: &Stats) -> (f64, f64) {
+#[cfg(feature = "lod")]
+pub fn floor_seconds(stats: &LodReport) -> (f64, f64) {
     (
-        stats.stage_seconds("floor"),
-        stats.get_metric("floor_cpu_seconds").unwrap_or(0.0),
+        stats.stages.seconds(LodStage::Floor),
+        stats.floor.map_or(0.0, |f| f.cpu_seconds),
     )
 }
 
@@ -163,7 +168,7 @@ impl Row {
     }
 }
 
-/// Stage columns of the CSV (seconds from `Stats::stages`).
+/// Stage columns of the CSV (seconds from `LodReport::stages`, by `LodStage` name).
 pub const STAGES: [&str; 7] = [
     "offset",
     "simplify",
@@ -341,7 +346,7 @@ fn bake_mesh(
     params: &pleat::lowpoly::LodParams,
     cage: bool,
     prog: &mut pleat::report::ProgressFn<'_>,
-) -> pleat::Result<(TriMesh, Stats)> {
+) -> pleat::Result<(TriMesh, LodReport)> {
     #[cfg(feature = "cage")]
     if cage {
         return pleat::cage::generate(mesh, params, prog);
@@ -352,18 +357,21 @@ fn bake_mesh(
 
 #[cfg(feature = "lod")]
 /// Counts, error, stage times from the stats; validity from independent checks of `out`.
-fn fill_from_output(row: &mut Row, input: &TriMesh, out: &TriMesh, stats: &Stats, cage: bool) {
+fn fill_from_output(row: &mut Row, input: &TriMesh, out: &TriMesh, stats: &LodReport, cage: bool) {
     row.status = "ok".into();
     row.faces_out = out.triangle_count();
-    row.hausdorff_over_l = stats.get_metric("hausdorff_rel").unwrap_or(f64::NAN);
-    let metric = |k: &str| stats.get_metric(k).unwrap_or(f64::NAN);
-    row.in_to_out_over_l = metric("hausdorff_in_to_out_rel");
-    row.out_to_in_over_l = metric("hausdorff_out_to_in_rel");
-    row.floor_over_l = metric("hausdorff_floor_rel");
-    row.rounds = stats.get_count("rounds").unwrap_or(0);
-    row.faces_offset = stats.get_count("faces_offset").unwrap_or(0);
-    row.reruns_exact = stats.get_count("reruns_exact").unwrap_or(0);
-    row.stages = stats.stages.clone();
+    row.hausdorff_over_l = stats.hausdorff_rel;
+    row.in_to_out_over_l = stats.hausdorff_in_to_out_rel;
+    row.out_to_in_over_l = stats.hausdorff_out_to_in_rel;
+    row.floor_over_l = stats.floor.map_or(f64::NAN, |f| f.rel);
+    row.rounds = stats.rounds;
+    row.faces_offset = stats.faces_offset;
+    row.reruns_exact = stats.reruns_exact;
+    row.stages = stats
+        .stages
+        .iter()
+        .map(|(s, t)| (s.name().into_owned(), t))
+        .collect();
     let v = Validity::of(out);
     row.watertight = v.watertight;
     row.manifold = v.manifold;
@@ -376,10 +384,10 @@ fn fill_from_output(row: &mut Row, input: &TriMesh, out: &TriMesh, stats: &Stats
     }
 }
 
-/// `(encloses, untouched)` from [`pleat::cage::check`].
+/// `(encloses, untouched)` from [`pleat::verify::check_cage`].
 #[cfg(feature = "cage")]
 fn cage_flags(out: &TriMesh, input: &TriMesh) -> (bool, bool) {
-    let c = pleat::cage::check(out, input);
+    let c = pleat::verify::check_cage(out, input);
     (c.encloses, c.untouched)
 }
 

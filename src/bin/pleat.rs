@@ -9,7 +9,7 @@ use pleat::lowpoly::LodParams;
 use pleat::mesh::io::read_mesh;
 #[cfg(feature = "lod")]
 use pleat::mesh::io::write_mesh;
-use pleat::mesh::{MeshReport, ReportOptions};
+use pleat::verify::{MeshReport, ReportOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -401,7 +401,7 @@ fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
             print_bake_summary(&path, n_p, out, stats);
         }
         if args.verbose {
-            print_stats(stats);
+            print_stats(&stats.entries());
         }
     }
     ExitCode::SUCCESS
@@ -424,7 +424,7 @@ fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
 }
 
 #[cfg(feature = "lod")]
-fn print_stats(s: &pleat::Stats) {
+fn print_stats(s: &pleat::report::StatEntries) {
     for (n, t) in &s.stages {
         println!("  {n:<28} {t:>10.3} s");
     }
@@ -444,17 +444,17 @@ fn print_bake_summary(
     path: &std::path::Path,
     n_p: f64,
     m: &pleat::mesh::TriMesh,
-    s: &pleat::Stats,
+    s: &pleat::lowpoly::LodReport,
 ) {
-    let ok = s.verified.iter().all(|v| v.1);
+    let ok = s.verified.all_hold();
     println!(
         "{}: n_p={n_p} {} triangles, Hausdorff/l={:.5} (d/l={:.5}), {} rounds, {:.2} s, \
          verified: {}",
         path.display(),
         m.triangle_count(),
-        s.get_metric("hausdorff_rel").unwrap_or(f64::NAN),
+        s.hausdorff_rel,
         1.0 / n_p,
-        s.get_count("rounds").unwrap_or(0),
+        s.rounds,
         s.total_seconds(),
         if ok {
             "watertight, manifold, intersection-free"
@@ -572,7 +572,7 @@ fn offset(
         return ExitCode::from(EXIT_FAILED);
     }
     if stats_json {
-        println!("{}", stats.to_json());
+        println!("{}", stats.entries().to_json());
     } else {
         eprintln!(
             "{} -> {}: {} triangles in {:.2} s; verified: {}",
@@ -582,6 +582,7 @@ fn offset(
             stats.total_seconds(),
             stats
                 .verified
+                .checked()
                 .iter()
                 .map(|(n, ok)| format!("{n}={ok}"))
                 .collect::<Vec<_>>()
@@ -823,7 +824,7 @@ mod wrinkle_cmd {
             weights,
             ..Default::default()
         };
-        let (cwf, report, _) =
+        let (cwf, report) =
             Cwf::from_frequency_field(mesh, FrequencyField::PerVertex(&k), a, &opts).map_err(op)?;
         write_cwf(out, &cwf).map_err(op)?;
         println!(
@@ -848,7 +849,7 @@ mod wrinkle_cmd {
         let ka = read_cwf(a, mesh.clone()).map_err(input)?;
         let kb = read_cwf(b, mesh).map_err(input)?;
         let bar = indicatif::ProgressBar::new(1000);
-        let (anim, report, _) = interpolate_with_progress(&ka, &kb, opts, &mut |p| {
+        let (anim, report) = interpolate_with_progress(&ka, &kb, opts, &mut |p| {
             bar.set_position((p.fraction * 1000.0) as u64);
             true
         })
@@ -957,7 +958,7 @@ mod wrinkle_cmd {
                     guide_frames: frames,
                     ..Default::default()
                 };
-                let (anim, rep, _) =
+                let (anim, rep) =
                     interpolate_with_progress(&a, &b, &opts, &mut |_| true).map_err(op)?;
                 for h in &rep.history {
                     let _ = writeln!(
@@ -994,7 +995,7 @@ mod wrinkle_cmd {
                         guide_frames: n,
                         ..opts
                     };
-                    let (an, r, _) =
+                    let (an, r) =
                         interpolate_with_progress(&a, &b, &o, &mut |_| true).map_err(op)?;
                     let mut sum = 0.0;
                     let mut count = 0usize;

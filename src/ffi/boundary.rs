@@ -152,11 +152,9 @@ pub(crate) unsafe fn destroy<H>(p: *mut H) {
     }
 }
 
-/// The boundary of exports that answer a value instead of a status (counts, flags): the value
-/// of `f`, or `fallback` if it panics.
-pub(crate) fn guard_value<T>(fallback: T, f: impl FnOnce() -> T) -> T {
-    catch_unwind(AssertUnwindSafe(f)).unwrap_or(fallback)
-}
+/// The fence of exports that answer a value instead of a status (lives with the other fences
+/// in `common`, which must not import this module).
+pub(crate) use super::common::guard_value;
 
 // ---------------------------------------------------------------------------------------------
 // Numbers

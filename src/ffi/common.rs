@@ -86,7 +86,8 @@ fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
 /// The panic fence: runs `f` on pleat's thread pool, catches panics, maps errors to statuses and
 /// records the message. Every `extern "C"` function that can fail goes through here or through
 /// [`guard_progress`] (the same fence with a progress relay); both end in `status_of`. The
-/// arguments are checked inside `f` with the helpers of `ffi::boundary`.
+/// arguments are checked inside `f` with the helpers of `ffi::boundary` (which imports this
+/// module, never the reverse).
 pub(crate) fn guard(f: impl FnOnce() -> crate::Result<()>) -> PleatStatus {
     status_of(catch_unwind(AssertUnwindSafe(|| with_pool(f))))
 }
@@ -191,10 +192,16 @@ pub extern "C" fn pleat_set_thread_count(n: u32) -> PleatStatus {
     })
 }
 
+/// The boundary of exports that answer a value instead of a status (counts, flags): the value
+/// of `f`, or `fallback` if it panics.
+pub(crate) fn guard_value<T>(fallback: T, f: impl FnOnce() -> T) -> T {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or(fallback)
+}
+
 /// Number of worker threads the next pleat call will use (≥ 1).
 #[no_mangle]
 pub extern "C" fn pleat_thread_count() -> u32 {
-    super::boundary::guard_value(1, || with_pool(rayon::current_num_threads) as u32)
+    guard_value(1, || with_pool(rayon::current_num_threads) as u32)
 }
 
 // ---------------------------------------------------------------------------------------------

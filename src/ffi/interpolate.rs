@@ -424,7 +424,7 @@ pub(super) mod imp {
             let p = read_versioned(params, "params")?;
             let opts = options(&p)?;
             let t0 = std::time::Instant::now();
-            let (anim, report, _) = interpolate_with_progress(&ka.cwf, &kb.cwf, &opts, relay)?;
+            let (anim, report) = interpolate_with_progress(&ka.cwf, &kb.cwf, &opts, relay)?;
             let s = PleatWrinkleInterpStats {
                 struct_size: 0,
                 iterations: report.iterations.min(u32::MAX as usize) as u32,

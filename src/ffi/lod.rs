@@ -172,9 +172,8 @@ pub(super) fn defaults_without_lod() -> PleatLodParams {
 #[cfg(feature = "lod")]
 pub(super) mod imp {
     use super::*;
-    use crate::lowpoly::LodParams;
+    use crate::lowpoly::{LodParams, LodReport, LodStage};
     use crate::mesh::TriMesh;
-    use crate::Stats;
 
     /// The Rust parameters of C LOD parameters (flags and `target_faces` checked here, the
     /// rest by the pipeline).
@@ -209,7 +208,7 @@ pub(super) mod imp {
         p: &PleatLodParams,
         cage: bool,
         prog: &mut crate::report::ProgressFn<'_>,
-    ) -> Result<(TriMesh, Stats)> {
+    ) -> Result<(TriMesh, LodReport)> {
         let rp = to_rust(p)?;
         if cage {
             #[cfg(feature = "cage")]
@@ -223,42 +222,43 @@ pub(super) mod imp {
         sizes: &[f64],
         p: &PleatLodParams,
         prog: &mut crate::report::ProgressFn<'_>,
-    ) -> Result<Vec<(TriMesh, Stats)>> {
+    ) -> Result<Vec<(TriMesh, LodReport)>> {
         crate::lowpoly::generate_chain(m, sizes, &to_rust(p)?, prog)
     }
 
-    fn verified(s: &Stats, name: &str) -> u32 {
-        s.verified.iter().any(|v| v.0 == name && v.1) as u32
+    /// 1 when the guarantee was checked and holds, else 0.
+    fn flag(v: Option<bool>) -> u32 {
+        (v == Some(true)) as u32
     }
 
-    pub(super) fn to_c(mesh: &TriMesh, s: &Stats) -> PleatLodStats {
-        let count = |n: &str| s.get_count(n).unwrap_or(0);
-        let metric = |n: &str| s.get_metric(n).unwrap_or(f64::NAN);
+    /// The C stats, field by field from the typed report.
+    pub(super) fn to_c(mesh: &TriMesh, s: &LodReport) -> PleatLodStats {
+        let v = &s.verified;
         PleatLodStats {
             struct_size: std::mem::size_of::<PleatLodStats>() as u32,
-            rounds: count("rounds") as u32,
+            rounds: s.rounds as u32,
             face_count: mesh.triangle_count() as u64,
             vertex_count: mesh.vertex_count() as u64,
-            start_face_count: count("faces_offset"),
-            collapse_count: count("collapses"),
+            start_face_count: s.faces_offset,
+            collapse_count: s.simplify.collapses,
             seconds_total: s.total_seconds(),
-            seconds_offset: s.stage_seconds("offset"),
-            seconds_simplify: s.stage_seconds("simplify"),
-            seconds_flow: s.stage_seconds("flow"),
-            seconds_align: s.stage_seconds("align"),
-            seconds_verify: s.stage_seconds("verify"),
-            offset_distance: metric("d"),
-            hausdorff: metric("hausdorff"),
-            hausdorff_relative: metric("hausdorff_rel"),
-            watertight: verified(s, "watertight"),
-            manifold: verified(s, "manifold"),
-            self_intersection_free: verified(s, "self_intersection_free"),
-            encloses_input: verified(s, "cage_encloses_without_touching"),
-            exact_rerun: (count("reruns_exact") > 0) as u32,
-            target_met: count("target_met") as u32,
-            hausdorff_in_to_out_relative: metric("hausdorff_in_to_out_rel"),
-            hausdorff_out_to_in_relative: metric("hausdorff_out_to_in_rel"),
-            hausdorff_floor_relative: metric("hausdorff_floor_rel"),
+            seconds_offset: s.stages.seconds(LodStage::Offset),
+            seconds_simplify: s.stages.seconds(LodStage::Simplify),
+            seconds_flow: s.stages.seconds(LodStage::Flow),
+            seconds_align: s.stages.seconds(LodStage::Align),
+            seconds_verify: s.stages.seconds(LodStage::Verify),
+            offset_distance: s.d,
+            hausdorff: s.hausdorff,
+            hausdorff_relative: s.hausdorff_rel,
+            watertight: flag(v.watertight),
+            manifold: flag(v.manifold),
+            self_intersection_free: flag(v.self_intersection_free),
+            encloses_input: flag(v.cage_encloses_without_touching),
+            exact_rerun: (s.reruns_exact > 0) as u32,
+            target_met: s.target_met as u32,
+            hausdorff_in_to_out_relative: s.hausdorff_in_to_out_rel,
+            hausdorff_out_to_in_relative: s.hausdorff_out_to_in_rel,
+            hausdorff_floor_relative: s.floor.map_or(f64::NAN, |f| f.rel),
         }
     }
 }

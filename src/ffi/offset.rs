@@ -168,7 +168,7 @@ pub unsafe extern "C" fn pleat_offset_surface(
             let p = to_rust(&read_versioned(params, "params")?)?;
             let (result, stats) = crate::lowpoly::offset_surface_with_progress(m, &p, relay)?;
             out.put_mesh(result);
-            emit_stats(out_stats, stats);
+            emit_stats(out_stats, stats.entries());
             Ok(())
         })
     })

@@ -3,7 +3,7 @@
 use super::boundary::{check_flags, required_versioned_out, versioned};
 use super::common::{guard, PleatStatus};
 use super::mesh::{mesh_ref, PleatMesh};
-use crate::mesh::{MeshReport, ReportOptions};
+use crate::verify::{MeshReport, ReportOptions};
 
 /// `pleat_mesh_check` flag: skip the self-intersection test (the most expensive part);
 /// `self_intersections_checked` is then 0.

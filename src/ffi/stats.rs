@@ -3,36 +3,39 @@
 
 use super::boundary::{arg_ref, destroy};
 use super::common::{guard, null_arg, PleatStatus};
-use crate::{Error, Stats};
+use crate::report::StatEntries;
+use crate::Error;
 use std::ffi::{c_char, CString};
 
 /// Statistics of one long operation (opaque). Returned through the optional `PleatStats **`
 /// output of long operations; destroyed with `pleat_stats_destroy`. Immutable.
 pub struct PleatStats {
-    pub(crate) stats: Stats,
+    /// The operation's typed report flattened by its `entries()` method.
+    pub(crate) stats: StatEntries,
     names: Vec<CString>,
 }
 
 impl PleatStats {
-    fn new(stats: Stats) -> PleatStats {
+    fn new(stats: StatEntries) -> PleatStats {
         let names = stats
             .stages
             .iter()
-            .map(|s| &s.0)
-            .chain(stats.counts.iter().map(|s| &s.0))
-            .chain(stats.metrics.iter().map(|s| &s.0))
-            .chain(stats.verified.iter().map(|s| &s.0))
+            .map(|s| s.0.as_ref())
+            .chain(stats.counts.iter().map(|s| s.0.as_ref()))
+            .chain(stats.metrics.iter().map(|s| s.0.as_ref()))
+            .chain(stats.verified.iter().map(|s| s.0))
             .map(|n| CString::new(n.replace('\0', "")).unwrap_or_default())
             .collect();
         PleatStats { stats, names }
     }
 }
 
-/// Writes a stats handle to `out` when `out` is non-NULL.
+/// Writes a stats handle holding `stats` (a report's `entries()`) to `out` when `out` is
+/// non-NULL.
 ///
 /// # Safety
 /// `out` is NULL or valid for a write.
-pub(crate) unsafe fn emit_stats(out: *mut *mut PleatStats, stats: Stats) {
+pub(crate) unsafe fn emit_stats(out: *mut *mut PleatStats, stats: StatEntries) {
     if !out.is_null() {
         *out = Box::into_raw(Box::new(PleatStats::new(stats)));
     }
@@ -52,7 +55,7 @@ pub enum PleatStatsKind {
     Verified = 3,
 }
 
-fn entries(s: &Stats, kind: PleatStatsKind) -> (usize, Vec<f64>) {
+fn entries(s: &StatEntries, kind: PleatStatsKind) -> (usize, Vec<f64>) {
     let offset = match kind {
         PleatStatsKind::Stage => 0,
         PleatStatsKind::Count => s.stages.len(),

@@ -607,7 +607,7 @@ pub unsafe extern "C" fn pleat_cwf_get_knoppel_report(
     wrinkle_only!([cwf, out] guard(|| {
         let c = imp::cwf_ref(cwf)?;
         let out = required_versioned_out(out, "out")?;
-        let Some(r) = c.knoppel else {
+        let Some(r) = &c.knoppel else {
             return Err(Error::InvalidArgument(
                 "this field's phase was given, not computed by Knöppel's method".into(),
             ));
@@ -838,8 +838,8 @@ pub(super) mod imp {
     use crate::ffi::mesh::mesh_ref;
     use crate::mesh::TriMesh;
     use crate::wrinkle::{
-        BoundaryRule, Complex, Cwf, EvalOptions, FrequencyField, KnoppelOptions, PhaseWeights,
-        SubdivisionOptions,
+        BoundaryRule, Complex, Cwf, EvalOptions, EvalStage, FrequencyField, KnoppelOptions,
+        PhaseWeights, SubdivisionOptions,
     };
 
     /// Borrows a field handle, failing with InvalidArgument on NULL.
@@ -915,7 +915,7 @@ pub(super) mod imp {
         let (cwf, report) = match zeta {
             Some(z) => (Cwf::new(base, omega, amplitude, z)?, None),
             None => {
-                let (c, r, _) =
+                let (c, r) =
                     Cwf::from_one_form(base, omega, amplitude, &KnoppelOptions::default())?;
                 (c, Some(r))
             }
@@ -1124,7 +1124,7 @@ pub(super) mod imp {
         } else {
             FrequencyField::PerFace(&k)
         };
-        let (cwf, report, _) = Cwf::from_frequency_field(m.clone(), field, a, &opts)?;
+        let (cwf, report) = Cwf::from_frequency_field(m.clone(), field, a, &opts)?;
         out.put_boxed(PleatCwf {
             cwf,
             knoppel: Some(report),
@@ -1228,15 +1228,8 @@ pub(super) mod imp {
                     .map(flatten3),
                 ev.omega.filter(|_| keep(PLEAT_WRINKLE_FIELD_OMEGA)),
             ];
-            let subdivision: f64 = (1..=p.levels)
-                .filter_map(|k| st.get_metric(&format!("level {k} seconds")))
-                .sum();
-            let displacement = st
-                .stages
-                .iter()
-                .filter(|s| s.0 == "displace")
-                .map(|s| s.1)
-                .sum();
+            let subdivision = st.subdivision_seconds();
+            let displacement = st.stages.seconds(EvalStage::Displace);
             let s = PleatWrinkleEvalStats {
                 struct_size: 0,
                 levels: p.levels,

@@ -30,8 +30,6 @@
 //!    the operation, `Δw(q) = (Σ_{new M_e} Ω_f(q) − Σ_{old M_e} Ω_f(q)) / 4π` (solid angles) must
 //!    round to 0. Together with "no touching", every input point stays strictly inside.
 
-#[cfg(test)]
-use super::measure;
 use crate::geom::{bbox_of, normalized, tri_normal, Vec3};
 use crate::mesh::halfedge::CollapseRecord;
 use crate::mesh::HalfEdgeMesh;
@@ -145,7 +143,7 @@ pub(crate) enum Reject {
     Uncovers,
 }
 
-/// Counters of the guard's work (reported in `Stats`).
+/// Counters of the guard's work (reported in `LodReport::guard`).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct GuardStats {
     pub checks: u64,
@@ -723,7 +721,10 @@ pub(crate) mod tests {
         // Onto another vertex: degenerate faces.
         assert_eq!(g.try_move(7, [1.0, 1.0, 0.0]), Err(Reject::Degenerate));
         g.mesh().check_invariants().unwrap();
-        assert!(measure::verify(&g.mesh().to_trimesh()).self_intersection_free);
+        assert_eq!(
+            crate::verify::MeshReport::compute(&g.mesh().to_trimesh()).self_intersection_free,
+            Some(true)
+        );
     }
 
     #[test]
@@ -754,7 +755,10 @@ pub(crate) mod tests {
         assert_eq!(rec.removed_faces.len(), 2);
         assert_eq!(g.mesh().face_count(), 10);
         let out = g.mesh().to_trimesh();
-        assert!(measure::verify(&out).self_intersection_free);
+        assert_eq!(
+            crate::verify::MeshReport::compute(&out).self_intersection_free,
+            Some(true)
+        );
     }
 
     #[test]

@@ -10,6 +10,12 @@
 //! goes through one guard (`guard.rs`) that keeps the mesh watertight, manifold, of the same
 //! topology and free of self-intersections, and in cage mode (`crate::cage`) disjoint from the
 //! input and enclosing it.
+//!
+//! Each bake returns a typed report ([`LodReport`], [`OffsetReport`]); the guarantees in it
+//! are checked at the end by `crate::verify`, which shares no code with the guard.
+//!
+//! May import: `crate::mesh`, `crate::spatial`, `crate::verify`, `crate::geom`,
+//! `crate::report`, `crate::error`.
 
 mod align;
 pub(crate) mod distance;
@@ -21,17 +27,18 @@ mod flow;
 pub(crate) mod guard;
 mod interior;
 pub(crate) mod mc33;
-pub(crate) mod measure;
+mod measure;
 mod offset;
 mod pipeline;
+mod report;
 mod simplify;
 
 pub use guard::CONE_HALF_ANGLE;
-pub use measure::{
-    hausdorff_sides, hausdorff_to_input, input_to_surface, HausdorffSides,
-    FINAL_SAMPLES_PER_DIAGONAL,
-};
 pub use offset::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};
 pub use pipeline::{generate, generate_chain, LodParams};
 #[cfg(feature = "cage")]
 pub(crate) use pipeline::{run, run_chain, Mode};
+pub use report::{
+    ExtractionCounts, FeatureCounts, FloorMeasure, GuardCounts, InteriorCounts, LodReport,
+    LodStage, OffsetReport, OffsetStage, OffsetVerification, SimplifyCounts,
+};

@@ -22,8 +22,12 @@ use super::extract::{deviation, extract, ExtractParams, Mode, PatchSet};
 use super::filter::vertices_on_real_curves;
 use super::flips::{flip_to_features, FlipCounts};
 use super::interior::{visible_components, ComponentBox};
-use crate::mesh::{HalfEdgeMesh, MeshReport, ReportOptions, TriMesh};
-use crate::report::{Progress, ProgressFn, Stats};
+use super::report::{
+    ExtractionCounts, FeatureCounts, InteriorCounts, OffsetReport, OffsetStage, OffsetVerification,
+};
+use crate::mesh::{HalfEdgeMesh, TriMesh};
+use crate::report::{Progress, ProgressFn};
+use crate::verify::{MeshReport, ReportOptions};
 use crate::{Error, Result};
 
 /// How the offset distance `d` is chosen.
@@ -58,8 +62,8 @@ pub struct OffsetParams {
     /// (default 2 GiB). Inputs that would exceed it fail with `Error::LimitExceeded` before
     /// the expensive work starts.
     pub memory_budget_bytes: u64,
-    /// Verify the output with independent checks and record them in `Stats::verified`
-    /// (default true).
+    /// Verify the output with independent checks and record them in
+    /// [`OffsetReport::verified`] (default true).
     pub verify: bool,
 }
 
@@ -126,7 +130,7 @@ impl OffsetParams {
 }
 
 /// Computes the `d`-offset surface of `mesh` (any soup) — see [`offset_surface_with_progress`].
-pub fn offset_surface(mesh: &TriMesh, params: &OffsetParams) -> Result<(TriMesh, Stats)> {
+pub fn offset_surface(mesh: &TriMesh, params: &OffsetParams) -> Result<(TriMesh, OffsetReport)> {
     offset_surface_with_progress(mesh, params, &mut |_| true)
 }
 
@@ -145,11 +149,13 @@ pub fn offset_surface_with_progress(
     mesh: &TriMesh,
     params: &OffsetParams,
     progress: &mut ProgressFn<'_>,
-) -> Result<(TriMesh, Stats)> {
+) -> Result<(TriMesh, OffsetReport)> {
     let r = params.resolve(mesh)?;
-    let mut stats = Stats::default();
-    stats.metric("d", r.d);
-    stats.metric("h", r.h);
+    let mut stats = OffsetReport {
+        d: r.d,
+        h: r.h,
+        ..OffsetReport::default()
+    };
     let band = BandParams {
         d: r.d,
         h: r.h,
@@ -157,7 +163,9 @@ pub fn offset_surface_with_progress(
     };
     check_budget_estimate(mesh, &band)?;
     step(progress, "bvh", 0.0)?;
-    let input = stats.time("bvh", || InputDistance::new(mesh));
+    let input = stats
+        .stages
+        .time(OffsetStage::Bvh, || InputDistance::new(mesh));
     let grid = distance_field(mesh, &input, &band, &mut stats, progress)?;
     let xp = ExtractParams {
         d: r.d,
@@ -175,7 +183,7 @@ pub fn offset_surface_with_progress(
     })?;
     stats
         .stages
-        .push(("extract".into(), t.elapsed().as_secs_f64()));
+        .push(OffsetStage::Extract, t.elapsed().as_secs_f64());
     record_extraction(&mut stats, &set);
     // The extraction holds the grid, the iso-points (key 8 B, position 24 B, normal and
     // closest primitive 32 B) and the packed mixed cubes (8 B) together; after dropping the
@@ -188,7 +196,7 @@ pub fn offset_surface_with_progress(
         let v = visible_patches(&set, &mut stats);
         stats
             .stages
-            .push(("interior".into(), t.elapsed().as_secs_f64()));
+            .push(OffsetStage::Interior, t.elapsed().as_secs_f64());
         v
     } else {
         vec![true; set.len()]
@@ -200,9 +208,9 @@ pub fn offset_surface_with_progress(
     }
     peak = peak.max(patchset_bytes(&set) + mesh_bytes(pos.len(), tris.len()));
     drop(set);
-    stats.count("output_vertices", pos.len() as u64);
-    stats.count("output_triangles", tris.len() as u64);
-    stats.metric("peak_memory_bytes", peak as f64);
+    stats.output_vertices = pos.len() as u64;
+    stats.output_triangles = tris.len() as u64;
+    stats.peak_memory_bytes = peak;
     let out = TriMesh::new(pos, tris)?;
     if params.verify {
         step(progress, "verify", 0.95)?;
@@ -210,7 +218,7 @@ pub fn offset_surface_with_progress(
         verify(&out, &input, r, &mut stats);
         stats
             .stages
-            .push(("verify".into(), t.elapsed().as_secs_f64()));
+            .push(OffsetStage::Verify, t.elapsed().as_secs_f64());
     }
     step(progress, "done", 1.0)?;
     Ok((out, stats))
@@ -244,7 +252,7 @@ fn distance_field(
     mesh: &TriMesh,
     input: &InputDistance,
     band: &BandParams,
-    stats: &mut Stats,
+    stats: &mut OffsetReport,
     progress: &mut ProgressFn<'_>,
 ) -> Result<DistanceGrid> {
     let (lo, hi) = mesh.bbox();
@@ -255,7 +263,9 @@ fn distance_field(
         band.h,
     )?;
     step(progress, "band", 0.02)?;
-    let keys = stats.time("band", || band_bricks(input, &spec, band))?;
+    let keys = stats
+        .stages
+        .time(OffsetStage::Band, || band_bricks(input, &spec, band))?;
     let t = Instant::now();
     let grid = evaluate_band(input, spec, keys, band, &mut |f| {
         progress(Progress {
@@ -265,9 +275,9 @@ fn distance_field(
     })?;
     stats
         .stages
-        .push(("distance".into(), t.elapsed().as_secs_f64()));
-    stats.count("bricks", grid.keys.len() as u64);
-    stats.count("grid_points", grid.stored_points());
+        .push(OffsetStage::Distance, t.elapsed().as_secs_f64());
+    stats.bricks = grid.keys.len() as u64;
+    stats.grid_points = grid.stored_points();
     Ok(grid)
 }
 
@@ -292,7 +302,7 @@ fn surface_with_features(
     visible: &[bool],
     params: &OffsetParams,
     h: f64,
-    stats: &mut Stats,
+    stats: &mut OffsetReport,
 ) -> Result<MeshParts> {
     let mode = |p: usize, feature: bool| match (visible[p], feature) {
         (false, _) => Mode::Skip,
@@ -300,7 +310,9 @@ fn surface_with_features(
         (true, true) => Mode::Feature,
     };
     if !params.features {
-        let (pos, tris, _) = stats.time("assemble", || set.assemble(&|p| mode(p, false)));
+        let (pos, tris, _) = stats
+            .stages
+            .time(OffsetStage::Assemble, || set.assemble(&|p| mode(p, false)));
         return Ok((pos, tris));
     }
     let t = Instant::now();
@@ -311,7 +323,7 @@ fn surface_with_features(
     let (mesh, flips1) = flipped(pos, tris, &back, set, h, Some(cos_sharp))?;
     stats
         .stages
-        .push(("flips".into(), t.elapsed().as_secs_f64()));
+        .push(OffsetStage::Flips, t.elapsed().as_secs_f64());
     let t = Instant::now();
     let real = vertices_on_real_curves(&mesh, params.theta0_deg, params.l0);
     let mut keep = vec![false; set.len()];
@@ -325,21 +337,20 @@ fn surface_with_features(
     drop((mesh, real, back));
     stats
         .stages
-        .push(("filter".into(), t.elapsed().as_secs_f64()));
+        .push(OffsetStage::Filter, t.elapsed().as_secs_f64());
     let t = Instant::now();
     let (pos, tris, back) = set.assemble(&|p| mode(p, keep[p]));
     let (mesh, flips2) = flipped(pos, tris, &back, set, h, None)?;
     stats
         .stages
-        .push(("flips_filtered".into(), t.elapsed().as_secs_f64()));
-    stats.count("flip_candidates", flips1.candidates);
-    stats.count("flips", flips1.flipped);
-    stats.count("flips_refused_geometry", flips1.refused_geometry);
-    stats.count(
-        "feature_vertices_kept",
-        keep.iter().filter(|&&k| k).count() as u64,
-    );
-    stats.count("flips_filtered", flips2.flipped);
+        .push(OffsetStage::FlipsFiltered, t.elapsed().as_secs_f64());
+    stats.features = Some(FeatureCounts {
+        flip_candidates: flips1.candidates,
+        flips: flips1.flipped,
+        flips_refused_geometry: flips1.refused_geometry,
+        feature_vertices_kept: keep.iter().filter(|&&k| k).count() as u64,
+        flips_filtered: flips2.flipped,
+    });
     Ok(mesh.to_trimesh().into_parts())
 }
 
@@ -364,23 +375,23 @@ fn flipped(
     Ok((mesh, counts))
 }
 
-fn record_extraction(stats: &mut Stats, set: &PatchSet) {
+fn record_extraction(stats: &mut OffsetReport, set: &PatchSet) {
     let c = &set.counts;
-    stats.count("cells_visited", c.cells);
-    stats.count("cells_mixed", c.mixed);
-    stats.count("patches_disk", c.disks);
-    stats.count("patches_annulus", c.annuli);
-    stats.count(
-        "feature_vertices",
-        set.feature
+    stats.extraction = ExtractionCounts {
+        cells_visited: c.cells,
+        cells_mixed: c.mixed,
+        patches_disk: c.disks,
+        patches_annulus: c.annuli,
+        feature_vertices: set
+            .feature
             .iter()
             .filter(|&&f| f != super::extract::NONE)
             .count() as u64,
-    );
-    stats.count("tunnels_split", c.tunnels_split);
-    stats.count("cells_unseparated", c.unseparated);
-    stats.count("cells_unresolved", c.unresolved);
-    stats.count("iso_points", set.n_iso as u64);
+        tunnels_split: c.tunnels_split,
+        cells_unseparated: c.unseparated,
+        cells_unresolved: c.unresolved,
+        iso_points: set.n_iso as u64,
+    };
 }
 
 fn patchset_bytes(set: &PatchSet) -> u64 {
@@ -403,11 +414,14 @@ fn mesh_bytes(nv: usize, nt: usize) -> u64 {
 /// Feature vertices and flips change the surface only inside each patch's polyhedron and each
 /// flip's tetrahedron, which no other component enters, so neither components nor
 /// containment change afterwards — and invisible components cost no feature work.
-fn visible_patches(set: &PatchSet, stats: &mut Stats) -> Vec<bool> {
+fn visible_patches(set: &PatchSet, stats: &mut OffsetReport) -> Vec<bool> {
     let (pcomp, n) = set.patch_components();
-    stats.count("components", n as u64);
+    let mut counts = InteriorCounts {
+        components: n as u64,
+        components_removed: 0,
+    };
     if n <= 1 {
-        stats.count("components_removed", 0);
+        stats.interior = Some(counts);
         return vec![true; set.len()];
     }
     let mut boxes = vec![ComponentBox::empty(crate::geom::Vec3::ZERO); n];
@@ -430,32 +444,30 @@ fn visible_patches(set: &PatchSet, stats: &mut Stats) -> Vec<bool> {
         t
     };
     let keep = visible_components(&set.positions, &boxes, &triangles);
-    stats.count(
-        "components_removed",
-        keep.iter().filter(|&&k| !k).count() as u64,
-    );
+    counts.components_removed = keep.iter().filter(|&&k| !k).count() as u64;
+    stats.interior = Some(counts);
     pcomp.iter().map(|&c| keep[c as usize]).collect()
 }
 
 /// Independent checks of the output ([`MeshReport`], code independent of this stage):
 /// watertight, manifold, consistently oriented, self-intersection-free; plus the exact
 /// distance of every vertex to the input (`|f(v) − d| ≤ h`).
-fn verify(out: &TriMesh, input: &InputDistance, r: Resolved, stats: &mut Stats) {
+fn verify(out: &TriMesh, input: &InputDistance, r: Resolved, stats: &mut OffsetReport) {
     let report = MeshReport::compute_with(out, &ReportOptions::default());
-    stats.verify("watertight", report.is_watertight);
-    stats.verify("manifold", report.is_manifold);
-    stats.verify("consistently_oriented", report.consistently_oriented);
-    stats.verify(
-        "self_intersection_free",
-        report.self_intersection_free == Some(true),
-    );
-    stats.count("output_components", report.n_components as u64);
+    let v = &mut stats.verified;
+    v.watertight = Some(report.is_watertight);
+    v.manifold = Some(report.is_manifold);
+    v.consistently_oriented = Some(report.consistently_oriented);
+    v.self_intersection_free = Some(report.self_intersection_free == Some(true));
     let cap = r.d + 4.0 * r.h;
     let max_dev = out
         .positions()
         .par_iter()
         .map(|&x| deviation(input, x.into(), r.d, cap))
         .reduce(|| 0.0, f64::max);
-    stats.metric("max_deviation_over_d", max_dev / r.d);
-    stats.verify("vertices_within_h_of_offset", max_dev <= r.h);
+    v.vertices_within_h_of_offset = Some(max_dev <= r.h);
+    stats.verification = Some(OffsetVerification {
+        output_components: report.n_components as u64,
+        max_deviation_over_d: max_dev / r.d,
+    });
 }

@@ -11,12 +11,14 @@ use std::time::Instant;
 use super::align::{align_sweep, reference_normals};
 use super::flow::flow_sweep;
 use super::guard::{Guard, GuardStats, InputModel};
-use super::measure::{self, Surface, Verification};
+use super::measure::{self, Surface};
 use super::offset::{offset_surface_with_progress, OffsetDistance, OffsetParams};
+use super::report::{FloorMeasure, GuardCounts, LodReport, LodStage, SimplifyCounts};
 use super::simplify::{simplify_pass, SimplifyOptions, SimplifyReport, DRIFT_CAP};
 use crate::mesh::{HalfEdgeMesh, TriMesh};
 use crate::report::{Progress, ProgressFn};
-use crate::{Error, Result, Stats};
+use crate::verify::{self, CageCheck, CageInput, MeshReport, ReportOptions};
+use crate::{Error, Result};
 
 /// Parameters of [`generate`] and [`generate_chain`] (and of cages, `crate::cage`). Start from
 /// [`LodParams::default`]; defaults are the dissertation's (§4.4: `n_p = 200`, `N = 50`,
@@ -30,7 +32,7 @@ pub struct LodParams {
     /// when it is met. When a round makes no collapse (or the loop converges) before the target
     /// is reached, the per-collapse distance bound `d` of Alg. 5 is doubled and the one-sided
     /// distance check tolerates patches up to that bound (counted in
-    /// `Stats` as `target_relaxations`), so the target is reached unless topology or the
+    /// [`LodReport::target_relaxations`]), so the target is reached unless topology or the
     /// guarantees forbid it or the `N` rounds run out. `None` minimises the count at error `d`.
     /// At least 4 when given.
     pub target_faces: Option<usize>,
@@ -50,7 +52,7 @@ pub struct LodParams {
     /// Run the feature-alignment step (Alg. 6). Default true.
     pub align: bool,
     /// Also measure the error floor set by the offset stage: the one-sided distance from the
-    /// input to the offset surface (`Stats` metric `hausdorff_floor_rel`), which no later
+    /// input to the offset surface ([`LodReport::floor`]), which no later
     /// step can lower. Costs one more distance measurement; for benchmarks. Default false.
     pub measure_floor: bool,
 }
@@ -200,11 +202,9 @@ impl<'p, 'f> Reporter<'p, 'f> {
 /// manifold, self-intersection-free mesh within about `d = l / n_p` of the input (Pro.I–III).
 /// `progress` is called on this thread; returning `false` cancels with `Error::Cancelled`.
 ///
-/// `Stats`: stage seconds (`offset`, `simplify`, `flow`, `align`, `verify`, `measure`), counts
-/// (`faces_offset`, `faces_round_<i>`, `rounds`, `collapses`, guard counters, `reruns_exact`,
-/// `faces`, `vertices`), metrics (`d`, `hausdorff`, `hausdorff_rel` = two-sided sampled
-/// Hausdorff / `l`, see `measure` for the sampling density), verified guarantees
-/// (`watertight`, `manifold`, `self_intersection_free`).
+/// [`LodReport`]: stage seconds, counts, the achieved error (`hausdorff_rel` = two-sided
+/// sampled Hausdorff / `l`, measured by `crate::verify::hausdorff`) and the guarantees verified
+/// by `crate::verify` (watertight, manifold, self-intersection-free, same topology).
 ///
 /// Errors: `InvalidArgument` for a bad parameter (NaN or `≤ 0` screen size, …),
 /// `LimitExceeded` over the memory budget, `InvalidMesh` for an input with nothing to
@@ -213,7 +213,7 @@ pub fn generate(
     input: &TriMesh,
     params: &LodParams,
     progress: &mut ProgressFn<'_>,
-) -> Result<(TriMesh, Stats)> {
+) -> Result<(TriMesh, LodReport)> {
     run(input, params, Mode::Lod, progress)
 }
 
@@ -222,13 +222,14 @@ pub fn generate(
 /// has every Pro.III guarantee, so the guard keeps them), with the one-sided distance check of
 /// Alg. 5 relaxed to `d` of the coarser level — the distance its own offset surface would start
 /// from. `params.screen_size` and `params.target_faces` are ignored (a face target is per
-/// level: call [`generate`]). Each level's `Stats` has a `chain_level` count (0 = finest).
+/// level: call [`generate`]). Each level's report has its [`LodReport::chain_level`]
+/// (0 = finest).
 pub fn generate_chain(
     input: &TriMesh,
     screen_sizes: &[f64],
     params: &LodParams,
     progress: &mut ProgressFn<'_>,
-) -> Result<Vec<(TriMesh, Stats)>> {
+) -> Result<Vec<(TriMesh, LodReport)>> {
     run_chain(input, screen_sizes, params, Mode::Lod, progress)
 }
 
@@ -238,11 +239,12 @@ pub(crate) fn run(
     params: &LodParams,
     mode: Mode,
     progress: &mut ProgressFn<'_>,
-) -> Result<(TriMesh, Stats)> {
+) -> Result<(TriMesh, LodReport)> {
     params.validate(input)?;
     let mut rep = Reporter::new(progress);
     let model = InputModel::new(input, mode == Mode::Cage);
-    bake_level(&model, input, params, mode, None, &mut rep, (0.0, 1.0))
+    let level = Level::new(&model, input, mode);
+    bake_level(&level, params, None, &mut rep, (0.0, 1.0))
 }
 
 /// [`generate_chain`] for either mode.
@@ -252,7 +254,7 @@ pub(crate) fn run_chain(
     params: &LodParams,
     mode: Mode,
     progress: &mut ProgressFn<'_>,
-) -> Result<Vec<(TriMesh, Stats)>> {
+) -> Result<Vec<(TriMesh, LodReport)>> {
     if screen_sizes.is_empty() {
         return Err(Error::InvalidArgument("no screen size given".into()));
     }
@@ -270,21 +272,15 @@ pub(crate) fn run_chain(
     order.sort_by(|&a, &b| screen_sizes[b].total_cmp(&screen_sizes[a]).then(a.cmp(&b)));
     let mut rep = Reporter::new(progress);
     let model = InputModel::new(input, mode == Mode::Cage);
-    let mut out: Vec<Option<(TriMesh, Stats)>> = vec![None; screen_sizes.len()];
+    let level = Level::new(&model, input, mode);
+    let mut out: Vec<Option<(TriMesh, LodReport)>> = vec![None; screen_sizes.len()];
     let mut prev: Option<TriMesh> = None;
     let n = order.len() as f64;
     for (rank, &i) in order.iter().enumerate() {
         let window = (rank as f64 / n, 1.0 / n);
-        let (mesh, mut stats) = bake_level(
-            &model,
-            input,
-            &level_params[i],
-            mode,
-            prev.as_ref(),
-            &mut rep,
-            window,
-        )?;
-        stats.count("chain_level", rank as u64);
+        let (mesh, mut stats) =
+            bake_level(&level, &level_params[i], prev.as_ref(), &mut rep, window)?;
+        stats.chain_level = Some(rank as u64);
         prev = Some(mesh.clone());
         out[i] = Some((mesh, stats));
     }
@@ -294,38 +290,58 @@ pub(crate) fn run_chain(
         .collect())
 }
 
+/// What every level of a bake shares: the guard's input model, the input, the mode, and in
+/// cage mode the independent verifier's prepared input.
+struct Level<'a> {
+    model: &'a InputModel,
+    input: &'a TriMesh,
+    mode: Mode,
+    cage_input: Option<CageInput<'a>>,
+}
+
+impl<'a> Level<'a> {
+    fn new(model: &'a InputModel, input: &'a TriMesh, mode: Mode) -> Level<'a> {
+        Level {
+            model,
+            input,
+            mode,
+            cage_input: (mode == Mode::Cage).then(|| CageInput::new(input)),
+        }
+    }
+}
+
 /// Bakes one level: start surface (offset of the input, or `finer` in a chain), the loop,
 /// verification, measurement.
 fn bake_level(
-    model: &InputModel,
-    input: &TriMesh,
+    level: &Level<'_>,
     params: &LodParams,
-    mode: Mode,
     finer: Option<&TriMesh>,
     rep: &mut Reporter<'_, '_>,
     window: (f64, f64),
-) -> Result<(TriMesh, Stats)> {
-    let mut stats = Stats::default();
+) -> Result<(TriMesh, LodReport)> {
+    let (model, input, mode) = (level.model, level.input, level.mode);
     let l = model.diag;
     let d = l / params.screen_size;
-    stats.metric("d", d);
+    let mut stats = LodReport {
+        d,
+        ..LodReport::default()
+    };
     let (w0, ws) = window;
     rep.window(w0, 0.2 * ws);
     rep.check("offset", 0.0)?;
     let t0 = Instant::now();
-    let mut offset_stats = Stats::default();
     let (start, slack) = match finer {
         Some(m) => (m.clone(), d),
-        None => (
-            initial_surface(input, model, params, d, mode, rep, &mut offset_stats)?,
-            0.0,
-        ),
+        None => {
+            let (m, dev) = initial_surface(level, params, d, rep)?;
+            stats.offset_max_deviation_over_d = dev;
+            (m, 0.0)
+        }
     };
     stats
         .stages
-        .push(("offset".into(), t0.elapsed().as_secs_f64()));
-    stats.metrics.extend(offset_stats.metrics);
-    stats.count("faces_offset", start.triangle_count() as u64);
+        .push(LodStage::Offset, t0.elapsed().as_secs_f64());
+    stats.faces_offset = start.triangle_count() as u64;
     let start_topology = topology_of(&start);
     rep.window(w0 + 0.2 * ws, 0.7 * ws);
     let cfg = LoopConfig {
@@ -342,25 +358,30 @@ fn bake_level(
     rep.window(w0 + 0.9 * ws, 0.1 * ws);
     rep.check("verify", 0.0)?;
     let t0 = Instant::now();
-    let mut v = verify_level(&mesh, model, mode);
+    let mut v = verify_level(&mesh, level);
     let mut reruns = 0;
-    if !v.0.self_intersection_free || !v.1 {
+    if !v.self_intersection_free || !v.cage_ok {
         // §4.3.3: the normal-cone shortcut let an intersection through: rerun exactly.
         reruns = 1;
         rep.window(w0 + 0.2 * ws, 0.7 * ws);
         let (m2, ls2) = optimize(&start, model, &cfg, true, rep)?;
         mesh = m2;
         ls = ls2;
-        v = verify_level(&mesh, model, mode);
+        v = verify_level(&mesh, level);
     }
     let verify_s = t0.elapsed().as_secs_f64();
     ls.write(&mut stats);
-    stats.stages.push(("verify".into(), verify_s));
-    stats.count("reruns_exact", reruns);
-    record_verification(&mut stats, v, mode);
-    let same_topology = (v.0.components, v.0.euler) == start_topology;
-    stats.verify("same_topology_as_offset", same_topology);
-    let ok = v.0.manifold && v.0.watertight && v.0.self_intersection_free && v.1 && same_topology;
+    stats.stages.push(LodStage::Verify, verify_s);
+    stats.reruns_exact = reruns;
+    let same_topology = (v.components, v.euler) == start_topology;
+    stats.verified.watertight = Some(v.watertight);
+    stats.verified.manifold = Some(v.manifold);
+    stats.verified.self_intersection_free = Some(v.self_intersection_free);
+    if mode == Mode::Cage {
+        stats.verified.cage_encloses_without_touching = Some(v.cage_ok);
+    }
+    stats.verified.same_topology_as_offset = Some(same_topology);
+    let ok = v.manifold && v.watertight && v.self_intersection_free && v.cage_ok && same_topology;
     if !ok {
         return Err(Error::Internal(format!(
             "the output failed independent verification ({v:?}); please report the input"
@@ -368,38 +389,38 @@ fn bake_level(
     }
     rep.check("measure", 0.5)?;
     let t0 = Instant::now();
-    let sides = measure::hausdorff_sides(&mesh, input);
+    let sides = verify::hausdorff_sides(&mesh, input);
     let h = sides.input_to_output.max(sides.output_to_input);
     stats
         .stages
-        .push(("measure".into(), t0.elapsed().as_secs_f64()));
+        .push(LodStage::Measure, t0.elapsed().as_secs_f64());
     if params.measure_floor && finer.is_none() {
         let (t0, c0) = (Instant::now(), crate::report::process_cpu_seconds());
-        let floor = measure::input_to_surface(&start, input);
-        stats.metric("hausdorff_floor_rel", floor / l);
+        let floor = verify::input_to_surface(&start, input);
+        let rel = floor / l;
         stats
             .stages
-            .push(("floor".into(), t0.elapsed().as_secs_f64()));
-        stats.metric(
-            "floor_cpu_seconds",
-            crate::report::process_cpu_seconds() - c0,
-        );
+            .push(LodStage::Floor, t0.elapsed().as_secs_f64());
+        stats.floor = Some(FloorMeasure {
+            rel,
+            cpu_seconds: crate::report::process_cpu_seconds() - c0,
+        });
     }
-    stats.metric("hausdorff", h);
-    stats.metric("hausdorff_rel", h / l);
-    stats.metric("hausdorff_in_to_out_rel", sides.input_to_output / l);
-    stats.metric("hausdorff_out_to_in_rel", sides.output_to_input / l);
-    stats.count("faces", mesh.triangle_count() as u64);
-    stats.count("vertices", mesh.vertex_count() as u64);
+    stats.hausdorff = h;
+    stats.hausdorff_rel = h / l;
+    stats.hausdorff_in_to_out_rel = sides.input_to_output / l;
+    stats.hausdorff_out_to_in_rel = sides.output_to_input / l;
+    stats.faces = mesh.triangle_count() as u64;
+    stats.vertices = mesh.vertex_count() as u64;
     rep.check("done", 1.0)?;
     Ok((mesh, stats))
 }
 
 /// `(components, Euler characteristic)` of a mesh (no self-intersection pass).
 fn topology_of(mesh: &TriMesh) -> (usize, i64) {
-    let r = crate::mesh::MeshReport::compute_with(
+    let r = MeshReport::compute_with(
         mesh,
-        &crate::mesh::ReportOptions {
+        &ReportOptions {
             self_intersections: false,
             weld: false,
         },
@@ -407,25 +428,38 @@ fn topology_of(mesh: &TriMesh) -> (usize, i64) {
     (r.n_components, r.euler_characteristic_total)
 }
 
-/// `(Pro.III verification, cage checks hold)`.
-fn verify_level(mesh: &TriMesh, model: &InputModel, mode: Mode) -> (Verification, bool) {
-    let v = measure::verify(mesh);
-    let cage_ok = match mode {
-        Mode::Lod => true,
-        Mode::Cage => {
-            let (untouched, encloses) = measure::verify_cage(mesh, model);
-            untouched && encloses
-        }
-    };
-    (v, cage_ok)
+/// What the independent verification (`crate::verify`) found on a level's output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Verification {
+    /// Edge- and vertex-manifold, no repeated-index faces, consistently oriented.
+    manifold: bool,
+    /// Closed and manifold.
+    watertight: bool,
+    /// No two faces intersect beyond their shared vertices/edges (CGAL's rules) and no face is
+    /// degenerate.
+    self_intersection_free: bool,
+    /// Number of connected components.
+    components: usize,
+    /// Total Euler characteristic.
+    euler: i64,
+    /// Cage mode: encloses the input without touching it; `true` for a LOD.
+    cage_ok: bool,
 }
 
-fn record_verification(stats: &mut Stats, v: (Verification, bool), mode: Mode) {
-    stats.verify("watertight", v.0.watertight);
-    stats.verify("manifold", v.0.manifold);
-    stats.verify("self_intersection_free", v.0.self_intersection_free);
-    if mode == Mode::Cage {
-        stats.verify("cage_encloses_without_touching", v.1);
+/// Pro.III by [`MeshReport`] (which shares none of the guard's shortcuts) and, in cage mode,
+/// the cage checks of `crate::verify::cage`.
+fn verify_level(mesh: &TriMesh, level: &Level<'_>) -> Verification {
+    let r = MeshReport::compute_with(mesh, &ReportOptions::default());
+    Verification {
+        manifold: r.is_manifold && r.consistently_oriented,
+        watertight: r.is_watertight,
+        self_intersection_free: r.self_intersection_free == Some(true),
+        components: r.n_components,
+        euler: r.euler_characteristic_total,
+        cage_ok: level
+            .cage_input
+            .as_ref()
+            .is_none_or(|c| c.check(mesh).is_cage()),
     }
 }
 
@@ -463,37 +497,40 @@ struct LoopStats {
 }
 
 impl LoopStats {
-    fn write(&self, s: &mut Stats) {
-        s.stages.push(("simplify".into(), self.simplify_s));
-        s.stages.push(("flow".into(), self.flow_s));
-        s.stages.push(("align".into(), self.align_s));
-        s.stages.push(("convergence".into(), self.converge_s));
-        s.metric("simplify_first_pass_s", self.simplify_first_s);
-        s.count("rounds", self.rounds);
-        for (i, f) in self.faces_per_round.iter().enumerate() {
-            s.count(&format!("faces_round_{}", i + 1), *f);
-        }
-        s.count("collapses", self.simplify.collapses);
-        s.count("collapse_candidates", self.simplify.candidates);
-        s.count("rejected_fold", self.simplify.rejected_fold);
-        s.count("rejected_hausdorff", self.simplify.rejected_hausdorff);
-        s.count("rejected_distance", self.simplify.rejected_distance);
-        s.count("rejected_guard", self.simplify.rejected_guard);
-        s.count("collapses_rechecked", self.simplify.rechecked);
+    fn write(&self, s: &mut LodReport) {
+        s.stages.push(LodStage::Simplify, self.simplify_s);
+        s.stages.push(LodStage::Flow, self.flow_s);
+        s.stages.push(LodStage::Align, self.align_s);
+        s.stages.push(LodStage::Convergence, self.converge_s);
+        s.simplify_first_pass_seconds = self.simplify_first_s;
+        s.rounds = self.rounds;
+        s.faces_per_round = self.faces_per_round.clone();
+        let r = &self.simplify;
+        s.simplify = SimplifyCounts {
+            collapses: r.collapses,
+            candidates: r.candidates,
+            rejected_fold: r.rejected_fold,
+            rejected_hausdorff: r.rejected_hausdorff,
+            rejected_distance: r.rejected_distance,
+            rejected_guard: r.rejected_guard,
+            rechecked: r.rechecked,
+        };
         let g = &self.guard;
-        s.count("guard_checks", g.checks);
-        s.count("guard_rejected_topology", g.rejected_topology);
-        s.count("guard_rejected_degenerate", g.rejected_degenerate);
-        s.count("guard_rejected_intersection", g.rejected_intersection);
-        s.count("guard_rejected_touch", g.rejected_touch);
-        s.count("guard_rejected_uncover", g.rejected_uncover);
-        s.count("guard_cone_fast_path", g.cone_fast_path);
-        s.count("guard_exact_tests", g.exact_tests);
-        s.count("target_met", self.target_met as u64);
-        s.count("target_relaxations", self.relaxations);
-        s.count("converged", self.converged as u64);
-        s.metric("flow_motion", self.flow_motion);
-        s.metric("align_motion", self.align_motion);
+        s.guard = GuardCounts {
+            checks: g.checks,
+            rejected_topology: g.rejected_topology,
+            rejected_degenerate: g.rejected_degenerate,
+            rejected_intersection: g.rejected_intersection,
+            rejected_touch: g.rejected_touch,
+            rejected_uncover: g.rejected_uncover,
+            cone_fast_path: g.cone_fast_path,
+            exact_tests: g.exact_tests,
+        };
+        s.target_met = self.target_met;
+        s.target_relaxations = self.relaxations;
+        s.converged = self.converged;
+        s.flow_motion = self.flow_motion;
+        s.align_motion = self.align_motion;
     }
 }
 
@@ -595,18 +632,15 @@ fn optimize(
 }
 
 /// The start surface `M_d`: the offset surface of stage 1 (§4.3.1) at distance `d`, which is
-/// watertight, manifold and intersection-free, and encloses the input at distance about `d`.
-/// In cage mode the enclosure and the absence of contact are checked here, since the guard
-/// only keeps them.
+/// watertight, manifold and intersection-free, and encloses the input at distance about `d`,
+/// with its largest vertex deviation over `d`. In cage mode the enclosure and the absence of
+/// contact are checked here, since the guard only keeps them.
 fn initial_surface(
-    input: &TriMesh,
-    model: &InputModel,
+    level: &Level<'_>,
     params: &LodParams,
     d: f64,
-    mode: Mode,
     rep: &mut Reporter<'_, '_>,
-    stats_out: &mut Stats,
-) -> Result<TriMesh> {
+) -> Result<(TriMesh, Option<f64>)> {
     let op = OffsetParams {
         distance: OffsetDistance::Absolute(d),
         theta0_deg: params.theta0_deg,
@@ -616,21 +650,26 @@ fn initial_surface(
     };
     let (mesh, ostats) = {
         let mut prog = |p: Progress<'_>| rep.report(p.stage, p.fraction);
-        offset_surface_with_progress(input, &op, &mut prog)?
+        offset_surface_with_progress(level.input, &op, &mut prog)?
     };
-    for (name, holds) in &ostats.verified {
-        let essential = ["watertight", "manifold", "self_intersection_free"];
-        if essential.contains(&name.as_str()) && !holds {
+    let v = &ostats.verified;
+    let essential = [
+        ("watertight", v.watertight),
+        ("manifold", v.manifold),
+        ("self_intersection_free", v.self_intersection_free),
+    ];
+    for (name, holds) in essential {
+        if holds == Some(false) {
             return Err(Error::Internal(format!(
                 "the offset surface failed its verification ({name}); please report the input"
             )));
         }
     }
-    if let Some(dev) = ostats.get_metric("max_deviation_over_d") {
-        stats_out.metric("offset_max_deviation_over_d", dev);
-    }
-    if mode == Mode::Cage {
-        let (untouched, encloses) = measure::verify_cage(&mesh, model);
+    if let Some(c) = &level.cage_input {
+        let CageCheck {
+            untouched,
+            encloses,
+        } = c.check(&mesh);
         if !(untouched && encloses) {
             return Err(Error::Internal(format!(
                 "the offset surface does not enclose the input without contact \
@@ -638,5 +677,6 @@ fn initial_surface(
             )));
         }
     }
-    Ok(mesh)
+    let deviation = ostats.verification.map(|v| v.max_deviation_over_d);
+    Ok((mesh, deviation))
 }

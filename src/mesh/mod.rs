@@ -1,13 +1,13 @@
-//! Mesh core: the indexed triangle mesh [`TriMesh`], file I/O, half-edge connectivity for local
-//! operations, and [`MeshReport`] validation of any triangle soup.
+//! Mesh core: the indexed triangle mesh [`TriMesh`], file I/O and half-edge connectivity for
+//! local operations (validation of any soup: `crate::verify::MeshReport`).
+//!
+//! May import: `crate::geom`, `crate::error` (the bottom layer).
 
 pub mod halfedge;
 pub mod io;
-mod report;
 mod trimesh;
 mod weld;
 
 pub use halfedge::HalfEdgeMesh;
-pub use report::{MeshReport, ReportOptions};
 pub use trimesh::{Edge, EdgeList, TriMesh};
 pub use weld::ExactWeld;

@@ -28,7 +28,6 @@ use rayon::prelude::*;
 use super::bvh::{corners_box, TriangleBvh};
 use super::tritri::{faces_intersect, is_collinear};
 use crate::mesh::{ExactWeld, TriMesh};
-use crate::Stats;
 
 /// All self-intersections of a soup: intersecting face pairs and degenerate faces.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -65,32 +64,48 @@ pub fn find_self_intersections_in(
     triangles: &[[u32; 3]],
 ) -> SelfIntersections {
     let weld = ExactWeld::compute(positions);
-    find_self_intersections_welded(positions, triangles, &weld, &mut Stats::default())
+    find_self_intersections_welded(positions, triangles, &weld).0
 }
 
-/// As [`find_self_intersections_in`] with the exact weld of `positions` already computed;
-/// records the stages `si_prepare` (welded faces, degenerate faces), `si_bvh` (chunk trees) and
-/// `si_pairs_and_tests` (traversal with the exact test of each candidate pair) in `stats`.
+/// Wall seconds of the phases of [`find_self_intersections_welded`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct SelfIntersectionTimes {
+    /// Welded faces and degenerate faces.
+    pub prepare: f64,
+    /// Chunk trees.
+    pub bvh: f64,
+    /// Traversal with the exact test of each candidate pair.
+    pub pairs_and_tests: f64,
+}
+
+/// As [`find_self_intersections_in`] with the exact weld of `positions` already computed, with
+/// the wall time of each phase.
 pub(crate) fn find_self_intersections_welded(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
     weld: &ExactWeld,
-    stats: &mut Stats,
-) -> SelfIntersections {
-    let (welded, faces, degenerate) = stats.time("si_prepare", || {
-        split_degenerate(positions, triangles, weld)
-    });
-    let chunks = stats.time("si_bvh", || {
-        ChunkedBvh::new(positions, &welded, &faces, CHUNK_FACES)
-    });
+) -> (SelfIntersections, SelfIntersectionTimes) {
+    let ((welded, faces, degenerate), prepare) =
+        timed(|| split_degenerate(positions, triangles, weld));
+    let (chunks, bvh) = timed(|| ChunkedBvh::new(positions, &welded, &faces, CHUNK_FACES));
     let narrow = Narrow {
         positions,
         welded: &welded,
     };
-    let pairs = stats.time("si_pairs_and_tests", || {
-        chunks.pairs_where(|f, g| narrow.intersect(f, g))
-    });
-    SelfIntersections { pairs, degenerate }
+    let (pairs, pairs_and_tests) = timed(|| chunks.pairs_where(|f, g| narrow.intersect(f, g)));
+    let times = SelfIntersectionTimes {
+        prepare,
+        bvh,
+        pairs_and_tests,
+    };
+    (SelfIntersections { pairs, degenerate }, times)
+}
+
+/// `f()` and its wall seconds.
+fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
+    let t0 = std::time::Instant::now();
+    let r = f();
+    (r, t0.elapsed().as_secs_f64())
 }
 
 /// True when `mesh` has a degenerate face or an intersecting face pair (CGAL's

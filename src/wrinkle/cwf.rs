@@ -6,10 +6,11 @@
 use super::areas::barycentric_areas;
 use super::complex::Complex;
 use super::knoppel::{knoppel_phase, KnoppelOptions, KnoppelReport};
+use super::report::CwfStage;
 use super::topology::Topology;
 use crate::geom::Vec3;
 use crate::mesh::TriMesh;
-use crate::report::Stats;
+use crate::report::StageTimes;
 use crate::{Error, Result};
 
 /// A complex wrinkle field (§3.3.1) on a validated base mesh.
@@ -98,20 +99,18 @@ impl Cwf {
         omega: Vec<f64>,
         amplitude: Vec<f64>,
         opts: &KnoppelOptions,
-    ) -> Result<(Cwf, KnoppelReport, Stats)> {
+    ) -> Result<(Cwf, KnoppelReport)> {
         let n = base.vertex_count();
-        let mut stats = Stats::default();
-        let mut cwf = stats.time("validate", || {
+        let mut stages = StageTimes::default();
+        let mut cwf = stages.time(CwfStage::Validate, || {
             Cwf::new(base, omega, amplitude, vec![Complex::ONE; n])
         })?;
-        let (zeta, report) = stats.time("knoppel", || {
+        let (zeta, mut report) = stages.time(CwfStage::Knoppel, || {
             knoppel_phase(&cwf.topo, cwf.base.positions(), &cwf.omega, opts)
         })?;
-        stats.metric("knoppel eigenvalue", report.eigenvalue);
-        stats.metric("knoppel residual", report.residual);
-        stats.count("knoppel iterations", report.iterations as u64);
+        report.stages = stages;
         cwf.zeta = zeta;
-        Ok((cwf, report, stats))
+        Ok((cwf, report))
     }
 
     /// Builds a CWF from per-vertex or per-face wave vectors and amplitudes (§3.2.1):
@@ -121,7 +120,7 @@ impl Cwf {
         frequency: FrequencyField<'_>,
         amplitude: Vec<f64>,
         opts: &KnoppelOptions,
-    ) -> Result<(Cwf, KnoppelReport, Stats)> {
+    ) -> Result<(Cwf, KnoppelReport)> {
         let omega = one_form_from_vectors(&base, frequency)?;
         Cwf::from_one_form(base, omega, amplitude, opts)
     }

@@ -24,6 +24,7 @@ use rayon::prelude::*;
 
 use super::complex::Complex;
 use super::cwf::Cwf;
+use super::report::{EvalReport, EvalStage, LevelPart, LevelReport};
 use super::subdivide::{
     apply_s0, apply_s1, apply_z, check_output_size, face_gradients, vertex_rules, BoundaryRule,
     SubdivisionOptions, VertexRule, ZContext,
@@ -31,7 +32,7 @@ use super::subdivide::{
 use super::topology::Topology;
 use crate::geom::{normalized, tri_normal, Vec3};
 use crate::mesh::TriMesh;
-use crate::report::{Progress, ProgressFn, Stats};
+use crate::report::{Progress, ProgressFn, StageTimes};
 use crate::Result;
 
 /// Options of [`Cwf::evaluate`].
@@ -104,15 +105,12 @@ struct Level<'a> {
 }
 
 impl Cwf {
-    /// Evaluates the wrinkled surface after `levels` Loop refinements (§3.5). `Stats` records
-    /// the wall time of each part of each level as stages `"level k: positions"`,
-    /// `"level k: cotangent vectors"`, `"level k: z"`, `"level k: topology"`,
-    /// `"level k: one-form"` (or `"level k: triangles"` on the last level) and `"displace"`,
-    /// the metric `"level k seconds"` (whole level), and counts `"level k vertices"` /
-    /// `"level k faces"`. Errors with
+    /// Evaluates the wrinkled surface after `levels` Loop refinements (§3.5). The
+    /// [`EvalReport`] records the wall time of each part of each level ([`EvalStage`]) and of
+    /// the displacement, and per level its seconds, vertices and faces. Errors with
     /// [`crate::Error::LimitExceeded`] above [`EvalOptions::max_output_faces`] and
     /// [`crate::Error::InvalidArgument`] for a non-finite displacement scale.
-    pub fn evaluate(&self, levels: usize, opts: &EvalOptions) -> Result<(Evaluated, Stats)> {
+    pub fn evaluate(&self, levels: usize, opts: &EvalOptions) -> Result<(Evaluated, EvalReport)> {
         self.evaluate_with_progress(levels, opts, &mut |_| true)
     }
 
@@ -125,7 +123,7 @@ impl Cwf {
         levels: usize,
         opts: &EvalOptions,
         progress: &mut ProgressFn<'_>,
-    ) -> Result<(Evaluated, Stats)> {
+    ) -> Result<(Evaluated, EvalReport)> {
         if !opts.displacement_scale.is_finite() {
             return crate::invalid_arg!(
                 "displacement_scale is {} (must be finite)",
@@ -133,8 +131,8 @@ impl Cwf {
             );
         }
         check_output_size(self.topo.n_faces(), levels, opts.max_output_faces)?;
-        let mut stats = Stats::default();
-        let mut level = stats.time("setup", || {
+        let mut stats = EvalReport::default();
+        let mut level = stats.stages.time(EvalStage::Setup, || {
             self.base_level(&opts.subdivision, opts.want_amplitude)
         });
         let mut faces = self.topo.faces.clone();
@@ -146,15 +144,14 @@ impl Cwf {
                 &level,
                 keep_topology,
                 opts.subdivision.boundary,
-                &mut stats,
+                &mut stats.stages,
                 l + 1,
             );
-            stats.metric(
-                &format!("level {} seconds", l + 1),
-                t0.elapsed().as_secs_f64(),
-            );
-            stats.count(&format!("level {} vertices", l + 1), next.x.len() as u64);
-            stats.count(&format!("level {} faces", l + 1), next_faces.len() as u64);
+            stats.levels.push(LevelReport {
+                seconds: t0.elapsed().as_secs_f64(),
+                vertices: next.x.len() as u64,
+                faces: next_faces.len() as u64,
+            });
             level = next;
             faces = next_faces;
             let stage = format!("level {}", l + 1);
@@ -165,7 +162,9 @@ impl Cwf {
                 return Err(crate::Error::Cancelled);
             }
         }
-        let out = stats.time("displace", || finish(level, faces, opts));
+        let out = stats
+            .stages
+            .time(EvalStage::Displace, || finish(level, faces, opts));
         if !progress(Progress {
             stage: "displace",
             fraction: 1.0,
@@ -213,27 +212,29 @@ fn work_done(k: usize, n: usize) -> f64 {
     (1..=k).map(cost).sum::<f64>() / total
 }
 
-/// One Loop step of every field, timing its parts as `"level k: <part>"` in `stats`. Without
+/// One Loop step of every field, timing its parts as [`EvalStage::Level`] in `stats`. Without
 /// `keep_topology` only the fine triangles are built (the last level needs no adjacency and no
 /// one-form).
 fn refine_level<'a>(
     c: &Level<'_>,
     keep_topology: bool,
     boundary: BoundaryRule,
-    stats: &mut Stats,
+    stats: &mut StageTimes<EvalStage>,
     k: usize,
 ) -> (Level<'a>, Vec<[u32; 3]>) {
     let topo = c.topo.as_ref();
-    let name = |part: &str| format!("level {k}: {part}");
-    let x = stats.time(&name("positions"), || apply_s0(topo, &c.rules, &c.x));
-    let amplitude = stats.time(&name("amplitude"), || {
+    let name = |part: LevelPart| EvalStage::Level(k, part);
+    let x = stats.time(name(LevelPart::Positions), || {
+        apply_s0(topo, &c.rules, &c.x)
+    });
+    let amplitude = stats.time(name(LevelPart::Amplitude), || {
         if c.amplitude.is_empty() {
             Vec::new()
         } else {
             apply_s0(topo, &c.rules, &c.amplitude)
         }
     });
-    let faces = stats.time(&name("cotangent vectors"), || {
+    let faces = stats.time(name(LevelPart::CotangentVectors), || {
         face_gradients(topo, &c.x, &c.omega)
     });
     let ctx = ZContext {
@@ -244,9 +245,9 @@ fn refine_level<'a>(
         z: &c.z,
         faces,
     };
-    let z = stats.time(&name("z"), || apply_z(&ctx, &x));
+    let z = stats.time(name(LevelPart::Z), || apply_z(&ctx, &x));
     if !keep_topology {
-        let faces = stats.time(&name("triangles"), || topo.refine_faces());
+        let faces = stats.time(name(LevelPart::Triangles), || topo.refine_faces());
         let next = Level {
             topo: std::borrow::Cow::Owned(empty_topology()),
             rules: Vec::new(),
@@ -257,8 +258,8 @@ fn refine_level<'a>(
         };
         return (next, faces);
     }
-    let fine = stats.time(&name("topology"), || topo.refine());
-    let omega = stats.time(&name("one-form"), || {
+    let fine = stats.time(name(LevelPart::Topology), || topo.refine());
+    let omega = stats.time(name(LevelPart::OneForm), || {
         apply_s1(topo, &fine, &c.rules, &c.omega)
     });
     let rules = vertex_rules(&fine, boundary);

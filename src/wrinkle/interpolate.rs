@@ -94,8 +94,9 @@ use super::areas::barycentric_areas;
 use super::complex::Complex;
 use super::cwf::Cwf;
 use super::omega_path::OmegaPath;
+use super::report::InterpStage;
 use super::spacetime::FrameBlocks;
-use crate::report::{Progress, ProgressFn, Stats};
+use crate::report::{Progress, ProgressFn, StageTimes, StatEntries};
 use crate::solve::{
     assemble, dot_n, entry_index, steihaug, sym_matvec_lower_into, Cholesky, CholeskyAnalysis,
     Entry, Parallelism, SparseMatrix,
@@ -223,6 +224,8 @@ pub struct InterpReport {
     pub cg_iterations: usize,
     /// Unknown reals (`2 V (N' − 1)`).
     pub unknowns: usize,
+    /// Wall seconds per stage (`setup`, then `assemble` and `solve` when there was a solve).
+    pub stages: StageTimes<InterpStage>,
 }
 
 impl InterpReport {
@@ -232,16 +235,38 @@ impl InterpReport {
     }
 }
 
+impl InterpReport {
+    /// Total wall seconds over the stages.
+    pub fn total_seconds(&self) -> f64 {
+        self.stages.total()
+    }
+
+    /// The report as named entries (`g_ave`, `c`, `final gradient norm`, `E_smooth`,
+    /// `E_compat`, `E_unit`; counts `iterations`, `factorizations`, `cg iterations`,
+    /// `unknowns`).
+    pub fn entries(&self) -> StatEntries {
+        let mut e = StatEntries::default();
+        self.stages.write_entries(&mut e);
+        e.metric_entry("g_ave", self.g_ave);
+        e.metric_entry("c", self.c);
+        e.metric_entry("final gradient norm", self.final_gradient_norm());
+        e.metric_entry("E_smooth", self.smooth_energy);
+        e.metric_entry("E_compat", self.compat_energy);
+        e.metric_entry("E_unit", self.unit_energy);
+        e.count_entry("iterations", self.iterations as u64);
+        e.count_entry("factorizations", self.factorizations as u64);
+        e.count_entry("cg iterations", self.cg_iterations as u64);
+        e.count_entry("unknowns", self.unknowns as u64);
+        e
+    }
+}
+
 /// Interpolates between keyframes `a` (t = 0) and `b` (t = 1) on the same base mesh. See the
 /// [module docs](self). Errors with [`Error::InvalidArgument`] when the keyframes' base meshes
 /// differ (connectivity, or a position by more than 1e-9 of the bounding-box diagonal) or an
 /// option is out of range, [`Error::Numerical`] if the factorization fails even with heavy
 /// damping.
-pub fn interpolate(
-    a: &Cwf,
-    b: &Cwf,
-    opts: &InterpOptions,
-) -> Result<(CwfAnimation, InterpReport, Stats)> {
+pub fn interpolate(a: &Cwf, b: &Cwf, opts: &InterpOptions) -> Result<(CwfAnimation, InterpReport)> {
     interpolate_with_progress(a, b, opts, &mut |_| true)
 }
 
@@ -252,41 +277,34 @@ pub fn interpolate_with_progress(
     b: &Cwf,
     opts: &InterpOptions,
     progress: &mut ProgressFn<'_>,
-) -> Result<(CwfAnimation, InterpReport, Stats)> {
+) -> Result<(CwfAnimation, InterpReport)> {
     let start = Instant::now();
     check_options(opts)?;
     check_same_base(a, b)?;
-    let mut stats = Stats::default();
-    let setup = stats.time("setup", || Setup::new(a, b, opts));
+    let mut stats = StageTimes::default();
+    let setup = stats.time(InterpStage::Setup, || Setup::new(a, b, opts));
     let n = opts.guide_frames;
     let omega_com: Vec<Vec<f64>> = (0..=n)
         .map(|i| setup.com.at(&a.topo, i as f64 / n as f64))
         .collect();
-    let (zeta, report) = if identical(a, b) {
+    let (zeta, mut report) = if identical(a, b) {
         let r = trivial_report(&setup, StopReason::IdenticalKeyframes, start);
         (vec![a.zeta().to_vec(); n + 1], r)
     } else if n == 1 {
         let r = trivial_report(&setup, StopReason::NoUnknowns, start);
         (vec![a.zeta().to_vec(), b.zeta().to_vec()], r)
     } else {
-        let problem = stats.time("assemble", || Problem::new(a, b, &setup, &omega_com, opts))?;
-        stats.time("solve", || problem.solve(opts, start, progress))?
+        let problem = stats.time(InterpStage::Assemble, || {
+            Problem::new(a, b, &setup, &omega_com, opts)
+        })?;
+        stats.time(InterpStage::Solve, || problem.solve(opts, start, progress))?
     };
     let omega = if identical(a, b) {
         vec![a.omega().to_vec(); n + 1]
     } else {
         full_omega(a, b, &setup, omega_com, n)
     };
-    stats.metric("g_ave", report.g_ave);
-    stats.metric("c", report.c);
-    stats.metric("final gradient norm", report.final_gradient_norm());
-    stats.metric("E_smooth", report.smooth_energy);
-    stats.metric("E_compat", report.compat_energy);
-    stats.metric("E_unit", report.unit_energy);
-    stats.count("iterations", report.iterations as u64);
-    stats.count("factorizations", report.factorizations as u64);
-    stats.count("cg iterations", report.cg_iterations as u64);
-    stats.count("unknowns", report.unknowns as u64);
+    report.stages = stats;
     let anim = CwfAnimation::from_guides(
         a,
         [a.amplitude().to_vec(), b.amplitude().to_vec()],
@@ -294,7 +312,7 @@ pub fn interpolate_with_progress(
         zeta,
         opts.substeps,
     )?;
-    Ok((anim, report, stats))
+    Ok((anim, report))
 }
 
 /// `ω(t)` of the explicit path (B.34/B.46) between the keyframes' full one-forms, without the
@@ -456,6 +474,7 @@ fn trivial_report(setup: &Setup, stop: StopReason, start: Instant) -> InterpRepo
         factorizations: 0,
         cg_iterations: 0,
         unknowns: 0,
+        stages: StageTimes::default(),
     }
 }
 
@@ -664,6 +683,7 @@ impl Problem {
             factorizations: counts[1],
             cg_iterations: counts[2],
             unknowns: 2 * self.n_unknown(),
+            stages: StageTimes::default(),
         };
         (frames, report)
     }

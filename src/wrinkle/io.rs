@@ -157,9 +157,9 @@ fn read_header(lines: &mut Lines<'_>) -> Result<Header> {
             "format version {version} is not supported (this pleat reads version {CWF_FORMAT_VERSION})"
         )));
     }
-    let vertices = lines.count("vertices")?;
-    let edges = lines.count("edges")?;
-    let faces = lines.count("faces")?;
+    let vertices = lines.header_number("vertices")?;
+    let edges = lines.header_number("edges")?;
+    let faces = lines.header_number("faces")?;
     let (n, f) = lines.fields(2)?;
     if f[0] != "connectivity" {
         return Err(lines.err(n, "expected 'connectivity <16 hex digits>'"));
@@ -247,7 +247,8 @@ impl<'a> Lines<'a> {
         Ok(())
     }
 
-    fn count(&mut self, kw: &str) -> Result<usize> {
+    /// The `<count>` of the next line, which must read `kw <count>`.
+    fn header_number(&mut self, kw: &str) -> Result<usize> {
         let (n, f) = self.fields(2)?;
         if f[0] != kw {
             return Err(self.err(n, &format!("expected '{kw} <count>', found '{}'", f[0])));

@@ -25,8 +25,10 @@
 
 use super::areas::barycentric_areas;
 use super::complex::Complex;
+use super::report::CwfStage;
 use super::topology::Topology;
 use crate::geom::Vec3;
+use crate::report::{StageTimes, StatEntries};
 use crate::solve::{
     assemble, inverse_iteration, Cholesky, CholeskyAnalysis, Entry, InverseIterationParams,
     Parallelism, ShiftSchedule, ShiftedProblem,
@@ -70,7 +72,7 @@ impl Default for KnoppelOptions {
 }
 
 /// What the Knöppel phase solve did.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct KnoppelReport {
     /// Smallest generalized eigenvalue `λ = z^H L z / z^H M z` found (the largest of these
     /// over the mesh's connected components, each of which is solved independently).
@@ -81,6 +83,27 @@ pub struct KnoppelReport {
     pub residual: f64,
     /// The shift σ used.
     pub shift: f64,
+    /// Wall seconds of building the CWF (`validate`, `knoppel`), filled by
+    /// [`Cwf::from_one_form`](super::Cwf::from_one_form).
+    pub stages: StageTimes<CwfStage>,
+}
+
+impl KnoppelReport {
+    /// Total wall seconds over the stages.
+    pub fn total_seconds(&self) -> f64 {
+        self.stages.total()
+    }
+
+    /// The report as named entries (metrics `knoppel eigenvalue`, `knoppel residual`; count
+    /// `knoppel iterations`).
+    pub fn entries(&self) -> StatEntries {
+        let mut e = StatEntries::default();
+        self.stages.write_entries(&mut e);
+        e.metric_entry("knoppel eigenvalue", self.eigenvalue);
+        e.metric_entry("knoppel residual", self.residual);
+        e.count_entry("knoppel iterations", self.iterations as u64);
+        e
+    }
 }
 
 /// Knöppel et al. 2015 phase `z̃` (unit per vertex) for the one-form `omega` (EdgeList
@@ -128,6 +151,7 @@ pub(crate) fn knoppel_phase(
         iterations: info.iterations,
         residual: info.residual,
         shift: sigma,
+        stages: StageTimes::default(),
     };
     Ok((normalize_per_vertex(&u), report))
 }

@@ -28,7 +28,7 @@
 //!     vec![[0, 1, 2], [0, 2, 3]],
 //! )?;
 //! let k = [[12.0, 0.0, 0.0]; 4]; // wave vector per vertex
-//! let (cwf, _, _) = Cwf::from_frequency_field(
+//! let (cwf, _) = Cwf::from_frequency_field(
 //!     base, FrequencyField::PerVertex(&k), vec![0.01; 4], &KnoppelOptions::default())?;
 //! let (wrinkled, stats) = cwf.evaluate(3, &EvalOptions::default())?;
 //! assert_eq!(wrinkled.mesh.triangle_count(), 2 * 64);
@@ -45,6 +45,7 @@ pub mod interpolate;
 pub mod io;
 pub mod knoppel;
 mod omega_path;
+pub mod report;
 mod spacetime;
 pub mod subdivide;
 mod topology;
@@ -64,4 +65,5 @@ pub use io::{
     connectivity_hash, cwf_to_string, parse_cwf, read_cwf, write_cwf, CWF_FORMAT_VERSION,
 };
 pub use knoppel::{KnoppelOptions, KnoppelReport, PhaseWeights};
+pub use report::{CwfStage, EvalReport, EvalStage, InterpStage, LevelPart, LevelReport};
 pub use subdivide::{BoundaryRule, LoopHierarchy, SubdivisionOptions};

@@ -2,10 +2,10 @@
 //!
 //! Bakes every mesh of a folder at every screen size `n_p` with [`pleat::lowpoly::generate`]
 //! (or [`pleat::cage::generate`] with `--cage`), checks each output independently with
-//! [`MeshReport`] (and the cage checks of [`pleat::cage::check`]), and writes
+//! [`MeshReport`] (and the cage checks of [`pleat::verify::check_cage`]), and writes
 //! - `lod_bench.csv`: one row per (mesh, `n_p`) with faces, wall seconds, per-stage seconds,
 //!   the sampled two-sided Hausdorff distance relative to the bounding-box diagonal `l`
-//!   ([`pleat::lowpoly::hausdorff_to_input`]: vertices plus a barycentric grid of spacing
+//!   ([`pleat::verify::hausdorff_to_input`]: vertices plus a barycentric grid of spacing
 //!   `l / 400`), the validity flags, and a `status` column (`ok`, or why the case failed);
 //! - `lod_bench.svg`: Hausdorff/l against seconds, both log scale, one polyline per mesh
 //!   (points in `n_p` order) and the mean over the meshes.

@@ -78,13 +78,13 @@ pub fn keyframe_pair(mesh: &TriMesh, kind: PairKind, wavelengths: f64) -> Result
     };
     let opts = KnoppelOptions::default();
     let (k0, k1) = (to_arrays(&k0), to_arrays(&k1));
-    let (a, _, _) = Cwf::from_frequency_field(
+    let (a, _) = Cwf::from_frequency_field(
         mesh.clone(),
         FrequencyField::PerVertex(&k0),
         vec![a0; n],
         &opts,
     )?;
-    let (b, _, _) =
+    let (b, _) =
         Cwf::from_frequency_field(mesh.clone(), FrequencyField::PerVertex(&k1), amp1, &opts)?;
     Ok((a, b))
 }

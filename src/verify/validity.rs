@@ -1,12 +1,17 @@
 //! [`MeshReport`]: the independent verifier of pleat's promises (watertight, manifold,
 //! self-intersection-free) for any triangle soup, defined key by key like `meshcheck`'s JSON.
+//!
+//! May import: `crate::mesh`, `crate::spatial`, `crate::report` (never a producer of meshes:
+//! `lowpoly`, `cage`, `wrinkle`).
+
+use std::borrow::Cow;
 
 use rayon::prelude::*;
 
-use super::{ExactWeld, TriMesh};
+use crate::mesh::{ExactWeld, TriMesh};
+use crate::report::{Stage, StageTimes};
 use crate::spatial::is_collinear;
 use crate::spatial::self_intersect::find_self_intersections_welded;
-use crate::Stats;
 
 /// What [`MeshReport::compute_with`] computes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -156,6 +161,49 @@ pub struct MeshReport {
     pub self_intersection_free: Option<bool>,
 }
 
+/// A timed phase of [`MeshReport::compute_timed`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ValidityStage {
+    /// Exact welding of coincident points (`weld`).
+    Weld,
+    /// Referenced vertices, degenerate faces, area, bounding box (`faces`).
+    Faces,
+    /// Connected components and signed volumes (`components`).
+    Components,
+    /// Edge sides, boundary / non-manifold / misoriented edges (`edges`).
+    Edges,
+    /// Vertex fans, non-manifold vertices (`fans`).
+    Fans,
+    /// Orientability (`orientability`).
+    Orientability,
+    /// Duplicate faces (`duplicate_faces`).
+    DuplicateFaces,
+    /// Self-intersections: welded and degenerate faces (`si_prepare`).
+    SiPrepare,
+    /// Self-intersections: chunk trees (`si_bvh`).
+    SiBvh,
+    /// Self-intersections: traversal with the exact test of each candidate pair
+    /// (`si_pairs_and_tests`).
+    SiPairsAndTests,
+}
+
+impl Stage for ValidityStage {
+    fn name(&self) -> Cow<'static, str> {
+        Cow::Borrowed(match self {
+            ValidityStage::Weld => "weld",
+            ValidityStage::Faces => "faces",
+            ValidityStage::Components => "components",
+            ValidityStage::Edges => "edges",
+            ValidityStage::Fans => "fans",
+            ValidityStage::Orientability => "orientability",
+            ValidityStage::DuplicateFaces => "duplicate_faces",
+            ValidityStage::SiPrepare => "si_prepare",
+            ValidityStage::SiBvh => "si_bvh",
+            ValidityStage::SiPairsAndTests => "si_pairs_and_tests",
+        })
+    }
+}
+
 impl MeshReport {
     /// The full report with default options (self-intersections included, no welding).
     pub fn compute(mesh: &TriMesh) -> MeshReport {
@@ -164,16 +212,20 @@ impl MeshReport {
 
     /// The report with the given options.
     pub fn compute_with(mesh: &TriMesh, options: &ReportOptions) -> MeshReport {
-        Self::compute_timed(mesh, options, &mut Stats::default())
+        Self::compute_timed(mesh, options, &mut StageTimes::default())
     }
 
     /// The report with the given options, recording the wall time of each phase in `stats`
-    /// (stages `weld`, `faces`, `components`, `edges`, `fans`, `orientability`,
-    /// `duplicate_faces`, then
-    /// `si_prepare`, `si_bvh`, `si_pairs_and_tests` for the self-intersection pass).
-    pub fn compute_timed(mesh: &TriMesh, options: &ReportOptions, stats: &mut Stats) -> MeshReport {
+    /// (every [`ValidityStage`] in declaration order; the three `Si*` stages only with the
+    /// self-intersection pass).
+    pub fn compute_timed(
+        mesh: &TriMesh,
+        options: &ReportOptions,
+        stats: &mut StageTimes<ValidityStage>,
+    ) -> MeshReport {
+        use ValidityStage as S;
         let positions = mesh.positions();
-        let weld = stats.time("weld", || ExactWeld::compute(positions));
+        let weld = stats.time(S::Weld, || ExactWeld::compute(positions));
         let welded_tris;
         let tris: &[[u32; 3]] = if options.weld && !weld.is_identity() {
             welded_tris = weld.apply(mesh.triangles());
@@ -181,19 +233,25 @@ impl MeshReport {
         } else {
             mesh.triangles()
         };
-        let faces = stats.time("faces", || FaceStats::compute(positions, tris));
-        let comps = stats.time("components", || {
+        let faces = stats.time(S::Faces, || FaceStats::compute(positions, tris));
+        let comps = stats.time(S::Components, || {
             Components::compute(positions, tris, &faces.used)
         });
-        let edges = stats.time("edges", || EdgePass::compute(positions.len(), tris, &comps));
-        let n_nonmanifold_vertices = stats.time("fans", || {
+        let edges = stats.time(S::Edges, || {
+            EdgePass::compute(positions.len(), tris, &comps)
+        });
+        let n_nonmanifold_vertices = stats.time(S::Fans, || {
             edges.count_nonmanifold_vertices(tris, &faces.comb_degenerate)
         });
-        let orientable = stats.time("orientability", || edges.is_orientable());
-        let n_duplicate_faces = stats.time("duplicate_faces", || count_duplicate_faces(tris));
-        let si = options
-            .self_intersections
-            .then(|| find_self_intersections_welded(positions, mesh.triangles(), &weld, stats));
+        let orientable = stats.time(S::Orientability, || edges.is_orientable());
+        let n_duplicate_faces = stats.time(S::DuplicateFaces, || count_duplicate_faces(tris));
+        let si = options.self_intersections.then(|| {
+            let (si, t) = find_self_intersections_welded(positions, mesh.triangles(), &weld);
+            stats.push(S::SiPrepare, t.prepare);
+            stats.push(S::SiBvh, t.bvh);
+            stats.push(S::SiPairsAndTests, t.pairs_and_tests);
+            si
+        });
 
         let is_edge_manifold = edges.n_nonmanifold == 0;
         let is_closed = edges.n_boundary == 0 && is_edge_manifold;

@@ -1,0 +1,396 @@
+//! Typed reports of the LOD capability: [`LodReport`] (one LOD or cage level, from
+//! [`super::generate`] and `crate::cage::generate`) and [`OffsetReport`] (from
+//! [`super::offset_surface`]). Every field states its unit; each report's `entries()` is the
+//! one place naming its entries for the JSON report and the generic C `PleatStats`.
+
+use std::borrow::Cow;
+
+use crate::report::{Guarantees, Stage, StageTimes, StatEntries};
+
+/// A timed stage of a LOD or cage bake.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LodStage {
+    /// The offset surface (or, in a chain, copying the finer level) (`offset`).
+    Offset,
+    /// Guarded QEM collapses, all rounds (`simplify`).
+    Simplify,
+    /// Flow toward the input, all rounds (`flow`).
+    Flow,
+    /// Feature alignment, all rounds (`align`).
+    Align,
+    /// Convergence tests between rounds (`convergence`).
+    Convergence,
+    /// Independent verification, including an exact rerun if one was needed (`verify`).
+    Verify,
+    /// Hausdorff measurement (`measure`).
+    Measure,
+    /// Measurement of the error floor, only with `LodParams::measure_floor` (`floor`).
+    Floor,
+}
+
+impl Stage for LodStage {
+    fn name(&self) -> Cow<'static, str> {
+        Cow::Borrowed(match self {
+            LodStage::Offset => "offset",
+            LodStage::Simplify => "simplify",
+            LodStage::Flow => "flow",
+            LodStage::Align => "align",
+            LodStage::Convergence => "convergence",
+            LodStage::Verify => "verify",
+            LodStage::Measure => "measure",
+            LodStage::Floor => "floor",
+        })
+    }
+}
+
+/// Edge-collapse counters of the simplification (Alg. 5), summed over rounds.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SimplifyCounts {
+    /// Collapses done.
+    pub collapses: u64,
+    /// Collapse candidates evaluated.
+    pub candidates: u64,
+    /// Rejected: a face would fold over.
+    pub rejected_fold: u64,
+    /// Rejected: the one-sided Hausdorff bound `d` would be exceeded.
+    pub rejected_hausdorff: u64,
+    /// Rejected: the new vertex would be too far from the input.
+    pub rejected_distance: u64,
+    /// Rejected by the guard (topology, intersections, cage contact).
+    pub rejected_guard: u64,
+    /// Collapses re-checked after a neighbour changed.
+    pub rechecked: u64,
+}
+
+/// Counters of the guard of local operations, summed over rounds.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct GuardCounts {
+    /// Operations checked.
+    pub checks: u64,
+    /// Rejected: would break manifoldness or change topology.
+    pub rejected_topology: u64,
+    /// Rejected: would create a degenerate face.
+    pub rejected_degenerate: u64,
+    /// Rejected: would create a self-intersection.
+    pub rejected_intersection: u64,
+    /// Rejected (cage): would touch the input.
+    pub rejected_touch: u64,
+    /// Rejected (cage): an input vertex would leave the cage.
+    pub rejected_uncover: u64,
+    /// Patches whose normal cone allowed skipping the shared-vertex pairs.
+    pub cone_fast_path: u64,
+    /// Exact triangle–triangle tests run.
+    pub exact_tests: u64,
+}
+
+/// The error floor set by the offset stage (measured only with `LodParams::measure_floor`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FloorMeasure {
+    /// One-sided sampled distance from the input to the offset surface, over the input's
+    /// bounding-box diagonal `l` (dimensionless): no later step can lower the input-to-output
+    /// error below it.
+    pub rel: f64,
+    /// CPU seconds (all threads) of that measurement.
+    pub cpu_seconds: f64,
+}
+
+/// What one LOD (or cage) level of [`super::generate`] / [`super::generate_chain`] /
+/// `crate::cage::generate` measured and verified.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LodReport {
+    /// Wall seconds per stage, in execution order (`offset`, `simplify`, `flow`, `align`,
+    /// `convergence`, `verify`, `measure`, then `floor` when measured).
+    pub stages: StageTimes<LodStage>,
+    /// Offset distance `d = l / n_p` (model units).
+    pub d: f64,
+    /// Largest distance of an offset-surface vertex from the `d`-iso-surface, over `d`
+    /// (dimensionless); `None` in a chain level started from the finer level.
+    pub offset_max_deviation_over_d: Option<f64>,
+    /// Faces of the start surface (offset surface, or the finer level in a chain).
+    pub faces_offset: u64,
+    /// Rounds of Alg. 3 run.
+    pub rounds: u64,
+    /// Faces after each round, in order.
+    pub faces_per_round: Vec<u64>,
+    /// Simplification counters.
+    pub simplify: SimplifyCounts,
+    /// Guard counters.
+    pub guard: GuardCounts,
+    /// A face target was given and met.
+    pub target_met: bool,
+    /// Times the per-collapse bound was doubled to reach the face target.
+    pub target_relaxations: u64,
+    /// The last round's convergence test passed (change below `ε·l`).
+    pub converged: bool,
+    /// Wall seconds of the first simplification pass (on the dense start surface).
+    pub simplify_first_pass_seconds: f64,
+    /// Total vertex motion of the flow steps (model units, summed over vertices and rounds).
+    pub flow_motion: f64,
+    /// Total vertex motion of the alignment steps (model units, summed).
+    pub align_motion: f64,
+    /// Reruns with exact checks only (0 or 1; §4.3.3: the normal-cone shortcut let an
+    /// intersection through).
+    pub reruns_exact: u64,
+    /// The error floor, when measured.
+    pub floor: Option<FloorMeasure>,
+    /// Two-sided sampled Hausdorff distance between output and input (model units;
+    /// `crate::verify::hausdorff_to_input`).
+    pub hausdorff: f64,
+    /// `hausdorff / l` (dimensionless).
+    pub hausdorff_rel: f64,
+    /// Input-to-output part of the Hausdorff distance, over `l` (dimensionless).
+    pub hausdorff_in_to_out_rel: f64,
+    /// Output-to-input part of the Hausdorff distance, over `l` (dimensionless).
+    pub hausdorff_out_to_in_rel: f64,
+    /// Output triangles.
+    pub faces: u64,
+    /// Output vertices.
+    pub vertices: u64,
+    /// Rank of this level in a chain, 0 = finest (baked first); `None` outside a chain.
+    pub chain_level: Option<u64>,
+    /// Guarantees verified afterwards by `crate::verify`: watertight, manifold (and
+    /// consistently oriented), self-intersection-free, same topology as the offset surface,
+    /// and for cages enclosure without contact.
+    pub verified: Guarantees,
+}
+
+impl LodReport {
+    /// Total wall seconds over all stages.
+    pub fn total_seconds(&self) -> f64 {
+        self.stages.total()
+    }
+
+    /// The report as named entries (JSON report, verbose CLI output), in pleat's documented
+    /// order. The only place the entry names are written.
+    pub fn entries(&self) -> StatEntries {
+        let mut e = StatEntries::default();
+        self.stages.write_entries(&mut e);
+        e.metric_entry("d", self.d);
+        if let Some(dev) = self.offset_max_deviation_over_d {
+            e.metric_entry("offset_max_deviation_over_d", dev);
+        }
+        e.count_entry("faces_offset", self.faces_offset);
+        e.metric_entry("simplify_first_pass_s", self.simplify_first_pass_seconds);
+        e.count_entry("rounds", self.rounds);
+        for (i, f) in self.faces_per_round.iter().enumerate() {
+            e.count_entry(format!("faces_round_{}", i + 1), *f);
+        }
+        let s = &self.simplify;
+        e.count_entry("collapses", s.collapses);
+        e.count_entry("collapse_candidates", s.candidates);
+        e.count_entry("rejected_fold", s.rejected_fold);
+        e.count_entry("rejected_hausdorff", s.rejected_hausdorff);
+        e.count_entry("rejected_distance", s.rejected_distance);
+        e.count_entry("rejected_guard", s.rejected_guard);
+        e.count_entry("collapses_rechecked", s.rechecked);
+        let g = &self.guard;
+        e.count_entry("guard_checks", g.checks);
+        e.count_entry("guard_rejected_topology", g.rejected_topology);
+        e.count_entry("guard_rejected_degenerate", g.rejected_degenerate);
+        e.count_entry("guard_rejected_intersection", g.rejected_intersection);
+        e.count_entry("guard_rejected_touch", g.rejected_touch);
+        e.count_entry("guard_rejected_uncover", g.rejected_uncover);
+        e.count_entry("guard_cone_fast_path", g.cone_fast_path);
+        e.count_entry("guard_exact_tests", g.exact_tests);
+        e.count_entry("target_met", self.target_met as u64);
+        e.count_entry("target_relaxations", self.target_relaxations);
+        e.count_entry("converged", self.converged as u64);
+        e.metric_entry("flow_motion", self.flow_motion);
+        e.metric_entry("align_motion", self.align_motion);
+        e.count_entry("reruns_exact", self.reruns_exact);
+        self.verified.write_entries(&mut e);
+        if let Some(f) = &self.floor {
+            e.metric_entry("hausdorff_floor_rel", f.rel);
+            e.metric_entry("floor_cpu_seconds", f.cpu_seconds);
+        }
+        e.metric_entry("hausdorff", self.hausdorff);
+        e.metric_entry("hausdorff_rel", self.hausdorff_rel);
+        e.metric_entry("hausdorff_in_to_out_rel", self.hausdorff_in_to_out_rel);
+        e.metric_entry("hausdorff_out_to_in_rel", self.hausdorff_out_to_in_rel);
+        e.count_entry("faces", self.faces);
+        e.count_entry("vertices", self.vertices);
+        if let Some(level) = self.chain_level {
+            e.count_entry("chain_level", level);
+        }
+        e
+    }
+}
+
+/// A timed stage of the offset surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OffsetStage {
+    /// The input's distance structures (`bvh`).
+    Bvh,
+    /// Bricks of the narrow band (`band`).
+    Band,
+    /// Exact distances at the band's grid points (`distance`).
+    Distance,
+    /// MC33 extraction and feature vertices (`extract`).
+    Extract,
+    /// Interior removal (`interior`).
+    Interior,
+    /// Assembly of the plain MC33 surface, without features (`assemble`).
+    Assemble,
+    /// Phase 1: every feature vertex, edge flips (`flips`).
+    Flips,
+    /// Feature filtering (`filter`).
+    Filter,
+    /// Phase 2: real feature vertices only, flips again (`flips_filtered`).
+    FlipsFiltered,
+    /// Independent verification of the output (`verify`).
+    Verify,
+}
+
+impl Stage for OffsetStage {
+    fn name(&self) -> Cow<'static, str> {
+        Cow::Borrowed(match self {
+            OffsetStage::Bvh => "bvh",
+            OffsetStage::Band => "band",
+            OffsetStage::Distance => "distance",
+            OffsetStage::Extract => "extract",
+            OffsetStage::Interior => "interior",
+            OffsetStage::Assemble => "assemble",
+            OffsetStage::Flips => "flips",
+            OffsetStage::Filter => "filter",
+            OffsetStage::FlipsFiltered => "flips_filtered",
+            OffsetStage::Verify => "verify",
+        })
+    }
+}
+
+/// Counts of the MC33 extraction.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ExtractionCounts {
+    /// Cells visited.
+    pub cells_visited: u64,
+    /// Cells with corners on both sides of the iso-value.
+    pub cells_mixed: u64,
+    /// Disk-like patches.
+    pub patches_disk: u64,
+    /// Annulus patches.
+    pub patches_annulus: u64,
+    /// Feature vertices computed (before filtering).
+    pub feature_vertices: u64,
+    /// Tunnels split into two patches.
+    pub tunnels_split: u64,
+    /// Cells whose components could not be separated.
+    pub cells_unseparated: u64,
+    /// Cells whose MC33 case could not be resolved.
+    pub cells_unresolved: u64,
+    /// Iso-points (edge crossings).
+    pub iso_points: u64,
+}
+
+/// Counts of interior removal.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct InteriorCounts {
+    /// Components of the template surface.
+    pub components: u64,
+    /// Components removed as lying inside another.
+    pub components_removed: u64,
+}
+
+/// Counts of the feature phases (edge flips and feature filtering).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FeatureCounts {
+    /// Flip candidates of phase 1.
+    pub flip_candidates: u64,
+    /// Flips done in phase 1.
+    pub flips: u64,
+    /// Flips refused for geometric reasons in phase 1.
+    pub flips_refused_geometry: u64,
+    /// Feature vertices on real feature curves (kept for phase 2).
+    pub feature_vertices_kept: u64,
+    /// Flips done in phase 2.
+    pub flips_filtered: u64,
+}
+
+/// Results of the independent verification of an offset surface.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct OffsetVerification {
+    /// Connected components of the output.
+    pub output_components: u64,
+    /// Largest `|f(v) − d|` over output vertices `v`, over `d` (dimensionless).
+    pub max_deviation_over_d: f64,
+}
+
+/// What [`super::offset_surface`] measured and verified.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct OffsetReport {
+    /// Wall seconds per stage, in execution order.
+    pub stages: StageTimes<OffsetStage>,
+    /// Offset distance `d` (model units).
+    pub d: f64,
+    /// Voxel edge `h` (model units).
+    pub h: f64,
+    /// Bricks of the narrow band.
+    pub bricks: u64,
+    /// Grid points with a stored distance.
+    pub grid_points: u64,
+    /// Extraction counts.
+    pub extraction: ExtractionCounts,
+    /// Interior removal counts (`None` when it was off).
+    pub interior: Option<InteriorCounts>,
+    /// Feature-phase counts (`None` without feature vertices).
+    pub features: Option<FeatureCounts>,
+    /// Output vertices.
+    pub output_vertices: u64,
+    /// Output triangles.
+    pub output_triangles: u64,
+    /// Estimated peak bytes of the largest stores (the benchmark's VmHWM is the measurement).
+    pub peak_memory_bytes: u64,
+    /// Verification results (`None` when verification was off).
+    pub verification: Option<OffsetVerification>,
+    /// Guarantees verified by `crate::verify` (empty when verification was off): watertight,
+    /// manifold, consistently oriented, self-intersection-free, vertices within `h`.
+    pub verified: Guarantees,
+}
+
+impl OffsetReport {
+    /// Total wall seconds over all stages.
+    pub fn total_seconds(&self) -> f64 {
+        self.stages.total()
+    }
+
+    /// The report as named entries (the generic C `PleatStats` and `pleat offset
+    /// --stats-json`), in pleat's documented order. The only place the entry names are
+    /// written.
+    pub fn entries(&self) -> StatEntries {
+        let mut e = StatEntries::default();
+        self.stages.write_entries(&mut e);
+        e.metric_entry("d", self.d);
+        e.metric_entry("h", self.h);
+        e.count_entry("bricks", self.bricks);
+        e.count_entry("grid_points", self.grid_points);
+        let x = &self.extraction;
+        e.count_entry("cells_visited", x.cells_visited);
+        e.count_entry("cells_mixed", x.cells_mixed);
+        e.count_entry("patches_disk", x.patches_disk);
+        e.count_entry("patches_annulus", x.patches_annulus);
+        e.count_entry("feature_vertices", x.feature_vertices);
+        e.count_entry("tunnels_split", x.tunnels_split);
+        e.count_entry("cells_unseparated", x.cells_unseparated);
+        e.count_entry("cells_unresolved", x.cells_unresolved);
+        e.count_entry("iso_points", x.iso_points);
+        if let Some(i) = &self.interior {
+            e.count_entry("components", i.components);
+            e.count_entry("components_removed", i.components_removed);
+        }
+        if let Some(f) = &self.features {
+            e.count_entry("flip_candidates", f.flip_candidates);
+            e.count_entry("flips", f.flips);
+            e.count_entry("flips_refused_geometry", f.flips_refused_geometry);
+            e.count_entry("feature_vertices_kept", f.feature_vertices_kept);
+            e.count_entry("flips_filtered", f.flips_filtered);
+        }
+        e.count_entry("output_vertices", self.output_vertices);
+        e.count_entry("output_triangles", self.output_triangles);
+        e.metric_entry("peak_memory_bytes", self.peak_memory_bytes as f64);
+        self.verified.write_entries(&mut e);
+        if let Some(v) = &self.verification {
+            e.count_entry("output_components", v.output_components);
+            e.metric_entry("max_deviation_over_d", v.max_deviation_over_d);
+        }
+        e
+    }
+}

@@ -1,0 +1,198 @@
+//! Cage checks of any mesh against any input soup: **contact** (exact triangle–triangle tests
+//! on Shewchuk's predicates, BVH candidates), **enclosure** (hierarchical fast winding numbers,
+//! Barill et al. 2018, of every referenced input vertex) and **clearance** (the gap between the
+//! two surfaces measured at their vertices).
+//!
+//! This is the verification of what the cage pipeline produces; it shares no code with the
+//! guard that keeps those properties during the cage's construction.
+//!
+//! May import: `crate::mesh`, `crate::spatial`, `crate::geom` (never `lowpoly`, `cage` or
+//! `wrinkle`).
+
+use rayon::prelude::*;
+
+use crate::mesh::TriMesh;
+use crate::spatial::{
+    is_collinear, segment_triangle_intersect, triangles_intersect, FastWindingNumber, TriangleBvh,
+};
+
+/// Result of [`check_cage`]: the two cage properties.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CageCheck {
+    /// No cage triangle touches or intersects an input triangle (exact tests on BVH
+    /// candidates; touching counts as contact).
+    pub untouched: bool,
+    /// Every referenced input vertex has winding number above 1/2 with respect to the cage
+    /// (hierarchical fast winding numbers, Barill et al. 2018).
+    pub encloses: bool,
+}
+
+impl CageCheck {
+    /// Both properties hold.
+    pub fn is_cage(&self) -> bool {
+        self.untouched && self.encloses
+    }
+}
+
+/// The input side of the cage checks, prepared once and reusable for several candidate cages
+/// of the same input: its triangles with a BVH, which of them are degenerate, and its
+/// referenced vertices.
+pub struct CageInput<'a> {
+    positions: &'a [[f64; 3]],
+    tris: &'a [[u32; 3]],
+    bvh: TriangleBvh,
+    /// Per triangle: corners exactly collinear (tested by its edges).
+    degenerate: Vec<bool>,
+    /// Referenced vertices, in index order.
+    points: Vec<[f64; 3]>,
+}
+
+impl<'a> CageInput<'a> {
+    /// Prepares `input` (any soup).
+    pub fn new(input: &'a TriMesh) -> CageInput<'a> {
+        let positions = input.positions();
+        let tris = input.triangles();
+        let degenerate = tris
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| positions[v as usize]);
+                is_collinear(a, b, c)
+            })
+            .collect();
+        CageInput {
+            positions,
+            tris,
+            bvh: TriangleBvh::new(positions, tris),
+            degenerate,
+            points: referenced_points(positions, tris),
+        }
+    }
+
+    /// Contact and enclosure of `cage` (see [`CageCheck`]).
+    pub fn check(&self, cage: &TriMesh) -> CageCheck {
+        CageCheck {
+            untouched: !self.touches(cage),
+            encloses: self.enclosed_by(cage),
+        }
+    }
+
+    /// True when some triangle of `cage` touches or intersects an input triangle (exact).
+    pub fn touches(&self, cage: &TriMesh) -> bool {
+        let pos = cage.positions();
+        let tris = cage.triangles();
+        (0..tris.len()).into_par_iter().any(|f| {
+            let tri = tris[f].map(|v| pos[v as usize]);
+            self.bvh
+                .query_triangle(&tri)
+                .any(|t| self.meets_triangle(&tri, t as usize))
+        })
+    }
+
+    /// True when every referenced input vertex has winding number above 1/2 with respect to
+    /// `cage` (accurate away from the cage surface, which the contact test guarantees).
+    pub fn enclosed_by(&self, cage: &TriMesh) -> bool {
+        let fwn = FastWindingNumber::new(cage);
+        fwn.winding_numbers(&self.points).iter().all(|&w| w > 0.5)
+    }
+
+    /// Whether the cage triangle `tri` meets input triangle `t`: a triangle–triangle test, or
+    /// for a degenerate input triangle a test of each of its edges against `tri`.
+    fn meets_triangle(&self, tri: &[[f64; 3]; 3], t: usize) -> bool {
+        let corners = self.tris[t].map(|v| self.positions[v as usize]);
+        if !self.degenerate[t] {
+            return triangles_intersect(tri, &corners);
+        }
+        (0..3).any(|i| segment_triangle_intersect([corners[i], corners[(i + 1) % 3]], tri))
+    }
+}
+
+/// Checks that `cage` encloses every vertex of `input` and touches none of its triangles —
+/// the verification the cage pipeline runs on its output, usable on any mesh (benchmarks,
+/// tests, other cage generators).
+pub fn check_cage(cage: &TriMesh, input: &TriMesh) -> CageCheck {
+    CageInput::new(input).check(cage)
+}
+
+/// Clearance between `cage` and `input` in model units: the smallest distance from a
+/// referenced vertex of either surface to the other surface (exact BVH distances). It bounds
+/// the true surface-to-surface gap from above (equal when the closest pair of points involves a
+/// vertex); `0` means contact at a vertex, `∞` when either surface is empty.
+pub fn clearance(cage: &TriMesh, input: &TriMesh) -> f64 {
+    let cage_to_input = vertices_to_surface(cage, input);
+    let input_to_cage = vertices_to_surface(input, cage);
+    cage_to_input.min(input_to_cage)
+}
+
+/// Smallest distance from a referenced vertex of `from` to the surface `to`.
+fn vertices_to_surface(from: &TriMesh, to: &TriMesh) -> f64 {
+    let bvh = TriangleBvh::new(to.positions(), to.triangles());
+    referenced_points(from.positions(), from.triangles())
+        .par_iter()
+        .map(|&p| {
+            bvh.closest_point(to.positions(), to.triangles(), p, f64::INFINITY)
+                .map_or(f64::INFINITY, |c| c.distance)
+        })
+        .reduce(|| f64::INFINITY, f64::min)
+}
+
+/// The vertices used by at least one triangle, in index order.
+fn referenced_points(positions: &[[f64; 3]], tris: &[[u32; 3]]) -> Vec<[f64; 3]> {
+    let mut used = vec![false; positions.len()];
+    for t in tris {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    (0..positions.len())
+        .filter(|&v| used[v])
+        .map(|v| positions[v])
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Axis-aligned cube `[o, o + s]³`, outward oriented.
+    fn cube(s: f64, o: f64) -> TriMesh {
+        let p = (0..8)
+            .map(|i: u32| {
+                [
+                    o + s * (i & 1) as f64,
+                    o + s * ((i >> 1) & 1) as f64,
+                    o + s * ((i >> 2) & 1) as f64,
+                ]
+            })
+            .collect();
+        let f = vec![
+            [0, 2, 3],
+            [0, 3, 1],
+            [4, 5, 7],
+            [4, 7, 6],
+            [0, 1, 5],
+            [0, 5, 4],
+            [2, 6, 7],
+            [2, 7, 3],
+            [0, 4, 6],
+            [0, 6, 2],
+            [1, 3, 7],
+            [1, 7, 5],
+        ];
+        TriMesh::new(p, f).unwrap()
+    }
+
+    #[test]
+    fn nested_cubes() {
+        let inner = cube(1.0, 0.0);
+        let outer = cube(3.0, -1.0);
+        let c = check_cage(&outer, &inner);
+        assert!(c.is_cage());
+        assert_eq!(clearance(&outer, &inner), 1.0);
+        // The inner cube does not enclose the outer one.
+        assert!(!check_cage(&inner, &outer).encloses);
+        // Touching counts as contact.
+        let touching = cube(2.0, 0.0);
+        assert!(!check_cage(&touching, &inner).untouched);
+        assert_eq!(clearance(&touching, &inner), 0.0);
+    }
+}

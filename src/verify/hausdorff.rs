@@ -1,0 +1,189 @@
+//! Sampled Hausdorff distances (Metro-style, Cignoni et al. 1998) between any two triangle
+//! soups: the error a LOD reports, and the floor of that error set by the offset stage.
+//!
+//! # Sampling density
+//! A surface is sampled at all its referenced vertices plus, on every triangle of nonzero area
+//! (exactly collinear corners are skipped, as area-weighted sampling would), a regular
+//! barycentric grid with `k = clamp(⌈longest edge / spacing⌉, 1, 32)` subdivisions per edge
+//! (`(k+1)(k+2)/2` points, corners included once via the vertices; the centroid is always
+//! added), with `spacing = l / `[`SAMPLES_PER_DIAGONAL`] and `l` the input's bounding-box
+//! diagonal. Each sample's exact distance to the other surface comes from a BVH closest-point
+//! query. The two-sided distance is the larger of the two one-sided maxima.
+//!
+//! The sampler is this module's own (it shares no code with the LOD loop's convergence test).
+//!
+//! May import: `crate::mesh`, `crate::spatial`, `crate::geom` (never `lowpoly`, `cage` or
+//! `wrinkle`).
+
+use rayon::prelude::*;
+
+use crate::geom::Vec3;
+use crate::mesh::TriMesh;
+use crate::spatial::{is_collinear, TriangleBvh};
+
+/// Samples per bounding-box diagonal of the measurement (spacing `l / 400`).
+pub const SAMPLES_PER_DIAGONAL: f64 = 400.0;
+
+/// Cap on the per-edge subdivisions of one triangle.
+pub const MAX_SUBDIVISIONS: usize = 32;
+
+/// Two-sided sampled Hausdorff distance (model units) between `output` and `input`: both
+/// surfaces sampled at their vertices plus a barycentric grid of spacing `l / 400` (`l` = the
+/// input's bounding-box diagonal), see the module docs. This is the `hausdorff` a LOD reports.
+/// Works on any two triangle soups, so benchmarks score other simplifiers with the same measure.
+pub fn hausdorff_to_input(output: &TriMesh, input: &TriMesh) -> f64 {
+    let s = hausdorff_sides(output, input);
+    s.input_to_output.max(s.output_to_input)
+}
+
+/// The two one-sided distances (model units) whose larger is [`hausdorff_to_input`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HausdorffSides {
+    /// Farthest input sample from the output: input the output does not cover (buried parts,
+    /// cavities closed by the offset, features cut off).
+    pub input_to_output: f64,
+    /// Farthest output sample from the input: output surface that is not on the input
+    /// (bridges over gaps, chords, drift).
+    pub output_to_input: f64,
+}
+
+/// Both one-sided sampled distances between `output` and `input`, with the sampling of
+/// [`hausdorff_to_input`].
+pub fn hausdorff_sides(output: &TriMesh, input: &TriMesh) -> HausdorffSides {
+    HausdorffSides {
+        input_to_output: one_sided(input, &Surface::new(output), input),
+        output_to_input: one_sided(output, &Surface::new(input), input),
+    }
+}
+
+/// One-sided sampled distance (model units) from `input` to `surface` (sampling of
+/// [`hausdorff_to_input`]). Applied to the offset surface it gives the *floor* of the
+/// input-to-output error: input the offset already hides (buried components, cavities and
+/// crevices narrower than `2d`) stays hidden through the LOD loop, which keeps its topology.
+pub fn input_to_surface(surface: &TriMesh, input: &TriMesh) -> f64 {
+    one_sided(input, &Surface::new(surface), input)
+}
+
+/// A triangle set with its BVH.
+struct Surface<'a> {
+    positions: &'a [[f64; 3]],
+    tris: &'a [[u32; 3]],
+    bvh: TriangleBvh,
+}
+
+impl<'a> Surface<'a> {
+    fn new(mesh: &'a TriMesh) -> Surface<'a> {
+        let positions = mesh.positions();
+        let tris = mesh.triangles();
+        Surface {
+            positions,
+            tris,
+            bvh: TriangleBvh::new(positions, tris),
+        }
+    }
+
+    /// Exact distance from `p` to the surface (∞ when it is empty).
+    fn distance(&self, p: Vec3) -> f64 {
+        self.bvh
+            .closest_point(self.positions, self.tris, p.to_array(), f64::INFINITY)
+            .map_or(f64::INFINITY, |c| c.distance)
+    }
+}
+
+/// Max over the samples of `from` (see the module docs) of the distance to `to`, at the
+/// spacing set by `input`'s diagonal.
+fn one_sided(from: &TriMesh, to: &Surface<'_>, input: &TriMesh) -> f64 {
+    let spacing = input.bbox_diagonal() / SAMPLES_PER_DIAGONAL;
+    let from_pos = from.positions();
+    let from_tris = from.triangles();
+    let mut used = vec![false; from_pos.len()];
+    for t in from_tris {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let vmax = (0..from_pos.len())
+        .into_par_iter()
+        .filter(|&v| used[v])
+        .map(|v| to.distance(Vec3::from(from_pos[v])))
+        .reduce(|| 0.0, f64::max);
+    let fmax = from_tris
+        .par_iter()
+        .map(|t| {
+            let corners = t.map(|v| from_pos[v as usize]);
+            if is_collinear(corners[0], corners[1], corners[2]) {
+                // Zero area: nothing of it is visible, and area-weighted sampling (Metro,
+                // the CGAL `compare` tool) never lands on it; its corners are sampled above.
+                return 0.0;
+            }
+            let tri = corners.map(Vec3::from);
+            let k = resolution(&tri, spacing, MAX_SUBDIVISIONS);
+            let mut m: f64 = 0.0;
+            for_each_interior_sample(&tri, k, |p| m = m.max(to.distance(p)));
+            m
+        })
+        .reduce(|| 0.0, f64::max);
+    vmax.max(fmax)
+}
+
+/// Calls `f` at the barycentric grid points of `t` with `k` subdivisions per edge, corners
+/// excluded (they are sampled as vertices), plus the centroid when `k < 3`.
+fn for_each_interior_sample(t: &[Vec3; 3], k: usize, mut f: impl FnMut(Vec3)) {
+    let k = k.max(1);
+    for i in 0..=k {
+        for j in 0..=(k - i) {
+            if i == k || j == k || i + j == 0 {
+                continue;
+            }
+            let u = i as f64 / k as f64;
+            let v = j as f64 / k as f64;
+            let w = 1.0 - u - v;
+            f(t[0] * w + t[1] * u + t[2] * v);
+        }
+    }
+    if k < 3 {
+        f((t[0] + t[1] + t[2]) * (1.0 / 3.0));
+    }
+}
+
+/// Subdivisions per edge so that samples are at most about `spacing` apart, in `[1, max_k]`.
+fn resolution(t: &[Vec3; 3], spacing: f64, max_k: usize) -> usize {
+    let e = (t[0] - t[1])
+        .length()
+        .max((t[1] - t[2]).length())
+        .max((t[2] - t[0]).length());
+    if spacing.is_nan() || spacing <= 0.0 || !e.is_finite() {
+        return 1;
+    }
+    ((e / spacing).ceil() as usize).clamp(1, max_k.max(1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(z: f64) -> TriMesh {
+        TriMesh::new(
+            vec![[0., 0., z], [1., 0., z], [1., 1., z], [0., 1., z]],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn parallel_squares_are_their_gap_apart() {
+        let s = hausdorff_sides(&square(0.25), &square(0.0));
+        assert_eq!(s.input_to_output, 0.25);
+        assert_eq!(s.output_to_input, 0.25);
+        assert_eq!(hausdorff_to_input(&square(0.0), &square(0.0)), 0.0);
+    }
+
+    #[test]
+    fn grid_counts() {
+        let t = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let mut n = 0;
+        for_each_interior_sample(&t, 4, |_| n += 1);
+        assert_eq!(n, 12);
+        assert_eq!(resolution(&t, 0.5, 8), 3);
+    }
+}
