@@ -23,21 +23,26 @@
 use super::flow::{local_update, record, MoveReport};
 use super::guard::Guard;
 use crate::geom::{normalized, tri_normal, Vec3};
+use crate::mesh::halfedge::{FaceData, VertexId};
 use crate::{Error, Result};
 
 /// Unit normals of the live faces of the guard's mesh, indexed by face id (`[0; 3]` for
 /// deleted or degenerate faces): `ñ_f / ‖ñ_f‖` of `M̃`, taken before the flow.
-pub(crate) fn reference_normals(g: &Guard<'_>) -> Vec<Vec3> {
+pub(crate) fn reference_normals(g: &Guard<'_>) -> FaceData<Vec3> {
     let m = g.mesh();
-    let mut n = vec![Vec3::ZERO; m.face_capacity()];
+    let mut n = FaceData::filled(m.face_capacity(), Vec3::ZERO);
     for f in m.faces() {
-        n[f as usize] = normalized(m.face_area_vector(f)).unwrap_or(Vec3::ZERO);
+        n[f] = normalized(m.face_area_vector(f)).unwrap_or(Vec3::ZERO);
     }
     n
 }
 
 /// The minimiser of eq. 4.5 for vertex `v`, or `None` when the ring is degenerate.
-pub(crate) fn aligned_position(g: &Guard<'_>, v: u32, reference: &[Vec3]) -> Option<Vec3> {
+pub(crate) fn aligned_position(
+    g: &Guard<'_>,
+    v: VertexId,
+    reference: &FaceData<Vec3>,
+) -> Option<Vec3> {
     let m = g.mesh();
     let pv = Vec3::from(m.position(v));
     let mut h = [[0.0f64; 3]; 3];
@@ -48,7 +53,7 @@ pub(crate) fn aligned_position(g: &Guard<'_>, v: u32, reference: &[Vec3]) -> Opt
         let b = Vec3::from(m.position(m.target(out)));
         let c = Vec3::from(m.position(m.target(m.next(out))));
         let cf = tri_normal(pv, b, c).length();
-        let t = reference[f as usize];
+        let t = reference[f];
         if cf.is_nan() || cf <= 0.0 || t == Vec3::ZERO {
             continue;
         }
@@ -121,12 +126,12 @@ fn capped_step(g: &Guard<'_>, p: Vec3, mut d: Vec3, cap: f64) -> Option<Vec3> {
 /// farther than `max(cap, current distance)` from the input (module docs).
 pub(crate) fn align_sweep(
     g: &mut Guard<'_>,
-    reference: &[Vec3],
+    reference: &FaceData<Vec3>,
     max_step: f64,
     cap: f64,
     keep_going: &mut dyn FnMut(f64) -> bool,
 ) -> Result<MoveReport> {
-    let verts: Vec<u32> = g
+    let verts: Vec<VertexId> = g
         .mesh()
         .vertices()
         .filter(|&v| g.mesh().vertex_halfedge(v).is_some())

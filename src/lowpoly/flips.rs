@@ -24,6 +24,7 @@
 use std::collections::HashSet;
 
 use crate::geom::{normalized, tri_normal, Vec3};
+use crate::mesh::halfedge::{EdgeId, FaceData, FaceId, HalfedgeId, VertexId};
 use crate::mesh::HalfEdgeMesh;
 use crate::spatial::{faces_intersect, is_collinear, TriangleBvh};
 
@@ -81,15 +82,21 @@ fn for_cells(pts: &[[f64; 3]], inv: f64, mut f: impl FnMut([i64; 3])) {
 }
 
 /// Vertex opposite half-edge `h` in its face.
-fn opposite(m: &HalfEdgeMesh, h: u32) -> Option<u32> {
+fn opposite(m: &HalfEdgeMesh, h: HalfedgeId) -> Option<VertexId> {
     m.face(h).map(|_| m.target(m.next(h)))
 }
 
 /// Would the edge `c–d` created by flipping `h = a→b` be sharp (normals of `(c, d, b)` and
 /// `(d, c, a)` with cosine below `cos_limit`)?
-fn flip_is_sharp(mesh: &HalfEdgeMesh, h: u32, c: u32, d: u32, cos_limit: f64) -> bool {
+fn flip_is_sharp(
+    mesh: &HalfEdgeMesh,
+    h: HalfedgeId,
+    c: VertexId,
+    d: VertexId,
+    cos_limit: f64,
+) -> bool {
     let (a, b) = (mesh.origin(h), mesh.target(h));
-    let p = |v: u32| Vec3::from(mesh.position(v));
+    let p = |v: VertexId| Vec3::from(mesh.position(v));
     let n1 = normalized(tri_normal(p(c), p(d), p(b)));
     let n2 = normalized(tri_normal(p(d), p(c), p(a)));
     matches!((n1, n2), (Some(x), Some(y)) if x.dot(y) < cos_limit)
@@ -98,13 +105,13 @@ fn flip_is_sharp(mesh: &HalfEdgeMesh, h: u32, c: u32, d: u32, cos_limit: f64) ->
 /// A candidate flip: the edge and its opposite vertices when queued.
 #[derive(Debug, Clone, Copy)]
 struct Candidate {
-    edge: u32,
-    c: u32,
-    d: u32,
+    edge: EdgeId,
+    c: VertexId,
+    d: VertexId,
 }
 
 fn candidates(mesh: &HalfEdgeMesh, is_feature: &[bool], sharp_only: Option<f64>) -> Vec<Candidate> {
-    let feature = |v: u32| is_feature.get(v as usize).copied().unwrap_or(false);
+    let feature = |v: VertexId| is_feature.get(v.index()).copied().unwrap_or(false);
     mesh.edges()
         .filter_map(|e| {
             let h = mesh.edge_halfedge(e);
@@ -118,7 +125,7 @@ fn candidates(mesh: &HalfEdgeMesh, is_feature: &[bool], sharp_only: Option<f64>)
 }
 
 /// The faces whose box meets a cell touched by a candidate's quad.
-fn relevant_faces(mesh: &HalfEdgeMesh, queue: &[Candidate], cell: f64) -> Vec<u32> {
+fn relevant_faces(mesh: &HalfEdgeMesh, queue: &[Candidate], cell: f64) -> Vec<FaceId> {
     let inv = 1.0 / cell;
     let mut cells = CellSet::default();
     for q in queue {
@@ -154,17 +161,22 @@ pub(crate) fn flip_to_features(
     if queue.is_empty() {
         return counts;
     }
-    let mut tris: Vec<[u32; 3]> = (0..mesh.face_capacity() as u32)
+    let mut tris: FaceData<[u32; 3]> = (0..mesh.face_capacity() as u32)
+        .map(FaceId::new)
         .map(|f| {
             if mesh.is_face_live(f) {
-                mesh.face_vertices(f)
+                mesh.face_vertices(f).map(VertexId::raw)
             } else {
                 [0, 0, 0]
             }
         })
         .collect();
     let subset = relevant_faces(mesh, &queue, cell);
-    let mut bvh = TriangleBvh::from_subset(mesh.positions(), &tris, &subset);
+    let mut bvh = TriangleBvh::from_subset(
+        mesh.positions(),
+        tris.as_slice(),
+        FaceId::raw_slice(&subset),
+    );
     for q in queue {
         let h = mesh.edge_halfedge(q.edge);
         if mesh.can_flip(h).is_err()
@@ -174,9 +186,9 @@ pub(crate) fn flip_to_features(
             continue;
         }
         let (a, b) = (mesh.origin(h), mesh.target(h));
-        let old = [mesh.face(h), mesh.face(mesh.twin(h))].map(|f| f.unwrap_or(u32::MAX));
-        let new = [[q.c, q.d, b], [q.d, q.c, a]];
-        if !flip_is_embedded(mesh, &bvh, &tris, new, old) {
+        let old = [mesh.face(h), mesh.face(mesh.twin(h))].map(|f| f.unwrap_or(FaceId::INVALID));
+        let new = [[q.c, q.d, b], [q.d, q.c, a]].map(|t| t.map(VertexId::raw));
+        if !flip_is_embedded(mesh, &bvh, tris.as_slice(), new, old.map(FaceId::raw)) {
             counts.refused_geometry += 1;
             continue;
         }
@@ -185,16 +197,17 @@ pub(crate) fn flip_to_features(
             continue;
         }
         for f in old {
-            tris[f as usize] = mesh.face_vertices(f);
+            tris[f] = mesh.face_vertices(f).map(VertexId::raw);
         }
-        bvh.update(mesh.positions(), &tris, &old);
+        bvh.update(mesh.positions(), tris.as_slice(), FaceId::raw_slice(&old));
         counts.flipped += 1;
     }
     counts
 }
 
 /// Are the two new triangles non-degenerate, not folded onto each other, and free of
-/// intersections with every other face (the two they replace excepted)?
+/// intersections with every other face (the two they replace excepted)? Raw indices: this is
+/// the BVH's boundary.
 fn flip_is_embedded(
     mesh: &HalfEdgeMesh,
     bvh: &TriangleBvh,

@@ -14,6 +14,7 @@ use rayon::prelude::*;
 
 use super::guard::Guard;
 use crate::geom::Vec3;
+use crate::mesh::halfedge::VertexId;
 use crate::{Error, Result};
 
 /// The safety factor of Alg. 4 line 5.
@@ -35,7 +36,7 @@ pub(crate) struct MoveReport {
 
 /// Alg. 4: tries `v + 0.95 α d` for `α = 1, 1/2, …` and applies the first the guard accepts.
 /// Returns the applied displacement length (0 when none was accepted).
-pub(crate) fn local_update(g: &mut Guard<'_>, v: u32, d: Vec3) -> f64 {
+pub(crate) fn local_update(g: &mut Guard<'_>, v: VertexId, d: Vec3) -> f64 {
     let p = Vec3::from(g.mesh().position(v));
     let mut alpha = 1.0;
     for _ in 0..=MAX_HALVINGS {
@@ -55,7 +56,7 @@ pub(crate) fn flow_sweep(
     r: f64,
     keep_going: &mut dyn FnMut(f64) -> bool,
 ) -> Result<MoveReport> {
-    let verts: Vec<u32> = g
+    let verts: Vec<VertexId> = g
         .mesh()
         .vertices()
         .filter(|&v| g.mesh().vertex_halfedge(v).is_some())

@@ -31,7 +31,7 @@
 //!    round to 0. Together with "no touching", every input point stays strictly inside.
 
 use crate::geom::{bbox_of, normalized, tri_normal, Vec3};
-use crate::mesh::halfedge::CollapseRecord;
+use crate::mesh::halfedge::{CollapseRecord, FaceData, FaceId, HalfedgeId, VertexId};
 use crate::mesh::HalfEdgeMesh;
 use crate::spatial::solid_angle;
 use crate::spatial::{self as sp, TriangleBvh};
@@ -159,12 +159,17 @@ pub(crate) struct GuardStats {
     pub exact_tests: u64,
 }
 
+/// The corners of face `f` as raw vertex indices (the BVH's triangle boundary).
+fn raw_corners(mesh: &HalfEdgeMesh, f: FaceId) -> [u32; 3] {
+    mesh.face_vertices(f).map(VertexId::raw)
+}
+
 /// One face of the neighbourhood of an operation as it is *after* the operation: id, vertex
 /// ids and corner positions.
 #[derive(Debug, Clone, Copy)]
 struct NFace {
-    id: u32,
-    v: [u32; 3],
+    id: FaceId,
+    v: [VertexId; 3],
     t: [[f64; 3]; 3],
 }
 
@@ -176,20 +181,21 @@ pub(crate) struct GuardScratch {
     m_1: Vec<NFace>,
     n_e: usize,
     /// Sorted ids of `M_1` and of the faces the operation removes: never candidates of `M_r`.
-    excluded: Vec<u32>,
+    excluded: Vec<FaceId>,
     /// Vertices of `M_e` (after the operation).
-    verts: Vec<u32>,
+    verts: Vec<VertexId>,
     /// Geometry that `M_e` replaced (cage mode only).
     old_patch: Vec<[[f64; 3]; 3]>,
     normals: Vec<Vec3>,
-    cand: Vec<u32>,
+    cand: Vec<FaceId>,
 }
 
 /// The working mesh plus everything needed to check local operations. See the module docs.
 pub(crate) struct Guard<'a> {
     mesh: HalfEdgeMesh,
-    /// Triangles by face id (stale for deleted faces), mirrored for the BVH.
-    tris: Vec<[u32; 3]>,
+    /// Triangles by face id (stale for deleted faces), mirrored for the BVH (raw vertex
+    /// indices: the BVH's boundary).
+    tris: FaceData<[u32; 3]>,
     bvh: TriangleBvh,
     input: &'a InputModel,
     cage: bool,
@@ -221,12 +227,13 @@ impl<'a> Guard<'a> {
     /// Wraps `mesh` (which must be watertight, manifold and intersection-free — and, in cage
     /// mode, enclose the input without touching it; the pipeline checks this first).
     pub fn new(mesh: HalfEdgeMesh, input: &'a InputModel, cage: bool) -> Guard<'a> {
-        let mut tris = vec![[0u32; 3]; mesh.face_capacity()];
-        let live: Vec<u32> = mesh.faces().collect();
+        let mut tris = FaceData::filled(mesh.face_capacity(), [0u32; 3]);
+        let live: Vec<FaceId> = mesh.faces().collect();
         for &f in &live {
-            tris[f as usize] = mesh.face_vertices(f);
+            tris[f] = raw_corners(&mesh, f);
         }
-        let bvh = TriangleBvh::from_subset(mesh.positions(), &tris, &live);
+        let bvh =
+            TriangleBvh::from_subset(mesh.positions(), tris.as_slice(), FaceId::raw_slice(&live));
         Guard {
             mesh,
             tris,
@@ -257,7 +264,7 @@ impl<'a> Guard<'a> {
     }
 
     /// Moves vertex `v` to `p` if the result passes every check; returns whether it did.
-    pub fn try_move(&mut self, v: u32, p: [f64; 3]) -> Result<(), Reject> {
+    pub fn try_move(&mut self, v: VertexId, p: [f64; 3]) -> Result<(), Reject> {
         let old_p = self.mesh.position(v);
         let mut s = std::mem::take(&mut self.scratch);
         s.old_patch.clear();
@@ -276,8 +283,12 @@ impl<'a> Guard<'a> {
         self.stats.add(&st);
         match r {
             Ok(()) => {
-                let faces: Vec<u32> = s.m_1[..s.n_e].iter().map(|f| f.id).collect();
-                self.bvh.update(self.mesh.positions(), &self.tris, &faces);
+                let faces: Vec<FaceId> = s.m_1[..s.n_e].iter().map(|f| f.id).collect();
+                self.bvh.update(
+                    self.mesh.positions(),
+                    self.tris.as_slice(),
+                    FaceId::raw_slice(&faces),
+                );
             }
             Err(_) => {
                 self.mesh
@@ -294,7 +305,7 @@ impl<'a> Guard<'a> {
     /// uses [`check_collapse`](Self::check_collapse) and
     /// [`commit_collapse`](Self::commit_collapse), which this composes.)
     #[cfg(test)]
-    pub fn try_collapse(&mut self, h: u32, p: [f64; 3]) -> Result<CollapseRecord, Reject> {
+    pub fn try_collapse(&mut self, h: HalfedgeId, p: [f64; 3]) -> Result<CollapseRecord, Reject> {
         if self.mesh.can_collapse(h).is_err() {
             self.stats.checks += 1;
             self.stats.rejected_topology += 1;
@@ -316,7 +327,7 @@ impl<'a> Guard<'a> {
     /// [`HalfEdgeMesh::can_collapse`]. `st` counts the work.
     pub fn check_collapse(
         &self,
-        h: u32,
+        h: HalfedgeId,
         p: [f64; 3],
         s: &mut GuardScratch,
         st: &mut GuardStats,
@@ -329,19 +340,22 @@ impl<'a> Guard<'a> {
     /// `check_collapse` accepted on the current mesh — or on a mesh
     /// that differs from it only by operations outside the collapse's `M_1` whose new faces
     /// were then tested against its `M_e` (see [`patches_intersect`]).
-    pub fn commit_collapse(&mut self, h: u32, p: [f64; 3]) -> CollapseRecord {
+    pub fn commit_collapse(&mut self, h: HalfedgeId, p: [f64; 3]) -> CollapseRecord {
         let rec = self
             .mesh
             .collapse_edge(h, p)
             .expect("a collapse that passed the guard's checks");
         for &f in &rec.removed_faces {
-            self.bvh.remove(f);
+            self.bvh.remove(f.raw());
         }
         for &f in &rec.modified_faces {
-            self.tris[f as usize] = self.mesh.face_vertices(f);
+            self.tris[f] = raw_corners(&self.mesh, f);
         }
-        self.bvh
-            .update(self.mesh.positions(), &self.tris, &rec.modified_faces);
+        self.bvh.update(
+            self.mesh.positions(),
+            self.tris.as_slice(),
+            FaceId::raw_slice(&rec.modified_faces),
+        );
         self.note_edits(rec.modified_faces.len() + rec.removed_faces.len());
         rec
     }
@@ -350,14 +364,18 @@ impl<'a> Guard<'a> {
     fn note_edits(&mut self, n: usize) {
         self.edits += n;
         if self.edits > self.mesh.face_count().max(64) {
-            let live: Vec<u32> = self.mesh.faces().collect();
-            self.bvh = TriangleBvh::from_subset(self.mesh.positions(), &self.tris, &live);
+            let live: Vec<FaceId> = self.mesh.faces().collect();
+            self.bvh = TriangleBvh::from_subset(
+                self.mesh.positions(),
+                self.tris.as_slice(),
+                FaceId::raw_slice(&live),
+            );
             self.edits = 0;
         }
     }
 
     /// Neighbourhood of a vertex that was just moved (the mesh holds the new position).
-    fn fill_move(&self, v: u32, s: &mut GuardScratch) {
+    fn fill_move(&self, v: VertexId, s: &mut GuardScratch) {
         let m = &self.mesh;
         s.m_1.clear();
         s.verts.clear();
@@ -394,12 +412,12 @@ impl<'a> Guard<'a> {
 
     /// Neighbourhood after collapsing `h = a→b` to `p`, read from the unchanged mesh: faces
     /// keep their ids, `b` becomes `a`, `a` sits at `p`, the faces of the edge disappear.
-    fn fill_collapse(&self, h: u32, p: [f64; 3], s: &mut GuardScratch) {
+    fn fill_collapse(&self, h: HalfedgeId, p: [f64; 3], s: &mut GuardScratch) {
         let m = &self.mesh;
         let (a, b) = (m.origin(h), m.target(h));
-        let dying = [m.face(h), m.face(m.twin(h))];
-        let map = |v: u32| if v == b { a } else { v };
-        let pos = |v: u32| if v == a { p } else { m.position(v) };
+        let dying = [m.face(h), m.face(h.twin())];
+        let map = |v: VertexId| if v == b { a } else { v };
+        let pos = |v: VertexId| if v == a { p } else { m.position(v) };
         s.m_1.clear();
         s.verts.clear();
         s.old_patch.clear();
@@ -514,10 +532,11 @@ impl<'a> Guard<'a> {
         s.cand.extend(
             self.bvh
                 .query_box(lo.to_array(), hi.to_array())
+                .map(FaceId::new)
                 .filter(|&g| s.excluded.binary_search(&g).is_err() && self.mesh.is_face_live(g)),
         );
         for &g in &s.cand {
-            let gt = self.tris[g as usize].map(|v| self.mesh.position(v));
+            let gt = self.tris[g].map(|v| self.mesh.position(VertexId::new(v)));
             let gbox = bbox(gt);
             for f in m_e {
                 if !boxes_overlap(bbox(f.t), gbox) {
@@ -587,7 +606,7 @@ fn check_within_m1(s: &GuardScratch, cone_ok: bool, st: &mut GuardStats) -> Resu
                 continue;
             }
             st.exact_tests += 1;
-            if sp::faces_intersect_at(f.v, &f.t, g.v, &g.t) {
+            if sp::faces_intersect_at(f.v.map(VertexId::raw), &f.t, g.v.map(VertexId::raw), &g.t) {
                 return Err(Reject::SelfIntersection);
             }
         }
@@ -700,26 +719,29 @@ pub(crate) mod tests {
         let mut g = guard_for(&m, &input, false);
         // Vertex 7 = (1,1,1) pushed below the bottom face: its faces cross it (inside M_1).
         assert_eq!(
-            g.try_move(7, [0.5, 0.5, -0.5]),
+            g.try_move(VertexId::new(7), [0.5, 0.5, -0.5]),
             Err(Reject::SelfIntersection)
         );
-        assert_eq!(g.mesh().position(7), [1., 1., 1.]);
+        assert_eq!(g.mesh().position(VertexId::new(7)), [1., 1., 1.]);
         // Into the other cube: found through the BVH (M_r).
         assert_eq!(
-            g.try_move(7, [2.5, 2.5, 2.5]),
+            g.try_move(VertexId::new(7), [2.5, 2.5, 2.5]),
             Err(Reject::SelfIntersection)
         );
-        assert!(g.try_move(7, [1.2, 1.2, 1.2]).is_ok());
-        assert_eq!(g.mesh().position(7), [1.2, 1.2, 1.2]);
+        assert!(g.try_move(VertexId::new(7), [1.2, 1.2, 1.2]).is_ok());
+        assert_eq!(g.mesh().position(VertexId::new(7)), [1.2, 1.2, 1.2]);
         // The other cube's corner (2,2,2) comes closer; the BVH follows the move, so a later
         // check near its new position sees it.
-        assert!(g.try_move(8, [1.5, 1.5, 1.5]).is_ok());
+        assert!(g.try_move(VertexId::new(8), [1.5, 1.5, 1.5]).is_ok());
         assert_eq!(
-            g.try_move(7, [1.6, 1.6, 1.6]),
+            g.try_move(VertexId::new(7), [1.6, 1.6, 1.6]),
             Err(Reject::SelfIntersection)
         );
         // Onto another vertex: degenerate faces.
-        assert_eq!(g.try_move(7, [1.0, 1.0, 0.0]), Err(Reject::Degenerate));
+        assert_eq!(
+            g.try_move(VertexId::new(7), [1.0, 1.0, 0.0]),
+            Err(Reject::Degenerate)
+        );
         g.mesh().check_invariants().unwrap();
         assert_eq!(
             crate::verify::MeshReport::compute(&g.mesh().to_trimesh()).self_intersection_free,
@@ -734,10 +756,10 @@ pub(crate) mod tests {
         let mut g = guard_for(&m, &input, false);
         g.set_exact_only(true);
         assert_eq!(
-            g.try_move(7, [0.5, 0.5, -0.5]),
+            g.try_move(VertexId::new(7), [0.5, 0.5, -0.5]),
             Err(Reject::SelfIntersection)
         );
-        assert!(g.try_move(7, [1.2, 1.2, 1.2]).is_ok());
+        assert!(g.try_move(VertexId::new(7), [1.2, 1.2, 1.2]).is_ok());
         assert_eq!(g.stats.cone_fast_path, 0);
     }
 
@@ -746,7 +768,10 @@ pub(crate) mod tests {
         let m = cube(1.0, 0.0);
         let input = InputModel::new(&m, false);
         let mut g = guard_for(&m, &input, false);
-        let h = g.mesh().find_halfedge(0, 3).unwrap();
+        let h = g
+            .mesh()
+            .find_halfedge(VertexId::new(0), VertexId::new(3))
+            .unwrap();
         // Collapsing the bottom diagonal to a point far above the cube folds it through.
         assert!(g.try_collapse(h, [0.5, 0.5, 5.0]).is_err());
         assert_eq!(g.mesh().face_count(), 12);
@@ -773,11 +798,17 @@ pub(crate) mod tests {
         let input = InputModel::new(&soup, true);
         let mut g = guard_for(&big, &input, true);
         // Cutting the corner off beyond the triangle: no contact, but the soup ends outside.
-        assert_eq!(g.try_move(7, [0.5, 0.5, 0.5]), Err(Reject::Uncovers));
+        assert_eq!(
+            g.try_move(VertexId::new(7), [0.5, 0.5, 0.5]),
+            Err(Reject::Uncovers)
+        );
         // Moving the corner onto an input vertex.
-        assert_eq!(g.try_move(7, [0.9, 0.9, 0.85]), Err(Reject::TouchesInput));
+        assert_eq!(
+            g.try_move(VertexId::new(7), [0.9, 0.9, 0.85]),
+            Err(Reject::TouchesInput)
+        );
         // Moving outward is fine.
-        assert!(g.try_move(7, [1.1, 1.1, 1.1]).is_ok());
+        assert!(g.try_move(VertexId::new(7), [1.1, 1.1, 1.1]).is_ok());
         assert_eq!(g.stats.rejected_uncover, 1);
         assert_eq!(g.stats.rejected_touch, 1);
     }

@@ -42,7 +42,7 @@ use rayon::prelude::*;
 
 use super::guard::{bbox, boxes_overlap, patches_intersect, Guard, GuardScratch, GuardStats};
 use crate::geom::{normalized, tri_normal, Vec3};
-use crate::mesh::halfedge::INVALID;
+use crate::mesh::halfedge::{EdgeData, EdgeId, FaceData, FaceId, HalfedgeId, VertexData, VertexId};
 use crate::spatial::closest::{for_each_sample, point_triangle_distance, sample_resolution};
 use crate::{Error, Result};
 
@@ -163,16 +163,16 @@ impl Quadric {
 
 /// Vertex quadrics of the current mesh (indexed by vertex id): face planes weighted by area
 /// plus the virtual edge planes.
-fn vertex_quadrics(g: &Guard<'_>) -> Vec<Quadric> {
+fn vertex_quadrics(g: &Guard<'_>) -> VertexData<Quadric> {
     let m = g.mesh();
-    let mut q = vec![Quadric::default(); m.vertex_capacity()];
+    let mut q = VertexData::filled(m.vertex_capacity(), Quadric::default());
     for f in m.faces() {
         let t = m.face_positions(f).map(Vec3::from);
         let nv = tri_normal(t[0], t[1], t[2]);
         let Some(n) = normalized(nv) else { continue };
         let fq = Quadric::plane(n, t[0], 0.5 * nv.length());
         for v in m.face_vertices(f) {
-            q[v as usize] = q[v as usize].add(&fq);
+            q[v] = q[v].add(&fq);
         }
     }
     for e in m.edges() {
@@ -188,8 +188,8 @@ fn vertex_quadrics(g: &Guard<'_>) -> Vec<Quadric> {
         };
         let l2 = (pb - pa).length_squared();
         let vq = Quadric::plane(pn, pa, VIRTUAL_PLANE_WEIGHT * l2);
-        q[a as usize] = q[a as usize].add(&vq);
-        q[b as usize] = q[b as usize].add(&vq);
+        q[a] = q[a].add(&vq);
+        q[b] = q[b].add(&vq);
     }
     q
 }
@@ -214,7 +214,7 @@ fn collapse_target(q: &Quadric, pa: Vec3, pb: Vec3) -> (Vec3, f64) {
 #[derive(Debug, Clone, Copy)]
 struct Entry {
     cost: f64,
-    edge: u32,
+    edge: EdgeId,
 }
 
 impl Entry {
@@ -239,7 +239,7 @@ const NOT_QUEUED: u32 = u32::MAX;
 struct Queue {
     v: Vec<Entry>,
     /// Heap slot of each edge, or [`NOT_QUEUED`].
-    slot: Vec<u32>,
+    slot: EdgeData<u32>,
 }
 
 impl Queue {
@@ -247,7 +247,7 @@ impl Queue {
     fn with_capacity(edges: usize) -> Queue {
         Queue {
             v: Vec::with_capacity(edges),
-            slot: vec![NOT_QUEUED; edges],
+            slot: EdgeData::filled(edges, NOT_QUEUED),
         }
     }
 
@@ -257,9 +257,9 @@ impl Queue {
 
     /// Queues `e.edge` with cost `e.cost`, or moves it there when already queued.
     fn push(&mut self, e: Entry) {
-        let k = e.edge as usize;
-        if k >= self.slot.len() {
-            self.slot.resize(k + 1, NOT_QUEUED);
+        let k = e.edge;
+        if k.index() >= self.slot.len() {
+            self.slot.resize(k.index() + 1, NOT_QUEUED);
         }
         let i = self.slot[k];
         if i == NOT_QUEUED {
@@ -279,12 +279,12 @@ impl Queue {
 
     fn pop(&mut self) -> Option<Entry> {
         let last = self.v.pop()?;
-        self.slot[last.edge as usize] = NOT_QUEUED;
+        self.slot[last.edge] = NOT_QUEUED;
         if self.v.is_empty() {
             return Some(last);
         }
         let top = self.v[0];
-        self.slot[top.edge as usize] = NOT_QUEUED;
+        self.slot[top.edge] = NOT_QUEUED;
         self.v[0] = last;
         self.sift_down(0);
         Some(top)
@@ -293,7 +293,7 @@ impl Queue {
     /// Places `v[i]` at slot `i` and records it.
     fn put(&mut self, i: usize, e: Entry) {
         self.v[i] = e;
-        self.slot[e.edge as usize] = i as u32;
+        self.slot[e.edge] = i as u32;
     }
 
     fn sift_up(&mut self, mut i: usize) {
@@ -349,30 +349,30 @@ const BATCH_MIN_FACES: usize = 2048;
 struct Pass<'g, 'a> {
     g: &'g mut Guard<'a>,
     opt: SimplifyOptions,
-    quadrics: Vec<Quadric>,
-    targets: Vec<Vec3>,
+    quadrics: VertexData<Quadric>,
+    targets: EdgeData<Vec3>,
     heap: Queue,
     /// Sampled distance to the input per face (NaN mean = not computed yet).
-    face_dist: Vec<FaceDist>,
+    face_dist: FaceData<FaceDist>,
     /// Distance to the input per vertex (NaN = not computed yet).
-    vert_dist: Vec<f64>,
+    vert_dist: VertexData<f64>,
     /// Vertex marks of the batch being formed: `mark_w[v] == epoch` ⇔ `v` is written by a
     /// selected collapse (endpoint or one-ring), `mark_r[v] == epoch` ⇔ `v` is read by one (its
     /// two-ring, which holds the vertices of its `M_1`).
-    mark_w: Vec<u32>,
-    mark_r: Vec<u32>,
+    mark_w: VertexData<u32>,
+    mark_r: VertexData<u32>,
     epoch: u32,
     /// Scratch: the vertices `W` of a candidate's footprint.
-    footprint: Vec<u32>,
+    footprint: Vec<VertexId>,
     scratch: GuardScratch,
     report: SimplifyReport,
 }
 
 /// A candidate collapse that passed every check (see [`Pass::evaluate`]).
 struct Accepted {
-    h: u32,
-    a: u32,
-    b: u32,
+    h: HalfedgeId,
+    a: VertexId,
+    b: VertexId,
     x: Vec3,
     new: Patch,
     new_face_dist: Vec<FaceDist>,
@@ -398,8 +398,8 @@ impl FaceDist {
 /// guard's counters.
 struct Eval {
     outcome: std::result::Result<Accepted, Rejection>,
-    vert_dist: Vec<(u32, f64)>,
-    face_dist: Vec<(u32, FaceDist)>,
+    vert_dist: Vec<(VertexId, f64)>,
+    face_dist: Vec<(FaceId, FaceDist)>,
     guard: GuardStats,
 }
 
@@ -420,11 +420,11 @@ impl<'g, 'a> Pass<'g, 'a> {
         let quadrics = vertex_quadrics(g);
         let m = g.mesh();
         let mut pass = Pass {
-            targets: vec![Vec3::ZERO; m.edge_capacity()],
-            face_dist: vec![FaceDist::UNKNOWN; m.face_capacity()],
-            vert_dist: vec![f64::NAN; m.vertex_capacity()],
-            mark_w: vec![0; m.vertex_capacity()],
-            mark_r: vec![0; m.vertex_capacity()],
+            targets: EdgeData::filled(m.edge_capacity(), Vec3::ZERO),
+            face_dist: FaceData::filled(m.face_capacity(), FaceDist::UNKNOWN),
+            vert_dist: VertexData::filled(m.vertex_capacity(), f64::NAN),
+            mark_w: VertexData::filled(m.vertex_capacity(), 0),
+            mark_r: VertexData::filled(m.vertex_capacity(), 0),
             epoch: 0,
             footprint: Vec::new(),
             heap: Queue::with_capacity(m.edge_capacity()),
@@ -434,7 +434,7 @@ impl<'g, 'a> Pass<'g, 'a> {
             report: SimplifyReport::default(),
             g,
         };
-        let edges: Vec<u32> = pass.g.mesh().edges().collect();
+        let edges: Vec<EdgeId> = pass.g.mesh().edges().collect();
         for e in edges {
             pass.push(e);
         }
@@ -447,13 +447,13 @@ impl<'g, 'a> Pass<'g, 'a> {
             .is_some_and(|n| self.g.mesh().face_count() <= n)
     }
 
-    fn push(&mut self, e: u32) {
+    fn push(&mut self, e: EdgeId) {
         let m = self.g.mesh();
         let h = m.edge_halfedge(e);
         let (a, b) = (m.origin(h), m.target(h));
-        let q = self.quadrics[a as usize].add(&self.quadrics[b as usize]);
+        let q = self.quadrics[a].add(&self.quadrics[b]);
         let (target, cost) = collapse_target(&q, m.position(a).into(), m.position(b).into());
-        self.targets[e as usize] = target;
+        self.targets[e] = target;
         self.heap.push(Entry { cost, edge: e });
     }
 
@@ -472,7 +472,7 @@ impl<'g, 'a> Pass<'g, 'a> {
     fn run(&mut self, keep_going: &mut dyn FnMut(f64) -> bool) -> Result<()> {
         let total = self.heap.len().max(1) as f64;
         let mut pops = 0u64;
-        let mut batch: Vec<u32> = Vec::with_capacity(BATCH);
+        let mut batch: Vec<EdgeId> = Vec::with_capacity(BATCH);
         let mut deferred: Vec<Entry> = Vec::with_capacity(BATCH);
         let mut applied: Vec<(Vec<[[f64; 3]; 3]>, Aabb)> = Vec::with_capacity(BATCH);
         'pass: while !self.target_reached() {
@@ -567,7 +567,7 @@ impl<'g, 'a> Pass<'g, 'a> {
     /// neighbourhood `M_1`). It joins when `W ∩ R' = ∅` and `R ∩ W' = ∅` for the batch's `W'`,
     /// `R'`; then no collapse of the batch changes anything another one reads except through
     /// the BVH, which [`run`](Self::run) handles.
-    fn reserve(&mut self, e: u32) -> bool {
+    fn reserve(&mut self, e: EdgeId) -> bool {
         let m = self.g.mesh();
         let h = m.edge_halfedge(e);
         let (a, b) = (m.origin(h), m.target(h));
@@ -582,19 +582,19 @@ impl<'g, 'a> Pass<'g, 'a> {
         let mut free = true;
         for i in 0..n_w {
             let v = fp[i];
-            if self.mark_r[v as usize] == ep {
+            if self.mark_r[v] == ep {
                 free = false;
                 break;
             }
             fp.extend(m.vertex_neighbors(v));
         }
-        free = free && fp[n_w..].iter().all(|&u| self.mark_w[u as usize] != ep);
+        free = free && fp[n_w..].iter().all(|&u| self.mark_w[u] != ep);
         if free {
             for &v in &fp[..n_w] {
-                self.mark_w[v as usize] = ep;
+                self.mark_w[v] = ep;
             }
             for &v in &fp {
-                self.mark_r[v as usize] = ep;
+                self.mark_r[v] = ep;
             }
         }
         self.footprint = fp;
@@ -603,7 +603,7 @@ impl<'g, 'a> Pass<'g, 'a> {
 
     /// Checks the collapse of edge `e` without changing anything, trying the quadric optimum
     /// first and then the edge midpoint and the two endpoints (see the module docs).
-    fn evaluate(&self, e: u32, s: &mut GuardScratch) -> Eval {
+    fn evaluate(&self, e: EdgeId, s: &mut GuardScratch) -> Eval {
         let mut ev = Eval {
             outcome: Err(Rejection::Guard),
             vert_dist: Vec::new(),
@@ -620,7 +620,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         };
         let (a, b) = (m.origin(h), m.target(h));
         let (pa, pb) = (Vec3::from(m.position(a)), Vec3::from(m.position(b)));
-        let mut candidates = [self.targets[e as usize]; 4];
+        let mut candidates = [self.targets[e]; 4];
         let mut n = 1;
         for c in [(pa + pb) * 0.5, pa, pb] {
             if !candidates[..n].contains(&c) {
@@ -650,9 +650,9 @@ impl<'g, 'a> Pass<'g, 'a> {
     /// All checks for collapsing `h = a→b` to `x`, cheapest first.
     fn try_position(
         &self,
-        h: u32,
-        a: u32,
-        b: u32,
+        h: HalfedgeId,
+        a: VertexId,
+        b: VertexId,
         x: Vec3,
         ev: &mut Eval,
         s: &mut GuardScratch,
@@ -683,10 +683,10 @@ impl<'g, 'a> Pass<'g, 'a> {
     /// Writes the distances an evaluation computed into the caches.
     fn fill_caches(&mut self, ev: &mut Eval) {
         for (v, d) in ev.vert_dist.drain(..) {
-            self.vert_dist[v as usize] = d;
+            self.vert_dist[v] = d;
         }
         for (f, d) in ev.face_dist.drain(..) {
-            self.face_dist[f as usize] = d;
+            self.face_dist[f] = d;
         }
     }
 
@@ -714,7 +714,7 @@ impl<'g, 'a> Pass<'g, 'a> {
 
     /// The patch before (faces around `a` and `b`) and after the collapse of `h = a→b` to `x`
     /// (the surviving faces with `a`, `b` replaced by `x`), each with its face ids.
-    fn patches(&self, h: u32, x: Vec3) -> (Patch, Patch) {
+    fn patches(&self, h: HalfedgeId, x: Vec3) -> (Patch, Patch) {
         let m = self.g.mesh();
         let (a, b) = (m.origin(h), m.target(h));
         let dying = [m.face(h), m.face(m.twin(h))];
@@ -748,7 +748,14 @@ impl<'g, 'a> Pass<'g, 'a> {
     /// face lies within `(α + β) max(|x − a|, |x − b|)` of `(α + β)x + γc` on the new edge
     /// `x–c`.) Only when that bound exceeds `d` are both patches sampled (skipping the shared
     /// ring vertices, at distance 0 on both sides).
-    fn within_hausdorff(&self, a: u32, b: u32, x: Vec3, old: &Patch, new: &Patch) -> bool {
+    fn within_hausdorff(
+        &self,
+        a: VertexId,
+        b: VertexId,
+        x: Vec3,
+        old: &Patch,
+        new: &Patch,
+    ) -> bool {
         let d = self.opt.d;
         let s = self.opt.spacing;
         let m = self.g.mesh();
@@ -772,7 +779,7 @@ impl<'g, 'a> Pass<'g, 'a> {
             }
             found.is_some()
         };
-        let one_side = |from: &Patch, to: &Patch, moved: &[(u32, Vec3)]| -> bool {
+        let one_side = |from: &Patch, to: &Patch, moved: &[(VertexId, Vec3)]| -> bool {
             for &(_, p) in moved {
                 if !near(p, to) {
                     return false;
@@ -798,8 +805,8 @@ impl<'g, 'a> Pass<'g, 'a> {
     }
 
     /// Distance of vertex `v` to the input, from the cache or computed (and noted in `ev`).
-    fn vertex_distance(&self, v: u32, ev: &mut Eval) -> f64 {
-        let d = self.vert_dist[v as usize];
+    fn vertex_distance(&self, v: VertexId, ev: &mut Eval) -> f64 {
+        let d = self.vert_dist[v];
         if !d.is_nan() {
             return d;
         }
@@ -812,7 +819,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         let p = m.position(v);
         let ub = m
             .vertex_neighbors(v)
-            .map(|u| self.vert_dist[u as usize] + Vec3::from(p).distance(Vec3::from(m.position(u))))
+            .map(|u| self.vert_dist[u] + Vec3::from(p).distance(Vec3::from(m.position(u))))
             .filter(|b| !b.is_nan())
             .fold(f64::INFINITY, f64::min);
         let d = if ub.is_finite() {
@@ -851,8 +858,14 @@ impl<'g, 'a> Pass<'g, 'a> {
 
     /// Distance of face `f` (vertices `vs`, corners `t`) to the input, from the cache or
     /// computed (and noted in `ev`).
-    fn face_distance(&self, f: u32, vs: [u32; 3], t: &[[f64; 3]; 3], ev: &mut Eval) -> FaceDist {
-        let d = self.face_dist[f as usize];
+    fn face_distance(
+        &self,
+        f: FaceId,
+        vs: [VertexId; 3],
+        t: &[[f64; 3]; 3],
+        ev: &mut Eval,
+    ) -> FaceDist {
+        let d = self.face_dist[f];
         if !d.mean.is_nan() {
             return d;
         }
@@ -872,8 +885,8 @@ impl<'g, 'a> Pass<'g, 'a> {
     /// Returns the new faces' distances when both hold.
     fn distance_not_increased(
         &self,
-        a: u32,
-        b: u32,
+        a: VertexId,
+        b: VertexId,
         x: Vec3,
         old: &Patch,
         new: &Patch,
@@ -929,18 +942,25 @@ impl<'g, 'a> Pass<'g, 'a> {
     }
 
     /// Book-keeping after an accepted collapse of `b` into `a`.
-    fn commit(&mut self, a: u32, b: u32, modified: &[u32], new: &Patch, fd: &[FaceDist]) {
+    fn commit(
+        &mut self,
+        a: VertexId,
+        b: VertexId,
+        modified: &[FaceId],
+        new: &Patch,
+        fd: &[FaceDist],
+    ) {
         self.report.collapses += 1;
-        self.quadrics[a as usize] = self.quadrics[a as usize].add(&self.quadrics[b as usize]);
-        self.vert_dist[a as usize] = f64::NAN;
+        self.quadrics[a] = self.quadrics[a].add(&self.quadrics[b]);
+        self.vert_dist[a] = f64::NAN;
         for (i, &f) in new.ids.iter().enumerate() {
-            self.face_dist[f as usize] = fd[i];
+            self.face_dist[f] = fd[i];
         }
         debug_assert!(modified.iter().all(|f| new.ids.contains(f)));
         let m = self.g.mesh();
-        let edges: Vec<u32> = m.outgoing(a).map(|h| m.edge(h)).collect();
+        let edges: Vec<EdgeId> = m.outgoing(a).map(|h| m.edge(h)).collect();
         for e in edges {
-            if e != INVALID {
+            if e.is_valid() {
                 self.push(e);
             }
         }
@@ -959,13 +979,13 @@ enum Rejection {
 /// Faces of a patch: ids, vertex ids and corner positions.
 #[derive(Debug, Default)]
 struct Patch {
-    ids: Vec<u32>,
-    verts: Vec<[u32; 3]>,
+    ids: Vec<FaceId>,
+    verts: Vec<[VertexId; 3]>,
     tris: Vec<[[f64; 3]; 3]>,
 }
 
 impl Patch {
-    fn push(&mut self, f: u32, vs: [u32; 3], t: [[f64; 3]; 3]) {
+    fn push(&mut self, f: FaceId, vs: [VertexId; 3], t: [[f64; 3]; 3]) {
         self.ids.push(f);
         self.verts.push(vs);
         self.tris.push(t);
@@ -1013,7 +1033,7 @@ mod tests {
     #[test]
     fn queue_pops_in_cost_then_edge_order() {
         let mut q = Queue::with_capacity(10);
-        let mut live: std::collections::BTreeMap<u32, f64> = Default::default();
+        let mut live: std::collections::BTreeMap<EdgeId, f64> = Default::default();
         let mut x = 12345u64;
         let mut next = || {
             x = x
@@ -1021,13 +1041,13 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             x >> 33
         };
-        let min_of = |live: &std::collections::BTreeMap<u32, f64>| {
+        let min_of = |live: &std::collections::BTreeMap<EdgeId, f64>| {
             live.iter()
                 .map(|(&e, &c)| (c, e))
                 .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
         };
         for i in 0..3000u32 {
-            let edge = (next() % 300) as u32;
+            let edge = EdgeId::new((next() % 300) as u32);
             let cost = (next() % 50) as f64;
             q.push(Entry { cost, edge });
             live.insert(edge, cost);

@@ -4,8 +4,11 @@
 //!
 //! # Representation
 //!
-//! Everything is index based: vertices, faces, edges and half-edges are `u32` ids into `Vec`
-//! storage, and [`INVALID`] (`u32::MAX`) means "none". Half-edges come in pairs: the two halves of
+//! Everything is index based: vertices, faces, edges and half-edges are typed `u32` ids
+//! ([`VertexId`], [`FaceId`], [`EdgeId`], [`HalfedgeId`]) into per-element storage, so passing
+//! one kind of id where another is expected is a type error; each id type's `INVALID`
+//! (`u32::MAX`) means "none". Raw indices appear only at the boundary ([`HalfEdgeMesh::from_trimesh`],
+//! [`HalfEdgeMesh::to_trimesh`], [`HalfEdgeMesh::positions`]). Half-edges come in pairs: the two halves of
 //! edge `e` are `2e` and `2e + 1`; that arithmetic lives only in the typed ids ([`HalfedgeId::twin`],
 //! [`HalfedgeId::edge`], [`EdgeId::halfedge`]), which also come with per-element containers
 //! ([`VertexData`], [`FaceData`], [`EdgeData`], [`HalfedgeData`]) indexable only by their own id
@@ -31,6 +34,7 @@
 //! # Example
 //!
 //! ```
+//! use pleat::mesh::halfedge::VertexId;
 //! use pleat::mesh::{HalfEdgeMesh, TriMesh};
 //! // A unit square split along the diagonal 0–2.
 //! let quad = TriMesh::new(
@@ -41,16 +45,17 @@
 //! assert_eq!((m.euler_characteristic(), m.boundary_loop_count()), (1, 1));
 //!
 //! // Collapse the boundary edge 0→1 (vertex 1 merges into 0), then revert it.
-//! let h = m.find_halfedge(0, 1).unwrap();
+//! let v = |i| VertexId::new(i);
+//! let h = m.find_halfedge(v(0), v(1)).unwrap();
 //! assert!(m.can_collapse(h).is_ok());
 //! let rec = m.collapse_edge(h, [0.5, 0., 0.])?;
-//! assert_eq!((rec.kept_vertex, rec.removed_vertex, m.face_count()), (0, 1, 1));
+//! assert_eq!((rec.kept_vertex, rec.removed_vertex, m.face_count()), (v(0), v(1), 1));
 //! m.undo(rec.undo)?;
 //! assert_eq!(m.to_trimesh(), quad);
 //!
 //! // Flip the diagonal: 0→2 lies in face (0, 2, 3), so it becomes 3→1.
-//! let rec = m.flip_edge(m.find_halfedge(0, 2).unwrap())?;
-//! assert_eq!(rec.new_vertices, [3, 1]);
+//! let rec = m.flip_edge(m.find_halfedge(v(0), v(2)).unwrap())?;
+//! assert_eq!(rec.new_vertices, [v(3), v(1)]);
 //! m.check_invariants()?;
 //! # Ok::<(), pleat::Error>(())
 //! ```
@@ -59,7 +64,7 @@
 //!
 //! Accessors take ids below the matching `*_capacity()`; an id at or beyond it panics with a
 //! message naming the kind of id and the capacity. A *deleted* id never panics in the
-//! connectivity accessors (they return [`INVALID`], `None` or an empty iterator) and the
+//! connectivity accessors (they return an `INVALID` id, `None` or an empty iterator) and the
 //! operations refuse it; only the face geometry helpers (`face_positions`, `face_normal`,
 //! `face_area`, `face_area_vector`) need a live face and panic on a deleted one. The C ABI never
 //! exposes half-edge ids.
@@ -83,25 +88,22 @@ pub use ids::{
 };
 pub use ops::{CollapseRecord, FlipRecord, Refusal, Undo};
 
-/// The id meaning "no element" (a boundary half-edge's face, a deleted element's links, ...).
-pub const INVALID: u32 = u32::MAX;
-
 /// One half-edge: its loop links, the vertex it leaves and the face on its left.
-/// All four fields are [`INVALID`] for a deleted half-edge.
+/// All four fields are `INVALID` for a deleted half-edge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct HalfEdge {
-    next: u32,
-    prev: u32,
-    origin: u32,
-    face: u32,
+    next: HalfedgeId,
+    prev: HalfedgeId,
+    origin: VertexId,
+    face: FaceId,
 }
 
 impl HalfEdge {
     const DELETED: HalfEdge = HalfEdge {
-        next: INVALID,
-        prev: INVALID,
-        origin: INVALID,
-        face: INVALID,
+        next: HalfedgeId::INVALID,
+        prev: HalfedgeId::INVALID,
+        origin: VertexId::INVALID,
+        face: FaceId::INVALID,
     };
 }
 
@@ -114,14 +116,14 @@ impl HalfEdge {
 /// the invariants every operation keeps and the id rules.
 #[derive(Debug, Clone)]
 pub struct HalfEdgeMesh {
-    positions: Vec<[f64; 3]>,
+    positions: VertexData<[f64; 3]>,
     /// Outgoing half-edge per vertex (boundary first); `INVALID` when isolated or deleted.
-    v_out: Vec<u32>,
-    v_alive: Vec<bool>,
-    halfedges: Vec<HalfEdge>,
+    v_out: VertexData<HalfedgeId>,
+    v_alive: VertexData<bool>,
+    halfedges: HalfedgeData<HalfEdge>,
     /// One half-edge per face (the one starting at the face's first corner); `INVALID` when
     /// deleted.
-    f_he: Vec<u32>,
+    f_he: FaceData<HalfedgeId>,
     n_vertices: usize,
     n_edges: usize,
     n_faces: usize,
@@ -129,24 +131,6 @@ pub struct HalfEdgeMesh {
     /// operation produced (stamps come from [`fresh_stamp`] and are never reused, even across
     /// meshes and clones).
     stamp: u64,
-}
-
-/// The twin of raw half-edge id `h` ([`HalfedgeId::twin`]).
-#[inline]
-fn twin(h: u32) -> u32 {
-    HalfedgeId::new(h).twin().raw()
-}
-
-/// The edge of raw half-edge id `h` ([`HalfedgeId::edge`]).
-#[inline]
-fn edge_of(h: u32) -> u32 {
-    HalfedgeId::new(h).edge().raw()
-}
-
-/// The first half-edge of raw edge id `e` ([`EdgeId::halfedge`]).
-#[inline]
-fn halfedge_of(e: u32) -> u32 {
-    EdgeId::new(e).halfedge().raw()
 }
 
 /// A stamp never handed out before in this process.
@@ -168,30 +152,30 @@ impl HalfEdgeMesh {
 
     #[inline]
     #[track_caller]
-    fn he(&self, h: u32) -> HalfEdge {
-        match self.halfedges.get(h as usize) {
+    fn he(&self, h: HalfedgeId) -> HalfEdge {
+        match self.halfedges.get(h) {
             Some(x) => *x,
-            None => out_of_range("half-edge", h, self.halfedges.len()),
+            None => out_of_range("half-edge", h.raw(), self.halfedges.len()),
         }
     }
 
     #[inline]
     #[track_caller]
-    fn check_vertex(&self, v: u32) -> usize {
-        if (v as usize) < self.v_out.len() {
-            v as usize
+    fn check_vertex(&self, v: VertexId) -> VertexId {
+        if v.index() < self.v_out.len() {
+            v
         } else {
-            out_of_range("vertex", v, self.v_out.len())
+            out_of_range("vertex", v.raw(), self.v_out.len())
         }
     }
 
     #[inline]
     #[track_caller]
-    fn check_face(&self, f: u32) -> usize {
-        if (f as usize) < self.f_he.len() {
-            f as usize
+    fn check_face(&self, f: FaceId) -> FaceId {
+        if f.index() < self.f_he.len() {
+            f
         } else {
-            out_of_range("face", f, self.f_he.len())
+            out_of_range("face", f.raw(), self.f_he.len())
         }
     }
 
@@ -240,48 +224,51 @@ impl HalfEdgeMesh {
 
     /// True when vertex `v` has not been deleted (isolated vertices are live).
     #[track_caller]
-    pub fn is_vertex_live(&self, v: u32) -> bool {
+    pub fn is_vertex_live(&self, v: VertexId) -> bool {
         self.v_alive[self.check_vertex(v)]
     }
 
     /// True when face `f` has not been deleted.
     #[track_caller]
-    pub fn is_face_live(&self, f: u32) -> bool {
-        self.f_he[self.check_face(f)] != INVALID
+    pub fn is_face_live(&self, f: FaceId) -> bool {
+        self.f_he[self.check_face(f)].is_valid()
     }
 
     /// True when half-edge `h` (and so its twin and its edge) has not been deleted.
     #[inline]
     #[track_caller]
-    pub fn is_halfedge_live(&self, h: u32) -> bool {
-        self.he(h).origin != INVALID
+    pub fn is_halfedge_live(&self, h: HalfedgeId) -> bool {
+        self.he(h).origin.is_valid()
     }
 
     /// True when edge `e` has not been deleted.
     #[track_caller]
-    pub fn is_edge_live(&self, e: u32) -> bool {
-        self.is_halfedge_live(self.edge_halfedge(e))
+    pub fn is_edge_live(&self, e: EdgeId) -> bool {
+        self.is_halfedge_live(e.halfedge())
     }
 
     /// The live vertex ids in increasing order (isolated vertices included).
-    pub fn vertices(&self) -> impl Iterator<Item = u32> + '_ {
-        (0..self.v_alive.len() as u32).filter(|&v| self.v_alive[v as usize])
+    pub fn vertices(&self) -> impl Iterator<Item = VertexId> + '_ {
+        self.v_alive.ids().filter(|&v| self.v_alive[v])
     }
 
     /// The live face ids in increasing order.
-    pub fn faces(&self) -> impl Iterator<Item = u32> + '_ {
-        (0..self.f_he.len() as u32).filter(|&f| self.f_he[f as usize] != INVALID)
+    pub fn faces(&self) -> impl Iterator<Item = FaceId> + '_ {
+        self.f_he.ids().filter(|&f| self.f_he[f].is_valid())
     }
 
     /// The live edge ids in increasing order.
-    pub fn edges(&self) -> impl Iterator<Item = u32> + '_ {
+    pub fn edges(&self) -> impl Iterator<Item = EdgeId> + '_ {
         (0..self.edge_capacity() as u32)
-            .filter(|&e| self.halfedges[halfedge_of(e) as usize].origin != INVALID)
+            .map(EdgeId::new)
+            .filter(|&e| self.halfedges[e.halfedge()].origin.is_valid())
     }
 
     /// The live half-edge ids in increasing order.
-    pub fn halfedges(&self) -> impl Iterator<Item = u32> + '_ {
-        (0..self.halfedges.len() as u32).filter(|&h| self.halfedges[h as usize].origin != INVALID)
+    pub fn halfedges(&self) -> impl Iterator<Item = HalfedgeId> + '_ {
+        self.halfedges
+            .ids()
+            .filter(|&h| self.halfedges[h].origin.is_valid())
     }
 
     // ----------------------------------------------------------------------------------------
@@ -290,95 +277,95 @@ impl HalfEdgeMesh {
     /// The opposite half-edge of the same edge ([`HalfedgeId::twin`]). Never fails (no range
     /// check).
     #[inline]
-    pub fn twin(&self, h: u32) -> u32 {
-        twin(h)
+    pub fn twin(&self, h: HalfedgeId) -> HalfedgeId {
+        h.twin()
     }
 
     /// The edge of half-edge `h` ([`HalfedgeId::edge`]). Never fails (no range check).
     #[inline]
-    pub fn edge(&self, h: u32) -> u32 {
-        edge_of(h)
+    pub fn edge(&self, h: HalfedgeId) -> EdgeId {
+        h.edge()
     }
 
     /// The first half-edge `2e` of edge `e` (its twin is `2e + 1`). Never fails (no range check).
     #[inline]
-    pub fn edge_halfedge(&self, e: u32) -> u32 {
-        halfedge_of(e)
+    pub fn edge_halfedge(&self, e: EdgeId) -> HalfedgeId {
+        e.halfedge()
     }
 
-    /// The next half-edge in `h`'s face (or boundary loop); [`INVALID`] when `h` is deleted.
+    /// The next half-edge in `h`'s face (or boundary loop); `INVALID` when `h` is deleted.
     #[inline]
     #[track_caller]
-    pub fn next(&self, h: u32) -> u32 {
+    pub fn next(&self, h: HalfedgeId) -> HalfedgeId {
         self.he(h).next
     }
 
-    /// The previous half-edge in `h`'s face (or boundary loop); [`INVALID`] when `h` is deleted.
+    /// The previous half-edge in `h`'s face (or boundary loop); `INVALID` when `h` is deleted.
     #[inline]
     #[track_caller]
-    pub fn prev(&self, h: u32) -> u32 {
+    pub fn prev(&self, h: HalfedgeId) -> HalfedgeId {
         self.he(h).prev
     }
 
-    /// The vertex `h` leaves; [`INVALID`] when `h` is deleted.
+    /// The vertex `h` leaves; `INVALID` when `h` is deleted.
     #[inline]
     #[track_caller]
-    pub fn origin(&self, h: u32) -> u32 {
+    pub fn origin(&self, h: HalfedgeId) -> VertexId {
         self.he(h).origin
     }
 
-    /// The vertex `h` points to (the origin of its twin); [`INVALID`] when `h` is deleted.
+    /// The vertex `h` points to (the origin of its twin); `INVALID` when `h` is deleted.
     #[inline]
     #[track_caller]
-    pub fn target(&self, h: u32) -> u32 {
-        self.he(twin(h)).origin
+    pub fn target(&self, h: HalfedgeId) -> VertexId {
+        self.he(h.twin()).origin
     }
 
     /// The face on the left of `h`, `None` for a boundary or deleted half-edge.
     #[inline]
     #[track_caller]
-    pub fn face(&self, h: u32) -> Option<u32> {
+    pub fn face(&self, h: HalfedgeId) -> Option<FaceId> {
         let f = self.he(h).face;
-        (f != INVALID).then_some(f)
+        f.is_valid().then_some(f)
     }
 
     /// True when `h` is a live half-edge without a face (it lies in a boundary loop).
     #[inline]
     #[track_caller]
-    pub fn is_boundary_halfedge(&self, h: u32) -> bool {
+    pub fn is_boundary_halfedge(&self, h: HalfedgeId) -> bool {
         let x = self.he(h);
-        x.origin != INVALID && x.face == INVALID
+        x.origin.is_valid() && !x.face.is_valid()
     }
 
     /// True when live edge `e` has only one face (false for a deleted edge).
     #[track_caller]
-    pub fn is_boundary_edge(&self, e: u32) -> bool {
-        let h = self.edge_halfedge(e);
-        self.is_boundary_halfedge(h) || self.is_boundary_halfedge(twin(h))
+    pub fn is_boundary_edge(&self, e: EdgeId) -> bool {
+        let h = e.halfedge();
+        self.is_boundary_halfedge(h) || self.is_boundary_halfedge(h.twin())
     }
 
     /// The half-edge from `a` to `b`, if that edge exists. O(valence of `a`).
     #[track_caller]
-    pub fn find_halfedge(&self, a: u32, b: u32) -> Option<u32> {
+    pub fn find_halfedge(&self, a: VertexId, b: VertexId) -> Option<HalfedgeId> {
         self.outgoing(a).find(|&h| self.target(h) == b)
     }
 
     // ----------------------------------------------------------------------------------------
     // Faces.
 
-    /// The half-edge starting at the first corner of face `f`; [`INVALID`] when `f` is deleted.
+    /// The half-edge starting at the first corner of face `f`; `INVALID` when `f` is deleted.
     #[track_caller]
-    pub fn face_halfedge(&self, f: u32) -> u32 {
+    pub fn face_halfedge(&self, f: FaceId) -> HalfedgeId {
         self.f_he[self.check_face(f)]
     }
 
     /// The three half-edges of face `f` in order, starting at its first corner;
     /// `[INVALID; 3]` when `f` is deleted.
     #[track_caller]
-    pub fn face_halfedges(&self, f: u32) -> [u32; 3] {
+    pub fn face_halfedges(&self, f: FaceId) -> [HalfedgeId; 3] {
         let h0 = self.face_halfedge(f);
-        if h0 == INVALID {
-            return [INVALID; 3];
+        if !h0.is_valid() {
+            return [HalfedgeId::INVALID; 3];
         }
         let h1 = self.next(h0);
         [h0, h1, self.next(h1)]
@@ -387,28 +374,28 @@ impl HalfEdgeMesh {
     /// The three corners of face `f`, counter-clockwise seen from the front; `[INVALID; 3]`
     /// when `f` is deleted.
     #[track_caller]
-    pub fn face_vertices(&self, f: u32) -> [u32; 3] {
+    pub fn face_vertices(&self, f: FaceId) -> [VertexId; 3] {
         self.face_halfedges(f).map(|h| {
-            if h == INVALID {
-                INVALID
-            } else {
+            if h.is_valid() {
                 self.origin(h)
+            } else {
+                VertexId::INVALID
             }
         })
     }
 
     /// The corner positions of live face `f` (panics on a deleted face).
     #[track_caller]
-    pub fn face_positions(&self, f: u32) -> [[f64; 3]; 3] {
+    pub fn face_positions(&self, f: FaceId) -> [[f64; 3]; 3] {
         let vs = self.face_vertices(f);
-        assert!(vs[0] != INVALID, "face {f} is deleted");
-        vs.map(|v| self.positions[v as usize])
+        assert!(vs[0].is_valid(), "face {f} is deleted");
+        vs.map(|v| self.positions[v])
     }
 
     /// `(b − a) × (c − a)` of live face `f`: normal direction with length twice the area
     /// (panics on a deleted face).
     #[track_caller]
-    pub fn face_area_vector(&self, f: u32) -> Vec3 {
+    pub fn face_area_vector(&self, f: FaceId) -> Vec3 {
         let [a, b, c] = self.face_positions(f).map(Vec3::from);
         tri_normal(a, b, c)
     }
@@ -416,7 +403,7 @@ impl HalfEdgeMesh {
     /// Unit normal of live face `f` (right-hand rule over its corners); `[0, 0, 0]` for a
     /// degenerate (zero-area) face. Panics on a deleted face.
     #[track_caller]
-    pub fn face_normal(&self, f: u32) -> Vec3 {
+    pub fn face_normal(&self, f: FaceId) -> Vec3 {
         let n = self.face_area_vector(f);
         let l = n.length();
         if l > 0.0 {
@@ -428,7 +415,7 @@ impl HalfEdgeMesh {
 
     /// Area of live face `f` (panics on a deleted face).
     #[track_caller]
-    pub fn face_area(&self, f: u32) -> f64 {
+    pub fn face_area(&self, f: FaceId) -> f64 {
         0.5 * self.face_area_vector(f).length()
     }
 
@@ -439,9 +426,9 @@ impl HalfEdgeMesh {
     /// the boundary. `None` when `v` is isolated or deleted.
     #[inline]
     #[track_caller]
-    pub fn vertex_halfedge(&self, v: u32) -> Option<u32> {
+    pub fn vertex_halfedge(&self, v: VertexId) -> Option<HalfedgeId> {
         let h = self.v_out[self.check_vertex(v)];
-        (h != INVALID).then_some(h)
+        h.is_valid().then_some(h)
     }
 
     /// The half-edges leaving `v`, counter-clockwise seen from the front. When `v` is on the
@@ -449,22 +436,22 @@ impl HalfEdgeMesh {
     /// across the fan, so every incident face is the face of exactly one of them. Empty for an
     /// isolated or deleted vertex. O(valence).
     #[track_caller]
-    pub fn outgoing(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
-        self.rotate(self.vertex_halfedge(v).unwrap_or(INVALID))
+    pub fn outgoing(&self, v: VertexId) -> impl Iterator<Item = HalfedgeId> + '_ {
+        self.rotate(self.vertex_halfedge(v).unwrap_or(HalfedgeId::INVALID))
     }
 
     /// The half-edges leaving `origin(start)`, counter-clockwise from live half-edge `start`
     /// (nothing when `start` is `INVALID`).
-    fn rotate(&self, start: u32) -> impl Iterator<Item = u32> + '_ {
+    fn rotate(&self, start: HalfedgeId) -> impl Iterator<Item = HalfedgeId> + '_ {
         let mut cur = start;
         std::iter::from_fn(move || {
-            if cur == INVALID {
+            if !cur.is_valid() {
                 return None;
             }
             let h = cur;
             // twin(prev(h)) also leaves origin(h): the next outgoing half-edge counter-clockwise.
-            let n = twin(self.halfedges[h as usize].prev);
-            cur = if n == start { INVALID } else { n };
+            let n = self.halfedges[h].prev.twin();
+            cur = if n == start { HalfedgeId::INVALID } else { n };
             Some(h)
         })
     }
@@ -472,20 +459,20 @@ impl HalfEdgeMesh {
     /// The faces around `v`, counter-clockwise seen from the front, each once (from the boundary
     /// edge across the fan for a boundary vertex). O(valence).
     #[track_caller]
-    pub fn vertex_faces(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
+    pub fn vertex_faces(&self, v: VertexId) -> impl Iterator<Item = FaceId> + '_ {
         self.outgoing(v).filter_map(|h| self.face(h))
     }
 
     /// The neighbours of `v` (the targets of [`outgoing`](Self::outgoing)), counter-clockwise,
     /// each once. O(valence).
     #[track_caller]
-    pub fn vertex_neighbors(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
+    pub fn vertex_neighbors(&self, v: VertexId) -> impl Iterator<Item = VertexId> + '_ {
         self.outgoing(v).map(|h| self.target(h))
     }
 
     /// Number of edges at `v` (0 for an isolated or deleted vertex). O(valence).
     #[track_caller]
-    pub fn valence(&self, v: u32) -> usize {
+    pub fn valence(&self, v: VertexId) -> usize {
         self.outgoing(v).count()
     }
 
@@ -493,27 +480,28 @@ impl HalfEdgeMesh {
     /// isolated and deleted vertices.
     #[inline]
     #[track_caller]
-    pub fn is_boundary_vertex(&self, v: u32) -> bool {
+    pub fn is_boundary_vertex(&self, v: VertexId) -> bool {
         self.vertex_halfedge(v)
-            .is_some_and(|h| self.halfedges[h as usize].face == INVALID)
+            .is_some_and(|h| !self.halfedges[h].face.is_valid())
     }
 
     /// True when `v` is live and has no edge (an unreferenced vertex of the input).
     #[track_caller]
-    pub fn is_isolated_vertex(&self, v: u32) -> bool {
-        self.is_vertex_live(v) && self.v_out[v as usize] == INVALID
+    pub fn is_isolated_vertex(&self, v: VertexId) -> bool {
+        self.is_vertex_live(v) && !self.v_out[v].is_valid()
     }
 
     /// Position of vertex `v` (a deleted vertex keeps its last position).
     #[inline]
     #[track_caller]
-    pub fn position(&self, v: u32) -> [f64; 3] {
+    pub fn position(&self, v: VertexId) -> [f64; 3] {
         self.positions[self.check_vertex(v)]
     }
 
-    /// All position slots, indexed by vertex id (deleted slots included).
+    /// All position slots, indexed by raw vertex index ([`VertexId::index`]; deleted slots
+    /// included).
     pub fn positions(&self) -> &[[f64; 3]] {
-        &self.positions
+        self.positions.as_slice()
     }
 
     /// Moves live vertex `v` to `p`.
@@ -522,7 +510,7 @@ impl HalfEdgeMesh {
     /// It does not touch topology, so it does not invalidate [`Undo`] records; undoing an
     /// operation restores only the positions that operation changed.
     #[track_caller]
-    pub fn set_position(&mut self, v: u32, p: [f64; 3]) -> Result<()> {
+    pub fn set_position(&mut self, v: VertexId, p: [f64; 3]) -> Result<()> {
         let i = self.check_vertex(v);
         if !self.v_alive[i] {
             return Err(Error::InvalidArgument(format!(
@@ -545,16 +533,16 @@ impl HalfEdgeMesh {
 
     /// Number of boundary loops (0 for a closed mesh). O(mesh).
     pub fn boundary_loop_count(&self) -> usize {
-        let mut seen = vec![false; self.halfedges.len()];
+        let mut seen = HalfedgeData::filled(self.halfedges.len(), false);
         let mut loops = 0;
-        for h in 0..self.halfedges.len() as u32 {
-            if seen[h as usize] || !self.is_boundary_halfedge(h) {
+        for h in self.halfedges.ids() {
+            if seen[h] || !self.is_boundary_halfedge(h) {
                 continue;
             }
             loops += 1;
             let mut x = h;
-            while !seen[x as usize] {
-                seen[x as usize] = true;
+            while !seen[x] {
+                seen[x] = true;
                 x = self.next(x);
             }
         }

@@ -1,21 +1,25 @@
 //! Building a [`HalfEdgeMesh`] from a [`TriMesh`] (with manifoldness checks), converting back,
 //! and compacting storage.
 
-use super::{edge_of, fresh_stamp, halfedge_of, twin, HalfEdge, HalfEdgeMesh, INVALID};
+use super::{
+    fresh_stamp, EdgeData, EdgeId, FaceData, FaceId, HalfEdge, HalfEdgeMesh, HalfedgeData,
+    HalfedgeId, VertexData, VertexId,
+};
+use super::{ElementId, IdVec};
 use crate::mesh::TriMesh;
 use crate::{Error, Result};
 
 /// Where every element went in [`HalfEdgeMesh::garbage_collect`]: `x[old] = new id`, or
-/// [`INVALID`] for a deleted element. New ids keep the relative order of the old ones, and a
+/// the id type's `INVALID` for a deleted element. New ids keep the relative order of the old ones, and a
 /// half-edge pair `2e, 2e + 1` maps to a pair `2e', 2e' + 1`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Compaction {
     /// Old vertex id → new vertex id.
-    pub vertices: Vec<u32>,
+    pub vertices: VertexData<VertexId>,
     /// Old face id → new face id.
-    pub faces: Vec<u32>,
-    /// Old half-edge id → new half-edge id (edge `e` maps to `halfedges[2e] / 2`).
-    pub halfedges: Vec<u32>,
+    pub faces: FaceData<FaceId>,
+    /// Old half-edge id → new half-edge id (edge `e` maps to `halfedges[e.halfedge()].edge()`).
+    pub halfedges: HalfedgeData<HalfedgeId>,
 }
 
 /// The corners of a triangle list grouped by the vertex they sit at (CSR). Corner `c = 3f + i`
@@ -130,7 +134,7 @@ fn check_repeated_vertices(tris: &[[u32; 3]]) -> Result<()> {
 
 /// The half-edge id of every corner, plus the corners whose edge has no second face.
 struct Pairing {
-    corner_he: Vec<u32>,
+    corner_he: Vec<HalfedgeId>,
     edge_count: usize,
     /// Corners whose twin is a boundary half-edge, in increasing edge order.
     boundary_corners: Vec<u32>,
@@ -168,11 +172,11 @@ fn edge_error(idx: &CornerIndex, a: u32, b: u32) -> Error {
 /// twice in the same direction, and two faces on the same three vertices.
 fn pair_corners(idx: &CornerIndex) -> Result<Pairing> {
     let nc = idx.out.len() as u32;
-    let mut corner_he = vec![INVALID; nc as usize];
+    let mut corner_he = vec![HalfedgeId::INVALID; nc as usize];
     let mut boundary_corners = Vec::new();
     let mut edge_count = 0u32;
     for c in 0..nc {
-        if corner_he[c as usize] != INVALID {
+        if corner_he[c as usize].is_valid() {
             continue;
         }
         let (a, b) = (idx.origin(c), idx.target(c));
@@ -181,7 +185,7 @@ fn pair_corners(idx: &CornerIndex) -> Result<Pairing> {
             .iter()
             .filter(|&&(c2, t)| t == b && c2 != c)
             .count();
-        let mut opposite = INVALID;
+        let mut opposite = u32::MAX;
         let mut n_opposite = 0;
         for &(c2, t) in idx.at(b) {
             if t == a {
@@ -192,10 +196,10 @@ fn pair_corners(idx: &CornerIndex) -> Result<Pairing> {
         if same > 0 || n_opposite > 1 {
             return Err(edge_error(idx, a, b));
         }
-        let e = edge_count;
+        let e = EdgeId::new(edge_count);
         edge_count += 1;
-        corner_he[c as usize] = halfedge_of(e);
-        if opposite == INVALID {
+        corner_he[c as usize] = e.halfedge();
+        if opposite == u32::MAX {
             boundary_corners.push(c);
         } else if idx.vertex(c, 2) == idx.vertex(opposite, 2) {
             return Err(invalid(format!(
@@ -205,7 +209,7 @@ fn pair_corners(idx: &CornerIndex) -> Result<Pairing> {
                 idx.vertex(c, 2)
             )));
         } else {
-            corner_he[opposite as usize] = twin(halfedge_of(e));
+            corner_he[opposite as usize] = e.halfedge().twin();
         }
     }
     Ok(Pairing {
@@ -217,39 +221,43 @@ fn pair_corners(idx: &CornerIndex) -> Result<Pairing> {
 
 /// Half-edge records for the face corners (loops of 3) and the boundary half-edges (origin and
 /// no face; their loop links are set by [`link_boundary`]).
-fn halfedge_records(idx: &CornerIndex, p: &Pairing) -> Vec<HalfEdge> {
-    let mut he = vec![HalfEdge::DELETED; 2 * p.edge_count];
+fn halfedge_records(idx: &CornerIndex, p: &Pairing) -> HalfedgeData<HalfEdge> {
+    let mut he = HalfedgeData::filled(2 * p.edge_count, HalfEdge::DELETED);
     for (f, t) in idx.tris.iter().enumerate() {
         let base = 3 * f;
         for i in 0..3 {
-            he[p.corner_he[base + i] as usize] = HalfEdge {
+            he[p.corner_he[base + i]] = HalfEdge {
                 next: p.corner_he[base + (i + 1) % 3],
                 prev: p.corner_he[base + (i + 2) % 3],
-                origin: t[i],
-                face: f as u32,
+                origin: VertexId::new(t[i]),
+                face: FaceId::new(f as u32),
             };
         }
     }
     for &c in &p.boundary_corners {
-        let bh = twin(p.corner_he[c as usize]);
-        he[bh as usize].origin = idx.target(c);
+        let bh = p.corner_he[c as usize].twin();
+        he[bh].origin = VertexId::new(idx.target(c));
     }
     he
 }
 
 /// Outgoing half-edge per vertex: the boundary half-edge leaving it if any (refusing a vertex
 /// with two, which is a bow-tie), else the half-edge of its first corner; `INVALID` if unused.
-fn vertex_outgoing(idx: &CornerIndex, p: &Pairing, vertex_count: usize) -> Result<Vec<u32>> {
-    let mut v_out = vec![INVALID; vertex_count];
+fn vertex_outgoing(
+    idx: &CornerIndex,
+    p: &Pairing,
+    vertex_count: usize,
+) -> Result<VertexData<HalfedgeId>> {
+    let mut v_out = VertexData::filled(vertex_count, HalfedgeId::INVALID);
     for &c in &p.boundary_corners {
         let b = idx.target(c);
-        if v_out[b as usize] != INVALID {
+        if v_out[VertexId::new(b)].is_valid() {
             return Err(non_manifold_vertex(idx, b));
         }
-        v_out[b as usize] = twin(p.corner_he[c as usize]);
+        v_out[VertexId::new(b)] = p.corner_he[c as usize].twin();
     }
-    for (v, out) in v_out.iter_mut().enumerate() {
-        if *out == INVALID {
+    for (v, out) in v_out.as_mut_slice().iter_mut().enumerate() {
+        if !out.is_valid() {
             if let Some(&(c, _)) = idx.at(v as u32).first() {
                 *out = p.corner_he[c as usize];
             }
@@ -261,35 +269,44 @@ fn vertex_outgoing(idx: &CornerIndex, p: &Pairing, vertex_count: usize) -> Resul
 /// Links the boundary half-edges into loops: the boundary half-edge `b→a` continues with the
 /// boundary half-edge leaving `a` (unique: each vertex has as many boundary half-edges in as out,
 /// and at most one out).
-fn link_boundary(idx: &CornerIndex, p: &Pairing, v_out: &[u32], he: &mut [HalfEdge]) {
+fn link_boundary(
+    idx: &CornerIndex,
+    p: &Pairing,
+    v_out: &VertexData<HalfedgeId>,
+    he: &mut HalfedgeData<HalfEdge>,
+) {
     for &c in &p.boundary_corners {
-        let bh = twin(p.corner_he[c as usize]);
-        let n = v_out[idx.origin(c) as usize];
-        he[bh as usize].next = n;
-        he[n as usize].prev = bh;
+        let bh = p.corner_he[c as usize].twin();
+        let n = v_out[VertexId::new(idx.origin(c))];
+        he[bh].next = n;
+        he[n].prev = bh;
     }
 }
 
 /// Refuses a vertex whose faces form more than one fan: rotating around it from its outgoing
 /// half-edge must visit every half-edge leaving it.
-fn check_single_fans(idx: &CornerIndex, v_out: &[u32], he: &[HalfEdge]) -> Result<()> {
-    for (v, &start) in v_out.iter().enumerate() {
-        if start == INVALID {
+fn check_single_fans(
+    idx: &CornerIndex,
+    v_out: &VertexData<HalfedgeId>,
+    he: &HalfedgeData<HalfEdge>,
+) -> Result<()> {
+    for (v, &start) in v_out.iter() {
+        if !start.is_valid() {
             continue;
         }
-        let boundary = he[start as usize].face == INVALID;
-        let expected = idx.at(v as u32).len() + boundary as usize;
+        let boundary = !he[start].face.is_valid();
+        let expected = idx.at(v.raw()).len() + boundary as usize;
         let mut seen = 0;
         let mut h = start;
         loop {
             seen += 1;
-            h = twin(he[h as usize].prev);
+            h = he[h].prev.twin();
             if h == start || seen > expected {
                 break;
             }
         }
         if seen != expected {
-            return Err(non_manifold_vertex(idx, v as u32));
+            return Err(non_manifold_vertex(idx, v.raw()));
         }
     }
     Ok(())
@@ -329,9 +346,9 @@ impl HalfEdgeMesh {
         check_single_fans(&idx, &v_out, &halfedges)?;
         let f_he = (0..tris.len()).map(|f| pairing.corner_he[3 * f]).collect();
         Ok(HalfEdgeMesh {
-            positions: mesh.positions().to_vec(),
+            positions: VertexData::from_vec(mesh.positions().to_vec()),
             v_out,
-            v_alive: vec![true; nv],
+            v_alive: VertexData::filled(nv, true),
             n_vertices: nv,
             n_edges: pairing.edge_count,
             n_faces: tris.len(),
@@ -349,12 +366,13 @@ impl HalfEdgeMesh {
     }
 
     /// [`to_trimesh`](Self::to_trimesh) plus the map from this mesh's vertex ids to the
-    /// returned mesh's (`INVALID` for deleted vertices).
-    pub fn to_trimesh_with_map(&self) -> (TriMesh, Vec<u32>) {
+    /// returned mesh's (`INVALID` for deleted vertices); the returned mesh's vertex index `i` is
+    /// `VertexId::raw` of the mapped id.
+    pub fn to_trimesh_with_map(&self) -> (TriMesh, VertexData<VertexId>) {
         let (vmap, positions) = self.compact_vertices();
         let triangles = self
             .faces()
-            .map(|f| self.face_vertices(f).map(|v| vmap[v as usize]))
+            .map(|f| self.face_vertices(f).map(|v| vmap[v].raw()))
             .collect();
         let mesh = TriMesh::new(positions, triangles)
             .expect("a HalfEdgeMesh always has a face and finite positions");
@@ -362,12 +380,12 @@ impl HalfEdgeMesh {
     }
 
     /// Old → new vertex ids over the live vertices in order, and their positions.
-    fn compact_vertices(&self) -> (Vec<u32>, Vec<[f64; 3]>) {
-        let mut map = vec![INVALID; self.v_alive.len()];
+    fn compact_vertices(&self) -> (VertexData<VertexId>, Vec<[f64; 3]>) {
+        let mut map = VertexData::filled(self.v_alive.len(), VertexId::INVALID);
         let mut positions = Vec::with_capacity(self.n_vertices);
         for v in self.vertices() {
-            map[v as usize] = positions.len() as u32;
-            positions.push(self.positions[v as usize]);
+            map[v] = VertexId::new(positions.len() as u32);
+            positions.push(self.positions[v]);
         }
         (map, positions)
     }
@@ -378,45 +396,63 @@ impl HalfEdgeMesh {
     /// with the returned [`Compaction`]).
     pub fn garbage_collect(&mut self) -> Compaction {
         let (vertices, positions) = self.compact_vertices();
-        let faces = renumber(self.f_he.iter().map(|&h| h != INVALID));
-        let edges = renumber(
+        let faces: FaceData<FaceId> = renumber(self.f_he.as_slice().iter().map(|h| h.is_valid()));
+        let edges: EdgeData<EdgeId> = renumber(
             self.halfedges
+                .as_slice()
                 .iter()
                 .step_by(2)
-                .map(|x| x.origin != INVALID),
+                .map(|x| x.origin.is_valid()),
         );
-        let halfedges: Vec<u32> = (0..self.halfedges.len() as u32)
-            .map(|h| match edges[edge_of(h) as usize] {
-                INVALID => INVALID,
-                // The same half of the new edge as `h` is of its old edge.
-                e if halfedge_of(edge_of(h)) == h => halfedge_of(e),
-                e => twin(halfedge_of(e)),
-            })
-            .collect();
-        let map = |m: &[u32], x: u32| if x == INVALID { INVALID } else { m[x as usize] };
-        self.positions = positions;
-        self.v_out = self
-            .vertices()
-            .map(|v| map(&halfedges, self.v_out[v as usize]))
-            .collect();
-        self.v_alive = vec![true; self.n_vertices];
-        self.halfedges = self
-            .halfedges
-            .iter()
-            .filter(|x| x.origin != INVALID)
-            .map(|x| HalfEdge {
-                next: halfedges[x.next as usize],
-                prev: halfedges[x.prev as usize],
-                origin: vertices[x.origin as usize],
-                face: map(&faces, x.face),
-            })
-            .collect();
-        self.f_he = self
-            .f_he
-            .iter()
-            .filter(|&&h| h != INVALID)
-            .map(|&h| halfedges[h as usize])
-            .collect();
+        let halfedges: HalfedgeData<HalfedgeId> = HalfedgeData::from_vec(
+            self.halfedges
+                .ids()
+                .map(|h| match edges[h.edge()] {
+                    e if !e.is_valid() => HalfedgeId::INVALID,
+                    // The same half of the new edge as `h` is of its old edge.
+                    e if h.edge().halfedge() == h => e.halfedge(),
+                    e => e.halfedge().twin(),
+                })
+                .collect(),
+        );
+        let map_face = |x: FaceId| {
+            if x.is_valid() {
+                faces[x]
+            } else {
+                FaceId::INVALID
+            }
+        };
+        let map_he = |x: HalfedgeId| {
+            if x.is_valid() {
+                halfedges[x]
+            } else {
+                HalfedgeId::INVALID
+            }
+        };
+        self.positions = VertexData::from_vec(positions);
+        self.v_out = VertexData::from_vec(self.vertices().map(|v| map_he(self.v_out[v])).collect());
+        self.v_alive = VertexData::filled(self.n_vertices, true);
+        self.halfedges = HalfedgeData::from_vec(
+            self.halfedges
+                .as_slice()
+                .iter()
+                .filter(|x| x.origin.is_valid())
+                .map(|x| HalfEdge {
+                    next: halfedges[x.next],
+                    prev: halfedges[x.prev],
+                    origin: vertices[x.origin],
+                    face: map_face(x.face),
+                })
+                .collect(),
+        );
+        self.f_he = FaceData::from_vec(
+            self.f_he
+                .as_slice()
+                .iter()
+                .filter(|h| h.is_valid())
+                .map(|&h| halfedges[h])
+                .collect(),
+        );
         self.stamp = fresh_stamp();
         Compaction {
             vertices,
@@ -427,15 +463,17 @@ impl HalfEdgeMesh {
 }
 
 /// New ids for the `true` entries in order; `INVALID` for the others.
-fn renumber(live: impl Iterator<Item = bool>) -> Vec<u32> {
+fn renumber<I: ElementId>(live: impl Iterator<Item = bool>) -> IdVec<I, I> {
     let mut n = 0u32;
-    live.map(|l| {
-        if l {
-            n += 1;
-            n - 1
-        } else {
-            INVALID
-        }
-    })
-    .collect()
+    IdVec::from_vec(
+        live.map(|l| {
+            if l {
+                n += 1;
+                I::from_raw(n - 1)
+            } else {
+                I::from_raw(u32::MAX)
+            }
+        })
+        .collect(),
+    )
 }

@@ -1,6 +1,6 @@
 //! [`HalfEdgeMesh::check_invariants`]: a full O(mesh) consistency check.
 
-use super::{edge_of, halfedge_of, twin, HalfEdge, HalfEdgeMesh, INVALID};
+use super::{FaceData, HalfEdge, HalfEdgeMesh, VertexData, VertexId};
 use crate::{Error, Result};
 
 fn bug(msg: String) -> Error {
@@ -44,7 +44,7 @@ impl HalfEdgeMesh {
             "odd number of half-edge slots"
         );
         ensure!(
-            self.halfedges.len() < INVALID as usize && self.f_he.len() < INVALID as usize,
+            self.halfedges.len() < u32::MAX as usize && self.f_he.len() < u32::MAX as usize,
             "id range exceeded"
         );
         Ok(())
@@ -52,23 +52,23 @@ impl HalfEdgeMesh {
 
     fn check_halfedge_links(&self) -> Result<()> {
         let (nh, nv, nf) = (self.halfedges.len(), self.v_out.len(), self.f_he.len());
-        for h in 0..nh as u32 {
-            let x = self.halfedges[h as usize];
-            let t = self.halfedges[twin(h) as usize];
-            if x.origin == INVALID {
+        for h in self.halfedges.ids() {
+            let x = self.halfedges[h];
+            let t = self.halfedges[h.twin()];
+            if !x.origin.is_valid() {
                 ensure!(x == HalfEdge::DELETED, "deleted half-edge {h} has links");
                 ensure!(
-                    t.origin == INVALID,
+                    !t.origin.is_valid(),
                     "half-edge {h} is deleted but its twin is not"
                 );
                 continue;
             }
             ensure!(
-                t.origin != INVALID,
+                t.origin.is_valid(),
                 "half-edge {h} is live but its twin is deleted"
             );
             ensure!(
-                (x.origin as usize) < nv && self.v_alive[x.origin as usize],
+                x.origin.index() < nv && self.v_alive[x.origin],
                 "half-edge {h} leaves dead or out-of-range vertex {}",
                 x.origin
             );
@@ -78,13 +78,10 @@ impl HalfEdgeMesh {
                 x.origin
             );
             ensure!(
-                (x.next as usize) < nh && (x.prev as usize) < nh,
+                x.next.index() < nh && x.prev.index() < nh,
                 "half-edge {h} has next/prev out of range"
             );
-            let (n, p) = (
-                self.halfedges[x.next as usize],
-                self.halfedges[x.prev as usize],
-            );
+            let (n, p) = (self.halfedges[x.next], self.halfedges[x.prev]);
             ensure!(n.prev == h, "prev(next({h})) != {h}");
             ensure!(p.next == h, "next(prev({h})) != {h}");
             ensure!(
@@ -94,16 +91,16 @@ impl HalfEdgeMesh {
                 t.origin
             );
             ensure!(n.face == x.face, "next({h}) lies in another face");
-            if x.face == INVALID {
-                ensure!(t.face != INVALID, "edge {} has no face", edge_of(h));
+            if !x.face.is_valid() {
+                ensure!(t.face.is_valid(), "edge {} has no face", h.edge());
             } else {
                 ensure!(
-                    (x.face as usize) < nf && self.f_he[x.face as usize] != INVALID,
+                    x.face.index() < nf && self.f_he[x.face].is_valid(),
                     "half-edge {h} lies in dead or out-of-range face {}",
                     x.face
                 );
                 ensure!(
-                    self.halfedges[n.next as usize].next == h,
+                    self.halfedges[n.next].next == h,
                     "face {} of half-edge {h} is not a triangle",
                     x.face
                 );
@@ -113,30 +110,23 @@ impl HalfEdgeMesh {
     }
 
     fn check_faces(&self) -> Result<()> {
-        let mut per_face = vec![0u8; self.f_he.len()];
-        for x in &self.halfedges {
-            if x.origin != INVALID && x.face != INVALID {
-                per_face[x.face as usize] = per_face[x.face as usize].saturating_add(1);
+        let mut per_face = FaceData::filled(self.f_he.len(), 0u8);
+        for x in self.halfedges.as_slice() {
+            if x.origin.is_valid() && x.face.is_valid() {
+                per_face[x.face] = per_face[x.face].saturating_add(1);
             }
         }
-        for f in 0..self.f_he.len() as u32 {
-            let h = self.f_he[f as usize];
-            if h == INVALID {
-                ensure!(
-                    per_face[f as usize] == 0,
-                    "deleted face {f} still has half-edges"
-                );
+        for f in self.f_he.ids() {
+            let h = self.f_he[f];
+            if !h.is_valid() {
+                ensure!(per_face[f] == 0, "deleted face {f} still has half-edges");
                 continue;
             }
             ensure!(
-                (h as usize) < self.halfedges.len() && self.halfedges[h as usize].face == f,
+                h.index() < self.halfedges.len() && self.halfedges[h].face == f,
                 "face {f}'s half-edge {h} is not in it"
             );
-            ensure!(
-                per_face[f as usize] == 3,
-                "face {f} has {} half-edges",
-                per_face[f as usize]
-            );
+            ensure!(per_face[f] == 3, "face {f} has {} half-edges", per_face[f]);
             let [a, b, c] = self.face_vertices(f);
             ensure!(
                 a != b && b != c && a != c,
@@ -144,8 +134,8 @@ impl HalfEdgeMesh {
             );
         }
         for e in self.edges() {
-            let h = halfedge_of(e);
-            if let (Some(c), Some(d)) = (self.opposite_vertex(h), self.opposite_vertex(twin(h))) {
+            let h = e.halfedge();
+            if let (Some(c), Some(d)) = (self.opposite_vertex(h), self.opposite_vertex(h.twin())) {
                 ensure!(
                     c != d,
                     "the two faces of edge {e} have the same three vertices"
@@ -156,21 +146,21 @@ impl HalfEdgeMesh {
     }
 
     fn check_vertices(&self) -> Result<()> {
-        let mut out_count = vec![0u32; self.v_out.len()];
-        let mut boundary_out = vec![0u32; self.v_out.len()];
-        for x in &self.halfedges {
-            if x.origin != INVALID {
-                out_count[x.origin as usize] += 1;
-                boundary_out[x.origin as usize] += (x.face == INVALID) as u32;
+        let mut out_count = VertexData::filled(self.v_out.len(), 0u32);
+        let mut boundary_out = VertexData::filled(self.v_out.len(), 0u32);
+        for x in self.halfedges.as_slice() {
+            if x.origin.is_valid() {
+                out_count[x.origin] += 1;
+                boundary_out[x.origin] += (!x.face.is_valid()) as u32;
             }
         }
-        for v in 0..self.v_out.len() as u32 {
-            let (out, i) = (self.v_out[v as usize], v as usize);
+        for v in self.v_out.ids() {
+            let (out, i) = (self.v_out[v], v);
             ensure!(
                 self.positions[i].iter().all(|c| c.is_finite()),
                 "vertex {v} has a non-finite position"
             );
-            if out == INVALID {
+            if !out.is_valid() {
                 ensure!(
                     out_count[i] == 0,
                     "vertex {v} has edges but no outgoing half-edge"
@@ -182,7 +172,7 @@ impl HalfEdgeMesh {
                 "deleted vertex {v} has an outgoing half-edge"
             );
             ensure!(
-                (out as usize) < self.halfedges.len() && self.halfedges[out as usize].origin == v,
+                out.index() < self.halfedges.len() && self.halfedges[out].origin == v,
                 "outgoing half-edge {out} of vertex {v} does not leave it"
             );
             ensure!(
@@ -191,7 +181,7 @@ impl HalfEdgeMesh {
                 boundary_out[i]
             );
             ensure!(
-                boundary_out[i] == 0 || self.halfedges[out as usize].face == INVALID,
+                boundary_out[i] == 0 || !self.halfedges[out].face.is_valid(),
                 "boundary vertex {v}'s outgoing half-edge {out} is not its boundary half-edge"
             );
             let fan = self.rotate(out).take(out_count[i] as usize + 1).count();
@@ -207,14 +197,14 @@ impl HalfEdgeMesh {
     /// Two edges joining the same vertices would give some vertex two half-edges to the same
     /// neighbour. Needs single fans (checked before), so rotation visits every half-edge. O(n).
     fn check_no_duplicate_edges(&self) -> Result<()> {
-        let mut seen_from = vec![INVALID; self.v_out.len()];
+        let mut seen_from = VertexData::filled(self.v_out.len(), VertexId::INVALID);
         for v in self.vertices() {
             for h in self.outgoing(v) {
-                let t = self.target(h) as usize;
+                let t = self.target(h);
                 ensure!(
                     seen_from[t] != v,
                     "two edges join vertices {v} and {t} (one of them is edge {})",
-                    edge_of(h)
+                    h.edge()
                 );
                 seen_from[t] = v;
             }
@@ -223,8 +213,8 @@ impl HalfEdgeMesh {
     }
 
     fn check_counts(&self) -> Result<()> {
-        let nv = self.v_alive.iter().filter(|&&a| a).count();
-        let nf = self.f_he.iter().filter(|&&h| h != INVALID).count();
+        let nv = self.v_alive.as_slice().iter().filter(|&&a| a).count();
+        let nf = self.f_he.as_slice().iter().filter(|h| h.is_valid()).count();
         let ne = self.edges().count();
         ensure!(
             (nv, ne, nf) == (self.n_vertices, self.n_edges, self.n_faces),

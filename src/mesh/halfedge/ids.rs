@@ -53,6 +53,15 @@ macro_rules! id_type {
             pub const fn is_valid(self) -> bool {
                 self.0 != u32::MAX
             }
+
+            /// The raw indices of `ids`, without copying (for index-based boundaries such as
+            /// the BVH).
+            #[inline]
+            pub fn raw_slice(ids: &[$name]) -> &[u32] {
+                // SAFETY: `$name` is `#[repr(transparent)]` over `u32`, so `[$name]` and
+                // `[u32]` have the same layout, and the lifetime is carried over.
+                unsafe { std::slice::from_raw_parts(ids.as_ptr().cast::<u32>(), ids.len()) }
+            }
         }
 
         impl ElementId for $name {
@@ -234,6 +243,14 @@ impl<I: ElementId, T> IdVec<I, T> {
         self.data.fill(value);
     }
 
+    /// Grows or shrinks to `len` slots, filling new ones with `value`.
+    pub fn resize(&mut self, len: usize, value: T)
+    where
+        T: Clone,
+    {
+        self.data.resize(len, value);
+    }
+
     /// Keeps the first `len` slots.
     pub fn truncate(&mut self, len: usize) {
         self.data.truncate(len);
@@ -254,6 +271,20 @@ impl<I: ElementId, T> Default for IdVec<I, T> {
 impl<I: ElementId, T: fmt::Debug> fmt::Debug for IdVec<I, T> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_list().entries(&self.data).finish()
+    }
+}
+
+/// The container whose element `i` is `data[i]`.
+impl<I: ElementId, T> From<Vec<T>> for IdVec<I, T> {
+    fn from(data: Vec<T>) -> Self {
+        Self::from_vec(data)
+    }
+}
+
+/// Collects elements in id order (the first gets id 0).
+impl<I: ElementId, T> FromIterator<T> for IdVec<I, T> {
+    fn from_iter<It: IntoIterator<Item = T>>(iter: It) -> Self {
+        Self::from_vec(iter.into_iter().collect())
     }
 }
 

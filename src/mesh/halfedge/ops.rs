@@ -4,7 +4,7 @@
 use std::fmt;
 
 use super::{
-    check_finite, edge_of, fresh_stamp, halfedge_of, twin, HalfEdge, HalfEdgeMesh, INVALID,
+    check_finite, fresh_stamp, EdgeId, FaceId, HalfEdge, HalfEdgeMesh, HalfedgeId, VertexId,
 };
 use crate::{Error, Result};
 
@@ -21,7 +21,7 @@ pub enum Refusal {
     /// not opposite the edge in one of its faces, so the collapse would fold two edges into one.
     LinkCondition {
         /// The extra common neighbour.
-        vertex: u32,
+        vertex: VertexId,
     },
     /// Collapse: the edge belongs to a tetrahedron (a closed component of 4 faces), which cannot
     /// get smaller.
@@ -33,7 +33,7 @@ pub enum Refusal {
     /// boundary).
     Valence {
         /// The vertex concerned.
-        vertex: u32,
+        vertex: VertexId,
         /// Its valence after the operation.
         valence: usize,
     },
@@ -42,9 +42,9 @@ pub enum Refusal {
     /// Flip: the edge the flip would create already exists.
     EdgeExists {
         /// One end of the existing edge.
-        a: u32,
+        a: VertexId,
         /// The other end.
-        b: u32,
+        b: VertexId,
     },
 }
 
@@ -76,10 +76,14 @@ impl std::error::Error for Refusal {}
 /// One saved record, restored by [`HalfEdgeMesh::undo`].
 #[derive(Debug, Clone, Copy)]
 enum Saved {
-    HalfEdge(u32, HalfEdge),
-    Face(u32, u32),
-    Vertex { id: u32, out: u32, alive: bool },
-    Position(u32, [f64; 3]),
+    HalfEdge(HalfedgeId, HalfEdge),
+    Face(FaceId, HalfedgeId),
+    Vertex {
+        id: VertexId,
+        out: HalfedgeId,
+        alive: bool,
+    },
+    Position(VertexId, [f64; 3]),
 }
 
 /// What [`HalfEdgeMesh::undo`] needs to revert one operation: the previous values of the records
@@ -101,19 +105,19 @@ pub struct Undo {
 #[derive(Debug, Clone)]
 pub struct CollapseRecord {
     /// The surviving vertex: the origin of the collapsed half-edge, now at the new position.
-    pub kept_vertex: u32,
+    pub kept_vertex: VertexId,
     /// The deleted vertex: the target of the collapsed half-edge.
-    pub removed_vertex: u32,
+    pub removed_vertex: VertexId,
     /// The deleted faces (the one or two faces of the edge).
-    pub removed_faces: Vec<u32>,
+    pub removed_faces: Vec<FaceId>,
     /// The deleted edges: the collapsed edge first, then one edge per deleted face.
-    pub removed_edges: Vec<u32>,
+    pub removed_edges: Vec<EdgeId>,
     /// For each deleted face, `[deleted edge, surviving edge]`: the two edges from the face's
     /// third vertex that were merged into one (the surviving one joins it to `kept_vertex`).
-    pub merged_edges: Vec<[u32; 2]>,
+    pub merged_edges: Vec<[EdgeId; 2]>,
     /// Every face around `kept_vertex` after the collapse: exactly the live faces whose corners
     /// changed or moved (for BVH refits and error updates).
-    pub modified_faces: Vec<u32>,
+    pub modified_faces: Vec<FaceId>,
     /// Reverts the collapse (see [`HalfEdgeMesh::undo`]).
     pub undo: Undo,
 }
@@ -122,14 +126,14 @@ pub struct CollapseRecord {
 #[derive(Debug, Clone)]
 pub struct FlipRecord {
     /// The flipped edge (same id before and after).
-    pub edge: u32,
+    pub edge: EdgeId,
     /// Its endpoints before the flip.
-    pub old_vertices: [u32; 2],
+    pub old_vertices: [VertexId; 2],
     /// Its endpoints after the flip: the flipped half-edge now runs from `new_vertices[0]` to
     /// `new_vertices[1]`.
-    pub new_vertices: [u32; 2],
+    pub new_vertices: [VertexId; 2],
     /// The two faces, both modified (same ids before and after).
-    pub faces: [u32; 2],
+    pub faces: [FaceId; 2],
     /// Reverts the flip (see [`HalfEdgeMesh::undo`]).
     pub undo: Undo,
 }
@@ -151,84 +155,84 @@ impl<'a> Editor<'a> {
         }
     }
 
-    fn he_mut(&mut self, h: u32) -> &mut HalfEdge {
-        let old = self.m.halfedges[h as usize];
+    fn he_mut(&mut self, h: HalfedgeId) -> &mut HalfEdge {
+        let old = self.m.halfedges[h];
         self.saved.push(Saved::HalfEdge(h, old));
-        &mut self.m.halfedges[h as usize]
+        &mut self.m.halfedges[h]
     }
 
     /// `next(a) = b`, `prev(b) = a`.
-    fn link(&mut self, a: u32, b: u32) {
+    fn link(&mut self, a: HalfedgeId, b: HalfedgeId) {
         self.he_mut(a).next = b;
         self.he_mut(b).prev = a;
     }
 
-    fn set_face_halfedge(&mut self, f: u32, h: u32) {
-        let old = self.m.f_he[f as usize];
+    fn set_face_halfedge(&mut self, f: FaceId, h: HalfedgeId) {
+        let old = self.m.f_he[f];
         self.saved.push(Saved::Face(f, old));
-        self.m.f_he[f as usize] = h;
+        self.m.f_he[f] = h;
     }
 
-    fn set_vertex(&mut self, v: u32, out: u32, alive: bool) {
-        let (old_out, old_alive) = (self.m.v_out[v as usize], self.m.v_alive[v as usize]);
+    fn set_vertex(&mut self, v: VertexId, out: HalfedgeId, alive: bool) {
+        let (old_out, old_alive) = (self.m.v_out[v], self.m.v_alive[v]);
         self.saved.push(Saved::Vertex {
             id: v,
             out: old_out,
             alive: old_alive,
         });
-        self.m.v_out[v as usize] = out;
-        self.m.v_alive[v as usize] = alive;
+        self.m.v_out[v] = out;
+        self.m.v_alive[v] = alive;
     }
 
-    fn set_out(&mut self, v: u32, out: u32) {
+    fn set_out(&mut self, v: VertexId, out: HalfedgeId) {
         self.set_vertex(v, out, true);
     }
 
-    fn set_position(&mut self, v: u32, p: [f64; 3]) {
-        let old = self.m.positions[v as usize];
+    fn set_position(&mut self, v: VertexId, p: [f64; 3]) {
+        let old = self.m.positions[v];
         self.saved.push(Saved::Position(v, old));
-        self.m.positions[v as usize] = p;
+        self.m.positions[v] = p;
     }
 
     /// Puts `by` in the place of `t` in `t`'s loop (face or boundary), taking over its face.
-    fn replace_in_loop(&mut self, t: u32, by: u32) {
-        let x = self.m.halfedges[t as usize];
+    fn replace_in_loop(&mut self, t: HalfedgeId, by: HalfedgeId) {
+        let x = self.m.halfedges[t];
         self.link(x.prev, by);
         self.link(by, x.next);
         self.he_mut(by).face = x.face;
-        if x.face != INVALID && self.m.f_he[x.face as usize] == t {
+        if x.face.is_valid() && self.m.f_he[x.face] == t {
             self.set_face_halfedge(x.face, by);
         }
     }
 
-    fn delete_edge(&mut self, e: u32) {
-        let h = halfedge_of(e);
+    fn delete_edge(&mut self, e: EdgeId) {
+        let h = e.halfedge();
         *self.he_mut(h) = HalfEdge::DELETED;
-        *self.he_mut(twin(h)) = HalfEdge::DELETED;
+        *self.he_mut(h.twin()) = HalfEdge::DELETED;
         self.m.n_edges -= 1;
     }
 
-    fn delete_face(&mut self, f: u32) {
-        self.set_face_halfedge(f, INVALID);
+    fn delete_face(&mut self, f: FaceId) {
+        self.set_face_halfedge(f, HalfedgeId::INVALID);
         self.m.n_faces -= 1;
     }
 
-    fn delete_vertex(&mut self, v: u32) {
-        self.set_vertex(v, INVALID, false);
+    fn delete_vertex(&mut self, v: VertexId) {
+        self.set_vertex(v, HalfedgeId::INVALID, false);
         self.m.n_vertices -= 1;
     }
 
     /// Makes `v`'s outgoing half-edge its boundary half-edge if it has one (rotating from `start`,
     /// a live half-edge leaving `v`), else keeps a live one.
-    fn fix_outgoing(&mut self, v: u32, start: u32) {
+    fn fix_outgoing(&mut self, v: VertexId, start: HalfedgeId) {
         let boundary = self
             .m
             .rotate(start)
             .find(|&h| self.m.is_boundary_halfedge(h));
-        let cur = self.m.v_out[v as usize];
+        let cur = self.m.v_out[v];
         let want = match boundary {
             Some(b) => b,
-            None if cur != INVALID && self.m.halfedges[cur as usize].origin == v => cur,
+            None if cur.is_valid() && self.m.halfedges[cur].origin == v => cur,
             None => start,
         };
         if want != cur {
@@ -251,12 +255,12 @@ impl<'a> Editor<'a> {
 
 impl HalfEdgeMesh {
     /// The vertex opposite half-edge `h` in its face (`None` for a boundary half-edge).
-    pub(super) fn opposite_vertex(&self, h: u32) -> Option<u32> {
+    pub(super) fn opposite_vertex(&self, h: HalfedgeId) -> Option<VertexId> {
         self.face(h).map(|_| self.target(self.next(h)))
     }
 
     /// Minimum valence of a manifold vertex: 3 inside, 2 on the boundary.
-    fn min_valence(&self, v: u32) -> usize {
+    fn min_valence(&self, v: VertexId) -> usize {
         if self.is_boundary_vertex(v) {
             2
         } else {
@@ -275,11 +279,11 @@ impl HalfEdgeMesh {
     /// lone triangle; and, as a safeguard, a vertex left below valence 3 (2 on the boundary).
     /// Panics if `h` is out of range.
     #[track_caller]
-    pub fn can_collapse(&self, h: u32) -> std::result::Result<(), Refusal> {
+    pub fn can_collapse(&self, h: HalfedgeId) -> std::result::Result<(), Refusal> {
         if !self.is_halfedge_live(h) {
             return Err(Refusal::Deleted);
         }
-        let o = twin(h);
+        let o = h.twin();
         let (a, b) = (self.origin(h), self.origin(o));
         let (c, d) = (self.opposite_vertex(h), self.opposite_vertex(o));
         let interior = c.is_some() && d.is_some();
@@ -290,7 +294,7 @@ impl HalfEdgeMesh {
         match (c, d) {
             (Some(c), Some(d)) => self.check_not_tetrahedron(a, b, c, d)?,
             (Some(x), None) | (None, Some(x)) => self.check_not_lone_triangle(a, b, x)?,
-            (None, None) => unreachable!("live edge {} has no face", edge_of(h)),
+            (None, None) => unreachable!("live edge {} has no face", h.edge()),
         }
         self.check_collapse_valences([a, b], valences, c, d, interior)
     }
@@ -299,12 +303,12 @@ impl HalfEdgeMesh {
     /// Returns the valences of `a` and `b`.
     fn check_common_neighbours(
         &self,
-        a: u32,
-        b: u32,
-        c: Option<u32>,
-        d: Option<u32>,
+        a: VertexId,
+        b: VertexId,
+        c: Option<VertexId>,
+        d: Option<VertexId>,
     ) -> std::result::Result<[usize; 2], Refusal> {
-        let mut around_a: Vec<u32> = self.vertex_neighbors(a).collect();
+        let mut around_a: Vec<VertexId> = self.vertex_neighbors(a).collect();
         around_a.sort_unstable();
         let mut valence_b = 0;
         for x in self.vertex_neighbors(b) {
@@ -320,13 +324,13 @@ impl HalfEdgeMesh {
     /// `a, b, c, d` a tetrahedron).
     fn check_not_tetrahedron(
         &self,
-        a: u32,
-        b: u32,
-        c: u32,
-        d: u32,
+        a: VertexId,
+        b: VertexId,
+        c: VertexId,
+        d: VertexId,
     ) -> std::result::Result<(), Refusal> {
         if let Some(cd) = self.find_halfedge(c, d) {
-            let (x, y) = (self.opposite_vertex(cd), self.opposite_vertex(twin(cd)));
+            let (x, y) = (self.opposite_vertex(cd), self.opposite_vertex(cd.twin()));
             if (x == Some(a) && y == Some(b)) || (x == Some(b) && y == Some(a)) {
                 return Err(Refusal::Tetrahedron);
             }
@@ -336,10 +340,15 @@ impl HalfEdgeMesh {
 
     /// Link condition with the virtual boundary vertex: for boundary edge `a–b` with face
     /// `a, b, x`, edges `a–x` and `b–x` must not both be on the boundary.
-    fn check_not_lone_triangle(&self, a: u32, b: u32, x: u32) -> std::result::Result<(), Refusal> {
-        let on_boundary = |u: u32| {
+    fn check_not_lone_triangle(
+        &self,
+        a: VertexId,
+        b: VertexId,
+        x: VertexId,
+    ) -> std::result::Result<(), Refusal> {
+        let on_boundary = |u: VertexId| {
             self.find_halfedge(u, x)
-                .is_some_and(|h| self.is_boundary_edge(edge_of(h)))
+                .is_some_and(|h| self.is_boundary_edge(h.edge()))
         };
         if on_boundary(a) && on_boundary(b) {
             Err(Refusal::IsolatedTriangle)
@@ -352,10 +361,10 @@ impl HalfEdgeMesh {
     /// keep a manifold valence.
     fn check_collapse_valences(
         &self,
-        [a, b]: [u32; 2],
+        [a, b]: [VertexId; 2],
         [valence_a, valence_b]: [usize; 2],
-        c: Option<u32>,
-        d: Option<u32>,
+        c: Option<VertexId>,
+        d: Option<VertexId>,
         interior: bool,
     ) -> std::result::Result<(), Refusal> {
         let faces = 1 + interior as usize;
@@ -392,7 +401,11 @@ impl HalfEdgeMesh {
     /// [`can_collapse`](Self::can_collapse) refuses or `new_position` is not finite. Panics if
     /// `h` is out of range.
     #[track_caller]
-    pub fn collapse_edge(&mut self, h: u32, new_position: [f64; 3]) -> Result<CollapseRecord> {
+    pub fn collapse_edge(
+        &mut self,
+        h: HalfedgeId,
+        new_position: [f64; 3],
+    ) -> Result<CollapseRecord> {
         if let Err(r) = self.can_collapse(h) {
             return Err(Error::InvalidArgument(format!(
                 "cannot collapse half-edge {h} ({}→{}): {r}",
@@ -406,43 +419,43 @@ impl HalfEdgeMesh {
         Ok(self.apply_collapse(h, new_position))
     }
 
-    pub(super) fn apply_collapse(&mut self, h: u32, p: [f64; 3]) -> CollapseRecord {
-        let o = twin(h);
+    pub(super) fn apply_collapse(&mut self, h: HalfedgeId, p: [f64; 3]) -> CollapseRecord {
+        let o = h.twin();
         let (a, b) = (self.origin(h), self.origin(o));
-        let around_b: Vec<u32> = self.outgoing(b).collect();
+        let around_b: Vec<HalfedgeId> = self.outgoing(b).collect();
         let (fl, fr) = (self.face(h), self.face(o));
         let mut removed_faces = Vec::with_capacity(2);
         let mut merged_edges = Vec::with_capacity(2);
         // A live half-edge leaving `a` after the collapse, to restore boundary-first from.
-        let mut a_start = INVALID;
+        let mut a_start = HalfedgeId::INVALID;
         let mut ed = Editor::new(self);
         if let Some(f) = fl {
             // Face a→b→c: edge b–c (h1 and its twin t1) goes, h2 = c→a takes t1's place.
             let (h1, h2) = (ed.m.next(h), ed.m.prev(h));
-            let (t1, c) = (twin(h1), ed.m.origin(h2));
+            let (t1, c) = (h1.twin(), ed.m.origin(h2));
             ed.replace_in_loop(t1, h2);
-            if ed.m.v_out[c as usize] == t1 {
+            if ed.m.v_out[c] == t1 {
                 ed.set_out(c, h2);
             }
             removed_faces.push(f);
-            merged_edges.push([edge_of(h1), edge_of(h2)]);
-            a_start = twin(h2);
+            merged_edges.push([h1.edge(), h2.edge()]);
+            a_start = h2.twin();
         }
         if let Some(f) = fr {
             // Face b→a→d: edge d–b (o2 and its twin t2) goes, o1 = a→d takes t2's place.
             let (o1, o2) = (ed.m.next(o), ed.m.prev(o));
-            let (t2, d) = (twin(o2), ed.m.origin(o2));
+            let (t2, d) = (o2.twin(), ed.m.origin(o2));
             ed.replace_in_loop(t2, o1);
-            if ed.m.v_out[d as usize] == o2 {
-                ed.set_out(d, twin(o1));
+            if ed.m.v_out[d] == o2 {
+                ed.set_out(d, o1.twin());
             }
             removed_faces.push(f);
-            merged_edges.push([edge_of(o2), edge_of(o1)]);
+            merged_edges.push([o2.edge(), o1.edge()]);
             a_start = o1;
         }
         // A boundary side of the edge: splice it out of its boundary loop.
         for x in [h, o] {
-            if ed.m.halfedges[x as usize].face == INVALID {
+            if !ed.m.halfedges[x].face.is_valid() {
                 let (p, n) = (ed.m.prev(x), ed.m.next(x));
                 ed.link(p, n);
             }
@@ -453,7 +466,7 @@ impl HalfEdgeMesh {
         for &f in &removed_faces {
             ed.delete_face(f);
         }
-        ed.delete_edge(edge_of(h));
+        ed.delete_edge(h.edge());
         for &[gone, _] in &merged_edges {
             ed.delete_edge(gone);
         }
@@ -461,7 +474,7 @@ impl HalfEdgeMesh {
         ed.fix_outgoing(a, a_start);
         ed.set_position(a, p);
         let undo = ed.finish();
-        let mut removed_edges = vec![edge_of(h)];
+        let mut removed_edges = vec![h.edge()];
         removed_edges.extend(merged_edges.iter().map(|m| m[0]));
         CollapseRecord {
             kept_vertex: a,
@@ -481,11 +494,11 @@ impl HalfEdgeMesh {
     /// valence 2 inside the surface (valence 3 before; a boundary endpoint may drop to 2).
     /// Panics if `h` is out of range.
     #[track_caller]
-    pub fn can_flip(&self, h: u32) -> std::result::Result<(), Refusal> {
+    pub fn can_flip(&self, h: HalfedgeId) -> std::result::Result<(), Refusal> {
         if !self.is_halfedge_live(h) {
             return Err(Refusal::Deleted);
         }
-        let o = twin(h);
+        let o = h.twin();
         let (Some(c), Some(d)) = (self.opposite_vertex(h), self.opposite_vertex(o)) else {
             return Err(Refusal::BoundaryEdge);
         };
@@ -514,7 +527,7 @@ impl HalfEdgeMesh {
     /// [`Error::InvalidArgument`] (leaving the mesh untouched) when [`can_flip`](Self::can_flip)
     /// refuses. Panics if `h` is out of range.
     #[track_caller]
-    pub fn flip_edge(&mut self, h: u32) -> Result<FlipRecord> {
+    pub fn flip_edge(&mut self, h: HalfedgeId) -> Result<FlipRecord> {
         if let Err(r) = self.can_flip(h) {
             return Err(Error::InvalidArgument(format!(
                 "cannot flip half-edge {h} ({}→{}): {r}",
@@ -525,16 +538,13 @@ impl HalfEdgeMesh {
         Ok(self.apply_flip(h))
     }
 
-    pub(super) fn apply_flip(&mut self, h: u32) -> FlipRecord {
-        let o = twin(h);
+    pub(super) fn apply_flip(&mut self, h: HalfedgeId) -> FlipRecord {
+        let o = h.twin();
         let (h1, h2) = (self.next(h), self.prev(h)); // b→c, c→a
         let (o1, o2) = (self.next(o), self.prev(o)); // a→d, d→b
         let (a, b) = (self.origin(h), self.origin(o));
         let (c, d) = (self.origin(h2), self.origin(o2));
-        let (fl, fr) = (
-            self.halfedges[h as usize].face,
-            self.halfedges[o as usize].face,
-        );
+        let (fl, fr) = (self.halfedges[h].face, self.halfedges[o].face);
         let mut ed = Editor::new(self);
         // Face fl: c→d (h), d→b (o2), b→c (h1). Face fr: d→c (o), c→a (h2), a→d (o1).
         ed.he_mut(h).origin = c;
@@ -549,14 +559,14 @@ impl HalfEdgeMesh {
         ed.he_mut(h2).face = fr;
         ed.set_face_halfedge(fl, h);
         ed.set_face_halfedge(fr, o);
-        if ed.m.v_out[a as usize] == h {
+        if ed.m.v_out[a] == h {
             ed.set_out(a, o1);
         }
-        if ed.m.v_out[b as usize] == o {
+        if ed.m.v_out[b] == o {
             ed.set_out(b, h1);
         }
         FlipRecord {
-            edge: edge_of(h),
+            edge: h.edge(),
             old_vertices: [a, b],
             new_vertices: [c, d],
             faces: [fl, fr],
@@ -578,13 +588,13 @@ impl HalfEdgeMesh {
         }
         for s in undo.saved.iter().rev() {
             match *s {
-                Saved::HalfEdge(h, x) => self.halfedges[h as usize] = x,
-                Saved::Face(f, h) => self.f_he[f as usize] = h,
+                Saved::HalfEdge(h, x) => self.halfedges[h] = x,
+                Saved::Face(f, h) => self.f_he[f] = h,
                 Saved::Vertex { id, out, alive } => {
-                    self.v_out[id as usize] = out;
-                    self.v_alive[id as usize] = alive;
+                    self.v_out[id] = out;
+                    self.v_alive[id] = alive;
                 }
-                Saved::Position(v, p) => self.positions[v as usize] = p,
+                Saved::Position(v, p) => self.positions[v] = p,
             }
         }
         [self.n_vertices, self.n_edges, self.n_faces] = undo.counts;

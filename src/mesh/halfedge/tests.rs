@@ -3,6 +3,18 @@ use std::collections::HashMap;
 use super::*;
 use crate::mesh::TriMesh;
 
+fn vid(i: u32) -> VertexId {
+    VertexId::new(i)
+}
+
+fn fid(i: u32) -> FaceId {
+    FaceId::new(i)
+}
+
+fn hid(i: u32) -> HalfedgeId {
+    HalfedgeId::new(i)
+}
+
 // ---------------------------------------------------------------------------------------------
 // Test meshes.
 
@@ -176,11 +188,11 @@ impl Lcg {
 /// Every stored record, to compare states exactly (the stamps aside).
 #[derive(Debug, PartialEq)]
 struct State {
-    positions: Vec<[f64; 3]>,
-    v_out: Vec<u32>,
-    v_alive: Vec<bool>,
-    halfedges: Vec<HalfEdge>,
-    f_he: Vec<u32>,
+    positions: VertexData<[f64; 3]>,
+    v_out: VertexData<HalfedgeId>,
+    v_alive: VertexData<bool>,
+    halfedges: HalfedgeData<HalfEdge>,
+    f_he: FaceData<HalfedgeId>,
     counts: [usize; 3],
 }
 
@@ -195,7 +207,7 @@ fn state(m: &HalfEdgeMesh) -> State {
     }
 }
 
-fn midpoint(m: &HalfEdgeMesh, h: u32) -> [f64; 3] {
+fn midpoint(m: &HalfEdgeMesh, h: HalfedgeId) -> [f64; 3] {
     let (a, b) = (m.position(m.origin(h)), m.position(m.target(h)));
     [
         (a[0] + b[0]) / 2.0,
@@ -204,9 +216,9 @@ fn midpoint(m: &HalfEdgeMesh, h: u32) -> [f64; 3] {
     ]
 }
 
-fn random_live_halfedge(m: &HalfEdgeMesh, rng: &mut Lcg) -> u32 {
+fn random_live_halfedge(m: &HalfEdgeMesh, rng: &mut Lcg) -> HalfedgeId {
     loop {
-        let h = rng.below(m.halfedge_capacity()) as u32;
+        let h = hid(rng.below(m.halfedge_capacity()) as u32);
         if m.is_halfedge_live(h) {
             return h;
         }
@@ -248,7 +260,7 @@ fn builds_open_grid_with_boundary_first_vertices() {
     let he = build(&g);
     assert_eq!(he.euler_characteristic(), 1);
     assert_eq!(he.boundary_loop_count(), 1);
-    let boundary: Vec<u32> = he
+    let boundary: Vec<_> = he
         .vertices()
         .filter(|&v| he.is_boundary_vertex(v))
         .collect();
@@ -257,24 +269,25 @@ fn builds_open_grid_with_boundary_first_vertices() {
     assert_eq!(boundary_edges as u32, 2 * (nx + ny));
     // Faces around each vertex, from the half-edge structure and by brute force.
     for v in he.vertices() {
-        let out: Vec<u32> = he.outgoing(v).collect();
+        let out: Vec<_> = he.outgoing(v).collect();
         assert_eq!(he.is_boundary_halfedge(out[0]), he.is_boundary_vertex(v));
         assert!(out[1..].iter().all(|&h| !he.is_boundary_halfedge(h)));
-        let mut faces: Vec<u32> = he.vertex_faces(v).collect();
+        let mut faces: Vec<_> = he.vertex_faces(v).collect();
         faces.sort_unstable();
-        let brute: Vec<u32> = (0..g.triangle_count() as u32)
-            .filter(|&f| g.triangles()[f as usize].contains(&v))
+        let brute: Vec<_> = (0..g.triangle_count() as u32)
+            .filter(|&f| g.triangles()[f as usize].contains(&v.raw()))
+            .map(fid)
             .collect();
         assert_eq!(faces, brute, "faces around vertex {v}");
-        let nb: Vec<u32> = he.vertex_neighbors(v).collect();
+        let nb: Vec<_> = he.vertex_neighbors(v).collect();
         assert_eq!(nb.len(), he.valence(v));
         for (&h, &n) in out.iter().zip(&nb) {
             assert_eq!(he.find_halfedge(v, n), Some(h));
         }
     }
     // The corner vertex (0, 0) has 2 faces (its cell's diagonal leaves it) and valence 3.
-    assert_eq!(he.vertex_faces(0).count(), 2);
-    assert_eq!(he.valence(0), 3);
+    assert_eq!(he.vertex_faces(vid(0)).count(), 2);
+    assert_eq!(he.valence(vid(0)), 3);
     assert_eq!(he.to_trimesh(), g);
 }
 
@@ -287,16 +300,19 @@ fn navigation_on_tetrahedron() {
         assert_eq!(m.prev(m.next(h)), h);
         assert_eq!(m.target(h), m.origin(m.twin(h)));
         assert_eq!(m.origin(m.next(h)), m.target(h));
-        assert_eq!(m.edge_halfedge(m.edge(h)), h & !1);
+        assert_eq!(m.edge_halfedge(m.edge(h)).raw(), h.raw() & !1);
         let f = m.face(h).unwrap();
         assert!(m.face_halfedges(f).contains(&h));
     }
-    assert_eq!(m.face_vertices(0), [0, 2, 1]);
-    assert_eq!(m.face_halfedge(0), m.find_halfedge(0, 2).unwrap());
-    assert_eq!(m.find_halfedge(1, 1), None);
+    assert_eq!(m.face_vertices(fid(0)), [0, 2, 1].map(vid));
+    assert_eq!(
+        m.face_halfedge(fid(0)),
+        m.find_halfedge(vid(0), vid(2)).unwrap()
+    );
+    assert_eq!(m.find_halfedge(vid(1), vid(1)), None);
     // Face 0 = (0, 2, 1) lies in z = 0 with its normal pointing down (outwards).
-    assert_eq!(m.face_normal(0).to_array(), [0., 0., -1.]);
-    assert!((m.face_area(0) - 0.5).abs() < 1e-15);
+    assert_eq!(m.face_normal(fid(0)).to_array(), [0., 0., -1.]);
+    assert!((m.face_area(fid(0)) - 0.5).abs() < 1e-15);
     let total: f64 = m.faces().map(|f| m.face_area(f)).sum();
     assert!((total - tet().surface_area()).abs() < 1e-12);
     for f in m.faces() {
@@ -314,43 +330,43 @@ fn positions_and_isolated_vertices() {
     p.push([5., 5., 5.]);
     let src = TriMesh::new(p, tet().triangles().to_vec()).unwrap();
     let mut m = build(&src);
-    assert!(m.is_isolated_vertex(4));
-    assert_eq!(m.vertex_halfedge(4), None);
-    assert_eq!(m.outgoing(4).count(), 0);
-    assert!(!m.is_boundary_vertex(4));
+    assert!(m.is_isolated_vertex(vid(4)));
+    assert_eq!(m.vertex_halfedge(vid(4)), None);
+    assert_eq!(m.outgoing(vid(4)).count(), 0);
+    assert!(!m.is_boundary_vertex(vid(4)));
     assert_eq!(m.vertex_count(), 5);
     assert_eq!(m.euler_characteristic(), 3);
     assert_eq!(m.to_trimesh(), src);
-    m.set_position(1, [2., 0., 0.]).unwrap();
-    assert_eq!(m.position(1), [2., 0., 0.]);
-    let err = m.set_position(1, [f64::NAN, 0., 0.]).unwrap_err();
+    m.set_position(vid(1), [2., 0., 0.]).unwrap();
+    assert_eq!(m.position(vid(1)), [2., 0., 0.]);
+    let err = m.set_position(vid(1), [f64::NAN, 0., 0.]).unwrap_err();
     assert!(err.to_string().contains("vertex 1"), "{err}");
-    assert_eq!(m.position(1), [2., 0., 0.]);
+    assert_eq!(m.position(vid(1)), [2., 0., 0.]);
 }
 
 #[test]
 #[should_panic(expected = "half-edge id 12 is out of range")]
 fn out_of_range_id_panics_clearly() {
-    build(&tet()).next(12);
+    build(&tet()).next(hid(12));
 }
 
 #[test]
 fn deleted_ids_do_not_panic() {
     let mut m = build(&icosphere(1));
     let h = m
-        .find_halfedge(0, m.vertex_neighbors(0).next().unwrap())
+        .find_halfedge(vid(0), m.vertex_neighbors(vid(0)).next().unwrap())
         .unwrap();
-    let r = m.collapse_edge(h, m.position(0)).unwrap();
+    let r = m.collapse_edge(h, m.position(vid(0))).unwrap();
     let (v, f, e) = (r.removed_vertex, r.removed_faces[0], r.removed_edges[0]);
     assert!(!m.is_vertex_live(v) && !m.is_face_live(f) && !m.is_edge_live(e));
     assert_eq!(m.vertex_halfedge(v), None);
     assert_eq!(m.outgoing(v).count(), 0);
-    assert_eq!(m.face_vertices(f), [INVALID; 3]);
-    assert_eq!(m.next(halfedge_of(e)), INVALID);
-    assert_eq!(m.face(halfedge_of(e)), None);
-    assert!(!m.is_boundary_halfedge(halfedge_of(e)) && !m.is_boundary_edge(e));
-    assert_eq!(m.can_collapse(halfedge_of(e)), Err(Refusal::Deleted));
-    assert_eq!(m.can_flip(halfedge_of(e)), Err(Refusal::Deleted));
+    assert_eq!(m.face_vertices(f), [VertexId::INVALID; 3]);
+    assert_eq!(m.next(e.halfedge()), HalfedgeId::INVALID);
+    assert_eq!(m.face(e.halfedge()), None);
+    assert!(!m.is_boundary_halfedge(e.halfedge()) && !m.is_boundary_edge(e));
+    assert_eq!(m.can_collapse(e.halfedge()), Err(Refusal::Deleted));
+    assert_eq!(m.can_flip(e.halfedge()), Err(Refusal::Deleted));
     assert!(m.set_position(v, [0.; 3]).is_err());
 }
 
@@ -365,14 +381,14 @@ fn assert_detects(m: &HalfEdgeMesh, what: &str) {
 fn check_invariants_detects_corruption() {
     let good = build(&grid(3, 3));
     let mut m = good.clone();
-    let n = m.halfedges[0].next;
-    m.halfedges[0].next = m.halfedges[n as usize].next;
+    let n = m.halfedges[hid(0)].next;
+    m.halfedges[hid(0)].next = m.halfedges[n].next;
     assert_detects(&m, "prev(next(0))");
 
     let mut m = good.clone();
-    let v = 1; // on the bottom border
+    let v = vid(1); // on the bottom border
     let inner = m.outgoing(v).nth(1).unwrap();
-    m.v_out[v as usize] = inner;
+    m.v_out[v] = inner;
     assert_detects(&m, "is not its boundary half-edge");
 
     let mut m = good.clone();
@@ -380,16 +396,16 @@ fn check_invariants_detects_corruption() {
     assert_detects(&m, "live counts");
 
     let mut m = good.clone();
-    m.positions[4][1] = f64::INFINITY;
+    m.positions[vid(4)][1] = f64::INFINITY;
     assert_detects(&m, "vertex 4 has a non-finite position");
 
     let mut m = good.clone();
-    m.halfedges[3] = HalfEdge::DELETED;
+    m.halfedges[hid(3)] = HalfEdge::DELETED;
     assert_detects(&m, "half-edge 2 is live but its twin is deleted");
 
     // Unchecked operations that the guards refuse break the invariants detectably.
     let mut t = build(&tet());
-    t.apply_flip(0);
+    t.apply_flip(hid(0));
     assert_detects(&t, "have the same three vertices");
     // A flip onto an existing edge c–d whose faces avoid a and b duplicates only the edge.
     let (mut m, _) = random_ops(&icosphere(2), 400, 21);
@@ -399,15 +415,15 @@ fn check_invariants_detects_corruption() {
         };
         let cd = m.find_halfedge(c, d).unwrap();
         let ab = [Some(m.origin(h)), Some(m.target(h))];
-        !ab.contains(&m.opposite_vertex(cd)) && !ab.contains(&m.opposite_vertex(twin(cd)))
+        !ab.contains(&m.opposite_vertex(cd)) && !ab.contains(&m.opposite_vertex(cd.twin()))
     });
     m.apply_flip(dup.expect("some flip would duplicate an edge"));
     assert_detects(&m, "two edges join vertices");
     let mut t = build(&tet());
-    t.apply_collapse(0, [0.; 3]);
+    t.apply_collapse(hid(0), [0.; 3]);
     assert!(t.check_invariants().is_err());
     let mut g = build(&grid(3, 3));
-    g.apply_collapse(g.find_halfedge(2, 7).unwrap(), [0.; 3]);
+    g.apply_collapse(g.find_halfedge(vid(2), vid(7)).unwrap(), [0.; 3]);
     assert!(
         g.check_invariants().is_err(),
         "a boundary pinch must be detected"
@@ -506,7 +522,7 @@ fn collapse_record_and_undo_on_icosphere() {
     let before = state(&m);
     let before_mesh = m.to_trimesh();
     let h = m
-        .find_halfedge(0, m.vertex_neighbors(0).next().unwrap())
+        .find_halfedge(vid(0), m.vertex_neighbors(vid(0)).next().unwrap())
         .unwrap();
     let (a, b) = (m.origin(h), m.target(h));
     let valence = m.valence(a) + m.valence(b) - 4;
@@ -516,10 +532,10 @@ fn collapse_record_and_undo_on_icosphere() {
     assert_eq!((r.kept_vertex, r.removed_vertex), (a, b));
     assert_eq!(r.removed_faces.len(), 2);
     assert_eq!(r.removed_edges.len(), 3);
-    assert_eq!(r.removed_edges[0], edge_of(h));
+    assert_eq!(r.removed_edges[0], h.edge());
     assert_eq!(m.position(a), p);
     assert_eq!(m.valence(a), valence);
-    let mut around: Vec<u32> = m.vertex_faces(a).collect();
+    let mut around: Vec<_> = m.vertex_faces(a).collect();
     let mut modified = r.modified_faces.clone();
     around.sort_unstable();
     modified.sort_unstable();
@@ -575,7 +591,7 @@ fn undo_stack_and_stale_records() {
     // A record undone once is stale afterwards, even when a later operation reuses the stamp
     // position.
     let h = m
-        .find_halfedge(0, m.vertex_neighbors(0).next().unwrap())
+        .find_halfedge(vid(0), m.vertex_neighbors(vid(0)).next().unwrap())
         .unwrap();
     let r1 = m.flip_edge(h).unwrap();
     let again = r1.undo.clone();
@@ -590,19 +606,19 @@ fn undo_stack_and_stale_records() {
 fn flip_on_octahedron_like_patch() {
     let mut m = build(&icosphere(0));
     let before = state(&m);
-    let h = m.find_halfedge(0, 11).unwrap();
-    let (c, d) = (m.target(m.next(h)), m.target(m.next(twin(h))));
+    let h = m.find_halfedge(vid(0), vid(11)).unwrap();
+    let (c, d) = (m.target(m.next(h)), m.target(m.next(h.twin())));
     let fl = m.face(h).unwrap();
     let r = m.flip_edge(h).unwrap();
     m.check_invariants().unwrap();
-    assert_eq!(r.old_vertices, [0, 11]);
+    assert_eq!(r.old_vertices, [vid(0), vid(11)]);
     assert_eq!(r.new_vertices, [c, d]);
     assert_eq!((m.origin(h), m.target(h)), (c, d));
     assert_eq!(m.face(h), Some(fl));
-    assert_eq!(m.find_halfedge(0, 11), None);
-    assert_eq!(m.valence(0), 4);
+    assert_eq!(m.find_halfedge(vid(0), vid(11)), None);
+    assert_eq!(m.valence(vid(0)), 4);
     // Flipping back restores the connectivity (not necessarily the same records).
-    assert_eq!(m.can_flip(twin(h)), Ok(()));
+    assert_eq!(m.can_flip(h.twin()), Ok(()));
     m.undo(r.undo).unwrap();
     assert_eq!(state(&m), before);
 }
@@ -636,24 +652,27 @@ fn specific_refusals() {
     // Grid: an interior edge between two boundary vertices pinches; boundary edges don't flip.
     let mut g = build(&grid(3, 3));
     // Diagonal of the corner cell (2, 0): from (2, 0) to (3, 1), both on the boundary.
-    let pinch = g.find_halfedge(2, 7).unwrap();
-    assert!(!g.is_boundary_edge(edge_of(pinch)));
+    let pinch = g.find_halfedge(vid(2), vid(7)).unwrap();
+    assert!(!g.is_boundary_edge(pinch.edge()));
     assert_eq!(g.can_collapse(pinch), Err(Refusal::BoundaryPinch));
-    assert_eq!(g.can_collapse(twin(pinch)), Err(Refusal::BoundaryPinch));
-    let inner = g.find_halfedge(1, 5).unwrap(); // boundary vertex 1 to interior vertex 5
+    assert_eq!(g.can_collapse(pinch.twin()), Err(Refusal::BoundaryPinch));
+    let inner = g.find_halfedge(vid(1), vid(5)).unwrap(); // boundary vertex 1 to interior vertex 5
     assert_eq!(g.can_collapse(inner), Ok(()));
-    let border = g.find_halfedge(0, 1).unwrap();
+    let border = g.find_halfedge(vid(0), vid(1)).unwrap();
     assert_eq!(g.can_flip(border), Err(Refusal::BoundaryEdge));
     // A boundary endpoint may drop to valence 2 by a flip: corner 0 then has a single face.
     let mut corner = g.clone();
-    let diagonal = corner.find_halfedge(0, 5).unwrap();
-    assert_eq!(corner.valence(0), 3);
+    let diagonal = corner.find_halfedge(vid(0), vid(5)).unwrap();
+    assert_eq!(corner.valence(vid(0)), 3);
     corner.flip_edge(diagonal).unwrap();
     corner.check_invariants().unwrap();
-    assert_eq!((corner.valence(0), corner.vertex_faces(0).count()), (2, 1));
+    assert_eq!(
+        (corner.valence(vid(0)), corner.vertex_faces(vid(0)).count()),
+        (2, 1)
+    );
     // Collapsing the boundary edge 0→1 keeps the corner vertex 0 and removes 1.
     assert_eq!(g.can_collapse(border), Ok(()));
-    g.collapse_edge(border, g.position(0)).unwrap();
+    g.collapse_edge(border, g.position(vid(0))).unwrap();
     g.check_invariants().unwrap();
     assert_eq!(g.boundary_loop_count(), 1);
     assert_eq!(g.euler_characteristic(), 1);
@@ -662,18 +681,20 @@ fn specific_refusals() {
     // that collapsing an edge into a "triangle without face" is refused.
     let mut s = build(&icosphere(0));
     // Vertex 0's neighbours 11, 5, 1, 7, 10 form a ring; flip 0–11 then 0–5: 0 has valence 3.
-    s.flip_edge(s.find_halfedge(0, 11).unwrap()).unwrap();
-    s.flip_edge(s.find_halfedge(0, 1).unwrap()).unwrap();
+    s.flip_edge(s.find_halfedge(vid(0), vid(11)).unwrap())
+        .unwrap();
+    s.flip_edge(s.find_halfedge(vid(0), vid(1)).unwrap())
+        .unwrap();
     s.check_invariants().unwrap();
-    assert_eq!(s.valence(0), 3);
-    let nb: Vec<u32> = s.vertex_neighbors(0).collect();
+    assert_eq!(s.valence(vid(0)), 3);
+    let nb: Vec<_> = s.vertex_neighbors(vid(0)).collect();
     // Flipping an edge at a valence-3 interior vertex would leave it with valence 2; in a
     // simplicial surface its neighbours are pairwise adjacent, so the new edge already exists.
     for &x in &nb {
-        let h = s.find_halfedge(0, x).unwrap();
+        let h = s.find_halfedge(vid(0), x).unwrap();
         assert!(matches!(s.can_flip(h), Err(Refusal::EdgeExists { .. })));
         assert!(matches!(
-            s.can_flip(twin(h)),
+            s.can_flip(h.twin()),
             Err(Refusal::EdgeExists { .. })
         ));
     }
@@ -686,7 +707,7 @@ fn specific_refusals() {
             found_link_refusal = true;
             let (a, b) = (s.origin(h), s.target(h));
             assert!(s.find_halfedge(a, vertex).is_some() && s.find_halfedge(b, vertex).is_some());
-            let opp = [s.opposite_vertex(h), s.opposite_vertex(twin(h))];
+            let opp = [s.opposite_vertex(h), s.opposite_vertex(h.twin())];
             assert!(!opp.contains(&Some(vertex)));
         }
     }
@@ -801,7 +822,7 @@ fn collapse_to_minimum(mesh: &TriMesh, seed: u64) -> HalfEdgeMesh {
     let mut m = build(mesh);
     let mut rng = Lcg(seed);
     loop {
-        let mut candidates: Vec<u32> = m
+        let mut candidates: Vec<_> = m
             .halfedges()
             .filter(|&h| m.can_collapse(h).is_ok())
             .collect();
@@ -838,7 +859,7 @@ fn round_trips_preserve_triangles() {
         let he = build(&m);
         let (back, map) = he.to_trimesh_with_map();
         assert_eq!(back, m);
-        assert!(map.iter().enumerate().all(|(i, &j)| i as u32 == j));
+        assert!(map.iter().all(|(i, &j)| i == j));
     }
 }
 
@@ -858,11 +879,11 @@ fn garbage_collect_compacts_in_order() {
     assert_eq!(m.halfedge_capacity(), m.halfedge_count());
     assert_eq!(m.to_trimesh(), before);
     for h in old.halfedges() {
-        let n = c.halfedges[h as usize];
-        assert_eq!(c.halfedges[twin(h) as usize], twin(n));
-        assert_eq!(m.origin(n), c.vertices[old.origin(h) as usize]);
-        assert_eq!(m.next(n), c.halfedges[old.next(h) as usize]);
-        assert_eq!(m.face(n), old.face(h).map(|f| c.faces[f as usize]));
+        let n = c.halfedges[h];
+        assert_eq!(c.halfedges[h.twin()], n.twin());
+        assert_eq!(m.origin(n), c.vertices[old.origin(h)]);
+        assert_eq!(m.next(n), c.halfedges[old.next(h)]);
+        assert_eq!(m.face(n), old.face(h).map(|f| c.faces[f]));
     }
     // Records from before the compaction, or from another mesh, are refused.
     assert!(m.undo(r.undo).is_err());
