@@ -36,6 +36,9 @@ pub mod lowpoly;
 #[cfg(feature = "cage")]
 pub mod cage;
 
+#[cfg(feature = "bake")]
+pub mod bake;
+
 #[cfg(feature = "wrinkle")]
 pub mod wrinkle;
 

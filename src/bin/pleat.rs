@@ -17,6 +17,10 @@ use std::process::ExitCode;
 #[path = "pleat/bench_lod.rs"]
 mod bench_lod;
 
+#[cfg(feature = "bake")]
+#[path = "pleat/bake.rs"]
+mod bake_cmd;
+
 #[derive(Parser)]
 #[command(
     name = "pleat",
@@ -143,6 +147,9 @@ struct BakeArgs {
     /// Also print every statistic (stage seconds, counts, metrics) of each level.
     #[arg(short, long)]
     verbose: bool,
+    #[cfg(feature = "bake")]
+    #[command(flatten)]
+    textures: bake_cmd::TextureArgs,
 }
 
 /// `pleat wrinkle ...` (needs the `wrinkle` feature; otherwise exits 2 with a message).
@@ -329,6 +336,10 @@ fn output_path(pattern: &std::path::Path, n_p: f64) -> PathBuf {
 #[cfg(feature = "lod")]
 fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
     let cmd = if cage { "cage" } else { "lod" };
+    #[cfg(feature = "bake")]
+    if args.textures.bake {
+        return bake_cmd::run(input, args, cmd);
+    }
     let sizes = &args.screen_size;
     let many = sizes.len() > 1;
     let pattern = args.output.to_string_lossy();
