@@ -71,7 +71,10 @@ fn textured_glb(
     push(f(&normals.concat()), &mut bin);
     push(f(&uvs.concat()), &mut bin);
     push(
-        tris.iter().flatten().flat_map(|i| i.to_le_bytes()).collect(),
+        tris.iter()
+            .flatten()
+            .flat_map(|i| i.to_le_bytes())
+            .collect(),
         &mut bin,
     );
     push(png.to_vec(), &mut bin);
@@ -79,7 +82,12 @@ fn textured_glb(
         .map(|k| positions.iter().map(|p| p[k]).fold(f32::INFINITY, f32::min))
         .collect();
     let hi: Vec<f32> = (0..3)
-        .map(|k| positions.iter().map(|p| p[k]).fold(f32::NEG_INFINITY, f32::max))
+        .map(|k| {
+            positions
+                .iter()
+                .map(|p| p[k])
+                .fold(f32::NEG_INFINITY, f32::max)
+        })
         .collect();
     let mut info = json!({"index": 0});
     if let serde_json::Value::Object(m) = tex_info_extra {
@@ -126,13 +134,19 @@ fn tiny_image() -> (u32, u32, Vec<u8>) {
     (w, h, rgba)
 }
 
-fn quad_glb(sampler: serde_json::Value, extra: serde_json::Value, uv_scale: f32) -> Vec<u8> {
+/// A unit quad whose vertices sit on texel centres (0,0), (3 + shift, 0), (3, 1), (0, 1).
+fn quad_glb(sampler: serde_json::Value, extra: serde_json::Value, shift: f32) -> Vec<u8> {
     let (w, h, rgba) = tiny_image();
-    let c = |i: f32, j: f32| [(i + 0.5) / w as f32 * uv_scale, (j + 0.5) / h as f32 * uv_scale];
+    let c = |i: f32, j: f32| [(i + 0.5) / w as f32, (j + 0.5) / h as f32];
     textured_glb(
-        &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+        &[
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ],
         &[[0.0, 0.0, 1.0]; 4],
-        &[c(0.0, 0.0), c(3.0, 0.0), c(3.0, 1.0), c(0.0, 1.0)],
+        &[c(0.0, 0.0), c(3.0 + shift, 0.0), c(3.0, 1.0), c(0.0, 1.0)],
         &[[0, 1, 2], [0, 2, 3]],
         &png(w, h, &rgba),
         sampler,
@@ -153,7 +167,7 @@ fn expected_linear(i: u32, j: u32) -> [f64; 4] {
 
 #[test]
 fn texels_are_read_exactly_at_their_centres() {
-    let data = quad_glb(json!({}), json!({}), 1.0);
+    let data = quad_glb(json!({}), json!({}), 0.0);
     let app = read_appearance_bytes(&data, None, "quad").unwrap();
     assert_eq!(app.textures.len(), 1);
     let tex = &app.textures[0];
@@ -184,27 +198,30 @@ fn Repeat() -> Wrap {
 
 #[test]
 fn wrap_modes_and_texture_transform() {
-    // UVs scaled by 2: vertex 1 at u = 3.5/4 · 2 = 1.75 → texel 7 mod 4 = 3 under REPEAT,
-    // mirrored: 7 → 2·4 − 1 − 7 = 0, clamped: 3.
+    // Vertex 1 on texel column 7 (u = 7.5/4): REPEAT reads column 7 mod 4 = 3, MIRRORED_REPEAT
+    // 2·4 − 1 − 7 = 0, CLAMP_TO_EDGE 3.
     for (mode, code, expect_i) in [
         (Wrap::Repeat, 10497, 3),
         (Wrap::Mirror, 33648, 0),
         (Wrap::Clamp, 33071, 3),
     ] {
-        let data = quad_glb(json!({"wrapS": code, "wrapT": 33071}), json!({}), 2.0);
+        let data = quad_glb(json!({"wrapS": code, "wrapT": 33071}), json!({}), 4.0);
         let app = read_appearance_bytes(&data, None, "quad").unwrap();
         assert_eq!(app.textures[0].wrap_s, mode);
         let s = app.sample(0, [0.0, 1.0, 0.0]);
-        assert_eq!(s.base_color, expected_linear(expect_i, 1), "{mode:?}");
+        assert_eq!(s.base_color, expected_linear(expect_i, 0), "{mode:?}");
     }
     // KHR_texture_transform: offset by one texel in u, scale 1.
     let data = quad_glb(
         json!({}),
         json!({"extensions": {"KHR_texture_transform": {"offset": [0.25, 0.0]}}}),
-        1.0,
+        0.0,
     );
     let app = read_appearance_bytes(&data, None, "quad").unwrap();
-    assert_eq!(app.sample(0, [1.0, 0.0, 0.0]).base_color, expected_linear(1, 0));
+    assert_eq!(
+        app.sample(0, [1.0, 0.0, 0.0]).base_color,
+        expected_linear(1, 0)
+    );
 }
 
 #[test]
@@ -285,7 +302,10 @@ fn sphere_glb() -> Vec<u8> {
     let mut rgba = Vec::new();
     for j in 0..h {
         for i in 0..w {
-            let p = sphere_point((f64::from(i) + 0.5) / f64::from(w), (f64::from(j) + 0.5) / f64::from(h));
+            let p = sphere_point(
+                (f64::from(i) + 0.5) / f64::from(w),
+                (f64::from(j) + 0.5) / f64::from(h),
+            );
             let c = field(p);
             rgba.extend_from_slice(&[
                 (255.0 * c[0]).round() as u8,
@@ -295,7 +315,15 @@ fn sphere_glb() -> Vec<u8> {
             ]);
         }
     }
-    textured_glb(&pos, &nrm, &uv, &tris, &png(w, h, &rgba), json!({}), json!({}))
+    textured_glb(
+        &pos,
+        &nrm,
+        &uv,
+        &tris,
+        &png(w, h, &rgba),
+        json!({}),
+        json!({}),
+    )
 }
 
 /// Bilinear sRGB value of a baked image at glTF UV (in [0, 1] display units).
@@ -310,10 +338,18 @@ fn image_at(img: &pleat::bake::Image8, uv: [f32; 2]) -> [f64; 3] {
         let t = img.texel(i, j);
         [0, 1, 2].map(|k| srgb_to_linear(f64::from(t[k]) / 255.0))
     };
-    let (a, b, c, d) = (at(x0, y0), at(x0 + 1.0, y0), at(x0, y0 + 1.0), at(x0 + 1.0, y0 + 1.0));
+    let (a, b, c, d) = (
+        at(x0, y0),
+        at(x0 + 1.0, y0),
+        at(x0, y0 + 1.0),
+        at(x0 + 1.0, y0 + 1.0),
+    );
     std::array::from_fn(|k| {
         linear_to_srgb(
-            (1.0 - fx) * (1.0 - fy) * a[k] + fx * (1.0 - fy) * b[k] + (1.0 - fx) * fy * c[k] + fx * fy * d[k],
+            (1.0 - fx) * (1.0 - fy) * a[k]
+                + fx * (1.0 - fy) * b[k]
+                + (1.0 - fx) * fy * c[k]
+                + fx * fy * d[k],
         )
     })
 }
@@ -331,12 +367,23 @@ fn field_errors(
     let uvs = level.uvs.as_ref().unwrap();
     let mut errs = Vec::new();
     for t in &level.triangles {
-        let p: Vec3 = t.iter().map(|&v| Vec3::from(level.positions[v as usize])).sum::<Vec3>() / 3.0;
+        let p: Vec3 = t
+            .iter()
+            .map(|&v| Vec3::from(level.positions[v as usize]))
+            .sum::<Vec3>()
+            / 3.0;
         let uv = [0, 1].map(|k| t.iter().map(|&v| uvs[v as usize][k]).sum::<f32>() / 3.0);
         let baked = image_at(img, uv);
         let q = index.closest(p).unwrap();
-        let want = field(Vec3::from(q.point), app.triangle_material[q.triangle as usize]);
-        errs.push((0..3).map(|k| 255.0 * (baked[k] - want[k]).abs()).fold(0.0, f64::max));
+        let want = field(
+            Vec3::from(q.point),
+            app.triangle_material[q.triangle as usize],
+        );
+        errs.push(
+            (0..3)
+                .map(|k| 255.0 * (baked[k] - want[k]).abs())
+                .fold(0.0, f64::max),
+        );
     }
     let mean = errs.iter().sum::<f64>() / errs.len() as f64;
     (mean, errs.iter().copied().fold(0.0, f64::max))
@@ -381,8 +428,16 @@ fn sphere_bake_matches_the_analytic_field_and_rereads() {
         let (mean, max) = field_errors(&l.baked, &app.mesh, |p, _| field(p), &app);
         eprintln!("  vs field: mean {mean:.2} max {max:.2} /255");
         let bound = 1.0 + 300.0 / (4.0 * l.baked.screen_size);
-        assert!(mean < bound, "mean error {mean} ≥ {bound} at n_p {}", l.baked.screen_size);
-        assert!(max < 8.0 * bound, "max error {max} at n_p {}", l.baked.screen_size);
+        assert!(
+            mean < bound,
+            "mean error {mean} ≥ {bound} at n_p {}",
+            l.baked.screen_size
+        );
+        assert!(
+            max < 8.0 * bound,
+            "max error {max} at n_p {}",
+            l.baked.screen_size
+        );
     }
     let refs: Vec<&BakedLevel> = levels.iter().map(|l| &l.baked).collect();
     let out = chain_glb(&refs).unwrap();
@@ -402,7 +457,11 @@ fn check_output(out: &[u8], n_levels: usize) {
         assert_eq!(root.extensions_used, vec!["MSFT_lod".to_string()]);
     }
     let app = read_appearance_bytes(out, None, "output").unwrap();
-    assert_eq!(app.materials.len(), 1, "the scene instantiates the finest level only");
+    assert_eq!(
+        app.materials.len(),
+        1,
+        "the scene instantiates the finest level only"
+    );
     assert!(app.has_textures());
 }
 
@@ -440,7 +499,15 @@ fn untextured_input_gives_vertex_colours() {
     );
     let out = chain_glb(&[b]).unwrap();
     let (doc, _, _) = gltf::import_slice(&out).unwrap();
-    assert!(doc.meshes().next().unwrap().primitives().next().unwrap().get(&gltf::Semantic::Colors(0)).is_some());
+    assert!(doc
+        .meshes()
+        .next()
+        .unwrap()
+        .primitives()
+        .next()
+        .unwrap()
+        .get(&gltf::Semantic::Colors(0))
+        .is_some());
 }
 
 // ------------------------------------------------------------------------ shared assets --
@@ -462,7 +529,13 @@ fn assets() -> Option<PathBuf> {
 
 /// The sidecar's field `i` at world point `p` (display sRGB in [0, 1]).
 fn sidecar_field(spec: &serde_json::Value, p: Vec3) -> [f64; 3] {
-    let v = |x: &serde_json::Value| Vec3::new(x[0].as_f64().unwrap(), x[1].as_f64().unwrap(), x[2].as_f64().unwrap());
+    let v = |x: &serde_json::Value| {
+        Vec3::new(
+            x[0].as_f64().unwrap(),
+            x[1].as_f64().unwrap(),
+            x[2].as_f64().unwrap(),
+        )
+    };
     let c = v(&spec["center"]);
     let diag = spec["diag"].as_f64().unwrap();
     std::array::from_fn(|k| {
@@ -496,7 +569,10 @@ fn shared_assets_read_with_their_fields() {
         let path = dir.join(name);
         let app = read_appearance(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
         let geom = pleat::mesh::io::gltf::read_gltf(&path).unwrap();
-        assert_eq!(app.mesh, geom, "{name}: same geometry as the geometry reader");
+        assert_eq!(
+            app.mesh, geom,
+            "{name}: same geometry as the geometry reader"
+        );
         if !name.starts_with("gen_") {
             continue;
         }
@@ -505,7 +581,13 @@ fn shared_assets_read_with_their_fields() {
         let mut errs = Vec::new();
         for t in 0..app.mesh.triangle_count() {
             let bary = [1.0 / 3.0; 3];
-            let p: Vec3 = app.mesh.triangle_positions(t).map(Vec3::from).iter().sum::<Vec3>() / 3.0;
+            let p: Vec3 = app
+                .mesh
+                .triangle_positions(t)
+                .map(Vec3::from)
+                .iter()
+                .sum::<Vec3>()
+                / 3.0;
             let f = &spec["fields"][app.triangle_material[t] as usize];
             let want = sidecar_field(f, p);
             let got = app.sample(t, bary).base_color;
@@ -520,7 +602,11 @@ fn shared_assets_read_with_their_fields() {
         let p95 = errs[errs.len() * 95 / 100];
         eprintln!("{name}: field error at centroids mean {mean:.2} p95 {p95:.2} /255");
         // README floor: textured mean 0.26 (tree soup 0.34), vertex colours mean 2.8.
-        let bound = if name.contains("vertexcolor") { 4.0 } else { 1.0 };
+        let bound = if name.contains("vertexcolor") {
+            4.0
+        } else {
+            1.0
+        };
         assert!(mean < bound, "{name}: mean {mean}");
     }
 }
@@ -542,8 +628,16 @@ fn shared_torus_bakes_with_normal_map() {
     .levels;
     let b = &levels[0].baked;
     assert!(b.material.normal.is_some());
-    let (mean, max) = field_errors(b, &app.mesh, |p, m| sidecar_field(&spec["fields"][m as usize], p), &app);
-    eprintln!("{name} n_p 50: vs field mean {mean:.2} max {max:.2} /255; report {:?}", b.report);
+    let (mean, max) = field_errors(
+        b,
+        &app.mesh,
+        |p, m| sidecar_field(&spec["fields"][m as usize], p),
+        &app,
+    );
+    eprintln!(
+        "{name} n_p 50: vs field mean {mean:.2} max {max:.2} /255; report {:?}",
+        b.report
+    );
     // Field frequencies up to 3 per diag: bound 1 + 3·(2·300)/(4·n_p·... ) — see the sphere
     // test; with f ≤ 3 the gradient doubles.
     assert!(mean < 1.0 + 600.0 / (4.0 * 50.0), "mean {mean}");

@@ -70,8 +70,14 @@ impl Texture {
         let y = uv[1] * h as f64 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let xs = [wrap(x0 as i64, w, self.wrap_s), wrap(x0 as i64 + 1, w, self.wrap_s)];
-        let ys = [wrap(y0 as i64, h, self.wrap_t), wrap(y0 as i64 + 1, h, self.wrap_t)];
+        let xs = [
+            wrap(x0 as i64, w, self.wrap_s),
+            wrap(x0 as i64 + 1, w, self.wrap_s),
+        ];
+        let ys = [
+            wrap(y0 as i64, h, self.wrap_t),
+            wrap(y0 as i64 + 1, h, self.wrap_t),
+        ];
         let mut out = [0.0; 4];
         let weights = [
             (1.0 - fx) * (1.0 - fy),
@@ -79,7 +85,12 @@ impl Texture {
             (1.0 - fx) * fy,
             fx * fy,
         ];
-        let taps = [(xs[0], ys[0]), (xs[1], ys[0]), (xs[0], ys[1]), (xs[1], ys[1])];
+        let taps = [
+            (xs[0], ys[0]),
+            (xs[1], ys[0]),
+            (xs[0], ys[1]),
+            (xs[1], ys[1]),
+        ];
         for (&wgt, &(i, j)) in weights.iter().zip(&taps) {
             if wgt == 0.0 {
                 continue;
@@ -299,7 +310,9 @@ impl Appearance {
         let tri = self.mesh.triangles()[t];
         let tw: Vec<[f64; 4]> = tri.iter().map(|&v| self.tangents[v as usize]).collect();
         if tw.iter().all(|x| x[3] != 0.0) {
-            let tv: Vec3 = (0..3).map(|k| Vec3::from([tw[k][0], tw[k][1], tw[k][2]]) * bary[k]).sum();
+            let tv: Vec3 = (0..3)
+                .map(|k| Vec3::from([tw[k][0], tw[k][1], tw[k][2]]) * bary[k])
+                .sum();
             let w = if tw[0][3] < 0.0 { -1.0 } else { 1.0 };
             if let Some(tu) = normalized(tv - n * n.dot(tv)) {
                 return (tu, n.cross(tu) * w);
@@ -316,7 +329,11 @@ impl Appearance {
             let bv = (e2 * du1 - e1 * du2) / det;
             if let Some(tu) = normalized(tv - n * n.dot(tv)) {
                 // glTF: the bitangent points to image up, i.e. decreasing v.
-                let w = if n.cross(tu).dot(-bv) < 0.0 { -1.0 } else { 1.0 };
+                let w = if n.cross(tu).dot(-bv) < 0.0 {
+                    -1.0
+                } else {
+                    1.0
+                };
                 return (tu, n.cross(tu) * w);
             }
         }
@@ -384,7 +401,7 @@ impl Appearance {
 /// folder). See the [module docs](self).
 pub fn read_appearance(path: &Path) -> Result<Appearance> {
     let name = path.display().to_string();
-    let data = std::fs::read(&path).map_err(|e| crate::mesh::io::io_error(&name, &e))?;
+    let data = std::fs::read(path).map_err(|e| crate::mesh::io::io_error(&name, &e))?;
     let base = path.parent().unwrap_or(Path::new("."));
     read_appearance_bytes(&data, Some(base), &name)
 }
@@ -604,9 +621,10 @@ impl Reader<'_> {
                 }
                 let v = self.values(&acc, what)?;
                 self.out.any_color = true;
-                self.out.colors.extend(v.chunks_exact(k).map(|c| {
-                    [c[0], c[1], c[2], if k == 4 { c[3] } else { 1.0 }]
-                }));
+                self.out.colors.extend(
+                    v.chunks_exact(k)
+                        .map(|c| [c[0], c[1], c[2], if k == 4 { c[3] } else { 1.0 }]),
+                );
             }
             Some(_) => return Err(self.err(format!("{what}: COLOR_0 count is wrong"))),
             None => self.out.colors.resize(base + n, [1.0; 4]),
@@ -614,7 +632,12 @@ impl Reader<'_> {
         // Material.
         let mat = self.material(prim.material(), what)?;
         for r in self.out.materials[mat as usize].refs() {
-            if self.out.uvs.get(r.tex_coord).is_none_or(|u| n > 0 && u[base][0].is_nan()) {
+            if self
+                .out
+                .uvs
+                .get(r.tex_coord)
+                .is_none_or(|u| n > 0 && u[base][0].is_nan())
+            {
                 return Err(self.err(format!(
                     "{what}: its material samples TEXCOORD_{} but the primitive has no such \
                      attribute",
@@ -631,7 +654,9 @@ impl Reader<'_> {
         let off = base as u32;
         for t in io::triangle_list(prim.mode(), &indices) {
             let [a, b, c] = t.map(|i| i + off);
-            self.out.triangles.push(if flip { [a, c, b] } else { [a, b, c] });
+            self.out
+                .triangles
+                .push(if flip { [a, c, b] } else { [a, b, c] });
             self.out.triangle_material.push(mat);
             self.out.triangle_flat.push(flat);
         }
@@ -646,8 +671,9 @@ impl Reader<'_> {
         let idx = m.index();
         let json = |slot: &str| -> Option<&serde_json::Value> {
             let i = idx?;
-            self.raw?
-                .pointer(&format!("/materials/{i}/{slot}/extensions/KHR_texture_transform"))
+            self.raw?.pointer(&format!(
+                "/materials/{i}/{slot}/extensions/KHR_texture_transform"
+            ))
         };
         let transforms = [
             "pbrMetallicRoughness/baseColorTexture",
@@ -657,7 +683,10 @@ impl Reader<'_> {
             "emissiveTexture",
         ]
         .map(|s| json(s).cloned());
-        let what = format!("{what} (material {})", idx.map_or("default".into(), |i| i.to_string()));
+        let what = format!(
+            "{what} (material {})",
+            idx.map_or("default".into(), |i| i.to_string())
+        );
         let base_color = match pbr.base_color_texture() {
             Some(info) => Some(self.texture_ref(
                 info.texture(),
@@ -771,9 +800,8 @@ impl Reader<'_> {
                     .ok_or_else(|| self.err(format!("{label}: malformed base64 data URI")))?
             }
             ::gltf::image::Source::Uri { uri, .. } => {
-                io::external_bytes(uri, 1 << 30, self.base, self.name).map_err(|e| {
-                    self.err(format!("{label}: image '{uri}' cannot be read: {e}"))
-                })?
+                io::external_bytes(uri, 1 << 30, self.base, self.name)
+                    .map_err(|e| self.err(format!("{label}: image '{uri}' cannot be read: {e}")))?
             }
         };
         let texels = decode_image(&bytes, srgb).map_err(|e| self.err(format!("{label}: {e}")))?;
@@ -911,11 +939,16 @@ pub fn linear_to_srgb(c: f64) -> f64 {
 
 /// Decodes a PNG or JPEG into `(width, height, linear RGBA texels)`; `srgb` decodes the colour
 /// channels' sRGB transfer (alpha is always linear).
-fn decode_image(bytes: &[u8], srgb: bool) -> std::result::Result<(u32, u32, Vec<[f32; 4]>), String> {
+fn decode_image(
+    bytes: &[u8],
+    srgb: bool,
+) -> std::result::Result<(u32, u32, Vec<[f32; 4]>), String> {
     let format = image::guess_format(bytes)
         .map_err(|e| format!("image data is neither PNG nor JPEG ({e})"))?;
     if !matches!(format, image::ImageFormat::Png | image::ImageFormat::Jpeg) {
-        return Err(format!("image format {format:?} is not supported (PNG or JPEG)"));
+        return Err(format!(
+            "image format {format:?} is not supported (PNG or JPEG)"
+        ));
     }
     let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
     let mut limits = image::Limits::default();

@@ -103,7 +103,13 @@ pub fn build_atlas(mesh: &TriMesh, side: u32, padding: u32) -> Result<Atlas> {
     let estimate = (f64::from(side) * f64::from(side) * 0.75 / area).sqrt();
     let mut scale = 1.0;
     for _ in 0..12 {
-        let atlas = run_xatlas(&positions, &indices, side, padding, (estimate * scale) as f32)?;
+        let atlas = run_xatlas(
+            &positions,
+            &indices,
+            side,
+            padding,
+            (estimate * scale) as f32,
+        )?;
         if let Some(a) = atlas {
             check_atlas(&a, &indices)?;
             return Ok(a);
@@ -152,7 +158,9 @@ fn run_xatlas(
     // outlive the call (xatlas copies the mesh in AddMesh).
     let status = unsafe { ffi::add_mesh(atlas.0, &decl) };
     if status != 0 {
-        return Err(Error::Internal(format!("xatlas AddMesh failed with status {status}")));
+        return Err(Error::Internal(format!(
+            "xatlas AddMesh failed with status {status}"
+        )));
     }
     // SAFETY: live atlas, plain-data options, no callbacks.
     unsafe {
@@ -219,17 +227,20 @@ fn check_atlas(a: &Atlas, indices: &[u32]) -> Result<()> {
         )));
     }
     let s = a.size as f32;
-    if let Some(uv) = a
-        .uv
-        .iter()
-        .find(|uv| !uv.iter().all(|c| c.is_finite() && (0.0..=s).contains(c)))
+    if let Some(uv) =
+        a.uv.iter()
+            .find(|uv| !uv.iter().all(|c| c.is_finite() && (0.0..=s).contains(c)))
     {
-        return Err(Error::Internal(format!("xatlas produced UV {uv:?} outside the atlas")));
+        return Err(Error::Internal(format!(
+            "xatlas produced UV {uv:?} outside the atlas"
+        )));
     }
     for (t, tri) in a.triangles.iter().enumerate() {
         for k in 0..3 {
             if a.xref.get(tri[k] as usize).copied() != Some(indices[3 * t + k]) {
-                return Err(Error::Internal(format!("xatlas reordered or dropped triangle {t}")));
+                return Err(Error::Internal(format!(
+                    "xatlas reordered or dropped triangle {t}"
+                )));
             }
         }
     }

@@ -111,7 +111,12 @@ impl Image8 {
     /// The RGBA texel at column `i`, row `j`.
     pub fn texel(&self, i: u32, j: u32) -> [u8; 4] {
         let k = 4 * (j as usize * self.width as usize + i as usize);
-        [self.rgba[k], self.rgba[k + 1], self.rgba[k + 2], self.rgba[k + 3]]
+        [
+            self.rgba[k],
+            self.rgba[k + 1],
+            self.rgba[k + 2],
+            self.rgba[k + 3],
+        ]
     }
 }
 
@@ -331,8 +336,16 @@ fn bake_textured(
     report.charts = atlas.chart_count;
 
     let lod_normals = vertex_normals(lod);
-    let positions: Vec<[f64; 3]> = atlas.xref.iter().map(|&v| lod.positions()[v as usize]).collect();
-    let normals: Vec<[f64; 3]> = atlas.xref.iter().map(|&v| lod_normals[v as usize]).collect();
+    let positions: Vec<[f64; 3]> = atlas
+        .xref
+        .iter()
+        .map(|&v| lod.positions()[v as usize])
+        .collect();
+    let normals: Vec<[f64; 3]> = atlas
+        .xref
+        .iter()
+        .map(|&v| lod_normals[v as usize])
+        .collect();
 
     let t = Instant::now();
     let corner_tangents = mikk_tangents(&positions, &normals, &atlas);
@@ -348,7 +361,14 @@ fn bake_textured(
     let n = side as usize;
     let row_bytes = 4 * n;
     let mut base = vec![0u8; row_bytes * n];
-    let mut mr = vec![0u8; if ch.metallic_roughness { row_bytes * n } else { 0 }];
+    let mut mr = vec![
+        0u8;
+        if ch.metallic_roughness {
+            row_bytes * n
+        } else {
+            0
+        }
+    ];
     let mut occ = vec![0u8; if ch.occlusion { row_bytes * n } else { 0 }];
     let mut emi = vec![0u8; if ch.emissive { row_bytes * n } else { 0 }];
     let mut nrm = vec![0u8; if ch.normal { row_bytes * n } else { 0 }];
@@ -370,13 +390,17 @@ fn bake_textured(
         .zip(par_rows(&mut nrm, row_bytes, n))
         .enumerate()
         .map(|(j, ((((b, m), o), e), nr))| {
-            let mut rows = Rows { base: b, mr: m, occ: o, emi: e, nrm: nr };
+            let mut rows = Rows {
+                base: b,
+                mr: m,
+                occ: o,
+                emi: e,
+                nrm: nr,
+            };
             ctx.bake_row(j, &mut rows)
         })
         .collect();
-    let (hits, total) = by_ray
-        .iter()
-        .fold((0, 0), |(h, t), &(a, b)| (h + a, t + b));
+    let (hits, total) = by_ray.iter().fold((0, 0), |(h, t), &(a, b)| (h + a, t + b));
     report.fallback_fraction = if total == 0 {
         0.0
     } else {
@@ -393,7 +417,13 @@ fn bake_textured(
     }
     report.dilate_seconds = t.elapsed().as_secs_f64();
 
-    let image = |rgba: Vec<u8>| (!rgba.is_empty()).then_some(Image8 { width: side, height: side, rgba });
+    let image = |rgba: Vec<u8>| {
+        (!rgba.is_empty()).then_some(Image8 {
+            width: side,
+            height: side,
+            rgba,
+        })
+    };
     let base_img = Image8 {
         width: side,
         height: side,
@@ -424,7 +454,10 @@ fn bake_textured(
     let inv = 1.0 / f64::from(side);
     Ok(BakedLevel {
         screen_size,
-        positions: out_vertices.iter().map(|&(v, _)| positions[v as usize]).collect(),
+        positions: out_vertices
+            .iter()
+            .map(|&(v, _)| positions[v as usize])
+            .collect(),
         normals: out_vertices
             .iter()
             .map(|&(v, _)| normals[v as usize].map(|c| c as f32))
@@ -446,9 +479,14 @@ fn bake_textured(
 /// Row chunks of an optional image (empty image: `n` empty rows).
 fn par_rows(img: &mut [u8], row_bytes: usize, n: usize) -> rayon::vec::IntoIter<&mut [u8]> {
     if img.is_empty() {
-        (0..n).map(|_| &mut [][..]).collect::<Vec<_>>().into_par_iter()
+        (0..n)
+            .map(|_| &mut [][..])
+            .collect::<Vec<_>>()
+            .into_par_iter()
     } else {
-        img.chunks_mut(row_bytes).collect::<Vec<_>>().into_par_iter()
+        img.chunks_mut(row_bytes)
+            .collect::<Vec<_>>()
+            .into_par_iter()
     }
 }
 
@@ -592,7 +630,11 @@ fn rasterize(atlas: &Atlas) -> Coverage {
     const REACH: f64 = 0.7072;
     for (t, tri) in atlas.triangles.iter().enumerate() {
         let uv = tri.map(|v| atlas.uv[v as usize].map(f64::from));
-        let lo = [0, 1].map(|a| (uv[0][a].min(uv[1][a]).min(uv[2][a]) - 1.0).floor().max(0.0) as usize);
+        let lo = [0, 1].map(|a| {
+            (uv[0][a].min(uv[1][a]).min(uv[2][a]) - 1.0)
+                .floor()
+                .max(0.0) as usize
+        });
         let hi = [0, 1].map(|a| {
             ((uv[0][a].max(uv[1][a]).max(uv[2][a]) + 1.0).ceil().max(0.0) as usize).min(n)
         });
@@ -622,10 +664,17 @@ fn rasterize(atlas: &Atlas) -> Coverage {
 /// Barycentric coordinates of the point of 2D triangle `t` closest to `c`, and its distance
 /// (0 inside, edges included).
 fn closest_in_triangle(t: &[[f64; 2]; 3], c: [f64; 2]) -> ([f64; 3], f64) {
-    let area = (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]);
+    let area =
+        (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]);
     if area != 0.0 {
-        let e = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
-        let b = [e(t[1], t[2]) / area, e(t[2], t[0]) / area, e(t[0], t[1]) / area];
+        let e = |a: [f64; 2], b: [f64; 2]| {
+            (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
+        };
+        let b = [
+            e(t[1], t[2]) / area,
+            e(t[2], t[0]) / area,
+            e(t[0], t[1]) / area,
+        ];
         if b.iter().all(|&x| x >= 0.0) {
             return (b, 0.0);
         }
@@ -740,9 +789,12 @@ fn mikk_tangents(positions: &[[f64; 3]], normals: &[[f64; 3]], atlas: &Atlas) ->
     geo.out
 }
 
+/// An output vertex: the atlas vertex it copies and its tangent.
+type OutVertex = (u32, [f32; 4]);
+
 /// Output vertices `(atlas vertex, tangent)` deduplicated in first-use order, and triangles
 /// over them.
-fn split_by_tangent(atlas: &Atlas, tangents: &[[f32; 4]]) -> (Vec<(u32, [f32; 4])>, Vec<[u32; 3]>) {
+fn split_by_tangent(atlas: &Atlas, tangents: &[[f32; 4]]) -> (Vec<OutVertex>, Vec<[u32; 3]>) {
     let mut map = std::collections::HashMap::new();
     let mut verts = Vec::new();
     let mut tris = Vec::with_capacity(atlas.triangles.len());
@@ -801,7 +853,8 @@ fn texel_errors(ctx: &TexelCtx<'_>, base: &Image8, max: usize) -> Vec<f64> {
         .map(|&k| {
             let (p, ..) = ctx.surface(ctx.cov.tri[k] as usize, ctx.cov.bary[k]);
             let px = base.texel((k % n) as u32, (k / n) as u32);
-            let baked = [0, 1, 2].map(|c| super::appearance::srgb_to_linear(f64::from(px[c]) / 255.0));
+            let baked =
+                [0, 1, 2].map(|c| super::appearance::srgb_to_linear(f64::from(px[c]) / 255.0));
             color_error(ctx.app, ctx.index, p, [baked[0], baked[1], baked[2], 1.0])
         })
         .collect()

@@ -50,7 +50,11 @@ impl Bin {
     }
 
     fn floats<const N: usize>(&mut self, values: &[[f32; N]], ty: &str, bounds: bool) -> usize {
-        let bytes: Vec<u8> = values.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+        let bytes: Vec<u8> = values
+            .iter()
+            .flatten()
+            .flat_map(|f| f.to_le_bytes())
+            .collect();
         let view = self.view(&bytes, Some(34962));
         let mut acc = json!({"bufferView": view, "componentType": 5126, "count": values.len(),
                              "type": ty});
@@ -59,7 +63,12 @@ impl Bin {
                 .map(|k| values.iter().map(|v| v[k]).fold(f32::INFINITY, f32::min))
                 .collect();
             let hi: Vec<f32> = (0..N)
-                .map(|k| values.iter().map(|v| v[k]).fold(f32::NEG_INFINITY, f32::max))
+                .map(|k| {
+                    values
+                        .iter()
+                        .map(|v| v[k])
+                        .fold(f32::NEG_INFINITY, f32::max)
+                })
                 .collect();
             acc["min"] = json!(lo);
             acc["max"] = json!(hi);
@@ -69,9 +78,14 @@ impl Bin {
     }
 
     fn indices(&mut self, tris: &[[u32; 3]]) -> usize {
-        let bytes: Vec<u8> = tris.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+        let bytes: Vec<u8> = tris
+            .iter()
+            .flatten()
+            .flat_map(|i| i.to_le_bytes())
+            .collect();
         let view = self.view(&bytes, Some(34963));
-        self.accessors.push(json!({"bufferView": view, "componentType": 5125,
+        self.accessors
+            .push(json!({"bufferView": view, "componentType": 5125,
                                    "count": 3 * tris.len(), "type": "SCALAR"}));
         self.accessors.len() - 1
     }
@@ -128,8 +142,14 @@ pub fn chain_glb(levels: &[&BakedLevel]) -> Result<Vec<u8>> {
             )));
         }
         let mut attributes = serde_json::Map::new();
-        attributes.insert("POSITION".into(), json!(bin.floats(&positions, "VEC3", true)));
-        attributes.insert("NORMAL".into(), json!(bin.floats(&level.normals, "VEC3", false)));
+        attributes.insert(
+            "POSITION".into(),
+            json!(bin.floats(&positions, "VEC3", true)),
+        );
+        attributes.insert(
+            "NORMAL".into(),
+            json!(bin.floats(&level.normals, "VEC3", false)),
+        );
         if let Some(t) = &level.tangents {
             attributes.insert("TANGENT".into(), json!(bin.floats(t, "VEC4", false)));
         }

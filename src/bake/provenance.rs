@@ -89,7 +89,10 @@ impl<'a> InputIndex<'a> {
             .bvh
             .closest_point(pos, self.mesh.triangles(), p.to_array(), f64::INFINITY)?;
         let t = c.triangle as usize;
-        let bary = barycentric(self.mesh.triangle_positions(t).map(Vec3::from), Vec3::from(c.point));
+        let bary = barycentric(
+            self.mesh.triangle_positions(t).map(Vec3::from),
+            Vec3::from(c.point),
+        );
         Some(Provenance {
             triangle: c.triangle,
             bary,
@@ -226,7 +229,7 @@ pub fn barycentric(t: [Vec3; 3], q: Vec3) -> [f64; 3] {
     let d20 = v2.dot(v0);
     let d21 = v2.dot(v1);
     let den = d00 * d11 - d01 * d01;
-    if !(den.abs() > 0.0) || !den.is_finite() {
+    if den == 0.0 || !den.is_finite() {
         // Degenerate triangle: the nearest corner.
         let d = t.map(|c| (c - q).length_squared());
         let k = (0..3).min_by(|&a, &b| d[a].total_cmp(&d[b])).unwrap_or(0);
@@ -247,7 +250,12 @@ mod tests {
 
     fn plane() -> TriMesh {
         TriMesh::new(
-            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
             vec![[0, 1, 2], [0, 2, 3]],
         )
         .unwrap()

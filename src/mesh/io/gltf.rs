@@ -670,8 +670,8 @@ pub(crate) fn external_bytes(
     base: Option<&Path>,
     name: &str,
 ) -> Result<Vec<u8>> {
-    let relative = percent_decode(uri)
-        .ok_or_else(|| parse_error(name, format!("malformed URI '{uri}'")))?;
+    let relative =
+        percent_decode(uri).ok_or_else(|| parse_error(name, format!("malformed URI '{uri}'")))?;
     let base = base.ok_or_else(|| {
         parse_error(
             name,
