@@ -425,6 +425,10 @@ fn sphere_bake_matches_the_analytic_field_and_rereads() {
         // and the baked texel is within half a texel (diag/(2·2 n_p)) of the centroid, so the
         // mean error is bounded by about 255 · 0.5 · 2π·1.5 · (d/4) / diag ≈ 300/(4 n_p) plus
         // the input's own floor (texture quantisation and faceting, ≈ 1/255): 4/255 at n_p=25.
+        assert_eq!(
+            r.overlapping_texels, 0,
+            "the atlas has no overlapping charts"
+        );
         let (mean, max) = field_errors(&l.baked, &app.mesh, |p, _| field(p), &app);
         eprintln!("  vs field: mean {mean:.2} max {max:.2} /255");
         let bound = 1.0 + 300.0 / (4.0 * l.baked.screen_size);
@@ -439,6 +443,18 @@ fn sphere_bake_matches_the_analytic_field_and_rereads() {
             l.baked.screen_size
         );
     }
+    // The bake's bytes do not depend on the thread count.
+    let index = InputIndex::new(&app.mesh);
+    let l = &levels[1];
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let serial = one
+        .install(|| pleat::bake::bake_level(&app, &index, &l.lod, 50.0, &BakeParams::default()))
+        .unwrap();
+    assert_eq!(serial.material, l.baked.material);
+    assert_eq!(serial.uvs, l.baked.uvs);
     let refs: Vec<&BakedLevel> = levels.iter().map(|l| &l.baked).collect();
     let out = chain_glb(&refs).unwrap();
     check_output(&out, levels.len());

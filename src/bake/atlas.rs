@@ -79,6 +79,9 @@ pub struct Atlas {
     pub triangles: Vec<[u32; 3]>,
     /// Number of charts.
     pub chart_count: u32,
+    /// Texel centres covered by two triangles that share no vertex (an overlap or fold in the
+    /// parameterisation); 0 for a valid atlas. See [`overlapping_texels`].
+    pub overlapping_texels: u64,
 }
 
 /// Builds the atlas of `mesh` with side `side` (see [`AtlasParams::side`]) and `padding` texels
@@ -99,27 +102,82 @@ pub fn build_atlas(mesh: &TriMesh, side: u32, padding: u32) -> Result<Atlas> {
     let indices: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
     let area = mesh.surface_area().max(f64::MIN_POSITIVE);
     // xatlas's own estimate for a given resolution (75 % utilisation), lowered until one atlas
-    // holds every chart.
+    // holds every chart. xatlas (this version) can leave a chart whose LSCM boundary
+    // self-intersects; such atlases are detected by rasterisation and recomputed with a lower
+    // chart-growth threshold (smaller charts), keeping the one with the fewest overlaps.
     let estimate = (f64::from(side) * f64::from(side) * 0.75 / area).sqrt();
-    let mut scale = 1.0;
-    for _ in 0..12 {
-        let atlas = run_xatlas(
-            &positions,
-            &indices,
-            side,
-            padding,
-            (estimate * scale) as f32,
-        )?;
-        if let Some(a) = atlas {
-            check_atlas(&a, &indices)?;
-            return Ok(a);
+    let mut best: Option<Atlas> = None;
+    for threshold in [2.0f32, 1.0, 0.5, 0.25] {
+        let mut scale = 1.0;
+        let mut found = None;
+        for _ in 0..12 {
+            let density = (estimate * scale) as f32;
+            if let Some(a) = run_xatlas(&positions, &indices, side, padding, density, threshold)? {
+                check_atlas(&a, &indices)?;
+                found = Some(a);
+                break;
+            }
+            scale *= 0.9;
         }
-        scale *= 0.9;
+        let Some(mut a) = found else { continue };
+        a.overlapping_texels = overlapping_texels(&a);
+        let done = a.overlapping_texels == 0;
+        if best
+            .as_ref()
+            .is_none_or(|b| a.overlapping_texels < b.overlapping_texels)
+        {
+            best = Some(a);
+        }
+        if done {
+            break;
+        }
     }
-    Err(Error::Internal(format!(
-        "xatlas could not pack the charts of {} triangles into one {side}² atlas",
-        mesh.triangle_count()
-    )))
+    best.ok_or_else(|| {
+        Error::Internal(format!(
+            "xatlas could not pack the charts of {} triangles into one {side}² atlas",
+            mesh.triangle_count()
+        ))
+    })
+}
+
+/// Texel centres inside two atlas triangles that share no atlas vertex (edge-adjacent and
+/// vertex-adjacent triangles may both claim a centre on their common boundary).
+pub fn overlapping_texels(a: &Atlas) -> u64 {
+    let n = a.size as usize;
+    let mut owner = vec![u32::MAX; n * n];
+    let mut count = 0;
+    for (t, tri) in a.triangles.iter().enumerate() {
+        let uv = tri.map(|v| a.uv[v as usize].map(f64::from));
+        let area = (uv[1][0] - uv[0][0]) * (uv[2][1] - uv[0][1])
+            - (uv[2][0] - uv[0][0]) * (uv[1][1] - uv[0][1]);
+        if area == 0.0 {
+            continue;
+        }
+        let lo = [0, 1].map(|k| (uv[0][k].min(uv[1][k]).min(uv[2][k]).floor().max(0.0)) as usize);
+        let hi =
+            [0, 1].map(|k| (uv[0][k].max(uv[1][k]).max(uv[2][k]).ceil().max(0.0) as usize).min(n));
+        for j in lo[1]..hi[1] {
+            for i in lo[0]..hi[0] {
+                let c = [i as f64 + 0.5, j as f64 + 0.5];
+                let e = |p: [f64; 2], q: [f64; 2]| {
+                    ((q[0] - p[0]) * (c[1] - p[1]) - (c[0] - p[0]) * (q[1] - p[1])) / area
+                };
+                let inside =
+                    e(uv[1], uv[2]) >= 0.0 && e(uv[2], uv[0]) >= 0.0 && e(uv[0], uv[1]) >= 0.0;
+                if !inside {
+                    continue;
+                }
+                let k = j * n + i;
+                let o = owner[k];
+                if o == u32::MAX {
+                    owner[k] = t as u32;
+                } else if !a.triangles[o as usize].iter().any(|v| tri.contains(v)) {
+                    count += 1;
+                }
+            }
+        }
+    }
+    count
 }
 
 /// One xatlas run; `None` when the charts spill over into a second atlas.
@@ -129,6 +187,7 @@ fn run_xatlas(
     side: u32,
     padding: u32,
     texels_per_unit: f32,
+    max_threshold: f32,
 ) -> Result<Option<Atlas>> {
     let decl = ffi::MeshDecl {
         vertex_count: (positions.len() / 3) as u32,
@@ -153,6 +212,8 @@ fn run_xatlas(
         conservative: padding > 0,
         padding,
     };
+    // SAFETY: a null print function silences xatlas's warnings on stdout.
+    unsafe { ffi::set_print(None, false) };
     let atlas = ffi::Handle::new()?;
     // SAFETY: `atlas` is a live atlas; `decl` points into `positions` and `indices`, which
     // outlive the call (xatlas copies the mesh in AddMesh).
@@ -166,7 +227,10 @@ fn run_xatlas(
     unsafe {
         ffi::generate(
             atlas.0,
-            ffi::ChartOptions::default(),
+            ffi::ChartOptions {
+                max_threshold,
+                ..ffi::ChartOptions::default()
+            },
             None,
             pack,
             None,
@@ -213,6 +277,7 @@ unsafe fn copy_output(a: &ffi::RawAtlas, side: u32) -> Result<Option<Atlas>> {
         uv: verts.iter().map(|v| v.uv).collect(),
         triangles: idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
         chart_count: a.chart_count,
+        overlapping_texels: 0,
     }))
 }
 
@@ -361,6 +426,11 @@ mod ffi {
     type ProgressFunc = Option<unsafe extern "C" fn(c_int, c_int, *mut c_void)>;
 
     extern "C" {
+        #[link_name = "_ZN6xatlas8SetPrintEPFiPKczEb"]
+        pub fn set_print(
+            print: Option<unsafe extern "C" fn(*const std::os::raw::c_char, ...) -> c_int>,
+            verbose: bool,
+        );
         #[link_name = "_ZN6xatlas6CreateEv"]
         pub fn create() -> *mut RawAtlas;
         #[link_name = "_ZN6xatlas7DestroyEPNS_5AtlasE"]

@@ -84,6 +84,9 @@ pub struct BakeReport {
     pub texels_covered: u64,
     /// Charts of the atlas.
     pub charts: u32,
+    /// Texel centres where two non-adjacent atlas triangles overlap (0 for a valid atlas;
+    /// xatlas occasionally leaves a folded chart, see `atlas::overlapping_texels`).
+    pub overlapping_texels: u64,
     /// Fraction of samples whose provenance came from the closest-point fallback, in [0, 1].
     pub fallback_fraction: f64,
     /// Mean appearance error: |baked base colour − input base colour at the closest input
@@ -334,6 +337,7 @@ fn bake_textured(
     report.atlas_seconds = t.elapsed().as_secs_f64();
     report.texture_size = side;
     report.charts = atlas.chart_count;
+    report.overlapping_texels = atlas.overlapping_texels;
 
     let lod_normals = vertex_normals(lod);
     let positions: Vec<[f64; 3]> = atlas
