@@ -528,19 +528,19 @@ fn untextured_input_gives_vertex_colours() {
 
 // ------------------------------------------------------------------------ shared assets --
 
+/// `../shared/assets/textured` from the crate root (the main checkout), else
+/// `../../shared/assets/textured` (a worktree under `/work/wt/`); `None` (test skipped) when
+/// absent.
 fn assets() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/textured");
-    let dir = if dir.is_dir() {
-        dir
-    } else {
-        PathBuf::from("/work/shared/assets/textured")
-    };
-    if dir.join("MANIFEST.csv").is_file() {
-        Some(dir)
-    } else {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let found = ["../shared/assets/textured", "../../shared/assets/textured"]
+        .iter()
+        .map(|d| root.join(d))
+        .find(|d| d.join("MANIFEST.csv").is_file());
+    if found.is_none() {
         eprintln!("SKIPPED: ../shared/assets/textured is absent");
-        None
     }
+    found
 }
 
 /// The sidecar's field `i` at world point `p` (display sRGB in [0, 1]).

@@ -110,6 +110,12 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
                 r.appearance_error_p95,
                 r.total_seconds
             );
+            if r.overlapping_texels > 0 {
+                println!(
+                    "  warning: {} texels where atlas charts overlap (xatlas left a folded chart)",
+                    r.overlapping_texels
+                );
+            }
         }
         println!(
             "geometry {:.2} s, bake {:.2} s; wrote {}",
