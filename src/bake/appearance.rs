@@ -186,8 +186,8 @@ pub struct Material {
 }
 
 impl Default for Material {
-    /// The glTF default material: white, fully rough dielectric... with glTF's defaults
-    /// (`metallicFactor = 1`, `roughnessFactor = 1`).
+    /// The glTF default material: white, `metallicFactor = 1`, `roughnessFactor = 1`, no
+    /// texture, opaque, single-sided.
     fn default() -> Self {
         Material {
             base_color_factor: [1.0; 4],

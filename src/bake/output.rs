@@ -18,11 +18,11 @@ use crate::{Error, Result};
 /// Reference viewport height in pixels for [`screen_coverage`].
 pub const REFERENCE_VIEWPORT: f64 = 1080.0;
 
-/// The `MSFT_screencoverage` value for a level made for `n_p` pixels: the fraction of a
+/// The `MSFT_screencoverage` value for `n_p` pixels: the fraction of a
 /// [`REFERENCE_VIEWPORT`]-pixel-high square viewport covered by a square whose side is the
-/// bounding-box diagonal at `n_p` pixels, `min(1, (n_p / 1080)²)`. A level is shown while the
-/// object covers at least the next finer level's threshold... i.e. level `i` gets the coverage
-/// of level `i + 1`'s `n_p` (the finer level takes over above it); the last level gets 0.
+/// bounding-box diagonal at `n_p` pixels, `min(1, (n_p / 1080)²)`. In the chain, level `i`
+/// (finest first) gets the coverage of level `i + 1`'s `n_p` — above it the finer level `i`
+/// is shown — and the coarsest level gets 0.
 pub fn screen_coverage(screen_size: f64) -> f64 {
     (screen_size / REFERENCE_VIEWPORT).powi(2).min(1.0)
 }
