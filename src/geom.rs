@@ -76,10 +76,7 @@ mod tests {
         let (va, vb) = (Vec3::from(a), Vec3::from(b));
         assert_eq!(va.dot(vb).to_bits(), old_dot.to_bits());
         assert_eq!(va.cross(vb).to_array(), old_cross);
-        assert_eq!(
-            va.length().to_bits(),
-            (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt().to_bits()
-        );
+        assert_eq!(va.length().to_bits(), (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt().to_bits());
         let t = 0.37;
         let old_lerp = [0, 1, 2].map(|k| a[k] + t * (b[k] - a[k]));
         assert_eq!(lerp(va, vb, t).to_array(), old_lerp);
