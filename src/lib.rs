@@ -38,6 +38,9 @@ pub mod lowpoly;
 #[cfg(feature = "cage")]
 pub mod cage;
 
+#[cfg(feature = "bake")]
+pub mod bake;
+
 #[cfg(feature = "wrinkle")]
 pub mod wrinkle;
 

@@ -388,3 +388,42 @@ fn wrinkle_demo_script_runs() {
     assert!(s.matches("watertight          yes").count() == 2, "{s}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `pleat lod IN.glb --bake` writes one GLB holding the chain, readable as glTF.
+#[cfg(feature = "bake")]
+#[test]
+fn lod_bake_writes_one_glb_chain() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let Some(asset) = ["../shared", "../../shared"]
+        .iter()
+        .map(|d| {
+            root.join(d)
+                .join("assets/textured/gen_spot_two_materials.glb")
+        })
+        .find(|p| p.is_file())
+    else {
+        eprintln!("SKIPPED: ../shared/assets/textured is absent");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("pleat-cli-bake-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("chain.glb");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_pleat"))
+        .args([
+            "lod",
+            asset.to_str().unwrap(),
+            "--screen-size",
+            "25,50",
+            "--bake",
+            "-q",
+            "-o",
+        ])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let (doc, _, images) = gltf::import(&out).unwrap();
+    assert_eq!(doc.meshes().count(), 2);
+    assert!(images.len() >= 2);
+    std::fs::remove_dir_all(&dir).ok();
+}

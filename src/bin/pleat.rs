@@ -20,6 +20,10 @@ mod bench_lod;
 #[path = "pleat/interp_bench.rs"]
 mod interp_bench;
 
+#[cfg(feature = "bake")]
+#[path = "pleat/bake.rs"]
+mod bake_cmd;
+
 #[derive(Parser)]
 #[command(
     name = "pleat",
@@ -146,6 +150,9 @@ struct BakeArgs {
     /// Also print every statistic (stage seconds, counts, metrics) of each level.
     #[arg(short, long)]
     verbose: bool,
+    #[cfg(feature = "bake")]
+    #[command(flatten)]
+    textures: bake_cmd::TextureArgs,
 }
 
 /// `pleat wrinkle ...` (needs the `wrinkle` feature; otherwise exits 2 with a message).
@@ -332,6 +339,10 @@ fn output_path(pattern: &std::path::Path, n_p: f64) -> PathBuf {
 #[cfg(feature = "lod")]
 fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
     let cmd = if cage { "cage" } else { "lod" };
+    #[cfg(feature = "bake")]
+    if args.textures.bake {
+        return bake_cmd::run(input, args, cmd);
+    }
     let sizes = &args.screen_size;
     let many = sizes.len() > 1;
     let pattern = args.output.to_string_lossy();

@@ -587,6 +587,135 @@ fn det3(m: &Mat4) -> f64 {
         + m[2][0] * (m[0][1] * m[1][2] - m[1][1] * m[0][2])
 }
 
+// ------------------------------------------------------- hooks for the appearance reader --
+
+/// A validated document and its buffers, as [`read_gltf_bytes`] loads them (used by
+/// `bake::appearance`, which reads materials, attributes and images on top of them).
+#[cfg(feature = "bake")]
+pub(crate) struct LoadedDocument {
+    /// The parsed document (validated as the geometry reader validates it).
+    pub document: Document,
+    /// Buffer contents, indexed like the document's buffers.
+    pub buffers: Vec<Vec<u8>>,
+}
+
+/// Parses, validates and loads the buffers of a glTF/GLB exactly as [`read_gltf_bytes`] does.
+#[cfg(feature = "bake")]
+pub(crate) fn load_document(
+    data: &[u8],
+    base_dir: Option<&Path>,
+    name: &str,
+) -> Result<LoadedDocument> {
+    check_glb_header(data, name)?;
+    let Gltf { document, blob } = Gltf::from_slice_without_validation(data)
+        .map_err(|e| parse_error(name, format!("glTF: {e}")))?;
+    validate(&document, name)?;
+    let buffers = load_buffers(&document, blob, base_dir, name)?;
+    Ok(LoadedDocument { document, buffers })
+}
+
+/// [`read_accessor`] for the appearance reader: `count × components` values as `f64`.
+#[cfg(feature = "bake")]
+pub(crate) fn accessor_values(
+    acc: &Accessor,
+    buffers: &[Vec<u8>],
+    name: &str,
+    what: &str,
+) -> Result<Vec<f64>> {
+    read_accessor(acc, &Ctx { buffers, name }, what)
+}
+
+/// [`read_indices`] for the appearance reader: every index checked `< n_vertices`.
+#[cfg(feature = "bake")]
+pub(crate) fn index_values(
+    acc: &Accessor,
+    n_vertices: usize,
+    buffers: &[Vec<u8>],
+    name: &str,
+    what: &str,
+) -> Result<Vec<u32>> {
+    read_indices(acc, n_vertices, &Ctx { buffers, name }, what)
+}
+
+/// The triangles of an index list in `mode`, as the geometry reader emits them.
+#[cfg(feature = "bake")]
+pub(crate) fn triangle_list(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
+    let mut out = Vec::new();
+    triangulate(mode, idx, |t| out.push(t));
+    out
+}
+
+/// The bytes of a whole buffer view, checked against its buffer.
+#[cfg(feature = "bake")]
+pub(crate) fn view_bytes<'b>(
+    view: &::gltf::buffer::View,
+    buffers: &'b [Vec<u8>],
+    name: &'b str,
+) -> Result<&'b [u8]> {
+    let ctx = Ctx { buffers, name };
+    view_slice(view, 0, 1, view.length(), view.length(), &ctx, "image")
+}
+
+/// The payload of a base64 `data:` URI.
+#[cfg(feature = "bake")]
+pub(crate) fn data_uri_bytes(uri: &str) -> Option<Vec<u8>> {
+    decode_data_uri(uri)
+}
+
+/// An external file relative to `base` (same rules as external buffers), at most `limit` bytes.
+#[cfg(feature = "bake")]
+pub(crate) fn external_bytes(
+    uri: &str,
+    limit: usize,
+    base: Option<&Path>,
+    name: &str,
+) -> Result<Vec<u8>> {
+    let relative =
+        percent_decode(uri).ok_or_else(|| parse_error(name, format!("malformed URI '{uri}'")))?;
+    let base = base.ok_or_else(|| {
+        parse_error(
+            name,
+            format!("external file '{uri}' cannot be resolved when reading from memory"),
+        )
+    })?;
+    let len = std::fs::metadata(base.join(&relative))
+        .map_err(|e| io_error(&base.join(&relative).display().to_string(), &e))?
+        .len();
+    read_external(uri, (len as usize).min(limit), Some(base), name)
+}
+
+/// The node's local matrix (column-major) as `f64`.
+#[cfg(feature = "bake")]
+pub(crate) fn node_matrix(node: &::gltf::Node) -> Mat4 {
+    to_f64(node.transform().matrix())
+}
+
+/// `a · b` for column-major matrices.
+#[cfg(feature = "bake")]
+pub(crate) fn mat_mul(a: &Mat4, b: &Mat4) -> Mat4 {
+    mul(a, b)
+}
+
+/// `m · (p, 1)`.
+#[cfg(feature = "bake")]
+pub(crate) fn mat_point(m: &Mat4, p: [f64; 3]) -> [f64; 3] {
+    transform(m, p)
+}
+
+/// Determinant of the linear part of `m`.
+#[cfg(feature = "bake")]
+pub(crate) fn mat_det3(m: &Mat4) -> f64 {
+    det3(m)
+}
+
+/// The identity matrix.
+#[cfg(feature = "bake")]
+pub(crate) const MAT_IDENTITY: Mat4 = IDENTITY;
+
+/// Column-major 4×4 matrix, `m[column][row]` (for the appearance reader).
+#[cfg(feature = "bake")]
+pub(crate) type Matrix4 = Mat4;
+
 // ---------------------------------------------------------------------------------- writing --
 
 /// Positions as `f32` followed by `u32` indices, little endian.

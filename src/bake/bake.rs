@@ -1,0 +1,875 @@
+//! Baking the input's material onto a LOD: per texel of the LOD's atlas, the LOD surface point
+//! → its provenance on the input → the input's material there.
+//!
+//! 1. **Rasterise** the atlas: each texel whose centre lies in an atlas triangle gets that
+//!    triangle and the centre's barycentric coordinates; texels within half a texel diagonal of
+//!    a triangle but outside every one get the nearest point of the nearest such triangle, so
+//!    bilinear filtering at chart borders reads surface values, not gutter.
+//! 2. **Sample** (rayon over rows, each texel independent, so the bytes do not depend on the
+//!    thread count): point and interpolated normal on the LOD, provenance
+//!    ([`InputIndex::query`]), material evaluation ([`Appearance::sample`]). Base colour is
+//!    interpolated in linear space by the input sampler and stored sRGB-encoded with linear
+//!    alpha; emissive likewise; metallic-roughness as glTF's (–, roughness, metallic);
+//!    occlusion in R (G = B = R).
+//! 3. **Normal map**: the input's shading normal (its own normal map included), flipped to the
+//!    LOD normal's side (the LOD wraps soups and thin parts from both sides), expressed in the
+//!    LOD's MikkTSpace frame exactly as engines reconstruct it: `n' = normalize(x·T + y·B +
+//!    z·N)` with `T`, `N` interpolated per pixel and `B = w · N × T`; the stored `(x, y, z)`
+//!    solves that 3×3 system, normalised. Tangents come from the `mikktspace` crate on the
+//!    atlas UVs with v flipped, so `B` points to image up (glTF's convention).
+//! 4. **Dilate** every image into the gutters and empty space: each empty texel copies the
+//!    texel a breadth-first search from all covered texels reaches it from (4-neighbours, fixed
+//!    order), so mip levels average a chart only with copies of its own border.
+//!
+//! Without any texture in the input, the LOD gets vertex colours instead (the sampled base
+//! colour, factor × COLOR_0, at each LOD vertex's provenance) and no atlas.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use super::appearance::{linear_to_srgb, AlphaMode, Appearance, MaterialSample};
+use super::atlas::{build_atlas, Atlas, AtlasParams};
+use super::provenance::{vertex_normals, InputIndex, ProvenanceParams};
+use crate::geom::{normalized, Vec3};
+use crate::mesh::TriMesh;
+use crate::{Error, Result};
+
+/// Parameters of [`bake_level`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BakeParams {
+    /// Atlas size rule and gutter.
+    pub atlas: AtlasParams,
+    /// Provenance envelope in units of the LOD's offset distance `d = l / n_p` (finite, > 0).
+    /// Default 3.
+    pub envelope_d: f64,
+    /// Bake a tangent-space normal map. Default true.
+    pub normal_map: bool,
+    /// At most this many texels are compared with the input for the appearance error
+    /// (0 skips the measurement). Default 20 000.
+    pub error_samples: usize,
+}
+
+impl Default for BakeParams {
+    fn default() -> Self {
+        BakeParams {
+            atlas: AtlasParams::default(),
+            envelope_d: 3.0,
+            normal_map: true,
+            error_samples: 20_000,
+        }
+    }
+}
+
+/// Timing, sizes and the appearance error of one baked level.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BakeReport {
+    /// Seconds spent building the UV atlas (xatlas).
+    pub atlas_seconds: f64,
+    /// Seconds spent on MikkTSpace tangents.
+    pub tangent_seconds: f64,
+    /// Seconds spent rasterising the atlas into texels.
+    pub raster_seconds: f64,
+    /// Seconds spent on provenance and material sampling (texels or vertices).
+    pub sample_seconds: f64,
+    /// Seconds spent dilating the images into their gutters.
+    pub dilate_seconds: f64,
+    /// Seconds spent measuring the appearance error.
+    pub measure_seconds: f64,
+    /// Wall seconds of the whole level bake (the LOD geometry not included).
+    pub total_seconds: f64,
+    /// Side of the square textures in texels (0 when vertex colours were baked instead).
+    pub texture_size: u32,
+    /// Texels covered by charts (sampled from the input), the rest being gutter.
+    pub texels_covered: u64,
+    /// Charts of the atlas.
+    pub charts: u32,
+    /// Texel centres where two non-adjacent atlas triangles overlap (0 for a valid atlas;
+    /// xatlas occasionally leaves a folded chart, see `atlas::overlapping_texels`).
+    pub overlapping_texels: u64,
+    /// Fraction of samples whose provenance came from the closest-point fallback, in [0, 1].
+    pub fallback_fraction: f64,
+    /// Mean appearance error: |baked base colour − input base colour at the closest input
+    /// point|, max over R, G, B, in sRGB units of 1/255, over up to
+    /// [`BakeParams::error_samples`] covered texels (vertices for vertex colours).
+    pub appearance_error_mean: f64,
+    /// 95th percentile of the same error, in 1/255.
+    pub appearance_error_p95: f64,
+    /// Maximum of the same error, in 1/255.
+    pub appearance_error_max: f64,
+}
+
+/// An 8-bit RGBA image, row-major, row 0 at the top (glTF's v = 0).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Image8 {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// `4 · width · height` bytes, RGBA.
+    pub rgba: Vec<u8>,
+}
+
+impl Image8 {
+    /// The RGBA texel at column `i`, row `j`.
+    pub fn texel(&self, i: u32, j: u32) -> [u8; 4] {
+        let k = 4 * (j as usize * self.width as usize + i as usize);
+        [
+            self.rgba[k],
+            self.rgba[k + 1],
+            self.rgba[k + 2],
+            self.rgba[k + 3],
+        ]
+    }
+}
+
+/// The material of a baked level (glTF metallic-roughness).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BakedMaterial {
+    /// baseColorFactor (linear).
+    pub base_color_factor: [f64; 4],
+    /// baseColorTexture (sRGB RGB, linear alpha).
+    pub base_color: Option<Image8>,
+    /// metallicFactor.
+    pub metallic_factor: f64,
+    /// roughnessFactor.
+    pub roughness_factor: f64,
+    /// metallicRoughnessTexture (G roughness, B metallic).
+    pub metallic_roughness: Option<Image8>,
+    /// occlusionTexture (R).
+    pub occlusion: Option<Image8>,
+    /// emissiveFactor (linear).
+    pub emissive_factor: [f64; 3],
+    /// emissiveTexture (sRGB).
+    pub emissive: Option<Image8>,
+    /// normalTexture (tangent space, MikkTSpace of the level's TANGENTs).
+    pub normal: Option<Image8>,
+    /// Alpha mode (of the input's first material).
+    pub alpha_mode: AlphaMode,
+    /// Alpha cutoff.
+    pub alpha_cutoff: f64,
+    /// Double-sided.
+    pub double_sided: bool,
+}
+
+/// One baked LOD level: a mesh with normals, optional tangents, UVs and colours, and its
+/// material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BakedLevel {
+    /// Screen size `n_p` the level was made for.
+    pub screen_size: f64,
+    /// Vertex positions (split at chart seams and tangent discontinuities).
+    pub positions: Vec<[f64; 3]>,
+    /// Unit vertex normals.
+    pub normals: Vec<[f32; 3]>,
+    /// MikkTSpace tangents `(x, y, z, w)` when textured.
+    pub tangents: Option<Vec<[f32; 4]>>,
+    /// glTF texture coordinates (0 … 1) when textured.
+    pub uvs: Option<Vec<[f32; 2]>>,
+    /// Linear RGBA vertex colours (the untextured path).
+    pub colors: Option<Vec<[f32; 4]>>,
+    /// Triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// Material.
+    pub material: BakedMaterial,
+    /// Timing and error.
+    pub report: BakeReport,
+}
+
+/// Bakes `app`'s appearance onto `lod`, a LOD of `app.mesh` made for screen size `screen_size`.
+/// `index` must index `app.mesh`. See the [module docs](self).
+///
+/// Errors: `InvalidArgument` for bad parameters; `Internal` when the atlas fails.
+pub fn bake_level(
+    app: &Appearance,
+    index: &InputIndex<'_>,
+    lod: &TriMesh,
+    screen_size: f64,
+    params: &BakeParams,
+) -> Result<BakedLevel> {
+    if !(params.envelope_d.is_finite() && params.envelope_d > 0.0) {
+        return Err(Error::InvalidArgument(format!(
+            "bake envelope must be finite and > 0 (in units of d), got {}",
+            params.envelope_d
+        )));
+    }
+    if !(screen_size.is_finite() && screen_size > 0.0) {
+        return Err(Error::InvalidArgument(format!(
+            "screen size must be finite and > 0, got {screen_size}"
+        )));
+    }
+    let start = Instant::now();
+    let diag = app.mesh.bbox_diagonal();
+    let prov = ProvenanceParams {
+        envelope: params.envelope_d * diag / screen_size,
+    };
+    let mut level = if app.has_textures() {
+        bake_textured(app, index, lod, screen_size, diag, &prov, params)?
+    } else {
+        bake_vertex_colors(app, index, lod, screen_size, &prov, params)
+    };
+    level.report.total_seconds = start.elapsed().as_secs_f64();
+    Ok(level)
+}
+
+/// The material fields that are not baked: from the input's first material.
+fn base_material(app: &Appearance) -> BakedMaterial {
+    let m = app.materials.first().cloned().unwrap_or_default();
+    BakedMaterial {
+        base_color_factor: [1.0; 4],
+        base_color: None,
+        metallic_factor: m.metallic_factor,
+        roughness_factor: m.roughness_factor,
+        metallic_roughness: None,
+        occlusion: None,
+        emissive_factor: [0.0; 3],
+        emissive: None,
+        normal: None,
+        alpha_mode: m.alpha_mode,
+        alpha_cutoff: m.alpha_cutoff,
+        double_sided: app.materials.iter().any(|m| m.double_sided),
+    }
+}
+
+fn bake_vertex_colors(
+    app: &Appearance,
+    index: &InputIndex<'_>,
+    lod: &TriMesh,
+    screen_size: f64,
+    prov: &ProvenanceParams,
+    params: &BakeParams,
+) -> BakedLevel {
+    let t0 = Instant::now();
+    let normals = vertex_normals(lod);
+    let found = index.query_all(lod.positions(), &normals, prov);
+    let colors: Vec<[f32; 4]> = found
+        .par_iter()
+        .map(|p| {
+            app.sample(p.triangle as usize, p.bary)
+                .base_color
+                .map(|c| c as f32)
+        })
+        .collect();
+    let mut report = BakeReport {
+        sample_seconds: t0.elapsed().as_secs_f64(),
+        fallback_fraction: fallback(found.iter().map(|p| p.by_ray)),
+        ..BakeReport::default()
+    };
+    if params.error_samples > 0 {
+        let t = Instant::now();
+        let stride = lod.vertex_count().div_ceil(params.error_samples).max(1);
+        let errs: Vec<f64> = (0..lod.vertex_count())
+            .step_by(stride)
+            .collect::<Vec<_>>()
+            .par_iter()
+            .map(|&v| {
+                let baked = colors[v].map(f64::from);
+                color_error(app, index, Vec3::from(lod.positions()[v]), baked)
+            })
+            .collect();
+        set_errors(&mut report, errs);
+        report.measure_seconds = t.elapsed().as_secs_f64();
+    }
+    let mut material = base_material(app);
+    let m = app.materials.first().cloned().unwrap_or_default();
+    material.emissive_factor = m.emissive_factor;
+    BakedLevel {
+        screen_size,
+        positions: lod.positions().to_vec(),
+        normals: normals.iter().map(|n| n.map(|c| c as f32)).collect(),
+        tangents: None,
+        uvs: None,
+        colors: Some(colors),
+        triangles: lod.triangles().to_vec(),
+        material,
+        report,
+    }
+}
+
+/// Which images the input needs.
+struct Channels {
+    metallic_roughness: bool,
+    occlusion: bool,
+    emissive: bool,
+    normal: bool,
+}
+
+impl Channels {
+    fn of(app: &Appearance, params: &BakeParams) -> Self {
+        let first = app.materials.first();
+        let differ = |f: &dyn Fn(&super::appearance::Material) -> f64| {
+            first.is_some_and(|m0| app.materials.iter().any(|m| f(m) != f(m0)))
+        };
+        Channels {
+            metallic_roughness: app.materials.iter().any(|m| m.metallic_roughness.is_some())
+                || differ(&|m| m.metallic_factor)
+                || differ(&|m| m.roughness_factor),
+            occlusion: app.materials.iter().any(|m| m.occlusion.is_some()),
+            emissive: app
+                .materials
+                .iter()
+                .any(|m| m.emissive_factor.iter().any(|&c| c != 0.0)),
+            normal: params.normal_map,
+        }
+    }
+}
+
+/// Per texel: the atlas triangle and barycentric coordinates (`u32::MAX` = empty).
+struct Coverage {
+    size: u32,
+    tri: Vec<u32>,
+    bary: Vec<[f32; 3]>,
+}
+
+fn bake_textured(
+    app: &Appearance,
+    index: &InputIndex<'_>,
+    lod: &TriMesh,
+    screen_size: f64,
+    diag: f64,
+    prov: &ProvenanceParams,
+    params: &BakeParams,
+) -> Result<BakedLevel> {
+    let mut report = BakeReport::default();
+    let t = Instant::now();
+    let side = params.atlas.side(lod, screen_size, diag);
+    let atlas = build_atlas(lod, side, params.atlas.padding)?;
+    report.atlas_seconds = t.elapsed().as_secs_f64();
+    report.texture_size = side;
+    report.charts = atlas.chart_count;
+    report.overlapping_texels = atlas.overlapping_texels;
+
+    let lod_normals = vertex_normals(lod);
+    let positions: Vec<[f64; 3]> = atlas
+        .xref
+        .iter()
+        .map(|&v| lod.positions()[v as usize])
+        .collect();
+    let normals: Vec<[f64; 3]> = atlas
+        .xref
+        .iter()
+        .map(|&v| lod_normals[v as usize])
+        .collect();
+
+    let t = Instant::now();
+    let corner_tangents = mikk_tangents(&positions, &normals, &atlas);
+    report.tangent_seconds = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let cov = rasterize(&atlas);
+    report.raster_seconds = t.elapsed().as_secs_f64();
+    report.texels_covered = cov.tri.iter().filter(|&&t| t != u32::MAX).count() as u64;
+
+    let ch = Channels::of(app, params);
+    let t = Instant::now();
+    let n = side as usize;
+    let row_bytes = 4 * n;
+    let mut base = vec![0u8; row_bytes * n];
+    let mut mr = vec![
+        0u8;
+        if ch.metallic_roughness {
+            row_bytes * n
+        } else {
+            0
+        }
+    ];
+    let mut occ = vec![0u8; if ch.occlusion { row_bytes * n } else { 0 }];
+    let mut emi = vec![0u8; if ch.emissive { row_bytes * n } else { 0 }];
+    let mut nrm = vec![0u8; if ch.normal { row_bytes * n } else { 0 }];
+    let ctx = TexelCtx {
+        app,
+        index,
+        prov,
+        atlas: &atlas,
+        positions: &positions,
+        normals: &normals,
+        tangents: &corner_tangents,
+        cov: &cov,
+    };
+    let by_ray: Vec<(u64, u64)> = base
+        .par_chunks_mut(row_bytes)
+        .zip(par_rows(&mut mr, row_bytes, n))
+        .zip(par_rows(&mut occ, row_bytes, n))
+        .zip(par_rows(&mut emi, row_bytes, n))
+        .zip(par_rows(&mut nrm, row_bytes, n))
+        .enumerate()
+        .map(|(j, ((((b, m), o), e), nr))| {
+            let mut rows = Rows {
+                base: b,
+                mr: m,
+                occ: o,
+                emi: e,
+                nrm: nr,
+            };
+            ctx.bake_row(j, &mut rows)
+        })
+        .collect();
+    let (hits, total) = by_ray.iter().fold((0, 0), |(h, t), &(a, b)| (h + a, t + b));
+    report.fallback_fraction = if total == 0 {
+        0.0
+    } else {
+        1.0 - hits as f64 / total as f64
+    };
+    report.sample_seconds = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let source = dilation_sources(&cov);
+    for img in [&mut base, &mut mr, &mut occ, &mut emi, &mut nrm] {
+        if !img.is_empty() {
+            apply_dilation(img, &source);
+        }
+    }
+    report.dilate_seconds = t.elapsed().as_secs_f64();
+
+    let image = |rgba: Vec<u8>| {
+        (!rgba.is_empty()).then_some(Image8 {
+            width: side,
+            height: side,
+            rgba,
+        })
+    };
+    let base_img = Image8 {
+        width: side,
+        height: side,
+        rgba: base,
+    };
+    if params.error_samples > 0 {
+        let t = Instant::now();
+        let errs = texel_errors(&ctx, &base_img, params.error_samples);
+        set_errors(&mut report, errs);
+        report.measure_seconds = t.elapsed().as_secs_f64();
+    }
+
+    // Output vertices: atlas vertices split where MikkTSpace gives corners different tangents.
+    let (out_vertices, out_triangles) = split_by_tangent(&atlas, &corner_tangents);
+    let mut material = base_material(app);
+    material.base_color = Some(base_img);
+    if ch.metallic_roughness {
+        material.metallic_factor = 1.0;
+        material.roughness_factor = 1.0;
+    }
+    material.metallic_roughness = image(mr);
+    material.occlusion = image(occ);
+    if ch.emissive {
+        material.emissive_factor = [1.0; 3];
+    }
+    material.emissive = image(emi);
+    material.normal = image(nrm);
+    let inv = 1.0 / f64::from(side);
+    Ok(BakedLevel {
+        screen_size,
+        positions: out_vertices
+            .iter()
+            .map(|&(v, _)| positions[v as usize])
+            .collect(),
+        normals: out_vertices
+            .iter()
+            .map(|&(v, _)| normals[v as usize].map(|c| c as f32))
+            .collect(),
+        tangents: Some(out_vertices.iter().map(|&(_, t)| t).collect()),
+        uvs: Some(
+            out_vertices
+                .iter()
+                .map(|&(v, _)| atlas.uv[v as usize].map(|c| (f64::from(c) * inv) as f32))
+                .collect(),
+        ),
+        colors: None,
+        triangles: out_triangles,
+        material,
+        report,
+    })
+}
+
+/// Row chunks of an optional image (empty image: `n` empty rows).
+fn par_rows(img: &mut [u8], row_bytes: usize, n: usize) -> rayon::vec::IntoIter<&mut [u8]> {
+    if img.is_empty() {
+        (0..n)
+            .map(|_| &mut [][..])
+            .collect::<Vec<_>>()
+            .into_par_iter()
+    } else {
+        img.chunks_mut(row_bytes)
+            .collect::<Vec<_>>()
+            .into_par_iter()
+    }
+}
+
+struct Rows<'a> {
+    base: &'a mut [u8],
+    mr: &'a mut [u8],
+    occ: &'a mut [u8],
+    emi: &'a mut [u8],
+    nrm: &'a mut [u8],
+}
+
+struct TexelCtx<'a> {
+    app: &'a Appearance,
+    index: &'a InputIndex<'a>,
+    prov: &'a ProvenanceParams,
+    atlas: &'a Atlas,
+    positions: &'a [[f64; 3]],
+    normals: &'a [[f64; 3]],
+    /// Per atlas triangle corner.
+    tangents: &'a [[f32; 4]],
+    cov: &'a Coverage,
+}
+
+/// `v` quantised to 8 bits.
+fn q8(v: f64) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+impl TexelCtx<'_> {
+    /// LOD point, interpolated normal (unit), and the (unnormalised) interpolated frame.
+    fn surface(&self, t: usize, b: [f32; 3]) -> (Vec3, Vec3, Vec3, Vec3, f64) {
+        let tri = self.atlas.triangles[t];
+        let b = b.map(f64::from);
+        let mut p = Vec3::ZERO;
+        let mut nn = Vec3::ZERO;
+        let mut tt = Vec3::ZERO;
+        let mut w = 0.0;
+        for k in 0..3 {
+            p += Vec3::from(self.positions[tri[k] as usize]) * b[k];
+            nn += Vec3::from(self.normals[tri[k] as usize]) * b[k];
+            let tg = self.tangents[3 * t + k];
+            tt += Vec3::new(f64::from(tg[0]), f64::from(tg[1]), f64::from(tg[2])) * b[k];
+            w += f64::from(tg[3]) * b[k];
+        }
+        let unit = normalized(nn).unwrap_or_else(|| {
+            let [a, bb, c] = tri.map(|v| Vec3::from(self.positions[v as usize]));
+            normalized((bb - a).cross(c - a)).unwrap_or(Vec3::Z)
+        });
+        (p, unit, nn, tt, if w < 0.0 { -1.0 } else { 1.0 })
+    }
+
+    /// Bakes row `j`; returns (texels found by ray, texels sampled).
+    fn bake_row(&self, j: usize, rows: &mut Rows<'_>) -> (u64, u64) {
+        let n = self.cov.size as usize;
+        let (mut hits, mut total) = (0, 0);
+        for i in 0..n {
+            let k = j * n + i;
+            let t = self.cov.tri[k];
+            if t == u32::MAX {
+                continue;
+            }
+            let (p, unit, nn, tt, w) = self.surface(t as usize, self.cov.bary[k]);
+            let Some(found) = self.index.query(p, unit, self.prov) else {
+                continue;
+            };
+            total += 1;
+            hits += u64::from(found.by_ray);
+            let s = self.app.sample(found.triangle as usize, found.bary);
+            self.write(i, rows, &s, unit, nn, tt, w);
+        }
+        (hits, total)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn write(
+        &self,
+        i: usize,
+        rows: &mut Rows<'_>,
+        s: &MaterialSample,
+        unit: Vec3,
+        nn: Vec3,
+        tt: Vec3,
+        w: f64,
+    ) {
+        let o = 4 * i;
+        let c = s.base_color;
+        rows.base[o..o + 4].copy_from_slice(&[
+            q8(linear_to_srgb(c[0])),
+            q8(linear_to_srgb(c[1])),
+            q8(linear_to_srgb(c[2])),
+            q8(c[3]),
+        ]);
+        if !rows.mr.is_empty() {
+            rows.mr[o..o + 4].copy_from_slice(&[0, q8(s.roughness), q8(s.metallic), 255]);
+        }
+        if !rows.occ.is_empty() {
+            let a = q8(s.occlusion);
+            rows.occ[o..o + 4].copy_from_slice(&[a, a, a, 255]);
+        }
+        if !rows.emi.is_empty() {
+            let e = s.emissive.map(|x| q8(linear_to_srgb(x)));
+            rows.emi[o..o + 4].copy_from_slice(&[e[0], e[1], e[2], 255]);
+        }
+        if !rows.nrm.is_empty() {
+            let mut target = Vec3::from(s.normal);
+            if target.dot(unit) < 0.0 {
+                target = -target;
+            }
+            let xyz = tangent_coords(tt, nn, w, target);
+            rows.nrm[o..o + 4].copy_from_slice(&[
+                q8(0.5 * xyz.x + 0.5),
+                q8(0.5 * xyz.y + 0.5),
+                q8(0.5 * xyz.z + 0.5),
+                255,
+            ]);
+        }
+    }
+}
+
+/// `(x, y, z)` with `normalize(x T + y B + z N) = target`, `B = w N × T`, normalised; `(0, 0,
+/// 1)` when the frame is singular.
+fn tangent_coords(t: Vec3, n: Vec3, w: f64, target: Vec3) -> Vec3 {
+    let b = n.cross(t) * w;
+    let m = glam::DMat3::from_cols(t, b, n);
+    if m.determinant().abs() < 1e-12 * (t.length() * b.length() * n.length()).max(1e-300) {
+        return Vec3::Z;
+    }
+    normalized(m.inverse() * target).unwrap_or(Vec3::Z)
+}
+
+/// Rasterises the atlas (see the [module docs](self), step 1).
+fn rasterize(atlas: &Atlas) -> Coverage {
+    let n = atlas.size as usize;
+    let mut cov = Coverage {
+        size: atlas.size,
+        tri: vec![u32::MAX; n * n],
+        bary: vec![[0.0; 3]; n * n],
+    };
+    // 0 empty, 1 border (outside, within reach), 2 inside.
+    let mut state = vec![0u8; n * n];
+    const REACH: f64 = 0.7072;
+    for (t, tri) in atlas.triangles.iter().enumerate() {
+        let uv = tri.map(|v| atlas.uv[v as usize].map(f64::from));
+        let lo = [0, 1].map(|a| {
+            (uv[0][a].min(uv[1][a]).min(uv[2][a]) - 1.0)
+                .floor()
+                .max(0.0) as usize
+        });
+        let hi = [0, 1].map(|a| {
+            ((uv[0][a].max(uv[1][a]).max(uv[2][a]) + 1.0).ceil().max(0.0) as usize).min(n)
+        });
+        for j in lo[1]..hi[1] {
+            for i in lo[0]..hi[0] {
+                let c = [i as f64 + 0.5, j as f64 + 0.5];
+                let (b, dist) = closest_in_triangle(&uv, c);
+                let k = j * n + i;
+                let (new_state, take) = if dist == 0.0 {
+                    (2, state[k] < 2)
+                } else if dist <= REACH {
+                    (1, state[k] == 0)
+                } else {
+                    (0, false)
+                };
+                if take {
+                    state[k] = new_state;
+                    cov.tri[k] = t as u32;
+                    cov.bary[k] = b.map(|x| x as f32);
+                }
+            }
+        }
+    }
+    cov
+}
+
+/// Barycentric coordinates of the point of 2D triangle `t` closest to `c`, and its distance
+/// (0 inside, edges included).
+fn closest_in_triangle(t: &[[f64; 2]; 3], c: [f64; 2]) -> ([f64; 3], f64) {
+    let area =
+        (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]);
+    if area != 0.0 {
+        let e = |a: [f64; 2], b: [f64; 2]| {
+            (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
+        };
+        let b = [
+            e(t[1], t[2]) / area,
+            e(t[2], t[0]) / area,
+            e(t[0], t[1]) / area,
+        ];
+        if b.iter().all(|&x| x >= 0.0) {
+            return (b, 0.0);
+        }
+    }
+    let mut best = ([1.0, 0.0, 0.0], f64::INFINITY);
+    for k in 0..3 {
+        let (a, b) = (t[k], t[(k + 1) % 3]);
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let len2 = d[0] * d[0] + d[1] * d[1];
+        let s = if len2 > 0.0 {
+            (((c[0] - a[0]) * d[0] + (c[1] - a[1]) * d[1]) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let q = [a[0] + s * d[0], a[1] + s * d[1]];
+        let dist = ((q[0] - c[0]).powi(2) + (q[1] - c[1]).powi(2)).sqrt();
+        if dist < best.1 {
+            let mut bary = [0.0; 3];
+            bary[k] = 1.0 - s;
+            bary[(k + 1) % 3] = s;
+            best = (bary, dist);
+        }
+    }
+    best
+}
+
+/// For every texel, the covered texel whose value it takes (itself when covered; `u32::MAX`
+/// when nothing is covered at all).
+fn dilation_sources(cov: &Coverage) -> Vec<u32> {
+    let n = cov.size as usize;
+    let mut src = vec![u32::MAX; n * n];
+    let mut queue = std::collections::VecDeque::new();
+    for (k, &t) in cov.tri.iter().enumerate() {
+        if t != u32::MAX {
+            src[k] = k as u32;
+            queue.push_back(k);
+        }
+    }
+    while let Some(k) = queue.pop_front() {
+        let (i, j) = (k % n, k / n);
+        let mut visit = |m: usize| {
+            if src[m] == u32::MAX {
+                src[m] = src[k];
+                queue.push_back(m);
+            }
+        };
+        if i > 0 {
+            visit(k - 1);
+        }
+        if i + 1 < n {
+            visit(k + 1);
+        }
+        if j > 0 {
+            visit(k - n);
+        }
+        if j + 1 < n {
+            visit(k + n);
+        }
+    }
+    src
+}
+
+fn apply_dilation(img: &mut [u8], src: &[u32]) {
+    for (k, &s) in src.iter().enumerate() {
+        let s = s as usize;
+        if s != k && s != u32::MAX as usize {
+            let (a, b) = (4 * s, 4 * k);
+            let px = [img[a], img[a + 1], img[a + 2], img[a + 3]];
+            img[b..b + 4].copy_from_slice(&px);
+        }
+    }
+}
+
+/// MikkTSpace tangents per atlas triangle corner (`3 t + k`), on UVs with v flipped so the
+/// bitangent points to image up.
+fn mikk_tangents(positions: &[[f64; 3]], normals: &[[f64; 3]], atlas: &Atlas) -> Vec<[f32; 4]> {
+    struct Geo<'a> {
+        positions: &'a [[f64; 3]],
+        normals: &'a [[f64; 3]],
+        atlas: &'a Atlas,
+        out: Vec<[f32; 4]>,
+    }
+    impl mikktspace::Geometry for Geo<'_> {
+        fn num_faces(&self) -> usize {
+            self.atlas.triangles.len()
+        }
+        fn num_vertices_of_face(&self, _face: usize) -> usize {
+            3
+        }
+        fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+            self.positions[self.atlas.triangles[face][vert] as usize].map(|c| c as f32)
+        }
+        fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+            self.normals[self.atlas.triangles[face][vert] as usize].map(|c| c as f32)
+        }
+        fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+            let uv = self.atlas.uv[self.atlas.triangles[face][vert] as usize];
+            let s = self.atlas.size as f32;
+            [uv[0] / s, 1.0 - uv[1] / s]
+        }
+        fn set_tangent_encoded(&mut self, tangent: [f32; 4], face: usize, vert: usize) {
+            self.out[3 * face + vert] = tangent;
+        }
+    }
+    let mut geo = Geo {
+        positions,
+        normals,
+        atlas,
+        out: vec![[1.0, 0.0, 0.0, 1.0]; 3 * atlas.triangles.len()],
+    };
+    mikktspace::generate_tangents(&mut geo);
+    geo.out
+}
+
+/// An output vertex: the atlas vertex it copies and its tangent.
+type OutVertex = (u32, [f32; 4]);
+
+/// Output vertices `(atlas vertex, tangent)` deduplicated in first-use order, and triangles
+/// over them.
+fn split_by_tangent(atlas: &Atlas, tangents: &[[f32; 4]]) -> (Vec<OutVertex>, Vec<[u32; 3]>) {
+    let mut map = std::collections::HashMap::new();
+    let mut verts = Vec::new();
+    let mut tris = Vec::with_capacity(atlas.triangles.len());
+    for (t, tri) in atlas.triangles.iter().enumerate() {
+        let mut out = [0u32; 3];
+        for k in 0..3 {
+            let tg = tangents[3 * t + k];
+            let key = (tri[k], tg.map(f32::to_bits));
+            out[k] = *map.entry(key).or_insert_with(|| {
+                verts.push((tri[k], tg));
+                (verts.len() - 1) as u32
+            });
+        }
+        tris.push(out);
+    }
+    (verts, tris)
+}
+
+fn fallback(by_ray: impl Iterator<Item = bool>) -> f64 {
+    let (mut n, mut miss) = (0usize, 0usize);
+    for b in by_ray {
+        n += 1;
+        miss += usize::from(!b);
+    }
+    if n == 0 {
+        0.0
+    } else {
+        miss as f64 / n as f64
+    }
+}
+
+/// |baked − input at the closest input point|, max over RGB, in sRGB 1/255 (`baked` linear).
+fn color_error(app: &Appearance, index: &InputIndex<'_>, p: Vec3, baked: [f64; 4]) -> f64 {
+    let Some(q) = index.closest(p) else {
+        return 0.0;
+    };
+    let c = app.sample(q.triangle as usize, q.bary).base_color;
+    (0..3)
+        .map(|k| (255.0 * (linear_to_srgb(c[k]) - linear_to_srgb(baked[k]))).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Errors at up to `max` texel centres inside charts (every k-th).
+fn texel_errors(ctx: &TexelCtx<'_>, base: &Image8, max: usize) -> Vec<f64> {
+    let inside: Vec<usize> = (0..ctx.cov.tri.len())
+        .filter(|&k| ctx.cov.tri[k] != u32::MAX)
+        .collect();
+    let stride = inside.len().div_ceil(max).max(1);
+    let n = ctx.cov.size as usize;
+    inside
+        .iter()
+        .step_by(stride)
+        .copied()
+        .collect::<Vec<_>>()
+        .par_iter()
+        .map(|&k| {
+            let (p, ..) = ctx.surface(ctx.cov.tri[k] as usize, ctx.cov.bary[k]);
+            let px = base.texel((k % n) as u32, (k / n) as u32);
+            let baked =
+                [0, 1, 2].map(|c| super::appearance::srgb_to_linear(f64::from(px[c]) / 255.0));
+            color_error(ctx.app, ctx.index, p, [baked[0], baked[1], baked[2], 1.0])
+        })
+        .collect()
+}
+
+fn set_errors(report: &mut BakeReport, mut errs: Vec<f64>) {
+    if errs.is_empty() {
+        return;
+    }
+    errs.sort_by(f64::total_cmp);
+    report.appearance_error_mean = errs.iter().sum::<f64>() / errs.len() as f64;
+    report.appearance_error_p95 = errs[((errs.len() - 1) as f64 * 0.95) as usize];
+    report.appearance_error_max = errs[errs.len() - 1];
+}

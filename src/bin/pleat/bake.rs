@@ -1,0 +1,128 @@
+//! `pleat lod IN.glb --screen-size 50,100,200 --bake [--texture-size N] -o OUT.glb`: the LOD
+//! chain with the input's materials baked onto every level, written as one `.glb` linked with
+//! `MSFT_lod` (feature `bake`).
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use pleat::bake::{bake_chain, chain_glb, read_appearance, AtlasParams, BakeParams, BakedLevel};
+use pleat::lowpoly::LodParams;
+
+use super::{progress_bar, BakeArgs, EXIT_FAILED, EXIT_INPUT};
+
+/// Options of the textured bake (flattened into `lod`'s options).
+#[derive(clap::Args)]
+pub struct TextureArgs {
+    /// Bake the input's materials (glTF: base colour, metallic-roughness, occlusion, emissive,
+    /// normal map; vertex colours when untextured) onto every level and write ONE .glb holding
+    /// the chain (MSFT_lod); the output needs no {np} placeholder.
+    #[arg(long)]
+    pub bake: bool,
+    /// Side of the baked square textures in texels [default: 2 texels per screen pixel at the
+    /// level's n_p, next power of two, 32..4096].
+    #[arg(long, requires = "bake")]
+    pub texture_size: Option<u32>,
+}
+
+/// Runs the textured bake; `cmd` names the subcommand in messages.
+pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
+    if cmd != "lod" {
+        eprintln!("pleat {cmd}: --bake is only available for `pleat lod`");
+        return ExitCode::from(EXIT_INPUT);
+    }
+    if args.faces.is_some() {
+        eprintln!("pleat {cmd}: --faces cannot be combined with --bake");
+        return ExitCode::from(EXIT_INPUT);
+    }
+    if let Some(s) = args.textures.texture_size {
+        if !(1..=16384).contains(&s) {
+            eprintln!("pleat {cmd}: --texture-size must be in 1..=16384, got {s}");
+            return ExitCode::from(EXIT_INPUT);
+        }
+    }
+    let app = match read_appearance(input) {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("pleat {cmd}: {e}");
+            return ExitCode::from(EXIT_INPUT);
+        }
+    };
+    let lod_params = LodParams {
+        max_rounds: args.rounds,
+        align: !args.no_align,
+        ..LodParams::default()
+    };
+    let params = BakeParams {
+        atlas: AtlasParams {
+            size: args.textures.texture_size,
+            ..AtlasParams::default()
+        },
+        ..BakeParams::default()
+    };
+    let bar = progress_bar(args.quiet);
+    let mut prog = |p: pleat::Progress<'_>| {
+        if let Some(b) = &bar {
+            b.set_position((p.fraction * 1000.0) as u64);
+            b.set_message(p.stage.to_string());
+        }
+        true
+    };
+    let result = bake_chain(&app, &args.screen_size, &lod_params, &params, &mut prog);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let chain = match result {
+        Ok(l) => l,
+        Err(e) => {
+            eprintln!("pleat {cmd}: {e}");
+            let code = match e {
+                pleat::Error::InvalidArgument(_) => EXIT_INPUT,
+                _ => EXIT_FAILED,
+            };
+            return ExitCode::from(code);
+        }
+    };
+    let levels = &chain.levels;
+    let refs: Vec<&BakedLevel> = levels.iter().map(|l| &l.baked).collect();
+    let bytes = match chain_glb(&refs) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("pleat {cmd}: {e}");
+            return ExitCode::from(EXIT_FAILED);
+        }
+    };
+    if let Err(e) = std::fs::write(&args.output, bytes) {
+        eprintln!("pleat {cmd}: cannot write '{}': {e}", args.output.display());
+        return ExitCode::from(EXIT_FAILED);
+    }
+    if !args.quiet {
+        for l in levels {
+            let r = &l.baked.report;
+            println!(
+                "n_p {:>5}: {:>6} faces, {:>4}² texels ({} covered, {} charts), appearance \
+                 error mean {:.2} p95 {:.2} /255, bake {:.2} s",
+                l.baked.screen_size,
+                l.baked.triangles.len(),
+                r.texture_size,
+                r.texels_covered,
+                r.charts,
+                r.appearance_error_mean,
+                r.appearance_error_p95,
+                r.total_seconds
+            );
+            if r.overlapping_texels > 0 {
+                println!(
+                    "  warning: {} texels where atlas charts overlap (xatlas left a folded chart)",
+                    r.overlapping_texels
+                );
+            }
+        }
+        println!(
+            "geometry {:.2} s, bake {:.2} s; wrote {}",
+            chain.geometry_seconds,
+            chain.bake_seconds,
+            args.output.display()
+        );
+    }
+    ExitCode::SUCCESS
+}
