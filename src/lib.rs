@@ -10,8 +10,18 @@
 //!   numerics module [`solve`] (sparse Cholesky, inverse iteration, Krylov; faer).
 //! - `cli`: the `pleat` command-line tool; `io-gltf`: glTF 2.0 reading and writing.
 //!
+//! - `bake`: textured LODs — UV atlas, baked materials and normal maps, glTF LOD chains.
+//!
 //! The mesh core ([`mesh`], [`spatial`]) and the independent verifier ([`verify`]) are always
 //! present.
+//!
+//! ## Layers
+//!
+//! Each module imports only the layers below it (checked by `tests/import_graph.rs`):
+//! [`geom`] (the one vector type), `error` and [`report`] at the bottom; then [`mesh`];
+//! [`spatial`] (the only user of parry's types); [`verify`] (independent checks, never a
+//! pipeline); the pipelines `lowpoly` → `cage` → `bake`, and `wrinkle` → `solve`; [`ffi`] and
+//! the CLI on top. The README's "Layout and layers" has the table.
 //!
 //! ```
 //! use pleat::mesh::TriMesh;
