@@ -30,6 +30,7 @@
 //!    the operation, `Δw(q) = (Σ_{new M_e} Ω_f(q) − Σ_{old M_e} Ω_f(q)) / 4π` (solid angles) must
 //!    round to 0. Together with "no touching", every input point stays strictly inside.
 
+use super::report::GuardCounts;
 use crate::geom::{bbox_of, normalized, tri_normal, Vec3};
 use crate::mesh::halfedge::{CollapseRecord, FaceData, FaceId, HalfedgeId, VertexId};
 use crate::mesh::HalfEdgeMesh;
@@ -143,22 +144,6 @@ pub(crate) enum Reject {
     Uncovers,
 }
 
-/// Counters of the guard's work (reported in `LodReport::guard`).
-#[derive(Debug, Clone, Default)]
-pub(crate) struct GuardStats {
-    pub checks: u64,
-    pub accepted: u64,
-    pub rejected_topology: u64,
-    pub rejected_degenerate: u64,
-    pub rejected_intersection: u64,
-    pub rejected_touch: u64,
-    pub rejected_uncover: u64,
-    /// Patches whose normal cone allowed skipping the shared-vertex pairs.
-    pub cone_fast_path: u64,
-    /// Exact triangle–triangle tests run.
-    pub exact_tests: u64,
-}
-
 /// The corners of face `f` as raw vertex indices (the BVH's triangle boundary).
 fn raw_corners(mesh: &HalfEdgeMesh, f: FaceId) -> [u32; 3] {
     mesh.face_vertices(f).map(VertexId::raw)
@@ -205,22 +190,7 @@ pub(crate) struct Guard<'a> {
     /// Leaf updates since the BVH was last built (it is rebuilt when they exceed the face
     /// count: incremental edits degrade the tree).
     edits: usize,
-    pub stats: GuardStats,
-}
-
-impl GuardStats {
-    /// Adds `o`'s counters to these.
-    pub fn add(&mut self, o: &GuardStats) {
-        self.checks += o.checks;
-        self.accepted += o.accepted;
-        self.rejected_topology += o.rejected_topology;
-        self.rejected_degenerate += o.rejected_degenerate;
-        self.rejected_intersection += o.rejected_intersection;
-        self.rejected_touch += o.rejected_touch;
-        self.rejected_uncover += o.rejected_uncover;
-        self.cone_fast_path += o.cone_fast_path;
-        self.exact_tests += o.exact_tests;
-    }
+    pub stats: GuardCounts,
 }
 
 impl<'a> Guard<'a> {
@@ -244,7 +214,7 @@ impl<'a> Guard<'a> {
             cone_cos: CONE_HALF_ANGLE.cos(),
             scratch: GuardScratch::default(),
             edits: 0,
-            stats: GuardStats::default(),
+            stats: GuardCounts::default(),
         }
     }
 
@@ -278,7 +248,7 @@ impl<'a> Guard<'a> {
             return Err(Reject::Degenerate);
         }
         self.fill_move(v, &mut s);
-        let mut st = GuardStats::default();
+        let mut st = GuardCounts::default();
         let r = self.check(&mut s, &mut st);
         self.stats.add(&st);
         match r {
@@ -312,7 +282,7 @@ impl<'a> Guard<'a> {
             return Err(Reject::Topology);
         }
         let mut s = std::mem::take(&mut self.scratch);
-        let mut st = GuardStats::default();
+        let mut st = GuardCounts::default();
         let r = self.check_collapse(h, p, &mut s, &mut st);
         self.stats.add(&st);
         self.scratch = s;
@@ -330,7 +300,7 @@ impl<'a> Guard<'a> {
         h: HalfedgeId,
         p: [f64; 3],
         s: &mut GuardScratch,
-        st: &mut GuardStats,
+        st: &mut GuardCounts,
     ) -> Result<(), Reject> {
         self.fill_collapse(h, p, s);
         self.check(s, st)
@@ -469,7 +439,7 @@ impl<'a> Guard<'a> {
     }
 
     /// Runs checks 2–4 of the module docs on the neighbourhood in `s`, counting in `st`.
-    fn check(&self, s: &mut GuardScratch, st: &mut GuardStats) -> Result<(), Reject> {
+    fn check(&self, s: &mut GuardScratch, st: &mut GuardCounts) -> Result<(), Reject> {
         st.checks += 1;
         let r = self.check_inner(s, st);
         match r {
@@ -483,7 +453,7 @@ impl<'a> Guard<'a> {
         r
     }
 
-    fn check_inner(&self, s: &mut GuardScratch, st: &mut GuardStats) -> Result<(), Reject> {
+    fn check_inner(&self, s: &mut GuardScratch, st: &mut GuardCounts) -> Result<(), Reject> {
         if s.m_1[..s.n_e]
             .iter()
             .any(|f| sp::is_collinear(f.t[0], f.t[1], f.t[2]))
@@ -525,7 +495,7 @@ impl<'a> Guard<'a> {
     /// `M_e` does not meet `M_r` (Alg. 7 with exact tests on all BVH candidates): one BVH
     /// query with the box of `M_e`, then per-face box filtering. Faces outside `M_1` do not
     /// touch the operation's vertices, so their stored geometry is current.
-    fn check_against_rest(&self, s: &mut GuardScratch, st: &mut GuardStats) -> Result<(), Reject> {
+    fn check_against_rest(&self, s: &mut GuardScratch, st: &mut GuardCounts) -> Result<(), Reject> {
         let m_e = &s.m_1[..s.n_e];
         let (lo, hi) = bbox(m_e.iter().flat_map(|f| f.t));
         s.cand.clear();
@@ -552,7 +522,7 @@ impl<'a> Guard<'a> {
     }
 
     /// Cage mode: `M_e` does not touch the input.
-    fn check_input_untouched(&self, s: &GuardScratch, st: &mut GuardStats) -> Result<(), Reject> {
+    fn check_input_untouched(&self, s: &GuardScratch, st: &mut GuardCounts) -> Result<(), Reject> {
         let input = self.input;
         for f in &s.m_1[..s.n_e] {
             for t in input.bvh.query_triangle(&f.t) {
@@ -593,7 +563,7 @@ impl<'a> Guard<'a> {
 
 /// `M_1` is intersection-free given it was before: pairs (f ∈ M_e, g ∈ M_1), each once. Pairs
 /// sharing a vertex (which no box test can cull) are skipped when the normal cone is narrow.
-fn check_within_m1(s: &GuardScratch, cone_ok: bool, st: &mut GuardStats) -> Result<(), Reject> {
+fn check_within_m1(s: &GuardScratch, cone_ok: bool, st: &mut GuardCounts) -> Result<(), Reject> {
     for i in 0..s.n_e {
         let f = &s.m_1[i];
         let fbox = bbox(f.t);
@@ -622,7 +592,7 @@ fn check_within_m1(s: &GuardScratch, cone_ok: bool, st: &mut GuardStats) -> Resu
 pub(crate) fn patches_intersect(
     a: &[[[f64; 3]; 3]],
     b: &[[[f64; 3]; 3]],
-    st: &mut GuardStats,
+    st: &mut GuardCounts,
 ) -> bool {
     let (alo, ahi) = bbox(a.iter().flatten().copied());
     let (blo, bhi) = bbox(b.iter().flatten().copied());

@@ -10,11 +10,11 @@ use std::time::Instant;
 
 use super::align::{align_sweep, reference_normals};
 use super::flow::flow_sweep;
-use super::guard::{Guard, GuardStats, InputModel};
+use super::guard::{Guard, InputModel};
 use super::measure::{self, Surface};
 use super::offset::{offset_surface_with_progress, OffsetDistance, OffsetParams};
 use super::report::{FloorMeasure, GuardCounts, LodReport, LodStage, SimplifyCounts};
-use super::simplify::{simplify_pass, SimplifyOptions, SimplifyReport, DRIFT_CAP};
+use super::simplify::{simplify_pass, SimplifyOptions, DRIFT_CAP};
 use crate::mesh::{HalfEdgeMesh, TriMesh};
 use crate::report::{Progress, ProgressFn};
 use crate::verify::{self, CageCheck, CageInput, MeshReport, ReportOptions};
@@ -487,8 +487,8 @@ struct LoopStats {
     converge_s: f64,
     rounds: u64,
     faces_per_round: Vec<u64>,
-    simplify: SimplifyReport,
-    guard: GuardStats,
+    simplify: SimplifyCounts,
+    guard: GuardCounts,
     converged: bool,
     flow_motion: f64,
     align_motion: f64,
@@ -505,43 +505,14 @@ impl LoopStats {
         s.simplify_first_pass_seconds = self.simplify_first_s;
         s.rounds = self.rounds;
         s.faces_per_round = self.faces_per_round.clone();
-        let r = &self.simplify;
-        s.simplify = SimplifyCounts {
-            collapses: r.collapses,
-            candidates: r.candidates,
-            rejected_fold: r.rejected_fold,
-            rejected_hausdorff: r.rejected_hausdorff,
-            rejected_distance: r.rejected_distance,
-            rejected_guard: r.rejected_guard,
-            rechecked: r.rechecked,
-        };
-        let g = &self.guard;
-        s.guard = GuardCounts {
-            checks: g.checks,
-            rejected_topology: g.rejected_topology,
-            rejected_degenerate: g.rejected_degenerate,
-            rejected_intersection: g.rejected_intersection,
-            rejected_touch: g.rejected_touch,
-            rejected_uncover: g.rejected_uncover,
-            cone_fast_path: g.cone_fast_path,
-            exact_tests: g.exact_tests,
-        };
+        s.simplify = self.simplify;
+        s.guard = self.guard;
         s.target_met = self.target_met;
         s.target_relaxations = self.relaxations;
         s.converged = self.converged;
         s.flow_motion = self.flow_motion;
         s.align_motion = self.align_motion;
     }
-}
-
-fn add_simplify(acc: &mut SimplifyReport, r: &SimplifyReport) {
-    acc.collapses += r.collapses;
-    acc.candidates += r.candidates;
-    acc.rejected_fold += r.rejected_fold;
-    acc.rejected_hausdorff += r.rejected_hausdorff;
-    acc.rejected_distance += r.rejected_distance;
-    acc.rejected_guard += r.rejected_guard;
-    acc.rechecked += r.rechecked;
 }
 
 /// Alg. 3 line 17: the sampled two-sided Hausdorff distance between the meshes before and
@@ -586,7 +557,7 @@ fn optimize(
             let mut kg = |x: f64| rep.report("simplify", frac(0.5 * x));
             simplify_pass(&mut g, &sopt, &mut kg)?
         };
-        add_simplify(&mut ls.simplify, &sr);
+        ls.simplify.add(&sr);
         ls.simplify_s += t0.elapsed().as_secs_f64();
         if i == 0 {
             ls.simplify_first_s = ls.simplify_s;
@@ -627,7 +598,7 @@ fn optimize(
             break;
         }
     }
-    ls.guard = g.stats.clone();
+    ls.guard = g.stats;
     Ok((g.mesh().to_trimesh(), ls))
 }
 

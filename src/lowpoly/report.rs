@@ -62,11 +62,26 @@ pub struct SimplifyCounts {
     pub rechecked: u64,
 }
 
+impl SimplifyCounts {
+    /// Adds `o`'s counters to these.
+    pub fn add(&mut self, o: &SimplifyCounts) {
+        self.collapses += o.collapses;
+        self.candidates += o.candidates;
+        self.rejected_fold += o.rejected_fold;
+        self.rejected_hausdorff += o.rejected_hausdorff;
+        self.rejected_distance += o.rejected_distance;
+        self.rejected_guard += o.rejected_guard;
+        self.rechecked += o.rechecked;
+    }
+}
+
 /// Counters of the guard of local operations, summed over rounds.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct GuardCounts {
     /// Operations checked.
     pub checks: u64,
+    /// Operations accepted.
+    pub accepted: u64,
     /// Rejected: would break manifoldness or change topology.
     pub rejected_topology: u64,
     /// Rejected: would create a degenerate face.
@@ -81,6 +96,21 @@ pub struct GuardCounts {
     pub cone_fast_path: u64,
     /// Exact triangle–triangle tests run.
     pub exact_tests: u64,
+}
+
+impl GuardCounts {
+    /// Adds `o`'s counters to these.
+    pub fn add(&mut self, o: &GuardCounts) {
+        self.checks += o.checks;
+        self.accepted += o.accepted;
+        self.rejected_topology += o.rejected_topology;
+        self.rejected_degenerate += o.rejected_degenerate;
+        self.rejected_intersection += o.rejected_intersection;
+        self.rejected_touch += o.rejected_touch;
+        self.rejected_uncover += o.rejected_uncover;
+        self.cone_fast_path += o.cone_fast_path;
+        self.exact_tests += o.exact_tests;
+    }
 }
 
 /// The error floor set by the offset stage (measured only with `LodParams::measure_floor`).

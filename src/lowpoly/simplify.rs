@@ -40,7 +40,8 @@
 
 use rayon::prelude::*;
 
-use super::guard::{bbox, boxes_overlap, patches_intersect, Guard, GuardScratch, GuardStats};
+use super::guard::{bbox, boxes_overlap, patches_intersect, Guard, GuardScratch};
+use super::report::{GuardCounts, SimplifyCounts};
 use crate::geom::{normalized, tri_normal, Vec3};
 use crate::mesh::halfedge::{EdgeData, EdgeId, FaceData, FaceId, HalfedgeId, VertexData, VertexId};
 use crate::spatial::closest::{for_each_sample, point_triangle_distance, sample_resolution};
@@ -70,20 +71,6 @@ pub(crate) struct SimplifyOptions {
     pub slack: f64,
     /// Sample spacing of the distance checks.
     pub spacing: f64,
-}
-
-/// What one pass did.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct SimplifyReport {
-    pub collapses: u64,
-    pub candidates: u64,
-    pub rejected_fold: u64,
-    pub rejected_hausdorff: u64,
-    pub rejected_distance: u64,
-    pub rejected_guard: u64,
-    /// Accepted collapses whose new faces met those of an earlier collapse of their batch and
-    /// were evaluated again (see `Pass::run`).
-    pub rechecked: u64,
 }
 
 /// A symmetric quadric `Q(x) = xᵀAx + 2bᵀx + c`.
@@ -365,7 +352,7 @@ struct Pass<'g, 'a> {
     /// Scratch: the vertices `W` of a candidate's footprint.
     footprint: Vec<VertexId>,
     scratch: GuardScratch,
-    report: SimplifyReport,
+    report: SimplifyCounts,
 }
 
 /// A candidate collapse that passed every check (see [`Pass::evaluate`]).
@@ -400,7 +387,7 @@ struct Eval {
     outcome: std::result::Result<Accepted, Rejection>,
     vert_dist: Vec<(VertexId, f64)>,
     face_dist: Vec<(FaceId, FaceDist)>,
-    guard: GuardStats,
+    guard: GuardCounts,
 }
 
 /// Runs one pass of Alg. 5 on the guard's mesh. `keep_going` is polled now and then with the
@@ -409,7 +396,7 @@ pub(crate) fn simplify_pass(
     g: &mut Guard<'_>,
     opt: &SimplifyOptions,
     keep_going: &mut dyn FnMut(f64) -> bool,
-) -> Result<SimplifyReport> {
+) -> Result<SimplifyCounts> {
     let mut pass = Pass::new(g, *opt);
     pass.run(keep_going)?;
     Ok(pass.report)
@@ -431,7 +418,7 @@ impl<'g, 'a> Pass<'g, 'a> {
             scratch: GuardScratch::default(),
             quadrics,
             opt,
-            report: SimplifyReport::default(),
+            report: SimplifyCounts::default(),
             g,
         };
         let edges: Vec<EdgeId> = pass.g.mesh().edges().collect();
@@ -608,7 +595,7 @@ impl<'g, 'a> Pass<'g, 'a> {
             outcome: Err(Rejection::Guard),
             vert_dist: Vec::new(),
             face_dist: Vec::new(),
-            guard: GuardStats::default(),
+            guard: GuardCounts::default(),
         };
         let m = self.g.mesh();
         let h0 = m.edge_halfedge(e);
