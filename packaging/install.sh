@@ -127,8 +127,9 @@ ln -sf "$soname" "$lib/libpleat.so"
 install_file 644 "$root/include/pleat.h" "$inc/pleat.h"
 install_file 644 "$root/bindings/cpp/pleat.hpp" "$inc/pleat.hpp"
 
-# Rust's std needs these when linked statically (`rustc --print native-static-libs`, Linux).
-native_static_libs="-lgcc_s -lutil -lrt -lpthread -lm -ldl -lc"
+# Rust's std needs these when linked statically (`rustc --print native-static-libs`, Linux);
+# -lstdc++ for xatlas (C++, feature `bake`), which the `cc` crate compiles into the library.
+native_static_libs="-lstdc++ -lgcc_s -lutil -lrt -lpthread -lm -ldl -lc"
 ptr_bytes=$(( $(getconf LONG_BIT 2>/dev/null || echo 64) / 8 ))
 subst() { # subst TEMPLATE DST
   sed -e "s|@PREFIX@|$prefix|g" -e "s|@LIBDIR@|$libdir|g" -e "s|@INCLUDEDIR@|$includedir|g" \
