@@ -371,13 +371,7 @@ fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
         ..LodParams::default()
     };
     let bar = progress_bar(args.quiet);
-    let mut prog = |p: pleat::Progress<'_>| {
-        if let Some(b) = &bar {
-            b.set_position((p.fraction * 1000.0) as u64);
-            b.set_message(p.stage.to_string());
-        }
-        true
-    };
+    let mut prog = |p: pleat::Progress<'_>| show_progress(&bar, p);
     let result = match (many, cage) {
         (false, false) => pleat::lowpoly::generate(&mesh, &params, &mut prog).map(|r| vec![r]),
         (true, false) => pleat::lowpoly::generate_chain(&mesh, sizes, &params, &mut prog),
@@ -432,6 +426,15 @@ fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
             .progress_chars("=> "),
     );
     Some(b)
+}
+
+/// Shows a library progress report on `bar` (when there is one); never cancels.
+fn show_progress(bar: &Option<indicatif::ProgressBar>, p: pleat::Progress<'_>) -> bool {
+    if let Some(b) = bar {
+        b.set_position((p.fraction * 1000.0) as u64);
+        b.set_message(p.stage.to_string());
+    }
+    true
 }
 
 #[cfg(feature = "lod")]
@@ -559,11 +562,7 @@ fn offset(
     };
     let bar = progress_bar(false);
     let result = pleat::lowpoly::offset_surface_with_progress(&mesh, params, &mut |p| {
-        if let Some(b) = &bar {
-            b.set_position((p.fraction * 1000.0) as u64);
-            b.set_message(p.stage.to_string());
-        }
-        true
+        show_progress(&bar, p)
     });
     if let Some(b) = &bar {
         b.finish_and_clear();

@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use pleat::bake::{bake_chain, chain_glb, read_appearance, AtlasParams, BakeParams, BakedLevel};
 use pleat::lowpoly::LodParams;
 
-use super::{progress_bar, BakeArgs, EXIT_FAILED, EXIT_INPUT};
+use super::{progress_bar, show_progress, BakeArgs, EXIT_FAILED, EXIT_INPUT};
 
 /// Options of the textured bake (flattened into `lod`'s options).
 #[derive(clap::Args)]
@@ -60,13 +60,7 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
         ..BakeParams::default()
     };
     let bar = progress_bar(args.quiet);
-    let mut prog = |p: pleat::Progress<'_>| {
-        if let Some(b) = &bar {
-            b.set_position((p.fraction * 1000.0) as u64);
-            b.set_message(p.stage.to_string());
-        }
-        true
-    };
+    let mut prog = |p: pleat::Progress<'_>| show_progress(&bar, p);
     let result = bake_chain(&app, &args.screen_size, &lod_params, &params, &mut prog);
     if let Some(b) = &bar {
         b.finish_and_clear();
