@@ -254,7 +254,16 @@ pub fn bake_level_with_progress(
     };
     let mut steps = Steps::new(progress, 0.0, 1.0);
     let mut level = if app.has_textures() {
-        bake_textured(app, index, lod, screen_size, diag, &prov, params, &mut steps)?
+        bake_textured(
+            app,
+            index,
+            lod,
+            screen_size,
+            diag,
+            &prov,
+            params,
+            &mut steps,
+        )?
     } else {
         bake_vertex_colors(app, index, lod, screen_size, &prov, params, &mut steps)?
     };

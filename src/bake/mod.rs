@@ -21,11 +21,13 @@ pub mod bake;
 pub mod output;
 pub mod provenance;
 
-pub use appearance::{read_appearance, read_appearance_bytes, Appearance, MaterialSample};
+pub use appearance::{
+    read_appearance, read_appearance_bytes, Appearance, AppearanceBuffers, BufferMaterial,
+    ImageBuffer, MaterialSample, UvBuffer,
+};
 pub use atlas::{build_atlas, Atlas, AtlasParams};
 pub use bake::{
-    bake_level, bake_level_with_progress, BakeParams, BakeReport, BakedLevel, BakedMaterial,
-    Image8,
+    bake_level, bake_level_with_progress, BakeParams, BakeReport, BakedLevel, BakedMaterial, Image8,
 };
 pub use output::{chain_glb, screen_coverage};
 pub use provenance::{provenance, InputIndex, Provenance, ProvenanceParams};
