@@ -1060,13 +1060,13 @@ pub unsafe extern "C" fn pleat_bake_copy_indices(
     requires!("bake", [bake, dst, index_capacity], {
         guard(|| {
             let b = arg_ref(bake, "bake")?;
-            imp::copy_tuples(
-                Some(&b.level.triangles),
-                dst,
-                index_capacity / 3,
-                "triangles",
-                |c| c,
-            )
+            let n = 3 * b.level.triangles.len();
+            if index_capacity < n {
+                return Err(Error::LimitExceeded(format!(
+                    "dst holds {index_capacity} indices; the bake has {n}"
+                )));
+            }
+            imp::copy_tuples(Some(&b.level.triangles), dst, n / 3, "triangles", |c| c)
         })
     })
 }
