@@ -752,3 +752,162 @@ fn normal_map_follows_gltf_tangent_conventions_and_reconstructs_the_input_normal
     // (≤ 0.5°) plus the normal's change across half a texel.
     assert!(median < 3.0, "median reconstruction angle {median}°");
 }
+
+// ------------------------------------------------ raw buffers, progress, cancel, threads --
+
+/// The quad's appearance again, from raw arrays (`Appearance::from_buffers`), per vertex and
+/// per corner: every sample equals the glTF reader's.
+#[test]
+fn appearance_from_buffers_samples_like_the_gltf_reader() {
+    use pleat::bake::{AppearanceBuffers, BufferMaterial, ImageBuffer, UvBuffer};
+    let data = quad_glb(json!({}), json!({}), 0.0);
+    let app = read_appearance_bytes(&data, None, "quad").unwrap();
+    let (w, h, rgba) = tiny_image();
+    let m0 = &app.materials[0];
+    let material = BufferMaterial {
+        base_color_factor: m0.base_color_factor,
+        base_color: Some(ImageBuffer {
+            width: w,
+            height: h,
+            rgba: &rgba,
+            srgb: true,
+        }),
+        metallic_factor: m0.metallic_factor,
+        roughness_factor: m0.roughness_factor,
+        ..BufferMaterial::default()
+    };
+    let corners: Vec<[f64; 2]> = app
+        .mesh
+        .triangles()
+        .iter()
+        .flat_map(|t| t.map(|v| app.uvs[0][v as usize]))
+        .collect();
+    for uvs in [
+        UvBuffer::PerVertex(&app.uvs[0]),
+        UvBuffer::PerCorner(&corners),
+    ] {
+        let raw = Appearance::from_buffers(&AppearanceBuffers {
+            mesh: &app.mesh,
+            uvs: Some(uvs),
+            normals: Some(&app.normals),
+            colors: None,
+            material,
+        })
+        .unwrap();
+        assert_eq!(raw.mesh.triangle_count(), app.mesh.triangle_count());
+        for t in 0..app.mesh.triangle_count() {
+            for bary in [[1.0, 0.0, 0.0], [0.2, 0.3, 0.5], [0.0, 0.5, 0.5]] {
+                assert_eq!(raw.sample(t, bary), app.sample(t, bary), "{uvs:?} t {t}");
+            }
+        }
+    }
+    // Bad buffers are clear errors.
+    let mut bad = app.uvs[0].clone();
+    bad[2][1] = f64::NAN;
+    let with = |uvs, material| {
+        Appearance::from_buffers(&AppearanceBuffers {
+            mesh: &app.mesh,
+            uvs,
+            normals: None,
+            colors: None,
+            material,
+        })
+    };
+    let e = with(Some(UvBuffer::PerVertex(&bad)), material).unwrap_err();
+    assert!(e.to_string().contains("uvs[2]"), "{e}");
+    let e = with(Some(UvBuffer::PerVertex(&bad[..3])), material).unwrap_err();
+    assert!(e.to_string().contains("uvs"), "{e}");
+    let e = with(None, material).unwrap_err();
+    assert!(e.to_string().contains("no UVs"), "{e}");
+    let huge = BufferMaterial {
+        base_color: Some(ImageBuffer {
+            width: 10_000,
+            height: 10_000,
+            rgba: &rgba,
+            srgb: true,
+        }),
+        ..material
+    };
+    let e = with(Some(UvBuffer::PerVertex(&app.uvs[0])), huge).unwrap_err();
+    assert!(matches!(e, pleat::Error::LimitExceeded(_)), "{e}");
+}
+
+/// `bake_level_with_progress`: the stages in order with rising fractions, a cancel at the
+/// texel stage honoured promptly, and the same bytes on 1 and 2 threads.
+#[test]
+fn bake_reports_progress_cancels_and_is_thread_independent() {
+    use pleat::bake::bake_level_with_progress;
+    use pleat::report::Progress;
+    let data = sphere_glb();
+    let app = read_appearance_bytes(&data, None, "sphere").unwrap();
+    let params = LodParams {
+        screen_size: 25.0,
+        max_rounds: 6,
+        ..LodParams::default()
+    };
+    let (lod, _) = pleat::lowpoly::generate(&app.mesh, &params, &mut |_| true).unwrap();
+    let index = InputIndex::new(&app.mesh);
+    let bake = BakeParams {
+        atlas: pleat::bake::AtlasParams {
+            size: Some(128),
+            ..Default::default()
+        },
+        ..BakeParams::default()
+    };
+    let mut seen: Vec<(String, f64)> = Vec::new();
+    let mut texel_times = Vec::new();
+    let full = bake_level_with_progress(&app, &index, &lod, 25.0, &bake, &mut |p: Progress| {
+        seen.push((p.stage.to_string(), p.fraction));
+        if p.stage == "bake: texels" {
+            texel_times.push(std::time::Instant::now());
+        }
+        true
+    })
+    .unwrap();
+    // The longest stretch without a cancellation point in the texel stage (≈ 10 ms of work
+    // on an idle core; the bound leaves room for a loaded machine).
+    let gap = texel_times
+        .windows(2)
+        .map(|w| (w[1] - w[0]).as_secs_f64())
+        .fold(0.0, f64::max);
+    eprintln!("longest texel chunk: {gap:.4} s");
+    assert!(texel_times.len() >= 3 && gap < 0.5, "gap {gap} s");
+    let stages: Vec<&str> = seen.iter().map(|s| s.0.as_str()).collect();
+    for s in [
+        "bake: atlas",
+        "bake: tangents",
+        "bake: rasterise",
+        "bake: texels",
+        "bake: dilation",
+        "bake: measure",
+    ] {
+        assert!(stages.contains(&s), "stage {s} missing from {stages:?}");
+    }
+    assert!(seen.windows(2).all(|w| w[0].1 <= w[1].1), "{seen:?}");
+    assert_eq!(seen.last().unwrap().1, 1.0);
+    // Cancel at the first texel report after the start of the texel stage.
+    let mut asked = None;
+    let r = bake_level_with_progress(&app, &index, &lod, 25.0, &bake, &mut |p: Progress| {
+        if p.stage == "bake: texels" && p.fraction > 0.2 {
+            asked = Some(std::time::Instant::now());
+            return false;
+        }
+        true
+    });
+    let after = asked.expect("cancel was asked").elapsed().as_secs_f64();
+    assert!(matches!(r, Err(pleat::Error::Cancelled)), "{:?}", r.err());
+    assert!(after < 0.1, "returning after the cancel took {after} s");
+    // 1 and 2 threads: the same level.
+    let on = |n: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .unwrap()
+            .install(|| pleat::bake::bake_level(&app, &index, &lod, 25.0, &bake))
+            .unwrap()
+    };
+    let (one, two) = (on(1), on(2));
+    assert_eq!(one.material, two.material);
+    assert_eq!(one.material, full.material);
+    assert_eq!((one.uvs, one.positions), (two.uvs, two.positions));
+}

@@ -28,6 +28,9 @@ fn features() -> Vec<&'static str> {
     if cfg!(feature = "io-gltf") {
         f.push("io-gltf");
     }
+    if cfg!(feature = "bake") {
+        f.push("bake");
+    }
     f
 }
 

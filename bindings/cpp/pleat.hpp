@@ -564,6 +564,138 @@ inline Animation Cwf::interpolate(const Cwf &other, const PleatWrinkleInterpPara
     return Animation(a);
 }
 
+/// Where LOD points come from on the input (`lod_provenance`, `points_provenance`): per point,
+/// the input triangle, barycentric coordinates (3 per point) and whether the cast along the
+/// normal found it (else the closest point).
+struct Provenance {
+    std::vector<uint32_t> triangle;
+    std::vector<double> bary;
+    std::vector<uint8_t> by_ray;
+};
+
+/// Provenance of every vertex of `lod` on `input` (pleat_lod_provenance).
+inline Provenance lod_provenance(const Mesh &lod, const Mesh &input,
+                                 const PleatProvenanceParams &params =
+                                     pleat_provenance_params_default()) {
+    size_t n = lod.vertex_count();
+    Provenance p{std::vector<uint32_t>(n), std::vector<double>(3 * n), std::vector<uint8_t>(n)};
+    check(pleat_lod_provenance(lod.get(), input.get(), &params, p.triangle.data(), n,
+                               p.bary.data(), 3 * n, p.by_ray.data(), n));
+    return p;
+}
+
+/// Provenance of `points` (xyz triples) cast along `normals` (xyz triples, or empty for the
+/// closest points) on `input` (pleat_points_provenance).
+inline Provenance points_provenance(const Mesh &input, const std::vector<double> &points,
+                                    const std::vector<double> &normals = {},
+                                    const PleatProvenanceParams &params =
+                                        pleat_provenance_params_default()) {
+    size_t n = points.size() / 3;
+    if (!normals.empty() && normals.size() != points.size())
+        throw Error(PLEAT_STATUS_INVALID_ARGUMENT, "normals: one xyz per point needed");
+    Provenance p{std::vector<uint32_t>(n), std::vector<double>(3 * n), std::vector<uint8_t>(n)};
+    check(pleat_points_provenance(input.get(), points.data(),
+                                  normals.empty() ? nullptr : normals.data(), n, &params,
+                                  p.triangle.data(), n, p.bary.data(), 3 * n, p.by_ray.data(),
+                                  n));
+    return p;
+}
+
+/// Default bake parameters with `screen_size` (the LOD's n_p) set.
+inline PleatBakeParams bake_params(double screen_size = 200.0) noexcept {
+    PleatBakeParams p = pleat_bake_params_default();
+    p.screen_size = screen_size;
+    return p;
+}
+
+/// A LOD with the input's appearance baked on (wraps PleatBake*): mesh arrays with atlas UVs,
+/// tangents and RGBA8 images (or vertex colours for an untextured input).
+class Bake {
+  public:
+    Bake() = default;
+    /// Takes ownership of a handle returned by the C API.
+    explicit Bake(PleatBake *raw) noexcept : raw_(raw) {}
+    Bake(const Bake &) = delete;
+    Bake &operator=(const Bake &) = delete;
+    Bake(Bake &&o) noexcept : raw_(std::exchange(o.raw_, nullptr)) {}
+    Bake &operator=(Bake &&o) noexcept {
+        if (this != &o) {
+            pleat_bake_free(raw_);
+            raw_ = std::exchange(o.raw_, nullptr);
+        }
+        return *this;
+    }
+    ~Bake() { pleat_bake_free(raw_); }
+
+    /// Bakes `material` (the input's appearance, its arrays borrowed for the call) onto `lod`
+    /// (pleat_bake_lod).
+    static Bake make(const Mesh &lod, const Mesh &input, const PleatBakeMaterial &material,
+                     const PleatBakeParams &params = pleat_bake_params_default(),
+                     const Progress &progress = {}) {
+        PleatBake *b = nullptr;
+        detail::ProgressRelay relay(progress);
+        relay.finish(pleat_bake_lod(lod.get(), input.get(), &material, &params,
+                                    relay.callback(), relay.user_data(), &b, nullptr));
+        return Bake(b);
+    }
+
+    size_t vertex_count() const noexcept { return pleat_bake_vertex_count(raw_); }
+    size_t triangle_count() const noexcept { return pleat_bake_triangle_count(raw_); }
+    /// Statistics (seconds per stage, texels, charts, appearance error).
+    PleatBakeStats stats() const {
+        PleatBakeStats s{};
+        s.struct_size = sizeof s;
+        check(pleat_bake_get_stats(raw_, &s));
+        return s;
+    }
+    /// True for a textured bake (UVs, tangents, images); false: vertex colours.
+    bool textured() const { return (stats().flags & PLEAT_BAKE_TEXTURED) != 0; }
+    /// xyz doubles per vertex.
+    std::vector<double> positions() const {
+        std::vector<double> v(3 * vertex_count());
+        check(pleat_bake_copy_positions(raw_, v.data(), vertex_count()));
+        return v;
+    }
+    /// 3 indices per triangle.
+    std::vector<uint32_t> indices() const {
+        std::vector<uint32_t> v(3 * triangle_count());
+        check(pleat_bake_copy_indices(raw_, v.data(), v.size()));
+        return v;
+    }
+    /// (u, v) floats per vertex in [0, 1] (textured bakes).
+    std::vector<float> uvs() const { return copy(&pleat_bake_copy_uvs, 2); }
+    /// Unit normals, xyz floats per vertex.
+    std::vector<float> normals() const { return copy(&pleat_bake_copy_normals, 3); }
+    /// MikkTSpace tangents, xyzw floats per vertex (textured bakes).
+    std::vector<float> tangents() const { return copy(&pleat_bake_copy_tangents, 4); }
+    /// Linear RGBA floats per vertex (untextured bakes).
+    std::vector<float> colors() const { return copy(&pleat_bake_copy_colors, 4); }
+    /// Baked image `which` (PLEAT_BAKE_IMAGE_*) as RGBA8 bytes, `width`/`height` set; empty
+    /// when the bake has none.
+    std::vector<uint8_t> image(uint32_t which, uint32_t &width, uint32_t &height) const {
+        check(pleat_bake_image_size(raw_, which, &width, &height));
+        std::vector<uint8_t> v(size_t(4) * width * height);
+        if (!v.empty()) check(pleat_bake_copy_image(raw_, which, v.data(), v.size()));
+        return v;
+    }
+    /// Writes a .glb (mesh, material, embedded PNG textures).
+    void write_glb(const std::string &path) const {
+        check(pleat_bake_write_glb(raw_, path.c_str()));
+    }
+
+    const PleatBake *get() const noexcept { return raw_; }
+    explicit operator bool() const noexcept { return raw_ != nullptr; }
+
+  private:
+    using CopyFn = PleatStatus (*)(const PleatBake *, float *, size_t);
+    std::vector<float> copy(CopyFn fn, size_t k) const {
+        std::vector<float> v(k * vertex_count());
+        check(fn(raw_, v.data(), vertex_count()));
+        return v;
+    }
+    PleatBake *raw_ = nullptr;
+};
+
 }  // namespace pleat
 
 #endif  // PLEAT_HPP

@@ -397,6 +397,299 @@ impl Appearance {
     }
 }
 
+/// Texture coordinates passed to [`Appearance::from_buffers`] (glTF convention: `v = 0` is the
+/// image's top row).
+#[derive(Debug, Clone, Copy)]
+pub enum UvBuffer<'a> {
+    /// One UV per mesh vertex.
+    PerVertex(&'a [[f64; 2]]),
+    /// One UV per triangle corner (`3 t + k`), as engines store seams; the mesh is then
+    /// unwelded (3 vertices per triangle, same triangle order).
+    PerCorner(&'a [[f64; 2]]),
+}
+
+/// A caller-decoded RGBA8 image for [`Appearance::from_buffers`]: row-major, row 0 at the top.
+#[derive(Debug, Clone, Copy)]
+pub struct ImageBuffer<'a> {
+    /// Width in texels (> 0).
+    pub width: u32,
+    /// Height in texels (> 0; `width · height` ≤ [`MAX_TEXTURE_TEXELS`]).
+    pub height: u32,
+    /// `4 · width · height` bytes, RGBA.
+    pub rgba: &'a [u8],
+    /// The colour channels are sRGB-encoded (glTF: base colour and emissive); alpha is linear.
+    pub srgb: bool,
+}
+
+/// One metallic-roughness material from caller buffers (glTF semantics and defaults; every
+/// texture read with the mesh's one UV set).
+#[derive(Debug, Clone, Copy)]
+pub struct BufferMaterial<'a> {
+    /// baseColorFactor, linear RGBA.
+    pub base_color_factor: [f64; 4],
+    /// baseColorTexture.
+    pub base_color: Option<ImageBuffer<'a>>,
+    /// metallicFactor.
+    pub metallic_factor: f64,
+    /// roughnessFactor.
+    pub roughness_factor: f64,
+    /// metallicRoughnessTexture (G roughness, B metallic).
+    pub metallic_roughness: Option<ImageBuffer<'a>>,
+    /// Tangent-space normal texture (glTF/MikkTSpace convention).
+    pub normal: Option<ImageBuffer<'a>>,
+    /// Normal scale.
+    pub normal_scale: f64,
+    /// Occlusion texture (R).
+    pub occlusion: Option<ImageBuffer<'a>>,
+    /// Occlusion strength.
+    pub occlusion_strength: f64,
+    /// emissiveFactor, linear RGB.
+    pub emissive_factor: [f64; 3],
+    /// Emissive texture.
+    pub emissive: Option<ImageBuffer<'a>>,
+    /// Wrap mode of every texture along u and v.
+    pub wrap: Wrap,
+}
+
+impl Default for BufferMaterial<'_> {
+    /// glTF's default material (white, metallic 1, roughness 1, no texture), REPEAT wrap.
+    fn default() -> Self {
+        BufferMaterial {
+            base_color_factor: [1.0; 4],
+            base_color: None,
+            metallic_factor: 1.0,
+            roughness_factor: 1.0,
+            metallic_roughness: None,
+            normal: None,
+            normal_scale: 1.0,
+            occlusion: None,
+            occlusion_strength: 1.0,
+            emissive_factor: [0.0; 3],
+            emissive: None,
+            wrap: Wrap::Repeat,
+        }
+    }
+}
+
+/// An input's appearance as raw arrays (an engine's own decoded mesh and textures), for
+/// [`Appearance::from_buffers`].
+#[derive(Debug, Clone, Copy)]
+pub struct AppearanceBuffers<'a> {
+    /// The input geometry.
+    pub mesh: &'a TriMesh,
+    /// Texture coordinates (required when the material has a texture).
+    pub uvs: Option<UvBuffer<'a>>,
+    /// Per-vertex shading normals (need not be unit; `None`: area-weighted vertex normals).
+    pub normals: Option<&'a [[f64; 3]]>,
+    /// Per-vertex linear RGBA colours multiplying the base colour (glTF `COLOR_0`).
+    pub colors: Option<&'a [[f64; 4]]>,
+    /// The one material of every triangle.
+    pub material: BufferMaterial<'a>,
+}
+
+/// `Err(InvalidArgument)` "`name`[i] is not finite" for the first non-finite value.
+fn check_finite<const N: usize>(v: &[[f64; N]], name: &str) -> Result<()> {
+    match v.iter().position(|x| !x.iter().all(|c| c.is_finite())) {
+        Some(i) => Err(Error::InvalidArgument(format!(
+            "{name}[{i}] is not finite (NaN or infinite)"
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// `Err(InvalidArgument)` unless `v` holds `want` entries.
+fn check_len<T>(v: &[T], want: usize, name: &str, per: &str) -> Result<()> {
+    if v.len() == want {
+        Ok(())
+    } else {
+        Err(Error::InvalidArgument(format!(
+            "{name} holds {} entries; {want} needed (one per {per})",
+            v.len()
+        )))
+    }
+}
+
+impl ImageBuffer<'_> {
+    /// The decoded linear texture (the checks of [`Appearance::from_buffers`]).
+    fn to_texture(self, name: &str, wrap: Wrap) -> Result<Texture> {
+        let texels = u64::from(self.width) * u64::from(self.height);
+        if texels == 0 {
+            return Err(Error::InvalidArgument(format!(
+                "{name} has zero size ({}×{})",
+                self.width, self.height
+            )));
+        }
+        if texels > MAX_TEXTURE_TEXELS {
+            return Err(Error::LimitExceeded(format!(
+                "{name} of {}×{} texels exceeds the budget of {MAX_TEXTURE_TEXELS} texels",
+                self.width, self.height
+            )));
+        }
+        check_len(self.rgba, 4 * texels as usize, name, "RGBA byte")?;
+        let lut = texel_lut(self.srgb);
+        let texels = self
+            .rgba
+            .chunks_exact(4)
+            .map(|p| {
+                [
+                    lut[p[0] as usize],
+                    lut[p[1] as usize],
+                    lut[p[2] as usize],
+                    f32::from(p[3]) / 255.0,
+                ]
+            })
+            .collect();
+        Ok(Texture {
+            width: self.width,
+            height: self.height,
+            texels,
+            wrap_s: wrap,
+            wrap_t: wrap,
+        })
+    }
+}
+
+/// Byte → linear value of a colour channel (sRGB decoded when `srgb`).
+fn texel_lut(srgb: bool) -> Vec<f32> {
+    (0..256)
+        .map(|i| {
+            let c = f64::from(i as u8) / 255.0;
+            (if srgb { srgb_to_linear(c) } else { c }) as f32
+        })
+        .collect()
+}
+
+impl Appearance {
+    /// The appearance of a mesh given as raw arrays (see [`AppearanceBuffers`]): one material,
+    /// one UV set (per vertex or per corner), optional normals and vertex colours. The result
+    /// samples exactly like a glTF asset with the same data read by [`read_appearance`]; with
+    /// per-corner UVs its mesh is the input unwelded (triangle `t` keeps its index, so
+    /// provenance triangle indices refer to the caller's triangles either way).
+    ///
+    /// Errors: `InvalidArgument` naming the array for a wrong count, a non-finite UV, normal or
+    /// colour, a texture without UVs, or a zero-sized image; `LimitExceeded` for an image over
+    /// [`MAX_TEXTURE_TEXELS`].
+    pub fn from_buffers(b: &AppearanceBuffers<'_>) -> Result<Appearance> {
+        let (nv, nt) = (b.mesh.vertex_count(), b.mesh.triangle_count());
+        if let Some(n) = b.normals {
+            check_len(n, nv, "normals", "vertex")?;
+            check_finite(n, "normals")?;
+        }
+        if let Some(c) = b.colors {
+            check_len(c, nv, "colors", "vertex")?;
+            check_finite(c, "colors")?;
+        }
+        match b.uvs {
+            Some(UvBuffer::PerVertex(uv)) => check_len(uv, nv, "uvs", "vertex")?,
+            Some(UvBuffer::PerCorner(uv)) => check_len(uv, 3 * nt, "uvs", "triangle corner")?,
+            None => {}
+        }
+        if let Some(UvBuffer::PerVertex(uv) | UvBuffer::PerCorner(uv)) = b.uvs {
+            check_finite(uv, "uvs")?;
+        }
+        let m = &b.material;
+        for (v, name) in [
+            (m.metallic_factor, "metallic_factor"),
+            (m.roughness_factor, "roughness_factor"),
+            (m.normal_scale, "normal_scale"),
+            (m.occlusion_strength, "occlusion_strength"),
+        ] {
+            if !v.is_finite() {
+                return Err(Error::InvalidArgument(format!(
+                    "{name} is {v}; must be finite"
+                )));
+            }
+        }
+        check_finite(&[m.base_color_factor], "base_color_factor")?;
+        check_finite(&[m.emissive_factor], "emissive_factor")?;
+
+        let mut textures = Vec::new();
+        let mut slot = |img: Option<ImageBuffer<'_>>, name: &str, scale: f64| {
+            img.map(|img| -> Result<TextureRef> {
+                if b.uvs.is_none() {
+                    return Err(Error::InvalidArgument(format!(
+                        "{name} is given but there are no UVs to sample it with"
+                    )));
+                }
+                textures.push(img.to_texture(name, m.wrap)?);
+                Ok(TextureRef {
+                    texture: textures.len() - 1,
+                    tex_coord: 0,
+                    transform: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                    scale,
+                })
+            })
+            .transpose()
+        };
+        let material = Material {
+            base_color_factor: m.base_color_factor,
+            base_color: slot(m.base_color, "base_color", 1.0)?,
+            metallic_factor: m.metallic_factor,
+            roughness_factor: m.roughness_factor,
+            metallic_roughness: slot(m.metallic_roughness, "metallic_roughness", 1.0)?,
+            normal: slot(m.normal, "normal", m.normal_scale)?,
+            occlusion: slot(m.occlusion, "occlusion", m.occlusion_strength)?,
+            emissive_factor: m.emissive_factor,
+            emissive: slot(m.emissive, "emissive", 1.0)?,
+            ..Material::default()
+        };
+
+        let normals: Vec<[f64; 3]> = match b.normals {
+            Some(n) => n
+                .iter()
+                .map(|&v| normalized(Vec3::from(v)).unwrap_or(Vec3::ZERO).to_array())
+                .collect(),
+            None => super::provenance::vertex_normals(b.mesh),
+        };
+        // Per-corner UVs: vertex 3t + k copies corner k of triangle t.
+        let corners: Option<Vec<u32>> = match b.uvs {
+            Some(UvBuffer::PerCorner(_)) => Some(
+                b.mesh
+                    .triangles()
+                    .iter()
+                    .flat_map(|t| t.iter().copied())
+                    .collect(),
+            ),
+            _ => None,
+        };
+        let per_vertex = |v: &[[f64; 3]]| -> Vec<[f64; 3]> {
+            match &corners {
+                Some(c) => c.iter().map(|&i| v[i as usize]).collect(),
+                None => v.to_vec(),
+            }
+        };
+        let mesh = match &corners {
+            Some(_) => TriMesh::new(
+                per_vertex(b.mesh.positions()),
+                (0..nt as u32)
+                    .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                    .collect(),
+            )?,
+            None => b.mesh.clone(),
+        };
+        let colors = b.colors.map(|c| match &corners {
+            Some(cs) => cs.iter().map(|&i| c[i as usize]).collect(),
+            None => c.to_vec(),
+        });
+        let uvs = match b.uvs {
+            Some(UvBuffer::PerVertex(uv) | UvBuffer::PerCorner(uv)) => vec![uv.to_vec()],
+            None => Vec::new(),
+        };
+        let n = mesh.vertex_count();
+        Ok(Appearance {
+            triangle_material: vec![0; nt],
+            triangle_flat: vec![false; nt],
+            normals: per_vertex(&normals),
+            tangents: vec![[0.0; 4]; n],
+            uvs,
+            colors,
+            materials: vec![material],
+            textures,
+            mesh,
+        })
+    }
+}
+
 /// Reads a `.glb`/`.gltf` file's appearance (external buffers and images relative to its
 /// folder). See the [module docs](self).
 pub fn read_appearance(path: &Path) -> Result<Appearance> {
@@ -966,12 +1259,7 @@ fn decode_image(
             "image of {w}×{h} texels exceeds the budget of {MAX_TEXTURE_TEXELS} texels"
         ));
     }
-    let lut: Vec<f32> = (0..256)
-        .map(|i| {
-            let c = f64::from(i as u8) / 255.0;
-            (if srgb { srgb_to_linear(c) } else { c }) as f32
-        })
-        .collect();
+    let lut = texel_lut(srgb);
     let rgba = img.to_rgba8();
     let texels = rgba
         .pixels()

@@ -33,7 +33,38 @@ use super::atlas::{build_atlas, Atlas, AtlasParams};
 use super::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 use crate::geom::{normalized, Vec3};
 use crate::mesh::TriMesh;
+use crate::report::{Progress, ProgressFn};
 use crate::{Error, Result};
+
+/// Texels baked between two progress reports (and cancellation checks): about 10 ms of work
+/// on one core, so a cancel takes effect well within 0.1 s.
+const TEXELS_PER_CHECK: usize = 4096;
+
+/// Maps a bake's stage progress into a window `[base, base + span]` of the caller's progress
+/// and turns a `false` answer into `Error::Cancelled`.
+pub(crate) struct Steps<'p, 'f> {
+    f: &'p mut ProgressFn<'f>,
+    base: f64,
+    span: f64,
+}
+
+impl<'p, 'f> Steps<'p, 'f> {
+    /// Reports into `[base, base + span]` of `f`'s range.
+    pub(crate) fn new(f: &'p mut ProgressFn<'f>, base: f64, span: f64) -> Self {
+        Steps { f, base, span }
+    }
+
+    /// Reports `stage` at `fraction` (in `[0, 1]`) of the window; `Err(Cancelled)` when the
+    /// callback answers `false`.
+    pub(crate) fn check(&mut self, stage: &str, fraction: f64) -> Result<()> {
+        let fraction = (self.base + self.span * fraction.clamp(0.0, 1.0)).clamp(0.0, 1.0);
+        if (self.f)(Progress { stage, fraction }) {
+            Ok(())
+        } else {
+            Err(Error::Cancelled)
+        }
+    }
+}
 
 /// Parameters of [`bake_level`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -187,6 +218,24 @@ pub fn bake_level(
     screen_size: f64,
     params: &BakeParams,
 ) -> Result<BakedLevel> {
+    bake_level_with_progress(app, index, lod, screen_size, params, &mut |_| true)
+}
+
+/// [`bake_level`] with progress and cancellation: `progress` is called on this thread with
+/// the stages `bake: provenance` (untextured inputs), `bake: atlas`, `bake: tangents` (the
+/// normal map's MikkTSpace frame), `bake: rasterise`, `bake: texels` (every
+/// [`TEXELS_PER_CHECK`] texels, so a cancel is honoured within about 10 ms of work),
+/// `bake: dilation` and `bake: measure`; fractions rise from 0 to 1. Returning `false` stops
+/// the bake with `Error::Cancelled`. The output is the same bytes as [`bake_level`]'s, whatever
+/// the thread count.
+pub fn bake_level_with_progress(
+    app: &Appearance,
+    index: &InputIndex<'_>,
+    lod: &TriMesh,
+    screen_size: f64,
+    params: &BakeParams,
+    progress: &mut ProgressFn<'_>,
+) -> Result<BakedLevel> {
     if !(params.envelope_d.is_finite() && params.envelope_d > 0.0) {
         return Err(Error::InvalidArgument(format!(
             "bake envelope must be finite and > 0 (in units of d), got {}",
@@ -203,10 +252,20 @@ pub fn bake_level(
     let prov = ProvenanceParams {
         envelope: params.envelope_d * diag / screen_size,
     };
+    let mut steps = Steps::new(progress, 0.0, 1.0);
     let mut level = if app.has_textures() {
-        bake_textured(app, index, lod, screen_size, diag, &prov, params)?
+        bake_textured(
+            app,
+            index,
+            lod,
+            screen_size,
+            diag,
+            &prov,
+            params,
+            &mut steps,
+        )?
     } else {
-        bake_vertex_colors(app, index, lod, screen_size, &prov, params)
+        bake_vertex_colors(app, index, lod, screen_size, &prov, params, &mut steps)?
     };
     level.report.total_seconds = start.elapsed().as_secs_f64();
     Ok(level)
@@ -238,7 +297,9 @@ fn bake_vertex_colors(
     screen_size: f64,
     prov: &ProvenanceParams,
     params: &BakeParams,
-) -> BakedLevel {
+    steps: &mut Steps<'_, '_>,
+) -> Result<BakedLevel> {
+    steps.check("bake: provenance", 0.0)?;
     let t0 = Instant::now();
     let normals = vertex_normals(lod);
     let found = index.query_all(lod.positions(), &normals, prov);
@@ -256,6 +317,7 @@ fn bake_vertex_colors(
         ..BakeReport::default()
     };
     if params.error_samples > 0 {
+        steps.check("bake: measure", 0.9)?;
         let t = Instant::now();
         let stride = lod.vertex_count().div_ceil(params.error_samples).max(1);
         let errs: Vec<f64> = (0..lod.vertex_count())
@@ -273,7 +335,8 @@ fn bake_vertex_colors(
     let mut material = base_material(app);
     let m = app.materials.first().cloned().unwrap_or_default();
     material.emissive_factor = m.emissive_factor;
-    BakedLevel {
+    steps.check("bake: measure", 1.0)?;
+    Ok(BakedLevel {
         screen_size,
         positions: lod.positions().to_vec(),
         normals: normals.iter().map(|n| n.map(|c| c as f32)).collect(),
@@ -283,7 +346,7 @@ fn bake_vertex_colors(
         triangles: lod.triangles().to_vec(),
         material,
         report,
-    }
+    })
 }
 
 /// Which images the input needs.
@@ -321,6 +384,7 @@ struct Coverage {
     bary: Vec<[f32; 3]>,
 }
 
+#[allow(clippy::too_many_arguments)]
 fn bake_textured(
     app: &Appearance,
     index: &InputIndex<'_>,
@@ -329,8 +393,10 @@ fn bake_textured(
     diag: f64,
     prov: &ProvenanceParams,
     params: &BakeParams,
+    steps: &mut Steps<'_, '_>,
 ) -> Result<BakedLevel> {
     let mut report = BakeReport::default();
+    steps.check("bake: atlas", 0.0)?;
     let t = Instant::now();
     let side = params.atlas.side(lod, screen_size, diag);
     let atlas = build_atlas(lod, side, params.atlas.padding)?;
@@ -351,10 +417,12 @@ fn bake_textured(
         .map(|&v| lod_normals[v as usize])
         .collect();
 
+    steps.check("bake: tangents", 0.1)?;
     let t = Instant::now();
     let corner_tangents = mikk_tangents(&positions, &normals, &atlas);
     report.tangent_seconds = t.elapsed().as_secs_f64();
 
+    steps.check("bake: rasterise", 0.15)?;
     let t = Instant::now();
     let cov = rasterize(&atlas);
     report.raster_seconds = t.elapsed().as_secs_f64();
@@ -386,24 +454,37 @@ fn bake_textured(
         tangents: &corner_tangents,
         cov: &cov,
     };
-    let by_ray: Vec<(u64, u64)> = base
-        .par_chunks_mut(row_bytes)
-        .zip(par_rows(&mut mr, row_bytes, n))
-        .zip(par_rows(&mut occ, row_bytes, n))
-        .zip(par_rows(&mut emi, row_bytes, n))
-        .zip(par_rows(&mut nrm, row_bytes, n))
-        .enumerate()
-        .map(|(j, ((((b, m), o), e), nr))| {
-            let mut rows = Rows {
-                base: b,
-                mr: m,
-                occ: o,
-                emi: e,
-                nrm: nr,
-            };
-            ctx.bake_row(j, &mut rows)
+    let mut rows: Vec<Rows<'_>> = rows_of(&mut base, row_bytes, n)
+        .into_iter()
+        .zip(rows_of(&mut mr, row_bytes, n))
+        .zip(rows_of(&mut occ, row_bytes, n))
+        .zip(rows_of(&mut emi, row_bytes, n))
+        .zip(rows_of(&mut nrm, row_bytes, n))
+        .map(|((((base, mr), occ), emi), nrm)| Rows {
+            base,
+            mr,
+            occ,
+            emi,
+            nrm,
         })
         .collect();
+    // Rows in chunks of about TEXELS_PER_CHECK texels, each chunk in parallel, a progress
+    // report (and cancellation point) between chunks; each row is independent, so the bytes
+    // do not depend on the chunking or the thread count.
+    let chunk = (TEXELS_PER_CHECK / n.max(1)).max(1);
+    let mut by_ray: Vec<(u64, u64)> = Vec::with_capacity(n);
+    steps.check("bake: texels", 0.2)?;
+    for (ci, part) in rows.chunks_mut(chunk).enumerate() {
+        let first = ci * chunk;
+        by_ray.par_extend(
+            part.par_iter_mut()
+                .enumerate()
+                .map(|(k, r)| ctx.bake_row(first + k, r)),
+        );
+        let done = (first + part.len()) as f64 / n.max(1) as f64;
+        steps.check("bake: texels", 0.2 + 0.7 * done)?;
+    }
+    drop(rows);
     let (hits, total) = by_ray.iter().fold((0, 0), |(h, t), &(a, b)| (h + a, t + b));
     report.fallback_fraction = if total == 0 {
         0.0
@@ -412,6 +493,7 @@ fn bake_textured(
     };
     report.sample_seconds = t.elapsed().as_secs_f64();
 
+    steps.check("bake: dilation", 0.9)?;
     let t = Instant::now();
     let source = dilation_sources(&cov);
     for img in [&mut base, &mut mr, &mut occ, &mut emi, &mut nrm] {
@@ -434,6 +516,7 @@ fn bake_textured(
         rgba: base,
     };
     if params.error_samples > 0 {
+        steps.check("bake: measure", 0.95)?;
         let t = Instant::now();
         let errs = texel_errors(&ctx, &base_img, params.error_samples);
         set_errors(&mut report, errs);
@@ -456,6 +539,7 @@ fn bake_textured(
     material.emissive = image(emi);
     material.normal = image(nrm);
     let inv = 1.0 / f64::from(side);
+    steps.check("bake: measure", 1.0)?;
     Ok(BakedLevel {
         screen_size,
         positions: out_vertices
@@ -480,17 +564,12 @@ fn bake_textured(
     })
 }
 
-/// Row chunks of an optional image (empty image: `n` empty rows).
-fn par_rows(img: &mut [u8], row_bytes: usize, n: usize) -> rayon::vec::IntoIter<&mut [u8]> {
+/// The rows of an optional image (empty image: `n` empty rows).
+fn rows_of(img: &mut [u8], row_bytes: usize, n: usize) -> Vec<&mut [u8]> {
     if img.is_empty() {
-        (0..n)
-            .map(|_| &mut [][..])
-            .collect::<Vec<_>>()
-            .into_par_iter()
+        (0..n).map(|_| &mut [][..]).collect()
     } else {
-        img.chunks_mut(row_bytes)
-            .collect::<Vec<_>>()
-            .into_par_iter()
+        img.chunks_mut(row_bytes).collect()
     }
 }
 

@@ -21,15 +21,23 @@ pub mod bake;
 pub mod output;
 pub mod provenance;
 
-pub use appearance::{read_appearance, read_appearance_bytes, Appearance, MaterialSample};
+pub use appearance::{
+    read_appearance, read_appearance_bytes, Appearance, AppearanceBuffers, BufferMaterial,
+    ImageBuffer, MaterialSample, UvBuffer,
+};
 pub use atlas::{build_atlas, Atlas, AtlasParams};
-pub use bake::{bake_level, BakeParams, BakeReport, BakedLevel, BakedMaterial, Image8};
+pub use bake::{
+    bake_level, bake_level_with_progress, BakeParams, BakeReport, BakedLevel, BakedMaterial, Image8,
+};
 pub use output::{chain_glb, screen_coverage};
 pub use provenance::{provenance, InputIndex, Provenance, ProvenanceParams};
 
 use crate::lowpoly::LodParams;
-use crate::report::ProgressFn;
+use crate::report::{Progress, ProgressFn};
 use crate::Result;
+
+/// Share of [`bake_chain`]'s progress range given to the geometry (the bake gets the rest).
+pub const GEOMETRY_SHARE: f64 = 0.7;
 
 /// A baked chain level: the LOD geometry, its `Stats` (passed through untouched) and the bake.
 pub struct ChainLevel {
@@ -53,7 +61,9 @@ pub struct BakedChain {
 
 /// LODs of `app.mesh` at every screen size (`lowpoly::generate_chain`), each baked with
 /// [`bake_level`]. Levels are returned in the order of `screen_sizes`. `progress` sees the
-/// geometry stages (the bake reports nothing; it is short next to them).
+/// geometry stages in the first [`GEOMETRY_SHARE`] of the range, then each level's bake stages
+/// ([`bake_level_with_progress`]) in an equal share of the rest; returning `false` cancels
+/// with `Error::Cancelled` (within a texel chunk during the bake).
 pub fn bake_chain(
     app: &Appearance,
     screen_sizes: &[f64],
@@ -62,15 +72,32 @@ pub fn bake_chain(
     progress: &mut ProgressFn<'_>,
 ) -> Result<BakedChain> {
     let t = std::time::Instant::now();
-    let levels = crate::lowpoly::generate_chain(&app.mesh, screen_sizes, lod_params, progress)?;
+    let levels = {
+        let mut geometry = |p: Progress<'_>| {
+            progress(Progress {
+                stage: p.stage,
+                fraction: GEOMETRY_SHARE * p.fraction,
+            })
+        };
+        crate::lowpoly::generate_chain(&app.mesh, screen_sizes, lod_params, &mut geometry)?
+    };
     let geometry_seconds = t.elapsed().as_secs_f64();
     let t = std::time::Instant::now();
     let index = InputIndex::new(&app.mesh);
+    let share = (1.0 - GEOMETRY_SHARE) / levels.len().max(1) as f64;
     let levels = levels
         .into_iter()
         .zip(screen_sizes)
-        .map(|((lod, stats), &n_p)| {
-            let baked = bake_level(app, &index, &lod, n_p, params)?;
+        .enumerate()
+        .map(|(i, ((lod, stats), &n_p))| {
+            let base = GEOMETRY_SHARE + share * i as f64;
+            let mut level = |p: Progress<'_>| {
+                progress(Progress {
+                    stage: p.stage,
+                    fraction: base + share * p.fraction,
+                })
+            };
+            let baked = bake_level_with_progress(app, &index, &lod, n_p, params, &mut level)?;
             Ok(ChainLevel { lod, stats, baked })
         })
         .collect::<Result<Vec<_>>>()?;

@@ -262,7 +262,8 @@ pub extern "C" fn pleat_abi_version() -> u32 {
     PLEAT_ABI_VERSION
 }
 
-/// 1 when this build includes the capability `name` ("lod", "cage", "wrinkle", "io-gltf"), 0
+/// 1 when this build includes the capability `name` ("lod", "cage", "wrinkle", "io-gltf",
+/// "bake"), 0
 /// otherwise or when `name` is NULL or unknown.
 ///
 /// # Safety
@@ -272,11 +273,12 @@ pub unsafe extern "C" fn pleat_has_feature(name: *const c_char) -> u32 {
     let Ok(name) = c_str_arg(name, "name") else {
         return 0;
     };
-    const BUILT: [(&str, bool); 4] = [
+    const BUILT: [(&str, bool); 5] = [
         ("lod", cfg!(feature = "lod")),
         ("cage", cfg!(feature = "cage")),
         ("wrinkle", cfg!(feature = "wrinkle")),
         ("io-gltf", cfg!(feature = "io-gltf")),
+        ("bake", cfg!(feature = "bake")),
     ];
     let on = BUILT.iter().any(|&(n, built)| n == name && built);
     on as u32
@@ -349,6 +351,34 @@ pub(crate) fn guard_progress(
         Some(pool) => run_on_pool(&pool, cb, user_data, f),
     };
     status_of(result)
+}
+
+/// [`guard_progress`] on a pool of its own with `threads` workers when `threads > 0` (a
+/// per-call thread count; the callback still runs on the calling thread), else exactly
+/// [`guard_progress`].
+#[cfg_attr(not(feature = "bake"), allow(dead_code))]
+pub(crate) fn guard_progress_threads(
+    threads: u32,
+    cb: PleatProgressFn,
+    user_data: *mut std::ffi::c_void,
+    f: impl FnOnce(&mut dyn FnMut(crate::Progress<'_>) -> bool) -> crate::Result<()>,
+) -> PleatStatus {
+    if threads == 0 {
+        return guard_progress(cb, user_data, f);
+    }
+    let pool = match rayon::ThreadPoolBuilder::new()
+        .num_threads(threads as usize)
+        .thread_name(|i| format!("pleat-call-{i}"))
+        .build()
+    {
+        Ok(p) => p,
+        Err(e) => {
+            return fail(Error::Internal(format!(
+                "cannot start {threads} threads: {e}"
+            )))
+        }
+    };
+    status_of(run_on_pool(&pool, cb, user_data, f))
 }
 
 fn run_on_pool(

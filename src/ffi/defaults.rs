@@ -107,3 +107,36 @@ fn read_versioned_honours_struct_size() {
          sizeof(PleatLodParams), e.g. with pleat_lod_params_default()"
     );
 }
+
+#[cfg(feature = "bake")]
+#[test]
+fn bake_params_default_is_rust_default() {
+    let c = pleat_bake_params_default();
+    assert_eq!(
+        c.struct_size as usize,
+        std::mem::size_of::<PleatBakeParams>()
+    );
+    let (rust, screen_size) = bake::imp::bake_params(&c).expect("the C default is valid");
+    assert_eq!(rust, crate::bake::BakeParams::default());
+    assert_eq!(
+        screen_size,
+        crate::lowpoly::LodParams::default().screen_size
+    );
+    let p = pleat_provenance_params_default();
+    assert_eq!(p.struct_size as usize, std::mem::size_of_val(&p));
+    assert_eq!(
+        (p.screen_size, p.envelope_d),
+        (screen_size, rust.envelope_d)
+    );
+    let m = pleat_bake_material_default();
+    let r = crate::bake::BufferMaterial::default();
+    assert_eq!(m.struct_size as usize, std::mem::size_of_val(&m));
+    assert_eq!(
+        (m.base_color_factor, m.metallic_factor, m.roughness_factor),
+        (r.base_color_factor, r.metallic_factor, r.roughness_factor)
+    );
+    assert_eq!(
+        (m.normal_scale, m.occlusion_strength, m.emissive_factor),
+        (r.normal_scale, r.occlusion_strength, r.emissive_factor)
+    );
+}

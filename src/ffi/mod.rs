@@ -18,6 +18,7 @@
 //! - The ABI is the same whatever cargo features the library was built with: a function whose
 //!   capability was left out returns `PLEAT_STATUS_UNSUPPORTED`.
 
+mod bake;
 mod boundary;
 mod common;
 mod edges;
@@ -29,6 +30,7 @@ mod report;
 mod stats;
 mod wrinkle;
 
+pub use bake::*;
 pub use common::*;
 pub use edges::*;
 pub use interpolate::*;

@@ -38,7 +38,8 @@ import numpy as _np
 
 __all__ = [
     "ABI_VERSION", "Mesh", "Cwf", "Animation", "PleatError", "version", "abi_version",
-    "has_feature", "set_thread_count", "thread_count", "library_path",
+    "has_feature", "set_thread_count", "thread_count", "library_path", "Bake", "bake",
+    "lod_provenance", "points_provenance", "BAKE_IMAGES",
 ]
 
 #: The C ABI version (``PLEAT_ABI_VERSION`` of pleat.h) this module's declarations match.
@@ -310,7 +311,7 @@ def thread_count():
 
 def has_feature(name):
     """True when this build of the library includes capability ``name`` ("lod", "cage",
-    "wrinkle", "tfw", "io-gltf"); without it those calls raise PleatError UNSUPPORTED."""
+    "wrinkle", "tfw", "io-gltf", "bake"); without it those calls raise PleatError UNSUPPORTED."""
     return bool(_lib.pleat_has_feature(name.encode()))
 
 
@@ -882,3 +883,280 @@ class Animation(_Handle):
         _check(_lib.pleat_cwf_animation_copy_history(self._h, _ptr(out, _c.c_double), n))
         return out[:n]
 
+
+
+# --- textured LODs: provenance and bake (capability "bake") --------------------------------
+
+_ProvParams = _struct("PleatProvenanceParams", _u32s("struct_size", "reserved")
+                      + _f64s("screen_size", "envelope_d", "envelope"))
+_Image = _struct("PleatImage", [("rgba", _c.c_void_p)]
+                 + _u32s("width", "height", "srgb", "reserved"))
+_BakeMaterial = _struct("PleatBakeMaterial", _u32s("struct_size", "uv_layout")
+                        + [("uvs", _F), ("uv_count", _sz), ("normals", _F), ("colors", _F),
+                           ("base_color_factor", _c.c_double * 4), ("base_color", _Image)]
+                        + _f64s("metallic_factor", "roughness_factor")
+                        + [("metallic_roughness", _Image), ("normal", _Image)]
+                        + _f64s("normal_scale") + [("occlusion", _Image)]
+                        + _f64s("occlusion_strength")
+                        + [("emissive_factor", _c.c_double * 3), ("emissive", _Image)]
+                        + _u32s("wrap", "reserved"))
+_BakeParams = _struct("PleatBakeParams", _u32s("struct_size", "texture_size")
+                      + _f64s("screen_size") + _u32s("padding", "threads")
+                      + _f64s("texels_per_pixel", "envelope_d")
+                      + _u32s("normal_map", "error_samples"))
+_BakeStats = _struct("PleatBakeStats", _u32s("struct_size", "flags", "texture_size", "charts")
+                     + _u64s("texels_covered", "overlapping_texels", "vertex_count",
+                             "triangle_count")
+                     + _f64s("seconds_total", "seconds_atlas", "seconds_tangents",
+                             "seconds_rasterise", "seconds_sample", "seconds_dilate",
+                             "seconds_measure", "fallback_fraction", "appearance_error_mean",
+                             "appearance_error_p95", "appearance_error_max"))
+_B = _c.POINTER(_c.c_uint8)
+for _name, _res, _args in [
+    ("pleat_provenance_params_default", _ProvParams, ()),
+    ("pleat_bake_material_default", _BakeMaterial, ()),
+    ("pleat_bake_params_default", _BakeParams, ()),
+    ("pleat_lod_provenance", _st, (_P, _P, _c.POINTER(_ProvParams), _U, _sz, _D, _sz, _B, _sz)),
+    ("pleat_points_provenance", _st, (_P, _D, _D, _sz, _c.POINTER(_ProvParams), _U, _sz, _D,
+                                      _sz, _B, _sz)),
+    ("pleat_bake_lod", _st, (_P, _P, _c.POINTER(_BakeMaterial), _c.POINTER(_BakeParams))
+     + _PROGRESS_ARGS + (_PP, _c.POINTER(_BakeStats))),
+    ("pleat_bake_free", None, (_P,)),
+    ("pleat_bake_vertex_count", _sz, (_P,)),
+    ("pleat_bake_triangle_count", _sz, (_P,)),
+    ("pleat_bake_get_stats", _st, (_P, _c.POINTER(_BakeStats))),
+    ("pleat_bake_copy_positions", _st, (_P, _D, _sz)),
+    ("pleat_bake_copy_indices", _st, (_P, _U, _sz)),
+    ("pleat_bake_copy_uvs", _st, (_P, _F, _sz)),
+    ("pleat_bake_copy_normals", _st, (_P, _F, _sz)),
+    ("pleat_bake_copy_tangents", _st, (_P, _F, _sz)),
+    ("pleat_bake_copy_colors", _st, (_P, _F, _sz)),
+    ("pleat_bake_image_size", _st, (_P, _u32, _U, _U)),
+    ("pleat_bake_copy_image", _st, (_P, _u32, _B, _sz)),
+    ("pleat_bake_write_glb", _st, (_P, _c.c_char_p)),
+]:
+    _sig(_name, _res, *_args)
+for _fn, _cls in [("pleat_provenance_params_default", _ProvParams),
+                  ("pleat_bake_material_default", _BakeMaterial),
+                  ("pleat_bake_params_default", _BakeParams)]:
+    if getattr(_lib, _fn)().struct_size != _c.sizeof(_cls):
+        raise ImportError(f"{_path}: {_cls.__name__} is {getattr(_lib, _fn)().struct_size} bytes "
+                          f"in the library, {_c.sizeof(_cls)} in this module")
+
+#: Names of the baked images (``Bake.image``), PLEAT_BAKE_IMAGE_* values.
+BAKE_IMAGES = {"base_color": 0, "metallic_roughness": 1, "occlusion": 2, "emissive": 3,
+               "normal": 4}
+_WRAP = {"repeat": 0, "clamp": 1, "mirror": 2}
+
+
+def _prov_params(screen_size, envelope_d, envelope):
+    p = _lib.pleat_provenance_params_default()
+    p.screen_size, p.envelope_d, p.envelope = float(screen_size), float(envelope_d), \
+        float(envelope)
+    return p
+
+
+def _provenance(n, call):
+    """Runs a provenance call into fresh arrays: (tri (n,), bary (n, 3), by_ray (n,) bool)."""
+    tri = _np.zeros(max(n, 1), dtype=_np.uint32)
+    bary = _np.zeros((max(n, 1), 3), dtype=_np.float64)
+    flags = _np.zeros(max(n, 1), dtype=_np.uint8)
+    _check(call(_ptr(tri, _c.c_uint32), n, _ptr(bary, _c.c_double), 3 * n,
+                _ptr(flags, _c.c_uint8), n))
+    return tri[:n], bary[:n], flags[:n].astype(bool)
+
+
+def lod_provenance(lod, input, screen_size=200.0, envelope_d=3.0, envelope=0.0):
+    """For every vertex of ``lod`` (a Mesh made from ``input`` at ``screen_size``): the input
+    triangle ``tri[i]`` and barycentric coordinates ``bary[i]`` of the point it stands for,
+    found by casting along the LOD's vertex normal within ``envelope_d · diag / screen_size``
+    (or ``envelope`` model units when > 0), ``by_ray[i]`` False where the closest point was
+    taken instead. Transfer any per-vertex attribute A of the input with
+    ``(A[input_triangles[tri]] * bary[..., None]).sum(1)``."""
+    p = _prov_params(screen_size, envelope_d, envelope)
+    return _provenance(lod.vertex_count, lambda *out: _lib.pleat_lod_provenance(
+        lod._h, input._h, _c.byref(p), *out))
+
+
+def points_provenance(input, points, normals=None, screen_size=200.0, envelope_d=3.0,
+                      envelope=0.0):
+    """As ``lod_provenance`` for arbitrary points (n, 3) cast along ``normals`` (n, 3); without
+    normals (or where a normal is zero) the closest input point."""
+    pts = _np.ascontiguousarray(points, dtype=_np.float64).reshape(-1, 3)
+    n = pts.shape[0]
+    nrm = None if normals is None else _doubles(normals, 3 * n, "normals (one xyz per point)")
+    p = _prov_params(screen_size, envelope_d, envelope)
+    return _provenance(n, lambda *out: _lib.pleat_points_provenance(
+        input._h, _ptr(pts if n else _np.zeros((1, 3)), _c.c_double),
+        None if nrm is None else _ptr(nrm, _c.c_double), n, _c.byref(p), *out))
+
+
+def _floats(values, k, n, what):
+    """``values`` as contiguous float32 of exactly n×k elements (None passes through)."""
+    if values is None:
+        return None
+    a = _np.ascontiguousarray(values, dtype=_np.float32).reshape(-1)
+    if a.size != n * k:
+        raise PleatError(1, f"{what}: {a.size} values given, {n * k} needed")
+    return a
+
+
+def _image(img, srgb, keep):
+    """A PleatImage over an (h, w, 4) or (h, w, 3) uint8 array (kept alive in ``keep``)."""
+    out = _Image()
+    if img is None:
+        return out
+    a = _np.asarray(img)
+    if a.dtype != _np.uint8 or a.ndim != 3 or a.shape[2] not in (3, 4):
+        raise PleatError(1, f"images must be (h, w, 4) or (h, w, 3) uint8, got {a.dtype} "
+                            f"{a.shape}")
+    if a.shape[2] == 3:
+        a = _np.concatenate([a, _np.full(a.shape[:2] + (1,), 255, _np.uint8)], axis=2)
+    a = _np.ascontiguousarray(a)
+    keep.append(a)
+    out.rgba = a.ctypes.data
+    out.height, out.width = a.shape[0], a.shape[1]
+    out.srgb = 1 if srgb else 0
+    return out
+
+
+class Bake(_Handle):
+    """A LOD with the input's appearance baked on (``bake``): mesh arrays with the atlas UVs
+    (the atlas splits vertices at chart seams), MikkTSpace tangents and RGBA8 images, or vertex
+    colours when the input had no image. ``stats`` is PleatBakeStats as a dict. Immutable."""
+
+    _destroy = "pleat_bake_free"
+
+    def __init__(self, handle, stats=None):
+        super().__init__(handle)
+        self.stats = stats
+
+    @property
+    def vertex_count(self):
+        """Vertices of the baked mesh."""
+        return int(_lib.pleat_bake_vertex_count(self._h))
+
+    @property
+    def triangle_count(self):
+        """Triangles of the baked mesh."""
+        return int(_lib.pleat_bake_triangle_count(self._h))
+
+    @property
+    def textured(self):
+        """True when the bake has UVs, tangents and images (False: vertex colours)."""
+        return bool(self.stats["flags"] & 1)
+
+    def _copy(self, fn, k, dtype, ctype):
+        n = self.vertex_count
+        out = _np.empty((max(n, 1), k), dtype=dtype)
+        _check(fn(self._h, _ptr(out, ctype), n))
+        return out[:n]
+
+    def positions(self):
+        """(n, 3) float64 vertex positions."""
+        return self._copy(_lib.pleat_bake_copy_positions, 3, _np.float64, _c.c_double)
+
+    def triangles(self):
+        """(m, 3) uint32 triangles."""
+        m = self.triangle_count
+        out = _np.empty((max(m, 1), 3), dtype=_np.uint32)
+        _check(_lib.pleat_bake_copy_indices(self._h, _ptr(out, _c.c_uint32), 3 * m))
+        return out[:m]
+
+    def uvs(self):
+        """(n, 2) float32 atlas UVs in [0, 1] (v = 0 at the images' top row)."""
+        return self._copy(_lib.pleat_bake_copy_uvs, 2, _np.float32, _c.c_float)
+
+    def normals(self):
+        """(n, 3) float32 unit vertex normals."""
+        return self._copy(_lib.pleat_bake_copy_normals, 3, _np.float32, _c.c_float)
+
+    def tangents(self):
+        """(n, 4) float32 MikkTSpace tangents (glTF TANGENT: xyz, handedness w)."""
+        return self._copy(_lib.pleat_bake_copy_tangents, 4, _np.float32, _c.c_float)
+
+    def colors(self):
+        """(n, 4) float32 linear RGBA vertex colours (untextured bakes only)."""
+        return self._copy(_lib.pleat_bake_copy_colors, 4, _np.float32, _c.c_float)
+
+    def image(self, which="base_color"):
+        """Baked image ``which`` (a key of BAKE_IMAGES) as (h, w, 4) uint8, or None when this
+        bake has none."""
+        code = BAKE_IMAGES[which]
+        w, h = _c.c_uint32(), _c.c_uint32()
+        _check(_lib.pleat_bake_image_size(self._h, code, _c.byref(w), _c.byref(h)))
+        if w.value == 0:
+            return None
+        out = _np.empty((h.value, w.value, 4), dtype=_np.uint8)
+        _check(_lib.pleat_bake_copy_image(self._h, code, _ptr(out, _c.c_uint8), out.size))
+        return out
+
+    def write_glb(self, path):
+        """Writes the bake as a .glb (mesh, material, embedded PNG textures)."""
+        _check(_lib.pleat_bake_write_glb(self._h, _os.fsencode(path)))
+
+    def __repr__(self):
+        return f"<pleat.Bake {self.vertex_count} vertices, {self.triangle_count} triangles>"
+
+
+def bake(lod, input, uvs=None, base_color=None, *, uv_layout="vertex", normals=None,
+         colors=None, base_color_factor=(1.0, 1.0, 1.0, 1.0), metallic_factor=1.0,
+         roughness_factor=1.0, metallic_roughness=None, normal=None, normal_scale=1.0,
+         occlusion=None, occlusion_strength=1.0, emissive=None, emissive_factor=(0.0, 0.0, 0.0),
+         wrap="repeat", screen_size=200.0, texture_size=0, padding=4, threads=0,
+         texels_per_pixel=2.0, envelope_d=3.0, normal_map=True, error_samples=20000,
+         progress=None):
+    """Bakes ``input``'s appearance onto ``lod`` (a Mesh made from it at ``screen_size``):
+    returns a Bake.
+
+    - ``uvs``: (n, 2) per input vertex (``uv_layout="vertex"``) or (3m, 2) per triangle
+      corner (``"corner"``); glTF convention (v = 0 at the image's top row).
+    - images: (h, w, 4) or (h, w, 3) uint8 arrays; ``base_color`` and ``emissive`` are
+      sRGB-encoded, ``metallic_roughness`` (G roughness, B metallic), ``occlusion`` (R) and
+      ``normal`` (tangent space) linear, as in glTF.
+    - ``normals`` (n, 3), ``colors`` (n, 4 linear RGBA): optional per input vertex.
+    - ``texture_size``: 0 for the screen-size rule; ``threads``: 0 for the global setting.
+    - ``progress(stage, fraction)``: return True to cancel (raises PleatError CANCELLED).
+    """
+    nv, nt = input.vertex_count, input.triangle_count
+    m = _lib.pleat_bake_material_default()
+    keep = []
+    if uv_layout not in ("vertex", "corner"):
+        raise PleatError(1, f"uv_layout must be 'vertex' or 'corner', got {uv_layout!r}")
+    m.uv_layout = 0 if uv_layout == "vertex" else 1
+    if uvs is not None:
+        count = nv if uv_layout == "vertex" else 3 * nt
+        a = _floats(uvs, 2, count, f"uvs (one (u, v) per {uv_layout})")
+        keep.append(a)
+        m.uvs, m.uv_count = _ptr(a, _c.c_float), count
+    for field, values, k in (("normals", normals, 3), ("colors", colors, 4)):
+        a = _floats(values, k, nv, f"{field} (one per input vertex)")
+        if a is not None:
+            keep.append(a)
+            setattr(m, field, _ptr(a, _c.c_float))
+    m.base_color_factor[:] = [float(x) for x in base_color_factor]
+    m.emissive_factor[:] = [float(x) for x in emissive_factor]
+    m.metallic_factor, m.roughness_factor = float(metallic_factor), float(roughness_factor)
+    m.normal_scale, m.occlusion_strength = float(normal_scale), float(occlusion_strength)
+    m.base_color = _image(base_color, True, keep)
+    m.emissive = _image(emissive, True, keep)
+    m.metallic_roughness = _image(metallic_roughness, False, keep)
+    m.occlusion = _image(occlusion, False, keep)
+    m.normal = _image(normal, False, keep)
+    if wrap not in _WRAP:
+        raise PleatError(1, f"wrap must be one of {sorted(_WRAP)}, got {wrap!r}")
+    m.wrap = _WRAP[wrap]
+    p = _lib.pleat_bake_params_default()
+    p.screen_size, p.texture_size, p.padding = float(screen_size), int(texture_size), \
+        int(padding)
+    p.threads, p.texels_per_pixel, p.envelope_d = int(threads), float(texels_per_pixel), \
+        float(envelope_d)
+    p.normal_map, p.error_samples = int(bool(normal_map)), int(error_samples)
+    stats = _BakeStats()
+    stats.struct_size = _c.sizeof(_BakeStats)
+    relay, out = _Relay(progress), _P()
+    st = _lib.pleat_bake_lod(lod._h, input._h, _c.byref(m), _c.byref(p), relay.fn, None,
+                             _c.byref(out), _c.byref(stats))
+    relay.finish(st)
+    del keep
+    return Bake(out, _as_dict(stats))
