@@ -4,7 +4,8 @@
 //! - Programs whose name starts with `assimp_` are built only when `pkg-config` finds assimp
 //!   (Debian: `apt-get install libassimp-dev`); otherwise they are skipped with a loud message.
 //! - When `valgrind` is on PATH (and `PLEAT_NO_VALGRIND` is unset) every program also runs under
-//!   memcheck: any invalid access or definite leak fails the test.
+//!   memcheck: any invalid access or definite leak fails the test (`examples_c/valgrind.supp`
+//!   suppresses the leaks of the vendored xatlas only).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -140,6 +141,11 @@ fn run(exe: &Path, valgrind: bool) {
             "--errors-for-leak-kinds=definite",
             "--show-leak-kinds=definite",
         ])
+        // Leaks inside the vendored xatlas (see the file's comment).
+        .arg(format!(
+            "--suppressions={}",
+            root().join("examples_c/valgrind.supp").display()
+        ))
         .arg(exe);
         c
     } else {
