@@ -40,13 +40,17 @@ pub mod animation;
 mod areas;
 mod complex;
 pub mod cwf;
+pub mod design;
+pub mod edit;
 pub mod evaluate;
 pub mod interpolate;
 pub mod io;
 pub mod knoppel;
 mod omega_path;
+pub mod region;
 pub mod report;
 mod spacetime;
+mod spd;
 pub mod subdivide;
 mod topology;
 
@@ -55,6 +59,9 @@ pub use animation::{
     ANIMATION_FORMAT_VERSION,
 };
 pub use complex::Complex;
+pub use design::{design, DesignOptions, DesignReport, WrinkleSource};
+pub use edit::{edit, EditOptions, EditReport, PhaseCoupling, RegionEdit};
+pub use region::{grow_faces, Adjacency, FaceClass};
 pub use cwf::{one_form_from_vectors, Cwf, FrequencyField, OmegaDecomposition};
 pub use evaluate::{EvalOptions, Evaluated};
 pub use interpolate::{
