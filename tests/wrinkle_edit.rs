@@ -16,7 +16,11 @@ use pleat::wrinkle::{
 };
 use wrinkle_common::{irregular_grid, Rng};
 
-const K: [f64; 3] = [4.0 * std::f64::consts::TAU, 1.5 * std::f64::consts::TAU, 0.0];
+const K: [f64; 3] = [
+    4.0 * std::f64::consts::TAU,
+    1.5 * std::f64::consts::TAU,
+    0.0,
+];
 
 fn plane_wave(base: TriMesh, k: [f64; 3], a: f64) -> Cwf {
     let n = base.vertex_count();
@@ -34,9 +38,7 @@ fn plane_wave(base: TriMesh, k: [f64; 3], a: f64) -> Cwf {
 fn nearest(m: &TriMesh, p: [f64; 2]) -> u32 {
     let d = |q: &[f64; 3]| (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
     (0..m.vertex_count() as u32)
-        .min_by(|&a, &b| {
-            d(&m.positions()[a as usize]).total_cmp(&d(&m.positions()[b as usize]))
-        })
+        .min_by(|&a, &b| d(&m.positions()[a as usize]).total_cmp(&d(&m.positions()[b as usize])))
         .unwrap()
 }
 
@@ -115,7 +117,11 @@ fn fixed_region_is_copied_bit_for_bit() {
             let ec = edge_classes(&cwf, &rep.face_class);
             for e in 0..ec.len() {
                 if ec[e] == FaceClass::Fixed {
-                    assert_eq!(out.omega()[e].to_bits(), cwf.omega()[e].to_bits(), "edge {e}");
+                    assert_eq!(
+                        out.omega()[e].to_bits(),
+                        cwf.omega()[e].to_bits(),
+                        "edge {e}"
+                    );
                 }
             }
             let vf = vertex_fixed(&cwf, &rep.face_class);
@@ -126,7 +132,11 @@ fn fixed_region_is_copied_bit_for_bit() {
                     assert_eq!(out.zeta()[j].im.to_bits(), cwf.zeta()[j].im.to_bits());
                 }
             }
-            assert!(rep.face_counts.iter().all(|&c| c > 0), "{:?}", rep.face_counts);
+            assert!(
+                rep.face_counts.iter().all(|&c| c > 0),
+                "{:?}",
+                rep.face_counts
+            );
         }
     }
 }
@@ -177,9 +187,17 @@ fn identity_edit_returns_the_input() {
         assert!((out.omega()[e] - cwf.omega()[e]).abs() < 1e-12, "edge {e}");
     }
     for j in 0..m.vertex_count() {
-        assert!((out.amplitude()[j] - cwf.amplitude()[j]).abs() < 1e-12, "a[{j}]");
+        assert!(
+            (out.amplitude()[j] - cwf.amplitude()[j]).abs() < 1e-12,
+            "a[{j}]"
+        );
         let d = out.zeta()[j] - cwf.zeta()[j];
-        assert!(d.abs() < 1e-9, "z[{j}] {:?} vs {:?}", out.zeta()[j], cwf.zeta()[j]);
+        assert!(
+            d.abs() < 1e-9,
+            "z[{j}] {:?} vs {:?}",
+            out.zeta()[j],
+            cwf.zeta()[j]
+        );
     }
     assert!(!rep.global && !rep.phase_fallback);
 }
@@ -203,7 +221,10 @@ fn global_rotation_and_scale_give_the_transformed_plane_wave() {
         let k1 = rot_z(K, theta).map(|c| sigma * c);
         for (e, &edge) in cwf.edges().iter().enumerate() {
             let want = dot(k1, edge_vec(&m, edge));
-            assert!((out.omega()[e] - want).abs() < 1e-12, "θ {theta} σ {sigma} edge {e}");
+            assert!(
+                (out.omega()[e] - want).abs() < 1e-12,
+                "θ {theta} σ {sigma} edge {e}"
+            );
         }
         for j in 0..m.vertex_count() {
             assert!((out.amplitude()[j] - 0.02 / sigma).abs() < 1e-15);
@@ -214,7 +235,11 @@ fn global_rotation_and_scale_give_the_transformed_plane_wave() {
         let g = out.zeta()[0] * phase(0).conj();
         for j in 0..m.vertex_count() {
             let d = out.zeta()[j] - g * phase(j);
-            assert!(d.abs() < 1e-6, "θ {theta} σ {sigma} vertex {j}: {}", d.abs());
+            assert!(
+                d.abs() < 1e-6,
+                "θ {theta} σ {sigma} vertex {j}: {}",
+                d.abs()
+            );
         }
     }
 }
@@ -254,7 +279,10 @@ fn local_edits_are_compatible_inside_the_region() {
             }
         }
         let rms = (sum / cnt as f64).sqrt();
-        eprintln!("θ {theta} σ {sigma}: inner RMS {rms:.3} rad, report {rep:?}", rep = (rep.compat_rms, rep.eigenvalue, rep.seconds));
+        eprintln!(
+            "θ {theta} σ {sigma}: inner RMS {rms:.3} rad, report {rep:?}",
+            rep = (rep.compat_rms, rep.eigenvalue, rep.seconds)
+        );
         assert!(rms <= 0.3, "θ {theta} σ {sigma}: RMS {rms}");
         // net singularity index over the edited area is unchanged (the region is interior)
         let idx = |c: &Cwf| -> i64 {
@@ -299,7 +327,11 @@ fn face_curls(c: &Cwf, omega: &[f64]) -> Vec<f64> {
 fn interface_amplitude_obeys_the_maximum_principle() {
     let m = irregular_grid(24, 0.0, 2); // right triangles: non-obtuse
     let cwf = plane_wave(m.clone(), K, 0.01);
-    for (theta, sigma, mu) in [(FRAC_PI_2, 1.0, 1.0), (0.0, 3.0, 1.0 / 3.0), (0.5, 1.0, 2.5)] {
+    for (theta, sigma, mu) in [
+        (FRAC_PI_2, 1.0, 1.0),
+        (0.0, 3.0, 1.0 / 3.0),
+        (0.5, 1.0, 2.5),
+    ] {
         let mut r = RegionEdit::new(disk_region(&m, [0.5, 0.5], 3));
         r.rotate = theta;
         r.frequency_scale = sigma;
@@ -331,11 +363,19 @@ fn bad_input_is_refused_with_a_message() {
     assert!(edit(&cwf, &[r], &EditOptions::default()).is_err());
     let e = edit(&cwf, &[RegionEdit::new(vec![])], &EditOptions::default()).unwrap_err();
     assert!(e.to_string().contains("empty"), "{e}");
-    let e = edit(&cwf, &[RegionEdit::new(vec![100_000])], &EditOptions::default()).unwrap_err();
+    let e = edit(
+        &cwf,
+        &[RegionEdit::new(vec![100_000])],
+        &EditOptions::default(),
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("100000"), "{e}");
     let e = edit(
         &cwf,
-        &[RegionEdit::new(region.clone()), RegionEdit::new(region.clone())],
+        &[
+            RegionEdit::new(region.clone()),
+            RegionEdit::new(region.clone()),
+        ],
         &EditOptions::default(),
     )
     .unwrap_err();
@@ -351,7 +391,12 @@ fn bad_input_is_refused_with_a_message() {
         amplitude: 0.01,
         rings: 3,
     };
-    let e = design(m.clone(), &[src([f64::NAN, 0.0, 0.0])], &DesignOptions::default()).unwrap_err();
+    let e = design(
+        m.clone(),
+        &[src([f64::NAN, 0.0, 0.0])],
+        &DesignOptions::default(),
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("source 0"), "{e}");
     let mut s = src(K);
     s.vertex = 9999;
@@ -359,7 +404,13 @@ fn bad_input_is_refused_with_a_message() {
     assert!(e.to_string().contains("9999"), "{e}");
     assert!(design(m.clone(), &[], &DesignOptions::default()).is_err());
     // non-manifold base: three triangles on one edge
-    let p = vec![[0.; 3], [1., 0., 0.], [0., 1., 0.], [0., -1., 0.], [0., 0., 1.]];
+    let p = vec![
+        [0.; 3],
+        [1., 0., 0.],
+        [0., 1., 0.],
+        [0., -1., 0.],
+        [0., 0., 1.],
+    ];
     let bad = TriMesh::new(p, vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]]).unwrap();
     let mut s = src(K);
     s.vertex = 0;
@@ -400,19 +451,28 @@ fn design_on_a_flat_grid_reproduces_the_wave_vector_and_zeros_outside() {
     }
     let mut in_v = vec![false; m.vertex_count()];
     for &f in &region {
-        m.triangles()[f as usize].iter().for_each(|&v| in_v[v as usize] = true);
+        m.triangles()[f as usize]
+            .iter()
+            .for_each(|&v| in_v[v as usize] = true);
     }
     for j in 0..m.vertex_count() {
         let a = cwf.amplitude()[j];
         if !in_v[j] {
-            assert_eq!(a.to_bits(), 0f64.to_bits(), "vertex {j} outside has a = {a}");
+            assert_eq!(
+                a.to_bits(),
+                0f64.to_bits(),
+                "vertex {j} outside has a = {a}"
+            );
         }
         assert!((0.0..=0.02 * (1.0 + 1e-12)).contains(&a), "vertex {j}: {a}");
     }
     assert!(vf.iter().any(|&b| b));
     assert_eq!(cwf.amplitude()[v as usize], 0.02);
     assert_eq!(rep.influenced[1], region.len());
-    assert!(rep.amplitude_residual < 1e-10 && rep.heat_residual < 1e-10, "{rep:?}");
+    assert!(
+        rep.amplitude_residual < 1e-10 && rep.heat_residual < 1e-10,
+        "{rep:?}"
+    );
 }
 
 #[test]

@@ -446,7 +446,10 @@ fn design_amplitude(
         // entries c·g gᵀ (c may be negative: push scaled pairs)
         let mut tmp = Vec::new();
         push_outer_lower(&mut tmp, &g);
-        t.extend(tmp.into_iter().map(|en| Entry::new(en.row, en.col, en.val * c)));
+        t.extend(
+            tmp.into_iter()
+                .map(|en| Entry::new(en.row, en.col, en.val * c)),
+        );
         for &(i, gi) in &gc {
             rhs[i] -= gi * h_const;
         }

@@ -26,9 +26,7 @@ use std::time::Instant;
 use super::areas::barycentric_areas;
 use super::complex::Complex;
 use super::cwf::{wrap_to_pi, Cwf};
-use super::knoppel::{
-    components, cotan_weights_raw, knoppel_phase, KnoppelOptions, PhaseWeights,
-};
+use super::knoppel::{components, cotan_weights_raw, knoppel_phase, KnoppelOptions, PhaseWeights};
 use super::omega_path::{corner_vector, face_unit_normal};
 use super::region::{classify, Adjacency, FaceClass, Labels};
 use super::spd::{matvec_full, push_hermitian, push_outer_lower, solve_spd};
@@ -304,7 +302,13 @@ fn edit_omega(
 }
 
 /// Mean over the edge's faces and endpoints of `(R_θ u_{f,v})·(x_b − x_a)`.
-fn rotated_edge_value(topo: &Topology, x: &[[f64; 3]], omega0: &[f64], e: usize, theta: f64) -> f64 {
+fn rotated_edge_value(
+    topo: &Topology,
+    x: &[[f64; 3]],
+    omega0: &[f64],
+    e: usize,
+    theta: f64,
+) -> f64 {
     let [a, b] = topo.edges[e];
     let ev = Vec3::from(x[b as usize]) - Vec3::from(x[a as usize]);
     let (s, c) = theta.sin_cos();
@@ -363,14 +367,25 @@ fn solve_interface_omega(
         let tri = topo.faces[f];
         add_row(&mut (0..3).map(|i| {
             let e = topo.face_edges[f][i] as usize;
-            (e, if topo.edges[e][0] == tri[i] { 1.0 } else { -1.0 })
+            (
+                e,
+                if topo.edges[e][0] == tri[i] {
+                    1.0
+                } else {
+                    -1.0
+                },
+            )
         }));
     }
     // divergence rows (vertices)
     for m in 0..topo.n_vertices {
         add_row(&mut topo.vert_edges.row(m).iter().map(|&e| {
             let e = e as usize;
-            let sign = if topo.edges[e][0] == m as u32 { 1.0 } else { -1.0 };
+            let sign = if topo.edges[e][0] == m as u32 {
+                1.0
+            } else {
+                -1.0
+            };
             (e, sign * cot[e])
         }));
     }
@@ -519,7 +534,9 @@ fn solve_phase(
     let u0: Vec<Complex> = (0..nv)
         .map(|j| match (labels.vertex[j], opts.phase) {
             (FaceClass::Fixed, PhaseCoupling::Unit) => cwf.zeta()[j],
-            (FaceClass::Fixed, PhaseCoupling::AmplitudeWeighted) => cwf.zeta()[j].scale(cwf.amplitude()[j]),
+            (FaceClass::Fixed, PhaseCoupling::AmplitudeWeighted) => {
+                cwf.zeta()[j].scale(cwf.amplitude()[j])
+            }
             _ => Complex::ZERO,
         })
         .collect();
@@ -540,7 +557,12 @@ fn solve_phase(
         let h_kk = w * ak * ak;
         let h_ll = w * al * al;
         let h_lk = tr.scale(-w * ak * al);
-        let entries = [(k, k, Complex::new(h_kk, 0.0)), (l, l, Complex::new(h_ll, 0.0)), (l, k, h_lk), (k, l, h_lk.conj())];
+        let entries = [
+            (k, k, Complex::new(h_kk, 0.0)),
+            (l, l, Complex::new(h_ll, 0.0)),
+            (l, k, h_lk),
+            (k, l, h_lk.conj()),
+        ];
         for (r, c, h) in entries {
             match (free[r], free[c]) {
                 (u32::MAX, u32::MAX) => u0_a_u0 += (u0[r].conj() * h * u0[c]).re,
@@ -589,7 +611,11 @@ fn solve_phase(
             groups[2 * i] = g;
             groups[2 * i + 1] = g;
             let z = cwf.zeta()[j];
-            let z = if z == Complex::ZERO { Complex::new(1.0, 0.5) } else { z };
+            let z = if z == Complex::ZERO {
+                Complex::new(1.0, 0.5)
+            } else {
+                z
+            };
             start[2 * i] = z.re;
             start[2 * i + 1] = z.im;
         }
@@ -601,13 +627,23 @@ fn solve_phase(
     let a = assemble(dim, &t, "the phase pencil (eq. 3.28)")?;
     let scale = {
         let diag = diag_of(&a);
-        diag.iter().zip(&mass2).map(|(d, m)| d / m).fold(0.0, f64::max).max(1e-300)
+        diag.iter()
+            .zip(&mass2)
+            .map(|(d, m)| d / m)
+            .fold(0.0, f64::max)
+            .max(1e-300)
     };
     let an = CholeskyAnalysis::new(&a)?;
-    let schedule = ShiftSchedule { initial: 1e-9 * scale, growth: 100.0, max_attempts: 5 };
+    let schedule = ShiftSchedule {
+        initial: 1e-9 * scale,
+        growth: 100.0,
+        max_attempts: 5,
+    };
     let llt = an
         .factor_with_growing_shift(&a, &mass2, schedule, Parallelism::Global)
-        .map_err(|_| Error::Numerical("the phase pencil (eq. 3.28) is not positive definite".into()))?;
+        .map_err(|_| {
+            Error::Numerical("the phase pencil (eq. 3.28) is not positive definite".into())
+        })?;
     let problem = ShiftedProblem {
         shifted: &llt,
         apply_a: |u: &[f64]| matvec_full(&a, u),
@@ -616,11 +652,16 @@ fn solve_phase(
         n_groups: n_groups as usize,
         scale,
     };
-    let params = InverseIterationParams { max_iterations: opts.max_iterations, tolerance: opts.tolerance };
+    let params = InverseIterationParams {
+        max_iterations: opts.max_iterations,
+        tolerance: opts.tolerance,
+    };
     let (u, info) = inverse_iteration(&problem, start, &params)?;
     let mut s = Complex::new(u[2 * s_idx], u[2 * s_idx + 1]);
     let mut fallback = false;
-    let mut ut: Vec<Complex> = (0..m).map(|i| Complex::new(u[2 * i], u[2 * i + 1])).collect();
+    let mut ut: Vec<Complex> = (0..m)
+        .map(|i| Complex::new(u[2 * i], u[2 * i + 1]))
+        .collect();
     if s.norm_sqr() * u0_m_u0 < 1e-20 {
         fallback = true;
         s = Complex::ONE;
@@ -634,10 +675,18 @@ fn solve_phase(
             continue;
         }
         let v = ut[free[j] as usize];
-        let v = if group_of_comp[comp[j] as usize] == 0 { v * s.conj() } else { v };
+        let v = if group_of_comp[comp[j] as usize] == 0 {
+            v * s.conj()
+        } else {
+            v
+        };
         let r = v.abs();
         let rel = ut[free[j] as usize].abs();
-        zeta[j] = if rel > 1e-12 * max && r > 0.0 { v.scale(1.0 / r) } else { Complex::ZERO };
+        zeta[j] = if rel > 1e-12 * max && r > 0.0 {
+            v.scale(1.0 / r)
+        } else {
+            Complex::ZERO
+        };
     }
     Ok(Phase {
         zeta,
@@ -658,15 +707,27 @@ fn harmonic_extension(t: &[Entry], m: usize, a_u0: &[Complex]) -> Result<Vec<Com
         .copied()
         .collect();
     let rhs: Vec<f64> = a_u0.iter().flat_map(|z| [-z.re, -z.im]).collect();
-    let (x, _) = solve_spd(2 * m, &lower, &rhs, "the phase harmonic extension (eq. 3.28, s = 1)")?;
-    Ok(x.chunks_exact(2).map(|c| Complex::new(c[0], c[1])).collect())
+    let (x, _) = solve_spd(
+        2 * m,
+        &lower,
+        &rhs,
+        "the phase harmonic extension (eq. 3.28, s = 1)",
+    )?;
+    Ok(x.chunks_exact(2)
+        .map(|c| Complex::new(c[0], c[1]))
+        .collect())
 }
 
 fn diag_of(a: &crate::solve::SparseMatrix) -> Vec<f64> {
     let cp = a.symbolic().col_ptr();
     let ri = a.symbolic().row_idx();
     (0..a.ncols())
-        .map(|j| (cp[j]..cp[j + 1]).filter(|&k| ri[k] == j).map(|k| a.val()[k]).sum())
+        .map(|j| {
+            (cp[j]..cp[j + 1])
+                .filter(|&k| ri[k] == j)
+                .map(|k| a.val()[k])
+                .sum()
+        })
         .collect()
 }
 

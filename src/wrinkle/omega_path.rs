@@ -200,7 +200,13 @@ pub(crate) fn face_unit_normal(topo: &Topology, x: &[[f64; 3]], f: usize) -> Vec
 
 /// The tangent vector `u_{f,c}` of B.51–B.52 at corner `c` of face `f` (zero when the triangle
 /// is degenerate).
-pub(crate) fn corner_vector(topo: &Topology, x: &[[f64; 3]], omega: &[f64], f: usize, c: usize) -> Vec3 {
+pub(crate) fn corner_vector(
+    topo: &Topology,
+    x: &[[f64; 3]],
+    omega: &[f64],
+    f: usize,
+    c: usize,
+) -> Vec3 {
     let t = topo.faces[f];
     let (m, k, l) = (t[c], t[(c + 1) % 3], t[(c + 2) % 3]);
     let xm = Vec3::from(x[m as usize]);

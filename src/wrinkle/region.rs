@@ -280,7 +280,12 @@ mod tests {
             last = v.len();
         }
         // an interior vertex of this grid has 6 faces
-        assert_eq!(grow_faces(&m, &[], &[centre], 1, Adjacency::Vertex).unwrap().len(), 6);
+        assert_eq!(
+            grow_faces(&m, &[], &[centre], 1, Adjacency::Vertex)
+                .unwrap()
+                .len(),
+            6
+        );
     }
 
     #[test]

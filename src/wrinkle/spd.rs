@@ -36,7 +36,9 @@ pub(crate) fn solve_spd(
             };
             an.factor_with_growing_shift(&a, &vec![1.0; dim], schedule, Parallelism::Global)
                 .map_err(|_| {
-                    Error::Numerical(format!("{what} is not positive definite (degenerate mesh?)"))
+                    Error::Numerical(format!(
+                        "{what} is not positive definite (degenerate mesh?)"
+                    ))
                 })?
         }
     };

@@ -45,10 +45,15 @@ pub fn parse_source(s: &str) -> Result<WrinkleSource, Fail> {
             .map_err(|_| bad(format!("--source {s:?}: field {} is not a count", i + 1)))
     };
     Ok(WrinkleSource {
-        vertex: u32::try_from(int(0)?).map_err(|_| bad(format!("--source {s:?}: vertex too large")))?,
+        vertex: u32::try_from(int(0)?)
+            .map_err(|_| bad(format!("--source {s:?}: vertex too large")))?,
         wave_vector: [num(1)?, num(2)?, num(3)?],
         amplitude: num(4)?,
-        rings: if parts.len() == 6 { int(5)? as usize } else { 5 },
+        rings: if parts.len() == 6 {
+            int(5)? as usize
+        } else {
+            5
+        },
     })
 }
 
@@ -104,10 +109,14 @@ pub fn parse_region(s: &str) -> Result<RegionSpec, Fail> {
         }
     }
     if r.couple && amplitude_given {
-        return Err(bad(format!("--region {s:?}: give either amplitude= or couple")));
+        return Err(bad(format!(
+            "--region {s:?}: give either amplitude= or couple"
+        )));
     }
     if r.seed_faces.is_empty() && r.seed_vertices.is_empty() {
-        return Err(bad(format!("--region {s:?}: no seed (seed=FACE or vertex=V)")));
+        return Err(bad(format!(
+            "--region {s:?}: no seed (seed=FACE or vertex=V)"
+        )));
     }
     Ok(r)
 }
@@ -192,10 +201,7 @@ pub fn run_edit(
             opts.adjacency,
         )
         .map_err(classify)?;
-        let mut e = RegionEdit {
-            faces,
-            ..spec.edit
-        };
+        let mut e = RegionEdit { faces, ..spec.edit };
         if spec.couple {
             e = e.coupled();
         }
@@ -228,10 +234,21 @@ pub fn run_edit(
         rep.phase_residual,
         rep.eigenvalue,
         rep.s.abs(),
-        if rep.global { "  (global edit: Knöppel)" } else { "" },
-        if rep.phase_fallback { "  (fallback s = 1)" } else { "" }
+        if rep.global {
+            "  (global edit: Knöppel)"
+        } else {
+            ""
+        },
+        if rep.phase_fallback {
+            "  (fallback s = 1)"
+        } else {
+            ""
+        }
     );
-    eprintln!("  compatibility RMS on edit + interface edges {:.3} rad", rep.compat_rms);
+    eprintln!(
+        "  compatibility RMS on edit + interface edges {:.3} rad",
+        rep.compat_rms
+    );
     if let Some(path) = labels {
         let text: String = rep
             .face_class
