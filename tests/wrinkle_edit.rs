@@ -115,8 +115,8 @@ fn fixed_region_is_copied_bit_for_bit() {
         for opts in [EditOptions::default(), EditOptions::reference()] {
             let (out, rep) = edit(&cwf, std::slice::from_ref(&r), &opts).unwrap();
             let ec = edge_classes(&cwf, &rep.face_class);
-            for e in 0..ec.len() {
-                if ec[e] == FaceClass::Fixed {
+            for (e, &c) in ec.iter().enumerate() {
+                if c == FaceClass::Fixed {
                     assert_eq!(
                         out.omega()[e].to_bits(),
                         cwf.omega()[e].to_bits(),
@@ -125,8 +125,8 @@ fn fixed_region_is_copied_bit_for_bit() {
                 }
             }
             let vf = vertex_fixed(&cwf, &rep.face_class);
-            for j in 0..vf.len() {
-                if vf[j] {
+            for (j, &fixed) in vf.iter().enumerate() {
+                if fixed {
                     assert_eq!(out.amplitude()[j].to_bits(), cwf.amplitude()[j].to_bits());
                     assert_eq!(out.zeta()[j].re.to_bits(), cwf.zeta()[j].re.to_bits());
                     assert_eq!(out.zeta()[j].im.to_bits(), cwf.zeta()[j].im.to_bits());
@@ -180,8 +180,8 @@ fn identity_edit_returns_the_input() {
     ];
     let (out, rep) = edit(&cwf, &regions, &EditOptions::default()).unwrap();
     let ec = edge_classes(&cwf, &rep.face_class);
-    for e in 0..ec.len() {
-        if ec[e] == FaceClass::Edit {
+    for (e, &c) in ec.iter().enumerate() {
+        if c == FaceClass::Edit {
             assert_eq!(out.omega()[e].to_bits(), cwf.omega()[e].to_bits());
         }
         assert!((out.omega()[e] - cwf.omega()[e]).abs() < 1e-12, "edge {e}");
@@ -455,9 +455,9 @@ fn design_on_a_flat_grid_reproduces_the_wave_vector_and_zeros_outside() {
             .iter()
             .for_each(|&v| in_v[v as usize] = true);
     }
-    for j in 0..m.vertex_count() {
+    for (j, &inside) in in_v.iter().enumerate() {
         let a = cwf.amplitude()[j];
-        if !in_v[j] {
+        if !inside {
             assert_eq!(
                 a.to_bits(),
                 0f64.to_bits(),

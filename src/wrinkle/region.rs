@@ -189,18 +189,18 @@ pub(crate) fn classify(
         dilate(topo, &mut mask, interface_rings[r], adjacency);
         near.iter_mut().zip(&mask).for_each(|(n, m)| *n |= m);
     }
-    for f in 0..nf {
-        if near[f] && face[f] != FaceClass::Edit {
-            face[f] = FaceClass::Interface;
+    for (c, &n) in face.iter_mut().zip(&near) {
+        if n && *c != FaceClass::Edit {
+            *c = FaceClass::Interface;
         }
     }
     let mut vertex = vec![FaceClass::Interface; topo.n_vertices];
     let mut fixed_v = vec![false; topo.n_vertices];
     let mut any_face = vec![false; topo.n_vertices];
-    for f in 0..nf {
-        for &v in &topo.faces[f] {
+    for (t, &c) in topo.faces.iter().zip(&face) {
+        for &v in t {
             any_face[v as usize] = true;
-            fixed_v[v as usize] |= face[f] == FaceClass::Fixed;
+            fixed_v[v as usize] |= c == FaceClass::Fixed;
         }
     }
     for v in 0..topo.n_vertices {
