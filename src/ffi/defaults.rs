@@ -107,3 +107,22 @@ fn read_versioned_honours_struct_size() {
          sizeof(PleatLodParams), e.g. with pleat_lod_params_default()"
     );
 }
+
+#[cfg(feature = "wrinkle")]
+#[test]
+fn cwf_design_and_edit_params_default_are_rust_default() {
+    let c = pleat_cwf_design_params_default();
+    assert_eq!(
+        c.struct_size as usize,
+        std::mem::size_of::<PleatCwfDesignParams>()
+    );
+    let rust = design::imp::design_options(&c).expect("the C default is valid");
+    assert_eq!(rust, crate::wrinkle::DesignOptions::default());
+    let c = pleat_cwf_edit_params_default();
+    assert_eq!(
+        c.struct_size as usize,
+        std::mem::size_of::<PleatCwfEditParams>()
+    );
+    let rust = design::imp::edit_options(&c).expect("the C default is valid");
+    assert_eq!(rust, crate::wrinkle::EditOptions::default());
+}

@@ -20,6 +20,7 @@
 
 mod boundary;
 mod common;
+mod design;
 mod edges;
 mod interpolate;
 mod lod;
@@ -30,6 +31,7 @@ mod stats;
 mod wrinkle;
 
 pub use common::*;
+pub use design::*;
 pub use edges::*;
 pub use interpolate::*;
 pub use lod::*;
