@@ -1,7 +1,8 @@
 /* Wrinkle design and region edits through the C ABI (issue 14, dissertation ch. 3.6):
    grow a region, rotate the wrinkles in it, check the fixed part is copied bit for bit, an
    identity edit returns the input, design from a source, evaluate the edited keyframe, and
-   misuse answers a status with a message. */
+   misuse answers a status with a message. Without the "wrinkle" capability every call answers
+   PLEAT_STATUS_UNSUPPORTED (checked). */
 #include "wrinkle_util.h"
 
 #define N 21
@@ -24,7 +25,7 @@ static void fixed_vertices(const uint8_t *labels, uint8_t *fixed) {
     free(touched);
 }
 
-int main(void) {
+static void edits(void) {
     const double k[3] = {4 * 2 * M_PI, 0, 0};
     PleatMesh *m = make_grid(N);
     size_t nv = pleat_mesh_vertex_count(m), nt = pleat_mesh_triangle_count(m), ne = 0, i, count = 0;
@@ -153,5 +154,31 @@ int main(void) {
     pleat_mesh_destroy(m);
     free(zeta), free(omega), free(amp), free(flags), free(labels), free(fixed), free(faces);
     free(a0), free(a1), free(z0), free(z1), free(w0), free(w1);
+}
+
+/* Without the capability the calls answer UNSUPPORTED; the defaults still work. */
+static void unsupported(void) {
+    PleatMesh *m = make_grid(5);
+    PleatCwf *out = NULL;
+    uint8_t flags[32];
+    uint32_t v = 12;
+    PleatWrinkleSource s = {12, 2, {1, 0, 0}, 0.01};
+    PleatCwfEditParams ep = pleat_cwf_edit_params_default();
+    PleatCwfDesignParams dp = pleat_cwf_design_params_default();
+    printf("SKIPPED: this pleat was built without \"wrinkle\"; checking UNSUPPORTED\n");
+    CHECK(ep.struct_size == sizeof ep && dp.struct_size == sizeof dp);
+    CHECK_STATUS(pleat_cwf_design(m, &s, 1, &dp, NULL, &out), PLEAT_STATUS_UNSUPPORTED);
+    CHECK_STATUS(pleat_cwf_edit(NULL, NULL, 0, &ep, &out, NULL), PLEAT_STATUS_UNSUPPORTED);
+    CHECK_STATUS(pleat_mesh_grow_faces(m, NULL, 0, &v, 1, 2, PLEAT_ADJACENCY_VERTEX, flags, NULL),
+                 PLEAT_STATUS_UNSUPPORTED);
+    CHECK(out == NULL);
+    pleat_mesh_destroy(m);
+}
+
+int main(void) {
+    if (pleat_has_feature("wrinkle"))
+        edits();
+    else
+        unsupported();
     return finish("wrinkle_edit");
 }
