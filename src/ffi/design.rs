@@ -8,7 +8,9 @@
 #![allow(clippy::too_many_arguments)]
 
 use super::boundary::{full_size, requires, versioned};
-use super::common::{guard, PleatStatus};
+#[cfg(feature = "wrinkle")]
+use super::common::guard;
+use super::common::PleatStatus;
 use super::mesh::PleatMesh;
 use super::wrinkle::{wrinkle_only, PleatCwf, PleatKnoppelParams};
 
