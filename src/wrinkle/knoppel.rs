@@ -215,7 +215,7 @@ fn factor_shifted(
 }
 
 /// Off-diagonal 2×2 blocks: `H_lk = −w e^{iω_kl}`, `H_kl = −w e^{−iω_kl}`.
-pub(crate) fn off_diagonal_triplets(topo: &Topology, w: &[f64], omega: &[f64]) -> Vec<Entry> {
+fn off_diagonal_triplets(topo: &Topology, w: &[f64], omega: &[f64]) -> Vec<Entry> {
     let mut t = Vec::with_capacity(8 * topo.n_edges() + 2 * topo.n_vertices);
     for (e, &[k, l]) in topo.edges.iter().enumerate() {
         let (k, l) = (k as usize, l as usize);
