@@ -62,6 +62,27 @@
 // `struct_size`) does not change it.
 #define PLEAT_ABI_VERSION 1
 
+// Region growth across shared vertices (the dissertation's n-ring; default).
+#define PLEAT_ADJACENCY_VERTEX 0
+
+// Region growth across shared edges (the reference implementation's dilation).
+#define PLEAT_ADJACENCY_EDGE 1
+
+// Phase of an edit (eq. 3.28): compatibility of the unit phase (the dissertation's text).
+#define PLEAT_EDIT_PHASE_UNIT 0
+
+// Phase of an edit: amplitude-weighted compatibility (the reference implementation).
+#define PLEAT_EDIT_PHASE_AMPLITUDE_WEIGHTED 1
+
+// Face label written by `pleat_cwf_edit`: fixed (copied bit for bit).
+#define PLEAT_FACE_FIXED 0
+
+// Face label: inside an edited region.
+#define PLEAT_FACE_EDIT 1
+
+// Face label: in the solved interface band.
+#define PLEAT_FACE_INTERFACE 2
+
 // `PleatWrinkleInterpStats::stop_reason`: the gradient norm reached the tolerance.
 #define PLEAT_INTERP_STOP_CONVERGED 0
 
@@ -412,6 +433,97 @@ typedef struct PleatBakeStats {
   double appearance_error_max;
 } PleatBakeStats;
 
+// Parameters of `pleat_cwf_design`. Get the defaults from `pleat_cwf_design_params_default()`;
+// `struct_size` versioned (at least 8).
+typedef struct PleatCwfDesignParams {
+  // `sizeof(PleatCwfDesignParams)`; at least 8.
+  uint32_t struct_size;
+  // `PLEAT_ADJACENCY_VERTEX` (default) or `PLEAT_ADJACENCY_EDGE`.
+  uint32_t adjacency;
+  // 1 (default): the amplitude equals the source's at each source vertex; 0: soft only.
+  uint32_t pin_sources;
+  // Reserved, set to 0.
+  uint32_t reserved;
+  // Heat time in units of the squared mean edge length, finite, > 0; default 1.
+  double heat_time;
+  // κ of eq. 3.25 (amplitude smoothness), finite, ≥ 0; default 1.
+  double kappa;
+  // γ of eq. 3.25 (curl penalty), finite, ≥ 0; default 1.
+  double gamma;
+  // Multiplier of the data weights `A_j / h̄²`, finite, ≥ 0; default 1.
+  double data_weight;
+} PleatCwfDesignParams;
+
+// Parameters of `pleat_cwf_edit`. Get the defaults from `pleat_cwf_edit_params_default()`;
+// `struct_size` versioned (at least 8).
+typedef struct PleatCwfEditParams {
+  // `sizeof(PleatCwfEditParams)`; at least 8.
+  uint32_t struct_size;
+  // `PLEAT_ADJACENCY_VERTEX` (default) or `PLEAT_ADJACENCY_EDGE` (interface growth).
+  uint32_t adjacency;
+  // `PLEAT_EDIT_PHASE_UNIT` (default) or `PLEAT_EDIT_PHASE_AMPLITUDE_WEIGHTED`.
+  uint32_t phase;
+  // Inverse-iteration steps of the phase solve, 1 to 1,000,000; default 200.
+  uint32_t max_iterations;
+  // ε_ω of eq. 3.26, finite, ≥ 0; default 1e-3.
+  double eps_omega;
+  // ε_a of eq. 3.27, finite, ≥ 0; default 1e-3.
+  double eps_amplitude;
+  // γ of eq. 3.27, finite, ≥ 0; default 1.
+  double gamma;
+  // Inverse-iteration tolerance, finite, > 0; default 1e-12.
+  double tolerance;
+} PleatCwfEditParams;
+
+// One wrinkle source of `pleat_cwf_design` (a plain array element, no `struct_size`).
+typedef struct PleatWrinkleSource {
+  // The source vertex of the base mesh.
+  uint32_t vertex;
+  // Region size in rings of faces, ≥ 1 (5 is the dissertation's GUI default).
+  uint32_t rings;
+  // Wave vector in radians per length unit (its tangential part is used); finite.
+  double wave_vector[3];
+  // Target amplitude (length unit), finite, ≥ 0.
+  double amplitude;
+} PleatWrinkleSource;
+
+// Parameters of Knöppel et al.'s phase solve (used when pleat computes z̃ from ω). Get the
+// defaults from `pleat_knoppel_params_default()`; `struct_size` versioned as
+// `PleatWrinkleEvalParams`.
+typedef struct PleatKnoppelParams {
+  // `sizeof(PleatKnoppelParams)`; at least 8.
+  uint32_t struct_size;
+  // `PLEAT_PHASE_WEIGHTS_COTAN` (default) or `PLEAT_PHASE_WEIGHTS_EDGE_AREA`.
+  uint32_t weights;
+  // Maximum inverse-iteration steps, 1 to 1,000,000; default 200.
+  uint32_t max_iterations;
+  // Reserved, set to 0.
+  uint32_t reserved;
+  // Convergence tolerance on the relative residual, finite, ≥ 0; default 1e-12.
+  double tolerance;
+  // Relative shift of the inverse iteration, finite, in [0, 1); default 1e-9.
+  double shift;
+} PleatKnoppelParams;
+
+// One region of `pleat_cwf_edit` (array element; `struct_size` must be
+// `sizeof(PleatCwfRegionEdit)` in every element).
+typedef struct PleatCwfRegionEdit {
+  // `sizeof(PleatCwfRegionEdit)`.
+  uint32_t struct_size;
+  // Interface band width in rings (≥ 1 unless the region covers the mesh); typical 3.
+  uint32_t interface_rings;
+  // The region's triangles (e.g. from `pleat_mesh_grow_faces`); non-NULL.
+  const uint32_t *faces;
+  // Number of `faces`, ≥ 1.
+  size_t face_count;
+  // Counter-clockwise rotation of the wrinkles about the normals, radians, finite.
+  double rotate_radians;
+  // Frequency scale σ, finite, > 0 (1: unchanged).
+  double frequency_scale;
+  // Amplitude scale μ, finite, ≥ 0 (1/σ keeps a·|ω|).
+  double amplitude_scale;
+} PleatCwfRegionEdit;
+
 // Parameters of `pleat_cwf_interpolate`. Get the defaults from
 // `pleat_wrinkle_interp_params_default()`; `struct_size` versioned as
 // `PleatWrinkleEvalParams`.
@@ -676,24 +788,6 @@ typedef struct PleatWrinkleEvalParams {
   // also limited to the u32 index range.
   uint64_t max_output_triangles;
 } PleatWrinkleEvalParams;
-
-// Parameters of Knöppel et al.'s phase solve (used when pleat computes z̃ from ω). Get the
-// defaults from `pleat_knoppel_params_default()`; `struct_size` versioned as
-// `PleatWrinkleEvalParams`.
-typedef struct PleatKnoppelParams {
-  // `sizeof(PleatKnoppelParams)`; at least 8.
-  uint32_t struct_size;
-  // `PLEAT_PHASE_WEIGHTS_COTAN` (default) or `PLEAT_PHASE_WEIGHTS_EDGE_AREA`.
-  uint32_t weights;
-  // Maximum inverse-iteration steps, 1 to 1,000,000; default 200.
-  uint32_t max_iterations;
-  // Reserved, set to 0.
-  uint32_t reserved;
-  // Convergence tolerance on the relative residual, finite, ≥ 0; default 1e-12.
-  double tolerance;
-  // Relative shift of the inverse iteration, finite, in [0, 1); default 1e-9.
-  double shift;
-} PleatKnoppelParams;
 
 // Outcome of the Knöppel phase solve of a `PleatCwf` (`pleat_cwf_get_knoppel_report`).
 typedef struct PleatKnoppelReport {
@@ -961,6 +1055,74 @@ uint32_t pleat_abi_version(void);
 // # Safety
 // `name` is NULL or a NUL-terminated string.
 uint32_t pleat_has_feature(const char *name);
+
+// The default design parameters (vertex rings, sources pinned, heat time 1, κ = γ = 1, data
+// weight 1), with `struct_size` set. Available in every build.
+struct PleatCwfDesignParams pleat_cwf_design_params_default(void);
+
+// The default edit parameters (vertex rings, unit phase, 200 iterations, ε_ω = ε_a = 1e-3,
+// γ = 1, tolerance 1e-12), with `struct_size` set. Available in every build.
+struct PleatCwfEditParams pleat_cwf_edit_params_default(void);
+
+// Designs a keyframe from wrinkle sources (§3.6.1): wave vectors extended from the sources by
+// the vector heat method, amplitude by eq. 3.25, phase by Knöppel; ω = 0 and a = 0 outside the
+// sources' regions.
+//
+// - `base`: non-NULL, a consistently oriented manifold; pleat keeps its own copy.
+// - `sources`, `source_count`: at least one source; vertices in range, distinct.
+// - `params`: NULL = `pleat_cwf_design_params_default()`.
+// - `knoppel_params`: the final phase solve; NULL = `pleat_knoppel_params_default()`.
+// - `out`: receives the new field; non-NULL; written only on success.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes described above.
+PleatStatus pleat_cwf_design(const struct PleatMesh *base,
+                             const struct PleatWrinkleSource *sources,
+                             size_t source_count,
+                             const struct PleatCwfDesignParams *params,
+                             const struct PleatKnoppelParams *knoppel_params,
+                             struct PleatCwf **out);
+
+// Edits regions of a keyframe (§3.6.2): per region rotate by `rotate_radians`, scale the
+// frequency by σ and the amplitude by μ; the interface band is solved (eqs. 3.26–3.28) and the
+// rest copied bit for bit. Regions must not share a vertex, and the interface must separate
+// edited from fixed vertices (the message names the vertex).
+//
+// - `cwf`: the keyframe; non-NULL.
+// - `regions`, `region_count`: at least one region.
+// - `params`: NULL = `pleat_cwf_edit_params_default()`.
+// - `out`: receives the edited keyframe (same base mesh); non-NULL.
+// - `face_labels_out`: NULL, or `pleat_cwf_triangle_count(cwf)` bytes receiving
+//   `PLEAT_FACE_FIXED` / `_EDIT` / `_INTERFACE` per triangle.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes described above.
+PleatStatus pleat_cwf_edit(const struct PleatCwf *cwf,
+                           const struct PleatCwfRegionEdit *regions,
+                           size_t region_count,
+                           const struct PleatCwfEditParams *params,
+                           struct PleatCwf **out,
+                           uint8_t *face_labels_out);
+
+// A region of `mesh`: the seed triangles and the triangles of the seed vertices (ring 1),
+// grown by `rings − 1` more rings across `adjacency`. Writes 1 (in the region) or 0 per
+// triangle to `flags_out` (`pleat_mesh_triangle_count(mesh)` bytes) and the number of region
+// triangles to `count_out` (NULL allowed).
+//
+// - `seed_faces` / `seed_vertices`: NULL only when their count is 0; ids in range.
+// - `rings` ≥ 1; `adjacency`: `PLEAT_ADJACENCY_VERTEX` or `PLEAT_ADJACENCY_EDGE`.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes described above.
+PleatStatus pleat_mesh_grow_faces(const struct PleatMesh *mesh,
+                                  const uint32_t *seed_faces,
+                                  size_t seed_face_count,
+                                  const uint32_t *seed_vertices,
+                                  size_t seed_vertex_count,
+                                  uint32_t rings,
+                                  uint32_t adjacency,
+                                  uint8_t *flags_out,
+                                  size_t *count_out);
 
 // Number of unique undirected edges of `mesh` (0 when `mesh` is NULL). Degenerate corners
 // (a triangle repeating a vertex) contribute no edge.

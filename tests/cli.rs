@@ -427,3 +427,65 @@ fn lod_bake_writes_one_glb_chain() {
     assert!(images.len() >= 2);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[cfg(feature = "wrinkle")]
+#[test]
+fn wrinkle_design_then_edit_reports_solves_and_refuses_bad_regions() {
+    let dir = scratch_with_octahedron("design-edit");
+    let base = dir.join("oct.obj");
+    let (d, e, labels) = (dir.join("d.cwf"), dir.join("e.cwf"), dir.join("labels.txt"));
+    let o = pleat(&[
+        "wrinkle",
+        "design",
+        path_str(&base),
+        "--source",
+        "4,3,-1,0,0.02,1",
+        "-o",
+        path_str(&d),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("vector heat") && err.contains("residual"),
+        "{err}"
+    );
+    let o = pleat(&[
+        "wrinkle",
+        "edit",
+        path_str(&base),
+        "--cwf",
+        path_str(&d),
+        "--region",
+        "vertex=4,rings=1,interface=1,rotate=90,scale=2,couple",
+        "--labels",
+        path_str(&labels),
+        "-o",
+        path_str(&e),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("3.26") && err.contains("3.28"), "{err}");
+    assert_eq!(std::fs::read_to_string(&labels).unwrap().lines().count(), 8);
+    assert!(std::fs::read_to_string(&e)
+        .unwrap()
+        .starts_with("pleat-cwf 1\n"));
+    // no seed, and a zero frequency scale: exit 2 with a message, nothing written
+    for region in ["rings=2", "vertex=4,scale=0"] {
+        let bad = dir.join("bad.cwf");
+        let o = pleat(&[
+            "wrinkle",
+            "edit",
+            path_str(&base),
+            "--cwf",
+            path_str(&d),
+            "--region",
+            region,
+            "-o",
+            path_str(&bad),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{region}");
+        assert!(!String::from_utf8_lossy(&o.stderr).is_empty());
+        assert!(!bad.exists());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -416,6 +416,27 @@ class Cwf {
                                               params, &c));
         return Cwf(c);
     }
+    /// A keyframe designed from wrinkle sources (dissertation 3.6.1; `pleat_cwf_design`).
+    static Cwf design(const Mesh &base, const std::vector<PleatWrinkleSource> &sources,
+                      const PleatCwfDesignParams *params = nullptr,
+                      const PleatKnoppelParams *knoppel = nullptr) {
+        PleatCwf *c = nullptr;
+        check(pleat_cwf_design(base.get(), sources.data(), sources.size(), params, knoppel, &c));
+        return Cwf(c);
+    }
+    /// This keyframe with `regions` edited (dissertation 3.6.2; `pleat_cwf_edit`); each
+    /// region's `struct_size` must be `sizeof(PleatCwfRegionEdit)`. `labels`, when given,
+    /// receives PLEAT_FACE_* per triangle.
+    Cwf edit(const std::vector<PleatCwfRegionEdit> &regions,
+             const PleatCwfEditParams *params = nullptr,
+             std::vector<uint8_t> *labels = nullptr) const {
+        PleatCwf *c = nullptr;
+        std::vector<uint8_t> l(triangle_count() + 1);
+        check(pleat_cwf_edit(raw_, regions.data(), regions.size(), params, &c, l.data()));
+        l.pop_back();
+        if (labels) *labels = std::move(l);
+        return Cwf(c);
+    }
     /// Reads a .cwf file written for `base`.
     static Cwf read(const Mesh &base, const std::string &path) {
         PleatCwf *c = nullptr;

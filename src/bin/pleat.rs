@@ -19,6 +19,9 @@ mod bench_lod;
 #[cfg(feature = "wrinkle")]
 #[path = "pleat/interp_bench.rs"]
 mod interp_bench;
+#[cfg(feature = "wrinkle")]
+#[path = "pleat/wrinkle_edit.rs"]
+mod wrinkle_edit;
 
 #[cfg(feature = "bake")]
 #[path = "pleat/bake.rs"]
@@ -246,6 +249,53 @@ enum WrinkleCommand {
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
         /// Output pattern, e.g. frame_{i}.obj.
+        #[arg(short = 'o', long = "output")]
+        out: PathBuf,
+    },
+    /// Design a keyframe from wrinkle sources (dissertation §3.6.1): wave vectors extended by
+    /// the vector heat method, amplitude by eq. 3.25, phase by Knöppel; zero outside the
+    /// sources' regions. Prints each solve's seconds and residual.
+    Design {
+        /// The base mesh.
+        base: PathBuf,
+        /// A source `V,KX,KY,KZ,A[,RINGS]`: vertex, wave vector (radians per length unit),
+        /// amplitude, region size in rings (default 5). Repeat for several sources.
+        #[arg(long = "source", allow_hyphen_values = true, required = true)]
+        sources: Vec<String>,
+        /// Heat time in units of the squared mean edge length.
+        #[arg(long, default_value_t = 1.0)]
+        heat_time: f64,
+        /// The reference implementation's weights (edge rings, γ = ¼, sources not pinned).
+        #[arg(long)]
+        reference: bool,
+        /// Output .cwf file.
+        #[arg(short = 'o', long = "output")]
+        out: PathBuf,
+    },
+    /// Edit regions of a keyframe (dissertation §3.6.2): rotate, rescale frequency and
+    /// amplitude; the interface is solved (eqs. 3.26–3.28), the rest copied bit for bit. The
+    /// result animates with `pleat wrinkle interp A.cwf B.cwf`.
+    Edit {
+        /// The base mesh.
+        base: PathBuf,
+        /// The keyframe to edit (.cwf).
+        #[arg(long)]
+        cwf: PathBuf,
+        /// A region `seed=FACE|vertex=V,rings=N,interface=M,rotate=DEG,scale=σ,amplitude=μ`
+        /// (or `couple` for μ = 1/σ); defaults rings 5, interface 3, identity op. Repeat for
+        /// several regions (they must not share a vertex).
+        #[arg(long = "region", allow_hyphen_values = true, required = true)]
+        regions: Vec<String>,
+        /// How rings grow: across vertices or across edges.
+        #[arg(long, value_parser = ["vertex", "edge"], default_value = "vertex")]
+        adjacency: String,
+        /// The reference implementation's weights (edge rings, γ = ¼, amplitude-weighted phase).
+        #[arg(long)]
+        reference: bool,
+        /// Also write the face labels (one per line: 0 fixed, 1 edit, 2 interface).
+        #[arg(long)]
+        labels: Option<PathBuf>,
+        /// Output .cwf file.
         #[arg(short = 'o', long = "output")]
         out: PathBuf,
     },
@@ -636,6 +686,10 @@ mod wrinkle_cmd {
         Fail(code, e.to_string())
     }
 
+    fn edit_fail((input, msg): crate::wrinkle_edit::Fail) -> Fail {
+        Fail(if input { EXIT_INPUT } else { 1 }, msg)
+    }
+
     pub fn run(cmd: WrinkleCommand) -> ExitCode {
         let (name, r) = match cmd {
             WrinkleCommand::Eval {
@@ -716,6 +770,38 @@ mod wrinkle_cmd {
             } => (
                 "eval-anim",
                 eval_anim(&base, &anim, levels as usize, scale, &out),
+            ),
+            WrinkleCommand::Design {
+                base,
+                sources,
+                heat_time,
+                reference,
+                out,
+            } => (
+                "design",
+                crate::wrinkle_edit::run_design(&base, &sources, heat_time, reference, &out)
+                    .map_err(edit_fail),
+            ),
+            WrinkleCommand::Edit {
+                base,
+                cwf,
+                regions,
+                adjacency,
+                reference,
+                labels,
+                out,
+            } => (
+                "edit",
+                crate::wrinkle_edit::run_edit(
+                    &base,
+                    &cwf,
+                    &regions,
+                    &adjacency,
+                    reference,
+                    labels.as_deref(),
+                    &out,
+                )
+                .map_err(edit_fail),
             ),
         };
         match r {

@@ -140,3 +140,22 @@ fn bake_params_default_is_rust_default() {
         (r.normal_scale, r.occlusion_strength, r.emissive_factor)
     );
 }
+
+#[cfg(feature = "wrinkle")]
+#[test]
+fn cwf_design_and_edit_params_default_are_rust_default() {
+    let c = pleat_cwf_design_params_default();
+    assert_eq!(
+        c.struct_size as usize,
+        std::mem::size_of::<PleatCwfDesignParams>()
+    );
+    let rust = design::imp::design_options(&c).expect("the C default is valid");
+    assert_eq!(rust, crate::wrinkle::DesignOptions::default());
+    let c = pleat_cwf_edit_params_default();
+    assert_eq!(
+        c.struct_size as usize,
+        std::mem::size_of::<PleatCwfEditParams>()
+    );
+    let rust = design::imp::edit_options(&c).expect("the C default is valid");
+    assert_eq!(rust, crate::wrinkle::EditOptions::default());
+}

@@ -21,6 +21,7 @@
 mod bake;
 mod boundary;
 mod common;
+mod design;
 mod edges;
 mod interpolate;
 mod lod;
@@ -32,6 +33,7 @@ mod wrinkle;
 
 pub use bake::*;
 pub use common::*;
+pub use design::*;
 pub use edges::*;
 pub use interpolate::*;
 pub use lod::*;

@@ -253,7 +253,7 @@ fn max_ratio(topo: &Topology, w: &[f64], mass: &[f64]) -> f64 {
 /// connection Laplacian is block-diagonal over components, so normalizing each component
 /// separately runs independent inverse iterations: every component gets its own smallest
 /// eigenvector instead of decaying towards the component with the smallest eigenvalue.
-fn components(topo: &Topology) -> (Vec<u32>, usize) {
+pub(crate) fn components(topo: &Topology) -> (Vec<u32>, usize) {
     let n = topo.n_vertices;
     let mut parent: Vec<u32> = (0..n as u32).collect();
     fn find(p: &mut [u32], mut v: u32) -> u32 {
@@ -311,6 +311,12 @@ fn floored(m: &[f64]) -> Vec<f64> {
 
 /// Cotangent weights `(cot α + cot β)/2`, clamped below at `1e-3` of their mean absolute value.
 pub(crate) fn cotan_weights(topo: &Topology, x: &[[f64; 3]]) -> Vec<f64> {
+    clamp_cotan_weights(cotan_weights_raw(topo, x))
+}
+
+/// Unclamped cotangent weights `c_mn = (cot α + cot β)/2` (the FEM stiffness of the cotan
+/// Laplacian, negative across obtuse angles; 0 for a degenerate triangle's corner).
+pub(crate) fn cotan_weights_raw(topo: &Topology, x: &[[f64; 3]]) -> Vec<f64> {
     let mut w = vec![0.0; topo.n_edges()];
     for (f, t) in topo.faces.iter().enumerate() {
         for s in 0..3 {
@@ -322,6 +328,10 @@ pub(crate) fn cotan_weights(topo: &Topology, x: &[[f64; 3]]) -> Vec<f64> {
             w[topo.face_edges[f][s] as usize] += 0.5 * cot;
         }
     }
+    w
+}
+
+fn clamp_cotan_weights(w: Vec<f64>) -> Vec<f64> {
     let mean = w.iter().map(|v| v.abs()).sum::<f64>() / w.len().max(1) as f64;
     let floor = if mean > 0.0 && mean.is_finite() {
         1e-3 * mean

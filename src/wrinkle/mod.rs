@@ -40,13 +40,17 @@ pub mod animation;
 mod areas;
 mod complex;
 pub mod cwf;
+pub mod design;
+pub mod edit;
 pub mod evaluate;
 pub mod interpolate;
 pub mod io;
 pub mod knoppel;
 mod omega_path;
+pub mod region;
 pub mod report;
 mod spacetime;
+mod spd;
 pub mod subdivide;
 mod topology;
 
@@ -56,6 +60,8 @@ pub use animation::{
 };
 pub use complex::Complex;
 pub use cwf::{one_form_from_vectors, Cwf, FrequencyField, OmegaDecomposition};
+pub use design::{design, DesignOptions, DesignReport, WrinkleSource};
+pub use edit::{edit, EditOptions, EditReport, PhaseCoupling, RegionEdit};
 pub use evaluate::{EvalOptions, Evaluated};
 pub use interpolate::{
     explicit_omega, interpolate, interpolate_with_progress, linear_interpolation, HessianModel,
@@ -65,5 +71,6 @@ pub use io::{
     connectivity_hash, cwf_to_string, parse_cwf, read_cwf, write_cwf, CWF_FORMAT_VERSION,
 };
 pub use knoppel::{KnoppelOptions, KnoppelReport, PhaseWeights};
+pub use region::{grow_faces, Adjacency, FaceClass};
 pub use report::{CwfStage, EvalReport, EvalStage, InterpStage, LevelPart, LevelReport};
 pub use subdivide::{BoundaryRule, LoopHierarchy, SubdivisionOptions};

@@ -186,7 +186,7 @@ impl OmegaPath {
 }
 
 /// Unit normal of face `f` (zero for a degenerate face).
-fn face_unit_normal(topo: &Topology, x: &[[f64; 3]], f: usize) -> Vec3 {
+pub(crate) fn face_unit_normal(topo: &Topology, x: &[[f64; 3]], f: usize) -> Vec3 {
     let p = topo.faces[f].map(|v| Vec3::from(x[v as usize]));
     let n = tri_normal(p[0], p[1], p[2]);
     let l = n.length();
@@ -200,7 +200,13 @@ fn face_unit_normal(topo: &Topology, x: &[[f64; 3]], f: usize) -> Vec3 {
 
 /// The tangent vector `u_{f,c}` of B.51–B.52 at corner `c` of face `f` (zero when the triangle
 /// is degenerate).
-fn corner_vector(topo: &Topology, x: &[[f64; 3]], omega: &[f64], f: usize, c: usize) -> Vec3 {
+pub(crate) fn corner_vector(
+    topo: &Topology,
+    x: &[[f64; 3]],
+    omega: &[f64],
+    f: usize,
+    c: usize,
+) -> Vec3 {
     let t = topo.faces[f];
     let (m, k, l) = (t[c], t[(c + 1) % 3], t[(c + 2) % 3]);
     let xm = Vec3::from(x[m as usize]);

@@ -39,7 +39,7 @@ import numpy as _np
 __all__ = [
     "ABI_VERSION", "Mesh", "Cwf", "Animation", "PleatError", "version", "abi_version",
     "has_feature", "set_thread_count", "thread_count", "library_path", "Bake", "bake",
-    "lod_provenance", "points_provenance", "BAKE_IMAGES",
+    "lod_provenance", "points_provenance", "BAKE_IMAGES", "grow_faces",
 ]
 
 #: The C ABI version (``PLEAT_ABI_VERSION`` of pleat.h) this module's declarations match.
@@ -180,6 +180,18 @@ _InterpStats = _struct("PleatWrinkleInterpStats",
                        + _f64s("total_seconds", "final_gradient_norm", "smooth_energy",
                                "compat_energy", "unit_energy", "g_ave", "c"))
 
+_WrinkleSource = _struct("PleatWrinkleSource", _u32s("vertex", "rings")
+                         + [("wave_vector", _c.c_double * 3)] + _f64s("amplitude"))
+_DesignParams = _struct("PleatCwfDesignParams",
+                        _u32s("struct_size", "adjacency", "pin_sources", "reserved")
+                        + _f64s("heat_time", "kappa", "gamma", "data_weight"))
+_RegionEdit = _struct("PleatCwfRegionEdit", _u32s("struct_size", "interface_rings")
+                      + [("faces", _U), ("face_count", _c.c_size_t)]
+                      + _f64s("rotate_radians", "frequency_scale", "amplitude_scale"))
+_EditParams = _struct("PleatCwfEditParams",
+                      _u32s("struct_size", "adjacency", "phase", "max_iterations")
+                      + _f64s("eps_omega", "eps_amplitude", "gamma", "tolerance"))
+
 _PROGRESS_ARGS = (_PROGRESS_FN, _c.c_void_p)
 for _name, _res, _args in [
     ("pleat_version", _c.c_char_p, ()),
@@ -251,6 +263,15 @@ for _name, _res, _args in [
     ("pleat_cwf_animation_write_file", _st, (_P, _c.c_char_p)),
     ("pleat_cwf_animation_read_file", _st, (_P, _c.c_char_p, _PP)),
     ("pleat_cwf_animation_destroy", None, (_P,)),
+    # wrinkle design and editing
+    ("pleat_cwf_design_params_default", _DesignParams, ()),
+    ("pleat_cwf_edit_params_default", _EditParams, ()),
+    ("pleat_cwf_design", _st, (_P, _c.POINTER(_WrinkleSource), _sz, _c.POINTER(_DesignParams),
+                               _c.POINTER(_KnoppelParams), _PP)),
+    ("pleat_cwf_edit", _st, (_P, _c.POINTER(_RegionEdit), _sz, _c.POINTER(_EditParams), _PP,
+                             _c.POINTER(_c.c_uint8))),
+    ("pleat_mesh_grow_faces", _st, (_P, _U, _sz, _U, _sz, _u32, _u32, _c.POINTER(_c.c_uint8),
+                                    _c.POINTER(_sz))),
 ]:
     _sig(_name, _res, *_args)
 
@@ -259,7 +280,9 @@ for _fn, _cls in [("pleat_lod_params_default", _LodParams),
                   ("pleat_offset_params_default", _OffsetParams),
                   ("pleat_wrinkle_eval_params_default", _EvalParams),
                   ("pleat_knoppel_params_default", _KnoppelParams),
-                  ("pleat_wrinkle_interp_params_default", _InterpParams)]:
+                  ("pleat_wrinkle_interp_params_default", _InterpParams),
+                  ("pleat_cwf_design_params_default", _DesignParams),
+                  ("pleat_cwf_edit_params_default", _EditParams)]:
     if getattr(_lib, _fn)().struct_size != _c.sizeof(_cls):
         raise ImportError(f"{_path}: {_cls.__name__} is {getattr(_lib, _fn)().struct_size} bytes "
                           f"in the library, {_c.sizeof(_cls)} in this module")
@@ -625,6 +648,21 @@ def _stats_json(stats):
 
 # --- wrinkle fields ------------------------------------------------------------------------
 
+_ADJACENCY = {"vertex": 0, "edge": 1}
+
+
+def grow_faces(base, seed_vertices=(), seed_faces=(), rings=5, adjacency="vertex"):
+    """Triangle ids of the region grown from seed vertices/faces by ``rings`` rings (ring 1 =
+    the seeds' triangles) across shared vertices or edges; a uint32 array."""
+    sv, sf = _indices(seed_vertices, "seed_vertices"), _indices(seed_faces, "seed_faces")
+    flags = _np.zeros(max(base.triangle_count, 1), dtype=_np.uint8)
+    _check(_lib.pleat_mesh_grow_faces(
+        base._h, _ptr(sf, _c.c_uint32) if sf.size else None, sf.size,
+        _ptr(sv, _c.c_uint32) if sv.size else None, sv.size, int(rings), _ADJACENCY[adjacency],
+        _ptr(flags, _c.c_uint8), None))
+    return _np.flatnonzero(flags[:base.triangle_count]).astype(_np.uint32)
+
+
 class Cwf(_Handle):
     """A complex wrinkle field on a base Mesh: omega per edge (the order of ``base.edges()``,
     integrated from the smaller to the larger vertex, radians), amplitude and unit phase zeta
@@ -717,6 +755,53 @@ class Cwf(_Handle):
     def triangle_count(self):
         """Triangles of the base mesh."""
         return int(_lib.pleat_cwf_triangle_count(self._h))
+
+    @classmethod
+    def design(cls, base, sources, adjacency="vertex", pin_sources=True, heat_time=1.0,
+               kappa=1.0, gamma=1.0, data_weight=1.0):
+        """A keyframe designed from sources (dissertation 3.6.1): ``sources`` is a list of
+        ``(vertex, (kx, ky, kz), amplitude, rings)``; omega by the vector heat method,
+        amplitude by eq. 3.25, phase by Knoppel; zero outside the sources' regions."""
+        arr = (_WrinkleSource * max(len(sources), 1))()
+        for i, (v, k, a, rings) in enumerate(sources):
+            arr[i].vertex, arr[i].rings, arr[i].amplitude = int(v), int(rings), float(a)
+            arr[i].wave_vector[:] = [float(x) for x in k]
+        p = _lib.pleat_cwf_design_params_default()
+        p.adjacency = _ADJACENCY[adjacency]
+        p.pin_sources = 1 if pin_sources else 0
+        p.heat_time, p.kappa, p.gamma, p.data_weight = heat_time, kappa, gamma, data_weight
+        h = _P()
+        _check(_lib.pleat_cwf_design(base._h, arr, len(sources), _c.byref(p), None,
+                                     _c.byref(h)))
+        return cls(h)
+
+    def edit(self, regions, adjacency="vertex", phase="unit", eps_omega=1e-3,
+             eps_amplitude=1e-3, gamma=1.0):
+        """Region edits (dissertation 3.6.2): ``regions`` is a list of dicts with ``faces``
+        (triangle ids, e.g. from ``grow_faces``) and optional ``interface_rings`` (3),
+        ``rotate`` (radians, 0), ``frequency_scale`` (1), ``amplitude_scale`` (1). Returns
+        ``(edited Cwf, labels)``: labels per triangle, 0 fixed, 1 edit, 2 interface."""
+        keep = []
+        arr = (_RegionEdit * max(len(regions), 1))()
+        for i, r in enumerate(regions):
+            faces = _indices(r["faces"], "faces")
+            keep.append(faces)
+            arr[i].struct_size = _c.sizeof(_RegionEdit)
+            arr[i].interface_rings = int(r.get("interface_rings", 3))
+            arr[i].faces = _ptr(faces, _c.c_uint32) if faces.size else None
+            arr[i].face_count = faces.size
+            arr[i].rotate_radians = float(r.get("rotate", 0.0))
+            arr[i].frequency_scale = float(r.get("frequency_scale", 1.0))
+            arr[i].amplitude_scale = float(r.get("amplitude_scale", 1.0))
+        p = _lib.pleat_cwf_edit_params_default()
+        p.adjacency = _ADJACENCY[adjacency]
+        p.phase = {"unit": 0, "amplitude_weighted": 1}[phase]
+        p.eps_omega, p.eps_amplitude, p.gamma = eps_omega, eps_amplitude, gamma
+        labels = _np.zeros(max(self.triangle_count, 1), dtype=_np.uint8)
+        h = _P()
+        _check(_lib.pleat_cwf_edit(self._h, arr, len(regions), _c.byref(p), _c.byref(h),
+                                   _ptr(labels, _c.c_uint8)))
+        return Cwf(h), labels[:self.triangle_count]
 
     def _copy(self, fn, n, per=1):
         out = _np.empty(max(per * n, 1), dtype=_np.float64)

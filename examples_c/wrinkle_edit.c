@@ -1,0 +1,184 @@
+/* Wrinkle design and region edits through the C ABI (issue 14, dissertation ch. 3.6):
+   grow a region, rotate the wrinkles in it, check the fixed part is copied bit for bit, an
+   identity edit returns the input, design from a source, evaluate the edited keyframe, and
+   misuse answers a status with a message. Without the "wrinkle" capability every call answers
+   PLEAT_STATUS_UNSUPPORTED (checked). */
+#include "wrinkle_util.h"
+
+#define N 21
+
+/* Per vertex of the N x N grid: 1 when every triangle around it is fixed. */
+static void fixed_vertices(const uint8_t *labels, uint8_t *fixed) {
+    size_t nv = (size_t)N * N, f = 0;
+    uint8_t *touched = (uint8_t *)calloc(nv, 1);
+    int i, j;
+    for (j = 0; j + 1 < N; j++)
+        for (i = 0; i + 1 < N; i++) {
+            uint32_t v00 = (uint32_t)(j * N + i), v10 = v00 + 1, v01 = v00 + N, v11 = v01 + 1;
+            uint32_t t[6] = {v00, v10, v11, v00, v11, v01};
+            int s, c;
+            for (s = 0; s < 2; s++, f++)
+                for (c = 0; c < 3; c++)
+                    if (labels[f] != PLEAT_FACE_FIXED) touched[t[3 * s + c]] = 1;
+        }
+    for (f = 0; f < nv; f++) fixed[f] = !touched[f];
+    free(touched);
+}
+
+static void edits(void) {
+    const double k[3] = {4 * 2 * M_PI, 0, 0};
+    PleatMesh *m = make_grid(N);
+    size_t nv = pleat_mesh_vertex_count(m), nt = pleat_mesh_triangle_count(m), ne = 0, i, count = 0;
+    double *zeta = (double *)malloc(2 * nv * sizeof *zeta);
+    double *omega = plane_wave(m, k, &ne, zeta);
+    double *amp = filled(nv, 0.01);
+    uint8_t *flags = (uint8_t *)malloc(nt), *labels = (uint8_t *)malloc(nt);
+    uint8_t *fixed = (uint8_t *)malloc(nv);
+    uint32_t *faces = (uint32_t *)malloc(nt * sizeof *faces);
+    uint32_t centre = (N / 2) * N + N / 2;
+    PleatCwf *a = NULL, *b = NULL, *c = NULL, *d = NULL;
+    PleatCwfRegionEdit r;
+    PleatCwfEditParams ep = pleat_cwf_edit_params_default();
+    PleatWrinkleSource src;
+    double *a0 = (double *)malloc(nv * sizeof *a0), *a1 = (double *)malloc(nv * sizeof *a1);
+    double *z0 = (double *)malloc(2 * nv * sizeof *z0), *z1 = (double *)malloc(2 * nv * sizeof *z1);
+    double *w0 = (double *)malloc(ne * sizeof *w0), *w1 = (double *)malloc(ne * sizeof *w1);
+    int same = 1, n_fixed = 0;
+
+    CHECK_STATUS(pleat_cwf_create(m, omega, ne, amp, zeta, nv, &a), PLEAT_STATUS_OK);
+    /* region: the centre vertex's triangles grown to 3 rings */
+    CHECK_STATUS(pleat_mesh_grow_faces(m, NULL, 0, &centre, 1, 3, PLEAT_ADJACENCY_VERTEX, flags,
+                                       &count),
+                 PLEAT_STATUS_OK);
+    CHECK(count > 6 && count < nt);
+    count = 0;
+    for (i = 0; i < nt; i++)
+        if (flags[i]) faces[count++] = (uint32_t)i;
+
+    memset(&r, 0, sizeof r);
+    r.struct_size = sizeof r;
+    r.interface_rings = 3;
+    r.faces = faces;
+    r.face_count = count;
+    r.rotate_radians = M_PI / 2;
+    r.frequency_scale = 1.0;
+    r.amplitude_scale = 1.0;
+    CHECK_STATUS(pleat_cwf_edit(a, &r, 1, &ep, &b, labels), PLEAT_STATUS_OK);
+
+    /* the fixed part is copied bit for bit */
+    fixed_vertices(labels, fixed);
+    pleat_cwf_copy_amplitude(a, a0, nv);
+    pleat_cwf_copy_amplitude(b, a1, nv);
+    pleat_cwf_copy_zeta(a, z0, nv);
+    pleat_cwf_copy_zeta(b, z1, nv);
+    for (i = 0; i < nv; i++)
+        if (fixed[i]) {
+            n_fixed++;
+            same &= memcmp(a0 + i, a1 + i, sizeof *a0) == 0;
+            same &= memcmp(z0 + 2 * i, z1 + 2 * i, 2 * sizeof *z0) == 0;
+        }
+    CHECK(n_fixed > 0 && same);
+
+    /* an identity edit returns the input */
+    r.rotate_radians = 0.0;
+    CHECK_STATUS(pleat_cwf_edit(a, &r, 1, NULL, &c, NULL), PLEAT_STATUS_OK);
+    pleat_cwf_copy_omega(a, w0, ne);
+    pleat_cwf_copy_omega(c, w1, ne);
+    same = 1;
+    for (i = 0; i < ne; i++) same &= fabs(w0[i] - w1[i]) < 1e-12;
+    CHECK(same);
+
+    /* the edited keyframe evaluates like any other field */
+    {
+        PleatMesh *wrinkled = NULL;
+        PleatWrinkleEvalParams p = pleat_wrinkle_eval_params_default();
+        p.levels = 1;
+        CHECK_STATUS(pleat_cwf_evaluate(b, &p, NULL, NULL, &wrinkled, NULL, NULL),
+                     PLEAT_STATUS_OK);
+        CHECK(pleat_mesh_triangle_count(wrinkled) == 4 * nt);
+        pleat_mesh_destroy(wrinkled);
+    }
+
+    /* design from one source */
+    src.vertex = centre;
+    src.rings = 4;
+    src.wave_vector[0] = k[0], src.wave_vector[1] = 0, src.wave_vector[2] = 0;
+    src.amplitude = 0.02;
+    CHECK_STATUS(pleat_cwf_design(m, &src, 1, NULL, NULL, &d), PLEAT_STATUS_OK);
+    pleat_cwf_copy_amplitude(d, a1, nv);
+    CHECK(a1[centre] == 0.02 && a1[0] == 0.0);
+
+    /* misuse: a status and a message, nothing written */
+    {
+        PleatCwf *none = NULL;
+        PleatCwfRegionEdit bad = r;
+        PleatWrinkleSource nan_src = src;
+        bad.frequency_scale = 0.0;
+        CHECK_STATUS(pleat_cwf_edit(a, &bad, 1, NULL, &none, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+        bad = r;
+        bad.struct_size = 4;
+        CHECK_STATUS(pleat_cwf_edit(a, &bad, 1, NULL, &none, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+        bad = r;
+        bad.faces = NULL;
+        CHECK_STATUS(pleat_cwf_edit(a, &bad, 1, NULL, &none, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+        bad = r;
+        bad.interface_rings = 0;
+        CHECK_STATUS(pleat_cwf_edit(a, &bad, 1, NULL, &none, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+        {
+            PleatCwfRegionEdit two[2];
+            two[0] = r, two[1] = r;
+            CHECK_STATUS(pleat_cwf_edit(a, two, 2, NULL, &none, NULL),
+                         PLEAT_STATUS_INVALID_ARGUMENT);
+        }
+        CHECK_STATUS(pleat_cwf_edit(NULL, &r, 1, NULL, &none, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(pleat_cwf_edit(a, &r, 1, NULL, NULL, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+        ep.phase = 7;
+        CHECK_STATUS(pleat_cwf_edit(a, &r, 1, &ep, &none, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+        nan_src.wave_vector[1] = NAN;
+        CHECK_STATUS(pleat_cwf_design(m, &nan_src, 1, NULL, NULL, &none),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(pleat_cwf_design(m, &src, 0, NULL, NULL, &none),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(pleat_mesh_grow_faces(m, NULL, 0, &centre, 1, 0, PLEAT_ADJACENCY_VERTEX,
+                                           flags, NULL),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(pleat_mesh_grow_faces(m, NULL, 0, &centre, 1, 2, 9, flags, NULL),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK(none == NULL);
+    }
+
+    pleat_cwf_destroy(a);
+    pleat_cwf_destroy(b);
+    pleat_cwf_destroy(c);
+    pleat_cwf_destroy(d);
+    pleat_mesh_destroy(m);
+    free(zeta), free(omega), free(amp), free(flags), free(labels), free(fixed), free(faces);
+    free(a0), free(a1), free(z0), free(z1), free(w0), free(w1);
+}
+
+/* Without the capability the calls answer UNSUPPORTED; the defaults still work. */
+static void unsupported(void) {
+    PleatMesh *m = make_grid(5);
+    PleatCwf *out = NULL;
+    uint8_t flags[32];
+    uint32_t v = 12;
+    PleatWrinkleSource s = {12, 2, {1, 0, 0}, 0.01};
+    PleatCwfEditParams ep = pleat_cwf_edit_params_default();
+    PleatCwfDesignParams dp = pleat_cwf_design_params_default();
+    printf("SKIPPED: this pleat was built without \"wrinkle\"; checking UNSUPPORTED\n");
+    CHECK(ep.struct_size == sizeof ep && dp.struct_size == sizeof dp);
+    CHECK_STATUS(pleat_cwf_design(m, &s, 1, &dp, NULL, &out), PLEAT_STATUS_UNSUPPORTED);
+    CHECK_STATUS(pleat_cwf_edit(NULL, NULL, 0, &ep, &out, NULL), PLEAT_STATUS_UNSUPPORTED);
+    CHECK_STATUS(pleat_mesh_grow_faces(m, NULL, 0, &v, 1, 2, PLEAT_ADJACENCY_VERTEX, flags, NULL),
+                 PLEAT_STATUS_UNSUPPORTED);
+    CHECK(out == NULL);
+    pleat_mesh_destroy(m);
+}
+
+int main(void) {
+    if (pleat_has_feature("wrinkle"))
+        edits();
+    else
+        unsupported();
+    return finish("wrinkle_edit");
+}

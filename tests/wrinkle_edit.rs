@@ -1,0 +1,540 @@
+//! Wrinkle design and editing (issue 14, dissertation §3.6; checks of `specs/cwf-design.md`):
+//! fixed bits, identity and global edits of plane waves, interface quality, amplitude bounds,
+//! bad input, design from sources, and edit → interpolate → evaluate end to end.
+
+#![cfg(feature = "wrinkle")]
+
+mod wrinkle_common;
+
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+
+use pleat::mesh::TriMesh;
+use pleat::wrinkle::{
+    design, edit, grow_faces, interpolate, Adjacency, Complex, Cwf, DesignOptions, EditOptions,
+    EvalOptions, FaceClass, FrequencyField, InterpOptions, KnoppelOptions, PhaseCoupling,
+    RegionEdit, WrinkleSource,
+};
+use wrinkle_common::{irregular_grid, Rng};
+
+const K: [f64; 3] = [
+    4.0 * std::f64::consts::TAU,
+    1.5 * std::f64::consts::TAU,
+    0.0,
+];
+
+fn plane_wave(base: TriMesh, k: [f64; 3], a: f64) -> Cwf {
+    let n = base.vertex_count();
+    Cwf::from_frequency_field(
+        base,
+        FrequencyField::PerVertex(&vec![k; n]),
+        vec![a; n],
+        &KnoppelOptions::default(),
+    )
+    .unwrap()
+    .0
+}
+
+/// The vertex nearest to `p`.
+fn nearest(m: &TriMesh, p: [f64; 2]) -> u32 {
+    let d = |q: &[f64; 3]| (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
+    (0..m.vertex_count() as u32)
+        .min_by(|&a, &b| d(&m.positions()[a as usize]).total_cmp(&d(&m.positions()[b as usize])))
+        .unwrap()
+}
+
+fn disk_region(m: &TriMesh, centre: [f64; 2], rings: usize) -> Vec<u32> {
+    grow_faces(m, &[], &[nearest(m, centre)], rings, Adjacency::Vertex).unwrap()
+}
+
+fn rot_z(k: [f64; 3], theta: f64) -> [f64; 3] {
+    let (s, c) = theta.sin_cos();
+    [c * k[0] - s * k[1], s * k[0] + c * k[1], k[2]]
+}
+
+fn edge_vec(m: &TriMesh, e: [u32; 2]) -> [f64; 3] {
+    let (a, b) = (m.positions()[e[0] as usize], m.positions()[e[1] as usize]);
+    [b[0] - a[0], b[1] - a[1], b[2] - a[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Edge classes from face classes (edit > fixed > interface).
+fn edge_classes(cwf: &Cwf, face_class: &[FaceClass]) -> Vec<FaceClass> {
+    let el = cwf.base().edges();
+    let mut cls = vec![FaceClass::Interface; cwf.edges().len()];
+    let mut has = vec![[false; 3]; cwf.edges().len()];
+    for (f, fe) in el.face_edges.iter().enumerate() {
+        for &e in fe {
+            has[e as usize][face_class[f] as usize] = true;
+        }
+    }
+    for (e, h) in has.iter().enumerate() {
+        cls[e] = if h[1] {
+            FaceClass::Edit
+        } else if h[0] {
+            FaceClass::Fixed
+        } else {
+            FaceClass::Interface
+        };
+    }
+    cls
+}
+
+fn vertex_fixed(cwf: &Cwf, face_class: &[FaceClass]) -> Vec<bool> {
+    let n = cwf.base().vertex_count();
+    let mut fixed = vec![false; n];
+    let mut non_fixed = vec![false; n];
+    for (f, t) in cwf.base().triangles().iter().enumerate() {
+        for &v in t {
+            if face_class[f] == FaceClass::Fixed {
+                fixed[v as usize] = true;
+            } else {
+                non_fixed[v as usize] = true;
+            }
+        }
+    }
+    (0..n).map(|j| fixed[j] || !non_fixed[j]).collect()
+}
+
+// ---------------------------------------------------------------------------------------------
+// C1: fixed region bit for bit
+
+#[test]
+fn fixed_region_is_copied_bit_for_bit() {
+    let mut rng = Rng::new(7);
+    for seed in 0..4u64 {
+        let m = irregular_grid(24, 0.25, seed);
+        let cwf = plane_wave(m.clone(), K, 0.01);
+        let centre = [rng.range(0.3, 0.7), rng.range(0.3, 0.7)];
+        let mut r = RegionEdit::new(disk_region(&m, centre, 3));
+        r.rotate = rng.range(-3.0, 3.0);
+        r.frequency_scale = rng.range(0.5, 3.0);
+        r.amplitude_scale = rng.range(0.2, 2.0);
+        for opts in [EditOptions::default(), EditOptions::reference()] {
+            let (out, rep) = edit(&cwf, std::slice::from_ref(&r), &opts).unwrap();
+            let ec = edge_classes(&cwf, &rep.face_class);
+            for (e, &c) in ec.iter().enumerate() {
+                if c == FaceClass::Fixed {
+                    assert_eq!(
+                        out.omega()[e].to_bits(),
+                        cwf.omega()[e].to_bits(),
+                        "edge {e}"
+                    );
+                }
+            }
+            let vf = vertex_fixed(&cwf, &rep.face_class);
+            for (j, &fixed) in vf.iter().enumerate() {
+                if fixed {
+                    assert_eq!(out.amplitude()[j].to_bits(), cwf.amplitude()[j].to_bits());
+                    assert_eq!(out.zeta()[j].re.to_bits(), cwf.zeta()[j].re.to_bits());
+                    assert_eq!(out.zeta()[j].im.to_bits(), cwf.zeta()[j].im.to_bits());
+                }
+            }
+            assert!(
+                rep.face_counts.iter().all(|&c| c > 0),
+                "{:?}",
+                rep.face_counts
+            );
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// C2: plane wave, flat grid: edit edges rotate exactly; scaling; identity copies ω bits
+
+#[test]
+fn local_rotation_of_a_plane_wave_rotates_edit_edges_exactly() {
+    let m = irregular_grid(24, 0.25, 3);
+    let cwf = plane_wave(m.clone(), K, 0.01);
+    let mut r = RegionEdit::new(disk_region(&m, [0.5, 0.5], 3));
+    r.rotate = FRAC_PI_2;
+    r.frequency_scale = 2.0;
+    let (out, rep) = edit(&cwf, &[r], &EditOptions::default()).unwrap();
+    let ec = edge_classes(&cwf, &rep.face_class);
+    let kr = rot_z(K, FRAC_PI_2).map(|c| 2.0 * c);
+    let h = 1.0 / 24.0;
+    let knorm = dot(K, K).sqrt();
+    for (e, &edge) in cwf.edges().iter().enumerate() {
+        if ec[e] == FaceClass::Edit {
+            let want = dot(kr, edge_vec(&m, edge));
+            assert!(
+                (out.omega()[e] - want).abs() <= 1e-12 * knorm * h * 4.0,
+                "edge {e}: {} vs {want}",
+                out.omega()[e]
+            );
+        }
+    }
+    assert!(rep.omega_residual < 1e-10, "{rep:?}");
+    assert!(rep.amplitude_residual < 1e-10, "{rep:?}");
+}
+
+#[test]
+fn identity_edit_returns_the_input() {
+    let m = irregular_grid(24, 0.25, 5);
+    let cwf = plane_wave(m.clone(), K, 0.01);
+    let regions = [
+        RegionEdit::new(disk_region(&m, [0.35, 0.35], 2)),
+        RegionEdit::new(disk_region(&m, [0.68, 0.62], 2)),
+    ];
+    let (out, rep) = edit(&cwf, &regions, &EditOptions::default()).unwrap();
+    let ec = edge_classes(&cwf, &rep.face_class);
+    for (e, &c) in ec.iter().enumerate() {
+        if c == FaceClass::Edit {
+            assert_eq!(out.omega()[e].to_bits(), cwf.omega()[e].to_bits());
+        }
+        assert!((out.omega()[e] - cwf.omega()[e]).abs() < 1e-12, "edge {e}");
+    }
+    for j in 0..m.vertex_count() {
+        assert!(
+            (out.amplitude()[j] - cwf.amplitude()[j]).abs() < 1e-12,
+            "a[{j}]"
+        );
+        let d = out.zeta()[j] - cwf.zeta()[j];
+        assert!(
+            d.abs() < 1e-9,
+            "z[{j}] {:?} vs {:?}",
+            out.zeta()[j],
+            cwf.zeta()[j]
+        );
+    }
+    assert!(!rep.global && !rep.phase_fallback);
+}
+
+// ---------------------------------------------------------------------------------------------
+// C4: global edits
+
+#[test]
+fn global_rotation_and_scale_give_the_transformed_plane_wave() {
+    let m = irregular_grid(16, 0.25, 9);
+    let cwf = plane_wave(m.clone(), K, 0.02);
+    let all: Vec<u32> = (0..m.triangle_count() as u32).collect();
+    for (theta, sigma) in [(FRAC_PI_2, 1.0), (FRAC_PI_4, 1.0), (0.0, 2.0), (0.3, 0.5)] {
+        let mut r = RegionEdit::new(all.clone());
+        r.interface_rings = 0;
+        r.rotate = theta;
+        r.frequency_scale = sigma;
+        let r = r.coupled();
+        let (out, rep) = edit(&cwf, &[r], &EditOptions::default()).unwrap();
+        assert!(rep.global);
+        let k1 = rot_z(K, theta).map(|c| sigma * c);
+        for (e, &edge) in cwf.edges().iter().enumerate() {
+            let want = dot(k1, edge_vec(&m, edge));
+            assert!(
+                (out.omega()[e] - want).abs() < 1e-12,
+                "θ {theta} σ {sigma} edge {e}"
+            );
+        }
+        for j in 0..m.vertex_count() {
+            assert!((out.amplitude()[j] - 0.02 / sigma).abs() < 1e-15);
+        }
+        // z̃ = e^{iφ} e^{i k1·x}
+        let p = m.positions();
+        let phase = |j: usize| Complex::cis(dot(k1, p[j]));
+        let g = out.zeta()[0] * phase(0).conj();
+        for j in 0..m.vertex_count() {
+            let d = out.zeta()[j] - g * phase(j);
+            assert!(
+                d.abs() < 1e-6,
+                "θ {theta} σ {sigma} vertex {j}: {}",
+                d.abs()
+            );
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// C5/C6: interface quality, net index
+
+#[test]
+fn local_edits_are_compatible_inside_the_region() {
+    // the spec's setting: 40² grid, 4 waves across, disk r = 0.3, 3 interface rings
+    let n = 40;
+    let m = irregular_grid(n, 0.2, 11);
+    let cwf = plane_wave(m.clone(), [4.0 * std::f64::consts::TAU, 0.0, 0.0], 0.01);
+    let centre = [0.5, 0.5];
+    let region: Vec<u32> = (0..m.triangle_count() as u32)
+        .filter(|&f| {
+            m.triangles()[f as usize].iter().all(|&v| {
+                let q = m.positions()[v as usize];
+                (q[0] - centre[0]).hypot(q[1] - centre[1]) < 0.3
+            })
+        })
+        .collect();
+    for (theta, sigma) in [(FRAC_PI_2, 1.0), (0.0, 2.0)] {
+        let mut r = RegionEdit::new(region.clone());
+        r.rotate = theta;
+        r.frequency_scale = sigma;
+        let (out, rep) = edit(&cwf, &[r], &EditOptions::default()).unwrap();
+        let dec = out.decompose_omega();
+        let ec = edge_classes(&cwf, &rep.face_class);
+        let (mut sum, mut cnt) = (0.0, 0);
+        for (e, &[a, b]) in out.edges().iter().enumerate() {
+            let (pa, pb) = (m.positions()[a as usize], m.positions()[b as usize]);
+            let mid = [(pa[0] + pb[0]) / 2.0, (pa[1] + pb[1]) / 2.0];
+            if ec[e] == FaceClass::Edit && (mid[0] - 0.5).hypot(mid[1] - 0.5) < 0.2 {
+                sum += dec.residual[e].powi(2);
+                cnt += 1;
+            }
+        }
+        let rms = (sum / cnt as f64).sqrt();
+        eprintln!(
+            "θ {theta} σ {sigma}: inner RMS {rms:.3} rad, report {rep:?}",
+            rep = (rep.compat_rms, rep.eigenvalue, rep.seconds)
+        );
+        assert!(rms <= 0.3, "θ {theta} σ {sigma}: RMS {rms}");
+        // net singularity index over the edited area is unchanged (the region is interior)
+        let idx = |c: &Cwf| -> i64 {
+            let d = c.decompose_omega();
+            let curls = face_curls(c, &d.compatible);
+            rep.face_class
+                .iter()
+                .enumerate()
+                .filter(|(_, &k)| k != FaceClass::Fixed)
+                .map(|(f, _)| (curls[f] / std::f64::consts::TAU).round() as i64)
+                .sum()
+        };
+        assert_eq!(idx(&out), idx(&cwf), "θ {theta} σ {sigma}");
+    }
+}
+
+fn face_curls(c: &Cwf, omega: &[f64]) -> Vec<f64> {
+    let el = c.base().edges();
+    c.base()
+        .triangles()
+        .iter()
+        .enumerate()
+        .map(|(f, t)| {
+            (0..3)
+                .map(|i| {
+                    let e = el.face_edges[f][i] as usize;
+                    if c.edges()[e][0] == t[i] {
+                        omega[e]
+                    } else {
+                        -omega[e]
+                    }
+                })
+                .sum()
+        })
+        .collect()
+}
+
+// ---------------------------------------------------------------------------------------------
+// C7: amplitude bounds (maximum principle)
+
+#[test]
+fn interface_amplitude_obeys_the_maximum_principle() {
+    let m = irregular_grid(24, 0.0, 2); // right triangles: non-obtuse
+    let cwf = plane_wave(m.clone(), K, 0.01);
+    for (theta, sigma, mu) in [
+        (FRAC_PI_2, 1.0, 1.0),
+        (0.0, 3.0, 1.0 / 3.0),
+        (0.5, 1.0, 2.5),
+    ] {
+        let mut r = RegionEdit::new(disk_region(&m, [0.5, 0.5], 3));
+        r.rotate = theta;
+        r.frequency_scale = sigma;
+        r.amplitude_scale = mu;
+        let (out, _) = edit(&cwf, &[r], &EditOptions::default()).unwrap();
+        let hi = 0.01f64.max(0.01 * mu) * (1.0 + 1e-12);
+        for (j, &a) in out.amplitude().iter().enumerate() {
+            assert!((0.0..=hi).contains(&a), "vertex {j}: {a} > {hi}");
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// C12: bad input
+
+#[test]
+fn bad_input_is_refused_with_a_message() {
+    let m = irregular_grid(12, 0.2, 1);
+    let cwf = plane_wave(m.clone(), K, 0.01);
+    let region = disk_region(&m, [0.5, 0.5], 2);
+    let mut r = RegionEdit::new(region.clone());
+    r.frequency_scale = 0.0;
+    let e = edit(&cwf, &[r.clone()], &EditOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("frequency scale"), "{e}");
+    r.frequency_scale = -2.0;
+    assert!(edit(&cwf, &[r.clone()], &EditOptions::default()).is_err());
+    r.frequency_scale = 1.0;
+    r.rotate = f64::NAN;
+    assert!(edit(&cwf, &[r], &EditOptions::default()).is_err());
+    let e = edit(&cwf, &[RegionEdit::new(vec![])], &EditOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("empty"), "{e}");
+    let e = edit(
+        &cwf,
+        &[RegionEdit::new(vec![100_000])],
+        &EditOptions::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("100000"), "{e}");
+    let e = edit(
+        &cwf,
+        &[
+            RegionEdit::new(region.clone()),
+            RegionEdit::new(region.clone()),
+        ],
+        &EditOptions::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("overlap"), "{e}");
+    let mut thin = RegionEdit::new(region);
+    thin.interface_rings = 0;
+    let e = edit(&cwf, &[thin], &EditOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("vertex"), "{e}");
+
+    let src = |k: [f64; 3]| WrinkleSource {
+        vertex: nearest(&m, [0.5, 0.5]),
+        wave_vector: k,
+        amplitude: 0.01,
+        rings: 3,
+    };
+    let e = design(
+        m.clone(),
+        &[src([f64::NAN, 0.0, 0.0])],
+        &DesignOptions::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("source 0"), "{e}");
+    let mut s = src(K);
+    s.vertex = 9999;
+    let e = design(m.clone(), &[s], &DesignOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("9999"), "{e}");
+    assert!(design(m.clone(), &[], &DesignOptions::default()).is_err());
+    // non-manifold base: three triangles on one edge
+    let p = vec![
+        [0.; 3],
+        [1., 0., 0.],
+        [0., 1., 0.],
+        [0., -1., 0.],
+        [0., 0., 1.],
+    ];
+    let bad = TriMesh::new(p, vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]]).unwrap();
+    let mut s = src(K);
+    s.vertex = 0;
+    let e = design(bad, &[s], &DesignOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("non-manifold"), "{e}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// C11: design
+
+#[test]
+fn design_on_a_flat_grid_reproduces_the_wave_vector_and_zeros_outside() {
+    let m = irregular_grid(20, 0.0, 4);
+    let v = nearest(&m, [0.5, 0.5]);
+    let src = WrinkleSource {
+        vertex: v,
+        wave_vector: K,
+        amplitude: 0.02,
+        rings: 4,
+    };
+    let (cwf, rep) = design(m.clone(), &[src], &DesignOptions::default()).unwrap();
+    let region = grow_faces(&m, &[], &[v], 4, Adjacency::Vertex).unwrap();
+    let mut in_f = vec![false; m.triangle_count()];
+    region.iter().for_each(|&f| in_f[f as usize] = true);
+    let fc: Vec<FaceClass> = in_f
+        .iter()
+        .map(|&b| if b { FaceClass::Edit } else { FaceClass::Fixed })
+        .collect();
+    let ec = edge_classes(&cwf, &fc);
+    let vf = vertex_fixed(&cwf, &fc);
+    for (e, &edge) in cwf.edges().iter().enumerate() {
+        if ec[e] == FaceClass::Edit {
+            let want = dot(K, edge_vec(&m, edge));
+            assert!((cwf.omega()[e] - want).abs() < 1e-12, "edge {e}");
+        } else {
+            assert_eq!(cwf.omega()[e].to_bits(), 0f64.to_bits());
+        }
+    }
+    let mut in_v = vec![false; m.vertex_count()];
+    for &f in &region {
+        m.triangles()[f as usize]
+            .iter()
+            .for_each(|&v| in_v[v as usize] = true);
+    }
+    for (j, &inside) in in_v.iter().enumerate() {
+        let a = cwf.amplitude()[j];
+        if !inside {
+            assert_eq!(
+                a.to_bits(),
+                0f64.to_bits(),
+                "vertex {j} outside has a = {a}"
+            );
+        }
+        assert!((0.0..=0.02 * (1.0 + 1e-12)).contains(&a), "vertex {j}: {a}");
+    }
+    assert!(vf.iter().any(|&b| b));
+    assert_eq!(cwf.amplitude()[v as usize], 0.02);
+    assert_eq!(rep.influenced[1], region.len());
+    assert!(
+        rep.amplitude_residual < 1e-10 && rep.heat_residual < 1e-10,
+        "{rep:?}"
+    );
+}
+
+#[test]
+fn symmetric_sources_give_a_symmetric_amplitude() {
+    let n = 20;
+    let m = irregular_grid(n, 0.0, 0);
+    // make the diagonals point-symmetric: regenerate with a fixed diagonal direction
+    let p = m.positions().to_vec();
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let mut t = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let m = TriMesh::new(p, t).unwrap();
+    let (a, b) = (id(6, 8), id(n - 6, n - 8));
+    let s = |v| WrinkleSource {
+        vertex: v,
+        wave_vector: K,
+        amplitude: 0.01,
+        rings: 4,
+    };
+    let (cwf, _) = design(m.clone(), &[s(a), s(b)], &DesignOptions::default()).unwrap();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (p, q) = (id(i, j) as usize, id(n - i, n - j) as usize);
+            let (x, y) = (cwf.amplitude()[p], cwf.amplitude()[q]);
+            assert!((x - y).abs() < 1e-12, "({i}, {j}): {x} vs {y}");
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// C10 / issue part 4: edit → interpolate → evaluate
+
+#[test]
+fn edited_keyframe_animates_and_evaluates() {
+    let m = irregular_grid(14, 0.2, 6);
+    let cwf = plane_wave(m.clone(), [12.0, 0.0, 0.0], 0.01);
+    let mut r = RegionEdit::new(disk_region(&m, [0.5, 0.5], 2));
+    r.rotate = FRAC_PI_2;
+    r.interface_rings = 2;
+    for phase in [PhaseCoupling::Unit, PhaseCoupling::AmplitudeWeighted] {
+        let opts = EditOptions {
+            phase,
+            ..EditOptions::default()
+        };
+        let (k1, _) = edit(&cwf, std::slice::from_ref(&r), &opts).unwrap();
+        let iopts = InterpOptions {
+            guide_frames: 8,
+            ..InterpOptions::default()
+        };
+        let (anim, _) = interpolate(&cwf, &k1, &iopts).unwrap();
+        let first = anim.frame(0).unwrap();
+        let last = anim.frame(anim.frame_count() - 1).unwrap();
+        assert_eq!(first.omega(), cwf.omega());
+        assert_eq!(last.omega(), k1.omega());
+        let mid = anim.frame_at(0.5).unwrap();
+        let (ev, _) = mid.evaluate(2, &EvalOptions::default()).unwrap();
+        assert_eq!(ev.mesh.triangle_count(), 16 * m.triangle_count());
+        assert!(ev.mesh.positions().iter().flatten().all(|c| c.is_finite()));
+    }
+}
