@@ -207,6 +207,28 @@ fn batch_outputs_equal_single_bakes_whatever_the_job_count() {
             );
         }
     }
+    // An output folder inside the input folder: last run's LODs are not this run's assets.
+    let folder = dir.join("nested");
+    std::fs::create_dir_all(&folder).unwrap();
+    write_assets(&folder, false);
+    let nested = folder.join("lod").join("{stem}.obj");
+    for _ in 0..2 {
+        let o = pleat(&[
+            "lod",
+            s(&folder),
+            "--screen-size",
+            "10",
+            "--rounds",
+            "2",
+            "-o",
+            s(&nested),
+            "--report",
+            s(&dir.join("nested.json")),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let r = report(&dir.join("nested.json"));
+        assert_eq!(r["assets"].as_array().unwrap().len(), 3, "{r}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

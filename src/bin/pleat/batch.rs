@@ -14,7 +14,7 @@
 //! Exit status: 0 when every asset is baked or cached, 1 when one failed, 2 for bad arguments or
 //! an unreadable manifest (before anything is baked).
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -172,10 +172,11 @@ fn plan(
             "no input meshes (folders are searched for obj, ply, off, stl, glb, gltf)".into(),
         );
     }
-    let assets = specs
+    let mut assets = specs
         .into_iter()
         .map(|s| s.resolve(args))
         .collect::<Result<Vec<_>, _>>()?;
+    drop_own_outputs(&mut assets);
     check_distinct_outputs(&assets)?;
     Ok((assets, jobs))
 }
@@ -263,6 +264,16 @@ fn is_mesh_file(path: &Path) -> bool {
     path.extension()
         .and_then(|e| MeshFormat::from_extension(&e.to_string_lossy().to_ascii_lowercase()))
         .is_some()
+}
+
+/// Drops the inputs that are outputs of this batch: an output folder inside an input folder
+/// must not turn last run's LODs into this run's assets.
+fn drop_own_outputs(assets: &mut Vec<Asset>) {
+    let outputs: HashSet<PathBuf> = assets
+        .iter()
+        .flat_map(|a| a.outputs.iter().cloned())
+        .collect();
+    assets.retain(|a| !outputs.contains(&a.input));
 }
 
 /// Two assets writing the same file would race: refused before baking.
