@@ -130,10 +130,15 @@ def cancel_from_the_progress_callback():
     print(f"  cancelled after {len(calls)} progress report(s), nothing kept")
 
 
-case(bake_corpus_mesh)
-case(degenerate_meshes_give_error_reports)
-case(cancel_from_the_progress_callback)
-failed = [n for n, err in results if err]
-print(f"blender add-on: {len(results) - len(failed)} passed, {len(failed)} failed")
-if failed:
-    sys.exit(1)
+def main():
+    case(bake_corpus_mesh)
+    case(degenerate_meshes_give_error_reports)
+    case(cancel_from_the_progress_callback)
+    failed = [n for n, err in results if err]
+    print(f"blender add-on: {len(results) - len(failed)} passed, {len(failed)} failed")
+    if failed:
+        sys.exit(1)
+
+
+if __name__ == "__main__":
+    main()

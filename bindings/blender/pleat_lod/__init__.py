@@ -120,6 +120,10 @@ def new_object(name, positions, triangles, like, stats):
     return obj
 
 
+#: Outcome of the operator's last run, for scripts and tests: (result set, objects added).
+last_result = (None, [])
+
+
 # --- the bake (no bpy here: it runs on a worker thread) ---------------------------------------
 
 class Cancelled(Exception):
@@ -246,7 +250,15 @@ class OBJECT_OT_pleat_bake_lods(bpy.types.Operator):
         return job, {o.name: o for o in objects}
 
     def _finish(self, context, job, by_name):
-        """Adds the baked levels as objects and reports; the operator's return value."""
+        """Adds the baked levels as objects and reports; the operator's return value (also
+        recorded in ``last_result``)."""
+        global last_result
+        result, added = self._add_and_report(job, by_name)
+        last_result = (result, [o.name for o in added])
+        return result
+
+    def _add_and_report(self, job, by_name):
+        """Adds the baked levels as objects and reports errors: (result set, objects)."""
         added = []
         for name, kind, n_p, positions, triangles, stats in job.done:
             label = f"{name}_{kind}{n_p:g}"
@@ -259,11 +271,11 @@ class OBJECT_OT_pleat_bake_lods(bpy.types.Operator):
             self.report({"ERROR"}, f"pleat: {name}: {message}")
         if cancelled:
             self.report({"WARNING"}, f"pleat: cancelled; kept {len(added)} baked level(s)")
-            return {"CANCELLED"}
+            return {"CANCELLED"}, added
         if failures:
-            return {"CANCELLED"} if not added else {"FINISHED"}
+            return ({"CANCELLED"} if not added else {"FINISHED"}), added
         self.report({"INFO"}, f"pleat: added {len(added)} object(s)")
-        return {"FINISHED"}
+        return {"FINISHED"}, added
 
     def execute(self, context):
         """Synchronous bake (scripts, background mode, redo panel)."""
