@@ -56,6 +56,24 @@ expect_run() { # expect_run EXE: runs the consumer, checks its line and that it 
   case $out in "pleat $version: LOD with "*" triangles") ;; *) echo "unexpected output" >&2; return 1 ;; esac
 }
 
+step "one version everywhere: Cargo.toml, pleat --version, pkg-config, CMake (Python below)"
+if [ -x "$target/$([ "$profile" = test ] && echo debug || echo release)/pleat" ]; then
+  cli=$target/$([ "$profile" = test ] && echo debug || echo release)/pleat
+  test "$("$cli" --version)" = "pleat $version"
+  ok "pleat --version is $version"
+else
+  skip "no pleat binary built for profile $profile: pleat --version not compared"
+fi
+if have cmake; then
+  mkdir -p "$tmp/version"
+  printf '%s\n' 'cmake_minimum_required(VERSION 3.16)' 'project(pleat_version NONE)' \
+    'find_package(pleat ${EXPECT} EXACT REQUIRED)' 'message(STATUS "pleat_VERSION=${pleat_VERSION}")' \
+    > "$tmp/version/CMakeLists.txt"
+  cmake -S "$tmp/version" -B "$tmp/version/build" -DCMAKE_PREFIX_PATH="$prefix" \
+    -DEXPECT="$version" | grep -x -- "-- pleat_VERSION=$version"
+  ok "CMake find_package(pleat $version EXACT)"
+fi
+
 step "README's C example is examples_c/consumer/consumer.c"
 awk '/^<!-- examples_c\/consumer\/consumer.c/ { on = 1; next }
      on && /^```c$/ { copy = 1; next }
@@ -134,6 +152,8 @@ if have python3 && python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
     # its bundled library on its own.
     (cd "$tmp" && env -u PLEAT_LIBRARY "$py" -c \
       'import pleat, sys; p = pleat.library_path(); print("pleat", pleat.version(), "loads", p); sys.exit("site-packages" not in p)')
+    (cd "$tmp" && env -u PLEAT_LIBRARY "$py" -c \
+      'import importlib.metadata as m, pleat, sys; v = (m.version("pleat"), pleat.__version__, pleat.version()); print("python versions", v); sys.exit(v != (sys.argv[1],) * 3)' "$version")
     (cd "$tmp" && env -u PLEAT_LIBRARY "$py" -m pytest -q -p no:cacheprovider "$root/bindings/python/tests")
     ok "Python package"
   else

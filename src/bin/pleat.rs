@@ -27,6 +27,10 @@ mod wrinkle_edit;
 #[path = "pleat/bake.rs"]
 mod bake_cmd;
 
+#[cfg(feature = "lod")]
+#[path = "pleat/batch.rs"]
+mod batch;
+
 #[derive(Parser)]
 #[command(
     name = "pleat",
@@ -79,16 +83,22 @@ enum Command {
     /// Bake LODs by screen size: watertight, manifold, self-intersection-free meshes that look
     /// like the input when its bounding-box diagonal covers N pixels.
     Lod {
-        /// The input mesh (any triangle soup).
-        input: PathBuf,
+        /// The input mesh (any triangle soup); several files, folders or --manifest bake a batch.
+        #[arg(required_unless_present = "manifest")]
+        inputs: Vec<PathBuf>,
+        #[command(flatten)]
+        batch: batch::BatchArgs,
         #[command(flatten)]
         bake: BakeArgs,
     },
     #[cfg(feature = "cage")]
     /// Bake a cage: like `lod`, but enclosing the input without touching it.
     Cage {
-        /// The input mesh (any triangle soup).
-        input: PathBuf,
+        /// The input mesh (any triangle soup); several files, folders or --manifest bake a batch.
+        #[arg(required_unless_present = "manifest")]
+        inputs: Vec<PathBuf>,
+        #[command(flatten)]
+        batch: batch::BatchArgs,
         #[command(flatten)]
         bake: BakeArgs,
     },
@@ -130,8 +140,9 @@ enum BenchCommand {
 #[cfg(feature = "lod")]
 #[derive(clap::Args)]
 struct BakeArgs {
-    /// Screen size(s) n_p in pixels, comma separated (`50,100,200`): one output per size.
-    #[arg(long, value_delimiter = ',', required = true)]
+    /// Screen size(s) n_p in pixels, comma separated (`50,100,200`): one output per size
+    /// (in a batch: for the manifest rows that give none).
+    #[arg(long, value_delimiter = ',', required_unless_present = "manifest")]
     screen_size: Vec<f64>,
     /// Target triangle count (only with a single screen size).
     #[arg(long)]
@@ -349,9 +360,17 @@ fn main() -> ExitCode {
             offset(&input, &output, &params, stats_json)
         }
         #[cfg(feature = "lod")]
-        Command::Lod { input, bake: b } => bake(&input, &b, false),
+        Command::Lod {
+            inputs,
+            batch: batch_args,
+            bake: b,
+        } => batch::dispatch(&inputs, &batch_args, &b, false),
         #[cfg(feature = "cage")]
-        Command::Cage { input, bake: b } => bake(&input, &b, true),
+        Command::Cage {
+            inputs,
+            batch: batch_args,
+            bake: b,
+        } => batch::dispatch(&inputs, &batch_args, &b, true),
         Command::Wrinkle(cmd) => wrinkle_cmd::run(cmd),
         Command::Bench(cmd) => bench(cmd),
     }
@@ -413,25 +432,10 @@ fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
             return ExitCode::from(EXIT_INPUT);
         }
     };
-    let params = LodParams {
-        screen_size: sizes[0],
-        target_faces: args.faces,
-        max_rounds: args.rounds,
-        align: !args.no_align,
-        ..LodParams::default()
-    };
+    let params = lod_params(args, sizes, args.faces);
     let bar = progress_bar(args.quiet);
     let mut prog = |p: pleat::Progress<'_>| show_progress(&bar, p);
-    let result = match (many, cage) {
-        (false, false) => pleat::lowpoly::generate(&mesh, &params, &mut prog).map(|r| vec![r]),
-        (true, false) => pleat::lowpoly::generate_chain(&mesh, sizes, &params, &mut prog),
-        #[cfg(feature = "cage")]
-        (false, true) => pleat::cage::generate(&mesh, &params, &mut prog).map(|r| vec![r]),
-        #[cfg(feature = "cage")]
-        (true, true) => pleat::cage::generate_chain(&mesh, sizes, &params, &mut prog),
-        #[cfg(not(feature = "cage"))]
-        (_, true) => unreachable!("the cage subcommand needs the cage feature"),
-    };
+    let result = bake_levels(&mesh, sizes, &params, cage, &mut prog);
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -460,6 +464,42 @@ fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
         }
     }
     ExitCode::SUCCESS
+}
+
+/// The LOD parameters of a bake at screen sizes `sizes` (the first one is the finest level's)
+/// with face target `faces`.
+#[cfg(feature = "lod")]
+fn lod_params(args: &BakeArgs, sizes: &[f64], faces: Option<usize>) -> LodParams {
+    LodParams {
+        screen_size: sizes[0],
+        target_faces: faces,
+        max_rounds: args.rounds,
+        align: !args.no_align,
+        ..LodParams::default()
+    }
+}
+
+/// One level per screen size of `mesh`: a LOD (or a cage when `cage`), a chain when there are
+/// several sizes. The single-input command and the batch both bake through here, so a batch
+/// writes the same bytes as one `pleat lod` per asset.
+#[cfg(feature = "lod")]
+fn bake_levels(
+    mesh: &pleat::mesh::TriMesh,
+    sizes: &[f64],
+    params: &LodParams,
+    cage: bool,
+    prog: &mut pleat::report::ProgressFn<'_>,
+) -> pleat::Result<Vec<(pleat::mesh::TriMesh, pleat::lowpoly::LodReport)>> {
+    match (sizes.len() > 1, cage) {
+        (false, false) => pleat::lowpoly::generate(mesh, params, prog).map(|r| vec![r]),
+        (true, false) => pleat::lowpoly::generate_chain(mesh, sizes, params, prog),
+        #[cfg(feature = "cage")]
+        (false, true) => pleat::cage::generate(mesh, params, prog).map(|r| vec![r]),
+        #[cfg(feature = "cage")]
+        (true, true) => pleat::cage::generate_chain(mesh, sizes, params, prog),
+        #[cfg(not(feature = "cage"))]
+        (_, true) => unreachable!("the cage subcommand needs the cage feature"),
+    }
 }
 
 /// An indicatif bar on a terminal (stderr), nothing otherwise.

@@ -39,7 +39,7 @@ import numpy as _np
 __all__ = [
     "ABI_VERSION", "Mesh", "Cwf", "Animation", "PleatError", "version", "abi_version",
     "has_feature", "set_thread_count", "thread_count", "library_path", "Bake", "bake",
-    "lod_provenance", "points_provenance", "BAKE_IMAGES", "grow_faces",
+    "lod_provenance", "points_provenance", "BAKE_IMAGES", "grow_faces", "__version__",
 ]
 
 #: The C ABI version (``PLEAT_ABI_VERSION`` of pleat.h) this module's declarations match.
@@ -310,6 +310,12 @@ def last_error():
 def version():
     """The library version (``major.minor.patch``, Cargo.toml's; also the package version)."""
     return _lib.pleat_version().decode()
+
+
+#: The package version: the loaded library's ``pleat_version()``, which is Cargo.toml's version,
+#: the wheel's metadata version (setup.py reads Cargo.toml), ``pleat --version`` and the
+#: pkg-config/CMake version of ``packaging/install.sh`` (tests/version.rs, .ci/packaging.sh).
+__version__ = version()
 
 
 def abi_version():
