@@ -562,8 +562,8 @@ const char *pleat_version(void);
 // The C ABI version the library was built with; compare with the header's `PLEAT_ABI_VERSION`.
 uint32_t pleat_abi_version(void);
 
-// 1 when this build includes the capability `name` ("lod", "cage", "wrinkle", "io-gltf"), 0
-// otherwise or when `name` is NULL or unknown.
+// 1 when this build includes the capability `name` ("lod", "cage", "wrinkle", "io-gltf",
+// "tfw"), 0 otherwise or when `name` is NULL or unknown.
 //
 // # Safety
 // `name` is NULL or a NUL-terminated string.

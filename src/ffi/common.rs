@@ -262,8 +262,8 @@ pub extern "C" fn pleat_abi_version() -> u32 {
     PLEAT_ABI_VERSION
 }
 
-/// 1 when this build includes the capability `name` ("lod", "cage", "wrinkle", "io-gltf"), 0
-/// otherwise or when `name` is NULL or unknown.
+/// 1 when this build includes the capability `name` ("lod", "cage", "wrinkle", "io-gltf",
+/// "tfw"), 0 otherwise or when `name` is NULL or unknown.
 ///
 /// # Safety
 /// `name` is NULL or a NUL-terminated string.
@@ -272,11 +272,12 @@ pub unsafe extern "C" fn pleat_has_feature(name: *const c_char) -> u32 {
     let Ok(name) = c_str_arg(name, "name") else {
         return 0;
     };
-    const BUILT: [(&str, bool); 4] = [
+    const BUILT: [(&str, bool); 5] = [
         ("lod", cfg!(feature = "lod")),
         ("cage", cfg!(feature = "cage")),
         ("wrinkle", cfg!(feature = "wrinkle")),
         ("io-gltf", cfg!(feature = "io-gltf")),
+        ("tfw", cfg!(feature = "tfw")),
     ];
     let on = BUILT.iter().any(|&(n, built)| n == name && built);
     on as u32
