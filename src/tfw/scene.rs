@@ -354,7 +354,9 @@ impl Scene {
     }
 
     /// The scene as JSON text in the format [`from_json_str`](Self::from_json_str) reads
-    /// (round-trips exactly: numbers are written with Rust's shortest round-trip formatting).
+    /// (numbers are written in the shortest round-trip form; reading them back is exact up to
+    /// an ulp: serde_json's default float parser is not correctly rounded, and enabling its
+    /// `float_roundtrip` feature would change what the `bake` code parses).
     pub fn to_json_string(&self) -> String {
         let m = &self.material;
         let mut o = Map::new();
