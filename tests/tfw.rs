@@ -476,7 +476,10 @@ fn scene_errors_name_the_field() {
     let e = err_of(&GOOD.replace("[0, 1] }", "[0, 7] }"));
     assert!(e.contains("dirichlet[0].vertices"), "{e}");
     let e = err_of(&GOOD.replace("[1, 0], [0, 1]]", "[2, 0], [4, 0]]"));
-    assert!(e.contains("panels[0].triangles[0]: rest triangle has zero area"), "{e}");
+    assert!(
+        e.contains("panels[0].triangles[0]: rest triangle has zero area"),
+        "{e}"
+    );
     let e = err_of(&GOOD.replace("[[0, 1, 2]]", "[[0, 1, 3]]"));
     assert!(e.contains("panels[0].triangles[0]"), "{e}");
     // programmatic scenes are validated too
@@ -518,4 +521,36 @@ fn poisson_zero_warns_and_still_solves() {
 fn has_feature_reports_tfw() {
     let on = unsafe { pleat::ffi::pleat_has_feature(c"tfw".as_ptr()) };
     assert_eq!(on, 1);
+}
+
+/// Iterations and wall time of the base solve on the spec's mesh sizes (run with
+/// `cargo test --test tfw -- --ignored --nocapture`).
+#[test]
+#[ignore]
+fn report_base_solve_on_spec_sizes() {
+    for scene in [
+        Scene::stretched_sheet(41, 13, 0.1),
+        Scene::twisted_cylinder(43, 16, 10.0),
+        Scene::twisted_cylinder(63, 21, 10.0),
+    ] {
+        let model = scene.assemble().unwrap();
+        let t = std::time::Instant::now();
+        let r = solve_base(&model, &BaseOptions::default(), &mut no_progress()).unwrap();
+        println!(
+            "{}: {} v, {:?}, {} it, {:.3} s, rel. gradient {:.1e}, {:?}",
+            scene.name,
+            model.positions.len(),
+            r.status,
+            r.history.len(),
+            t.elapsed().as_secs_f64(),
+            r.relative_gradient,
+            r.strain
+        );
+        for h in &r.history {
+            println!(
+                "  E {:.9e} |g| {:.2e} t {} shift {:.1e} {:.3} s",
+                h.energy, h.gradient_norm, h.step, h.shift, h.seconds
+            );
+        }
+    }
 }

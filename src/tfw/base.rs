@@ -455,11 +455,7 @@ impl BaseProblem {
         }
         // ∂p/∂(e1, e2): p0 = e1·e1, p1 = e1·e2, p2 = e2·e2.
         let zero = [0.0; 3];
-        let dp: [[[f64; 3]; 2]; 3] = [
-            [scale(e1, 2.0), zero],
-            [e2, e1],
-            [zero, scale(e2, 2.0)],
-        ];
+        let dp: [[[f64; 3]; 2]; 3] = [[scale(e1, 2.0), zero], [e2, e1], [zero, scale(e2, 2.0)]];
         let mut ge = [[0.0; 3]; 2];
         let mut he = [[[[0.0; 3]; 3]; 2]; 2]; // he[i][j][a][b]: e_i component a, e_j comp. b
         for m in 0..3 {
@@ -560,7 +556,9 @@ pub fn solve_base(
     progress: &mut ProgressFn<'_>,
 ) -> Result<BaseResult> {
     if options.load_steps == 0 {
-        return Err(Error::InvalidArgument("tfw: load_steps must be >= 1".into()));
+        return Err(Error::InvalidArgument(
+            "tfw: load_steps must be >= 1".into(),
+        ));
     }
     if !(options.bending_scale >= 0.0 && options.bending_scale.is_finite()) {
         return Err(Error::InvalidArgument(

@@ -201,7 +201,10 @@ impl Scene {
         }
         let nu = finite("material.poisson", m.poisson)?;
         if !(nu > -1.0 && nu < 1.0) {
-            return Err(bad("material.poisson", format!("must be in (-1, 1), got {nu}")));
+            return Err(bad(
+                "material.poisson",
+                format!("must be in (-1, 1), got {nu}"),
+            ));
         }
         if !(0.0..=0.5).contains(&nu) {
             warnings.push(format!("material.poisson = {nu} is outside [0, 0.5]"));
@@ -392,7 +395,10 @@ impl Scene {
                 let mut dm = Map::new();
                 dm.insert("panel".into(), Value::from(d.panel));
                 dm.insert("vertices".into(), serde_json::json!(d.vertices));
-                dm.insert("translation".into(), serde_json::json!(d.motion.translation));
+                dm.insert(
+                    "translation".into(),
+                    serde_json::json!(d.motion.translation),
+                );
                 if let Some(r) = d.motion.rotation {
                     dm.insert(
                         "rotation".into(),
@@ -717,10 +723,7 @@ fn parse_scene(v: &Value) -> Result<Scene> {
     let material = Material {
         young: number(required(mo, "material", "young")?, "material.young")?,
         poisson: number(required(mo, "material", "poisson")?, "material.poisson")?,
-        thickness: number(
-            required(mo, "material", "thickness")?,
-            "material.thickness",
-        )?,
+        thickness: number(required(mo, "material", "thickness")?, "material.thickness")?,
         density: opt_number(mo, "material", "density", 0.0)?,
     };
     let (mut gravity, mut pressure) = ([0.0; 3], 0.0);
@@ -784,17 +787,14 @@ fn parse_scene(v: &Value) -> Result<Scene> {
             let path = format!("dirichlet[{k}]");
             let o = object(d, &path, &["panel", "vertices", "translation", "rotation"])?;
             let panel = index(required(o, &path, "panel")?, &format!("{path}.panel"))? as usize;
-            let vertices = array(
-                required(o, &path, "vertices")?,
-                &format!("{path}.vertices"),
-            )?
-            .iter()
-            .enumerate()
-            .map(|(i, x)| {
-                let vp = format!("{path}.vertices[{i}]");
-                u32::try_from(index(x, &vp)?).map_err(|_| bad(&vp, "index exceeds u32"))
-            })
-            .collect::<Result<Vec<_>>>()?;
+            let vertices = array(required(o, &path, "vertices")?, &format!("{path}.vertices"))?
+                .iter()
+                .enumerate()
+                .map(|(i, x)| {
+                    let vp = format!("{path}.vertices[{i}]");
+                    u32::try_from(index(x, &vp)?).map_err(|_| bad(&vp, "index exceeds u32"))
+                })
+                .collect::<Result<Vec<_>>>()?;
             let translation = match o.get("translation") {
                 None => [0.0; 3],
                 Some(t) => fixed::<3>(t, &format!("{path}.translation"))?,
@@ -810,10 +810,7 @@ fn parse_scene(v: &Value) -> Result<Scene> {
                             None => [0.0; 3],
                             Some(x) => fixed::<3>(x, &format!("{rp}.origin"))?,
                         },
-                        degrees: number(
-                            required(ro, &rp, "degrees")?,
-                            &format!("{rp}.degrees"),
-                        )?,
+                        degrees: number(required(ro, &rp, "degrees")?, &format!("{rp}.degrees"))?,
                     })
                 }
             };
