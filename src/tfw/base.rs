@@ -347,12 +347,12 @@ impl BaseProblem {
         for (t, (e, g, h)) in self.triangles.iter().zip(&blocks) {
             energy += e;
             let dof = |k: usize| 3 * t[k / 3] as usize + k % 3;
-            for a in 0..9 {
-                gradient[dof(a)] += g[a];
-                for b in 0..9 {
+            for (a, (ga, ha)) in g.iter().zip(h).enumerate() {
+                gradient[dof(a)] += ga;
+                for (b, hab) in ha.iter().enumerate() {
                     let (r, c) = (dof(a), dof(b));
                     if r >= c {
-                        hessian.push((r, c, h[a][b]));
+                        hessian.push((r, c, *hab));
                     }
                 }
             }
@@ -478,6 +478,7 @@ impl BaseProblem {
             }
         }
         // Σ_m g_m ∇²p_m: ∇²p0 = 2I on (e1,e1), ∇²p1 = I on (e1,e2),(e2,e1), ∇²p2 = 2I on (e2,e2).
+        #[allow(clippy::needless_range_loop)] // diagonal of four 3×3 blocks
         for a in 0..3 {
             he[0][0][a][a] += 2.0 * k * d.grad[0];
             he[0][1][a][a] += k * d.grad[1];
@@ -667,7 +668,8 @@ pub fn solve_base(
             last_shift = shift;
             let mut slope: f64 = g.iter().zip(&d).map(|(a, b)| a * b).sum();
             let mut gradient_step = false;
-            if !(slope < 0.0) || d.iter().any(|v: &f64| !v.is_finite()) {
+            let descent = slope < 0.0 && d.iter().all(|v: &f64| v.is_finite());
+            if !descent {
                 d = g.iter().map(|v| -v / diag_scale).collect();
                 slope = g.iter().zip(&d).map(|(a, b)| a * b).sum();
                 gradient_step = true;
@@ -794,7 +796,7 @@ fn corrected_laplacian(
             }
         }
     }
-    entries.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+    entries.sort_by_key(|a| (a.0, a.1));
     let mut rows = vec![Vec::new(); n];
     for (r, c, w) in entries {
         let row: &mut Vec<(u32, f64)> = &mut rows[r as usize];
@@ -818,7 +820,7 @@ fn normal_matrix(n: usize, rows: &[Vec<(u32, f64)>], areas: &[f64]) -> Vec<(u32,
             }
         }
     }
-    e.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+    e.sort_by_key(|a| (a.0, a.1));
     let mut out: Vec<(u32, u32, f64)> = Vec::with_capacity(e.len());
     for (j, k, v) in e {
         match out.last_mut() {

@@ -4,6 +4,7 @@
 /// Replaces the symmetric `N×N` matrix `a` by its projection onto the PSD cone (negative
 /// eigenvalues clamped to 0), `V max(Λ, 0) Vᵀ`. Cyclic Jacobi: accurate to rounding for the
 /// 9×9 blocks it is used on; at most 50 sweeps.
+#[allow(clippy::needless_range_loop)] // rotations index two rows and columns at once
 pub fn project_psd<const N: usize>(a: &mut [[f64; N]; N]) {
     let mut m = *a;
     let mut v = [[0.0; N]; N];

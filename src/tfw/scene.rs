@@ -100,14 +100,11 @@ impl Motion {
                 k[0] * v[1] - k[1] * v[0],
             ];
             // Rodrigues' formula.
-            for i in 0..3 {
-                q[i] = r.origin[i] + v[i] * cs + kxv[i] * sn + k[i] * kv * (1.0 - cs);
-            }
+            q = std::array::from_fn(|i| {
+                r.origin[i] + v[i] * cs + kxv[i] * sn + k[i] * kv * (1.0 - cs)
+            });
         }
-        for i in 0..3 {
-            q[i] += s * self.translation[i];
-        }
-        q
+        std::array::from_fn(|i| q[i] + s * self.translation[i])
     }
 }
 
@@ -196,7 +193,7 @@ impl Scene {
     pub fn validate(&self) -> Result<Vec<String>> {
         let mut warnings = Vec::new();
         let m = &self.material;
-        if !(finite("material.young", m.young)? > 0.0) {
+        if finite("material.young", m.young)? <= 0.0 {
             return Err(bad("material.young", "must be > 0"));
         }
         let nu = finite("material.poisson", m.poisson)?;
@@ -216,7 +213,7 @@ impl Scene {
                     .into(),
             );
         }
-        if !(finite("material.thickness", m.thickness)? > 0.0) {
+        if finite("material.thickness", m.thickness)? <= 0.0 {
             return Err(bad("material.thickness", "must be > 0"));
         }
         if finite("material.density", m.density)? < 0.0 {
@@ -224,7 +221,7 @@ impl Scene {
         }
         finite3("loads.gravity", self.gravity)?;
         finite("loads.pressure", self.pressure)?;
-        if !(finite("seam_tolerance", self.seam_tolerance)? >= 0.0) {
+        if finite("seam_tolerance", self.seam_tolerance)? < 0.0 {
             return Err(bad("seam_tolerance", "must be >= 0"));
         }
         if self.panels.is_empty() {
@@ -549,7 +546,7 @@ fn validate_panel(path: &str, p: &Panel) -> Result<()> {
         }
         let f = rest_form(tri.map(|i| p.rest[i as usize]));
         let det = f[0] * f[2] - f[1] * f[1];
-        if !(det > 1e-24 * (f[0] + f[2]).powi(2)) {
+        if det.is_nan() || det <= 1e-24 * (f[0] + f[2]).powi(2) {
             return Err(bad(&tp, "rest triangle has zero area"));
         }
     }
