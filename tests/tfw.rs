@@ -554,3 +554,167 @@ fn report_base_solve_on_spec_sizes() {
         }
     }
 }
+
+mod wrinkle_free {
+    use super::*;
+    use pleat::mesh::TriMesh;
+    use pleat::tfw::wfree::{
+        embedded_wave_vector, face_neighbours, face_strains, initial_face_field,
+        wrinkle_free_faces, WRule,
+    };
+
+    #[test]
+    fn face_strain_directions_of_a_known_stretch() {
+        let rest = rest_form([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+        let base = TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.1, 0.0, 0.0], [0.0, 0.9, 0.0]],
+            vec![[0, 1, 2]],
+        )
+        .unwrap();
+        let s = face_strains(&[rest], &base)[0];
+        assert!((s.lambda_t - 0.21).abs() < 1e-14 && (s.lambda_c + 0.19).abs() < 1e-14);
+        assert!(s.tension_dir[1].abs() < 1e-14 && (s.tension_dir[0].abs() - 1.0).abs() < 1e-14);
+        assert!(
+            s.compression_dir[0].abs() < 1e-14 && (s.compression_dir[1].abs() - 1.0).abs() < 1e-14
+        );
+    }
+
+    /// Grid faces of a small sheet with λ_c = +1 left of x = 0, −1 right of it, and the face
+    /// nearest each of two points given the opposite sign.
+    fn synthetic() -> (Vec<[u32; 3]>, Vec<f64>, Vec<f64>, usize, usize) {
+        let model = small_sheet(13, 7).assemble().unwrap();
+        let cx: Vec<f64> = model
+            .triangles
+            .iter()
+            .map(|t| {
+                t.iter()
+                    .map(|&v| model.positions[v as usize][0])
+                    .sum::<f64>()
+                    / 3.0
+            })
+            .collect();
+        let cy: Vec<f64> = model
+            .triangles
+            .iter()
+            .map(|t| {
+                t.iter()
+                    .map(|&v| model.positions[v as usize][1])
+                    .sum::<f64>()
+                    / 3.0
+            })
+            .collect();
+        let nearest = |x: f64, y: f64| {
+            (0..cx.len())
+                .min_by(|&a, &b| {
+                    let da = (cx[a] - x).powi(2) + (cy[a] - y).powi(2);
+                    let db = (cx[b] - x).powi(2) + (cy[b] - y).powi(2);
+                    da.total_cmp(&db)
+                })
+                .unwrap()
+        };
+        let mut l: Vec<f64> = cx
+            .iter()
+            .map(|&x| if x < 0.0 { 1.0 } else { -1.0 })
+            .collect();
+        let (neg_in_w, pos_out) = (nearest(-0.07, 0.0), nearest(0.07, 0.0));
+        l[neg_in_w] = -1.0;
+        l[pos_out] = 1.0;
+        (model.triangles, l, cx, neg_in_w, pos_out)
+    }
+
+    #[test]
+    fn text_rule_smooths_outliers() {
+        let (tris, l, cx, neg_in_w, pos_out) = synthetic();
+        let w = wrinkle_free_faces(&tris, &l, WRule::Text);
+        assert!(w[neg_in_w], "a compressed face surrounded by W joins W");
+        assert!(!w[pos_out], "an isolated tension face stays out of W");
+        for (f, &x) in cx.iter().enumerate() {
+            if x < -0.03 {
+                assert!(w[f], "face {f} at x {x}");
+            }
+            if x > 0.03 {
+                assert!(!w[f], "face {f} at x {x}");
+            }
+        }
+    }
+
+    #[test]
+    fn reference_rule_fills_by_vertices() {
+        let (tris, l, cx, neg_in_w, pos_out) = synthetic();
+        let w = wrinkle_free_faces(&tris, &l, WRule::Reference);
+        assert!(w[neg_in_w] && w[pos_out]);
+        for (f, &x) in cx.iter().enumerate() {
+            if x < 0.0 {
+                assert!(w[f]);
+            }
+        }
+        // λ_c = 0 exactly: W under the reference's ≥ 0, not under the text's > 0
+        let zero = vec![0.0; tris.len()];
+        assert!(wrinkle_free_faces(&tris, &zero, WRule::Reference)
+            .iter()
+            .all(|&x| x));
+        assert!(wrinkle_free_faces(&tris, &zero, WRule::Text)
+            .iter()
+            .all(|&x| !x));
+        // pure tension: every face in W
+        let pos = vec![0.01; tris.len()];
+        assert!(wrinkle_free_faces(&tris, &pos, WRule::Text)
+            .iter()
+            .all(|&x| x));
+    }
+
+    #[test]
+    fn initialization_on_the_twisted_cylinder() {
+        let model = Scene::twisted_cylinder(24, 9, 10.0).assemble().unwrap();
+        let r = solve_base(&model, &BaseOptions::default(), &mut no_progress()).unwrap();
+        let strains = face_strains(&model.rest_forms, &r.mesh);
+        let lc: Vec<f64> = strains.iter().map(|s| s.lambda_c).collect();
+        let w = wrinkle_free_faces(&model.triangles, &lc, WRule::Text);
+        let mut clamped = vec![false; model.positions.len()];
+        for &(v, _) in &model.clamps {
+            clamped[v as usize] = true;
+        }
+        let k = 0.01;
+        let init = initial_face_field(&r.mesh, &model.rest_forms, &strains, &w, &clamped, k);
+        let max_a = init.face_amplitude.iter().fold(0.0f64, |m, &a| m.max(a));
+        assert!((max_a - k).abs() < 1e-15);
+        assert!(init.vertex_amplitude.iter().all(|&a| a >= 0.0));
+        assert!(clamped
+            .iter()
+            .zip(&init.vertex_amplitude)
+            .all(|(&c, &a)| !c || a == 0.0));
+        let mut active = 0;
+        for (f, s) in strains.iter().enumerate() {
+            let a = init.face_amplitude[f];
+            if a == 0.0 {
+                continue;
+            }
+            active += 1;
+            // eq. 2.8: ½ a² |ω|²_Ī = |λ_c|, |ω|²_Ī = ωᵀ Ī⁻¹ ω
+            let r = model.rest_forms[f];
+            let o = init.face_omega[f];
+            let det = r[0] * r[2] - r[1] * r[1];
+            let n2 = (r[2] * o[0] * o[0] - 2.0 * r[1] * o[0] * o[1] + r[0] * o[1] * o[1]) / det;
+            assert!((0.5 * a * a * n2 - s.lambda_c.abs()).abs() < 1e-12 * s.lambda_c.abs());
+        }
+        assert!(active > model.triangles.len() / 2);
+        // combing: neighbouring wave vectors agree in sign almost everywhere
+        let nb = face_neighbours(&model.triangles);
+        let (mut agree, mut pairs) = (0, 0);
+        for f in 0..nb.len() {
+            for &g in &nb[f] {
+                if f < g && init.face_amplitude[f] > 0.0 && init.face_amplitude[g] > 0.0 {
+                    pairs += 1;
+                    let (a, b) = (
+                        embedded_wave_vector(&r.mesh, f, init.face_omega[f]),
+                        embedded_wave_vector(&r.mesh, g, init.face_omega[g]),
+                    );
+                    if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] >= 0.0 {
+                        agree += 1;
+                    }
+                }
+            }
+        }
+        assert!(agree as f64 >= 0.95 * pairs as f64, "{agree} of {pairs}");
+    }
+}

@@ -14,9 +14,12 @@
 //!   with the free-boundary correction + pressure + gravity, exact gradients and Hessians,
 //!   Newton with Armijo line search on [`crate::solve`]'s sparse Cholesky (symbolic analysis
 //!   reused), Dirichlet by elimination and load steps; a [`BaseStatus`] says why it stopped.
+//! - [`wfree`]: per-face strain eigenpairs (2.29), the wrinkle-free faces W (text and
+//!   reference rules), and the per-face part of the initialization (A.6.2: amplitudes, face
+//!   one-forms, sign combing, vertex amplitudes).
 //!
 //! **Not implemented yet** (spec steps 3–8): irregular Delaunay meshing of panels (spade),
-//! obstacles, the wrinkle-free faces W, the ω/amplitude initialization, the wrinkle energy
+//! obstacles, the Helmholtz projection of the initial face one-forms, the wrinkle energy
 //! E^wf and its SQP (clarabel), curvature by quadric fitting, the `Cwf` output with the `v2`
 //! evaluation term, the C API, the CLI and benchmarks.
 //!
@@ -38,6 +41,7 @@ pub mod base;
 mod dense;
 pub mod material;
 pub mod scene;
+pub mod wfree;
 
 pub use base::{
     solve_base, BaseEval, BaseOptions, BaseProblem, BaseResult, BaseStatus, NewtonIteration,
