@@ -559,8 +559,8 @@ mod wrinkle_free {
     use super::*;
     use pleat::mesh::TriMesh;
     use pleat::tfw::wfree::{
-        embedded_wave_vector, face_neighbours, face_strains, initial_face_field,
-        wrinkle_free_faces, WRule,
+        embedded_wave_vector, face_neighbours, face_strains, helmholtz_projection,
+        initial_face_field, wrinkle_free_faces, WRule,
     };
 
     #[test]
@@ -716,6 +716,35 @@ mod wrinkle_free {
             }
         }
         assert!(agree as f64 >= 0.95 * pairs as f64, "{agree} of {pairs}");
+        // Helmholtz projection: curl-free on every non-W face
+        let p = helmholtz_projection(&r.mesh, &model.rest_forms, &init.face_omega, &w).unwrap();
+        assert!(p.curl_residual <= 1e-10, "{}", p.curl_residual);
+        assert!(p.omega.iter().any(|&x| x.abs() > 1e-3));
+    }
+
+    #[test]
+    fn projection_of_an_exact_differential_returns_it() {
+        let model = small_sheet(9, 6).assemble().unwrap();
+        let base = TriMesh::new(model.positions.clone(), model.triangles.clone()).unwrap();
+        let psi = |v: u32| {
+            let p = model.positions[v as usize];
+            30.0 * p[0] + 50.0 * p[1]
+        };
+        let face_omega: Vec<[f64; 2]> = model
+            .triangles
+            .iter()
+            .map(|t| [psi(t[1]) - psi(t[0]), psi(t[2]) - psi(t[0])])
+            .collect();
+        let w = vec![false; model.triangles.len()];
+        let p = helmholtz_projection(&base, &model.rest_forms, &face_omega, &w).unwrap();
+        assert!(p.curl_residual <= 1e-10, "{}", p.curl_residual);
+        for (e, &o) in base.edges().edges.iter().zip(&p.omega) {
+            let want = psi(e.0[1]) - psi(e.0[0]);
+            assert!(
+                (o - want).abs() <= 1e-6 * want.abs().max(1e-3),
+                "{o} vs {want}"
+            );
+        }
     }
 }
 

@@ -15,11 +15,12 @@
 //!   Newton with Armijo line search on [`crate::solve`]'s sparse Cholesky (symbolic analysis
 //!   reused), Dirichlet by elimination and load steps; a [`BaseStatus`] says why it stopped.
 //! - [`wfree`]: per-face strain eigenpairs (2.29), the wrinkle-free faces W (text and
-//!   reference rules), and the per-face part of the initialization (A.6.2: amplitudes, face
-//!   one-forms, sign combing, vertex amplitudes).
+//!   reference rules), and the initialization (A.6.2: amplitudes, face one-forms, sign
+//!   combing, vertex amplitudes, Helmholtz projection to a one-form on pleat's edges that is
+//!   curl-free on every non-W face).
 //!
 //! **Not implemented yet** (spec steps 3–8): irregular Delaunay meshing of panels (spade),
-//! obstacles, the Helmholtz projection of the initial face one-forms, the wrinkle energy
+//! obstacles, the wrinkle energy
 //! E^wf and its SQP (clarabel), curvature by quadric fitting, the `Cwf` output with the `v2`
 //! evaluation term, the C API, the CLI and benchmarks.
 //!
@@ -36,6 +37,12 @@
 //!   Newton before its quadratic phase reaches the 1e-8 gradient), and reports
 //!   [`BaseStatus::EnergyStalled`] unless the gradient test also holds.
 //! - The stretched sheet's stretch is not given by the dissertation: it is a parameter.
+//! - Helmholtz projection: the method of multipliers on one Cholesky factorization instead of
+//!   a KKT/LDLT solve (`crate::solve` has no indefinite factorization); same minimizer, the
+//!   curl constraint met to rounding (see [`wfree`]). Regularization `1e-8·mean diag` instead of
+//!   an absolute 1e-8, so it does not depend on units.
+//! - Sign combing compares the faces' wave vectors embedded in 3D on the base surface (the
+//!   transport between neighbouring faces is the base embedding).
 
 pub mod base;
 mod dense;
