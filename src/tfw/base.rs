@@ -12,7 +12,7 @@
 //!   `c_b = bending_scale · α h³/24` (the reference code's value; the text's `α h³/12` is
 //!   reachable with `bending_scale = 2`, spec Risk 2). Quadratic, exact Hessian `2 c_b LᵀM⁻¹L`.
 //! - `E_p = −p V`, `V = Σ_f x0·(x1×x2)/6`. Not convex: each face's 9×9 Hessian block is
-//!   projected onto the PSD cone (Jacobi, [`super::dense`]) unless the exact Hessian is asked
+//!   projected onto the PSD cone (cyclic Jacobi, `tfw::dense`) unless the exact Hessian is asked
 //!   for (tests).
 //! - `E_g = −Σ_i ρ h Ā_i g·x_i`.
 //!
