@@ -11,6 +11,8 @@
 //! - `cli`: the `pleat` command-line tool; `io-gltf`: glTF 2.0 reading and writing.
 //!
 //! - `bake`: textured LODs — UV atlas, baked materials and normal maps, glTF LOD chains.
+//! - `tfw`: wrinkles from physics (ch. 2) — scenes and the tension-field base surface solve
+//!   ([`tfw`]); builds on `wrinkle` and [`solve`].
 //!
 //! The mesh core ([`mesh`], [`spatial`]) and the independent verifier ([`verify`]) are always
 //! present.
@@ -20,7 +22,8 @@
 //! Each module imports only the layers below it (checked by `tests/import_graph.rs`):
 //! [`geom`] (the one vector type), `error` and [`report`] at the bottom; then [`mesh`];
 //! [`spatial`] (the only user of parry's types); [`verify`] (independent checks, never a
-//! pipeline); the pipelines `lowpoly` → `cage` → `bake`, and `wrinkle` → `solve`; [`ffi`] and
+//! pipeline); the pipelines `lowpoly` → `cage` → `bake`, `wrinkle` → `solve`, and `tfw` →
+//! `wrinkle`, `solve`; [`ffi`] and
 //! the CLI on top. The README's "Layout and layers" has the table.
 //!
 //! ```
@@ -53,6 +56,9 @@ pub mod bake;
 
 #[cfg(feature = "wrinkle")]
 pub mod wrinkle;
+
+#[cfg(feature = "tfw")]
+pub mod tfw;
 
 // Numerics (faer): built with the features that need it.
 #[cfg(feature = "wrinkle")]

@@ -606,6 +606,10 @@ const LAYERS: &[(&str, &[&str])] = &[
     ),
     ("wrinkle", &["geom", "error", "report", "mesh", "solve"]),
     (
+        "tfw",
+        &["geom", "error", "report", "mesh", "solve", "wrinkle"],
+    ),
+    (
         "bake",
         &[
             "geom", "error", "report", "mesh", "spatial", "verify", "lowpoly", "cage",

@@ -263,8 +263,7 @@ pub extern "C" fn pleat_abi_version() -> u32 {
 }
 
 /// 1 when this build includes the capability `name` ("lod", "cage", "wrinkle", "io-gltf",
-/// "bake"), 0
-/// otherwise or when `name` is NULL or unknown.
+/// "bake", "tfw"), 0 otherwise or when `name` is NULL or unknown.
 ///
 /// # Safety
 /// `name` is NULL or a NUL-terminated string.
@@ -279,6 +278,7 @@ pub unsafe extern "C" fn pleat_has_feature(name: *const c_char) -> u32 {
         ("wrinkle", cfg!(feature = "wrinkle")),
         ("io-gltf", cfg!(feature = "io-gltf")),
         ("bake", cfg!(feature = "bake")),
+        ("tfw", cfg!(feature = "tfw")),
     ];
     let on = BUILT.iter().any(|&(n, built)| n == name && built);
     on as u32

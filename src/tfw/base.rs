@@ -1,0 +1,869 @@
+//! The base surface (§2.4.1, appendix A.2): minimize
+//! `E = E_TFT + E_b + E_p + E_g` over the free vertex positions by Newton's method with an
+//! Armijo line search on the crate's sparse Cholesky ([`crate::solve`], symbolic analysis
+//! computed once: the pattern never changes).
+//!
+//! - `E_TFT = Σ_f (h/4) A_f W̃(λ1, λ2)`, `W̃` the relaxed density of A.2
+//!   ([`relaxed_density_in_form`]), exact gradient and Hessian by the chain rule through the
+//!   first fundamental form `I_f = [e1·e1, e1·e2, e2·e2]`. Convex in x (spec); its Hessian is
+//!   PSD face by face.
+//! - `E_b = c_b Σ_i ‖(L x)_i‖² / Ā_i` (eq. 2.28), `L` the cotan Laplacian of the rest pattern
+//!   with the Wang et al. 2015 free-boundary correction, `Ā_i` barycentric rest areas,
+//!   `c_b = bending_scale · α h³/24` (the reference code's value; the text's `α h³/12` is
+//!   reachable with `bending_scale = 2`, spec Risk 2). Quadratic, exact Hessian `2 c_b LᵀM⁻¹L`.
+//! - `E_p = −p V`, `V = Σ_f x0·(x1×x2)/6`. Not convex: each face's 9×9 Hessian block is
+//!   projected onto the PSD cone (cyclic Jacobi, `tfw::dense`) unless the exact Hessian is asked
+//!   for (tests).
+//! - `E_g = −Σ_i ρ h Ā_i g·x_i`.
+//!
+//! Dirichlet vertices are eliminated. Regularization: the assembled Hessian is factored as
+//! `H + σI`, σ starting at `1e-10 · mean|H_ii|` (or a tenth of the last σ that was needed) and
+//! growing ×10 until faer's Cholesky succeeds (slack faces contribute nothing, so H is
+//! singular in plane there; with ν = 0 the bending vanishes too). A direction that is not a
+//! descent direction is replaced by the scaled negative gradient.
+//!
+//! Termination (spec step 2): `‖g‖∞ ≤ tol · ‖g₀‖∞` ([`BaseStatus::Converged`]); an accepted step
+//! changing E by less than `energy_tolerance · |E|` ([`BaseStatus::EnergyStalled`], the
+//! rounding floor of E is reached first when the gradient tolerance is very small); the
+//! iteration limit; or a failed line search. The Armijo test allows an increase of
+//! 4 ulp·|E| so that steps whose predicted decrease is below the rounding of E are not
+//! rejected spuriously; apart from that, E never increases.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use crate::mesh::TriMesh;
+use crate::report::{Progress, ProgressFn};
+use crate::solve::{assemble, CholeskyAnalysis, Entry, Parallelism, ShiftSchedule};
+use crate::tfw::dense::project_psd;
+use crate::tfw::material::{principal_strains, relaxed_density_in_form, Branch, Lame};
+use crate::tfw::scene::Model;
+use crate::{Error, Result};
+
+/// Which energy terms to evaluate (all by default).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Terms {
+    /// Tension-field membrane energy.
+    pub membrane: bool,
+    /// Quadratic bending (2.28).
+    pub bending: bool,
+    /// Pressure `−pV`.
+    pub pressure: bool,
+    /// Gravity.
+    pub gravity: bool,
+}
+
+impl Terms {
+    /// Every term.
+    pub const ALL: Terms = Terms {
+        membrane: true,
+        bending: true,
+        pressure: true,
+        gravity: true,
+    };
+    /// No term (start from this and switch one on).
+    pub const NONE: Terms = Terms {
+        membrane: false,
+        bending: false,
+        pressure: false,
+        gravity: false,
+    };
+}
+
+/// Options of [`solve_base`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BaseOptions {
+    /// Newton iterations per load step.
+    pub max_iterations: usize,
+    /// Stop when `‖g‖∞ ≤ gradient_tolerance · ‖g₀‖∞` (g over free DOFs, g₀ at the start of the
+    /// load step). Default 1e-8.
+    pub gradient_tolerance: f64,
+    /// Stop when an accepted step changes E by less than this times |E|. Default 1e-14.
+    pub energy_tolerance: f64,
+    /// Dirichlet motions are applied in this many equal increments (≥ 1; R `num_interpolation`).
+    pub load_steps: usize,
+    /// Multiplier of the bending coefficient `α h³/24` (spec Risk 2).
+    pub bending_scale: f64,
+}
+
+impl Default for BaseOptions {
+    /// 200 iterations, gradient 1e-8, energy 1e-14, one load step, bending scale 1.
+    fn default() -> Self {
+        BaseOptions {
+            max_iterations: 200,
+            gradient_tolerance: 1e-8,
+            energy_tolerance: 1e-14,
+            load_steps: 1,
+            bending_scale: 1.0,
+        }
+    }
+}
+
+/// Why [`solve_base`] stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BaseStatus {
+    /// The relative gradient reached the tolerance.
+    Converged,
+    /// E stopped changing (relative change below `energy_tolerance`) before the gradient
+    /// tolerance was met: E is at its rounding floor.
+    EnergyStalled,
+    /// The iteration limit was reached.
+    MaxIterations,
+    /// The line search found no decrease along the (Newton or gradient) direction.
+    LineSearchFailed,
+    /// Every Cholesky attempt failed (not even a large diagonal shift helped).
+    FactorizationFailed,
+}
+
+impl BaseStatus {
+    /// A one-line explanation.
+    pub fn describe(&self) -> &'static str {
+        match self {
+            BaseStatus::Converged => "converged: relative gradient below tolerance",
+            BaseStatus::EnergyStalled => {
+                "stopped: energy change below its rounding floor before the gradient tolerance"
+            }
+            BaseStatus::MaxIterations => "stopped: iteration limit reached",
+            BaseStatus::LineSearchFailed => "stopped: line search found no decrease",
+            BaseStatus::FactorizationFailed => "stopped: Hessian factorization failed",
+        }
+    }
+}
+
+/// One Newton iteration of [`solve_base`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewtonIteration {
+    /// Load step (1-based).
+    pub load_step: usize,
+    /// Energy after the step.
+    pub energy: f64,
+    /// `‖g‖∞` over free DOFs before the step.
+    pub gradient_norm: f64,
+    /// Accepted line-search step length t ∈ (0, 1].
+    pub step: f64,
+    /// `‖t d‖∞` of the accepted update (m).
+    pub step_norm: f64,
+    /// Diagonal shift σ used to factor the Hessian.
+    pub shift: f64,
+    /// True when the Newton direction was replaced by the negative gradient.
+    pub gradient_step: bool,
+    /// Wall-clock seconds since the start of [`solve_base`].
+    pub seconds: f64,
+}
+
+/// The energy terms at one state.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct TermEnergies {
+    /// Tension-field membrane energy (J).
+    pub membrane: f64,
+    /// Quadratic bending energy (J).
+    pub bending: f64,
+    /// Pressure energy `−pV` (J).
+    pub pressure: f64,
+    /// Gravity energy (J).
+    pub gravity: f64,
+}
+
+/// Per-face strain state of a base surface.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StrainSummary {
+    /// Faces in pure tension.
+    pub tension_faces: usize,
+    /// Faces in tension with relaxed compression (wrinkle candidates).
+    pub wrinkled_faces: usize,
+    /// Faces compressed in every direction.
+    pub slack_faces: usize,
+    /// Faces with `det I ≤ 1e-12 det Ī` (collapsed in 3D; TFT does not see inversion).
+    pub degenerate_faces: usize,
+    /// Rest-area fraction of slack faces (the problem is out of scope, S:588, when large).
+    pub slack_area_fraction: f64,
+    /// Rest-area fraction of wrinkled faces.
+    pub wrinkled_area_fraction: f64,
+}
+
+/// The result of [`solve_base`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct BaseResult {
+    /// The base surface (stitched mesh at the equilibrium positions).
+    pub mesh: TriMesh,
+    /// Why the last load step stopped.
+    pub status: BaseStatus,
+    /// Every Newton iteration of every load step.
+    pub history: Vec<NewtonIteration>,
+    /// The energy terms at the result.
+    pub energies: TermEnergies,
+    /// `‖g‖∞ / ‖g₀‖∞` at the result (last load step).
+    pub relative_gradient: f64,
+    /// The strain state at the result.
+    pub strain: StrainSummary,
+    /// Warnings from the scene and the solve.
+    pub warnings: Vec<String>,
+}
+
+/// Energy, gradient and Hessian (lower triangle, full `3n` numbering, duplicates to be summed).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BaseEval {
+    /// The energy.
+    pub energy: f64,
+    /// The gradient, `3n` entries (x, y, z per vertex).
+    pub gradient: Vec<f64>,
+    /// Hessian entries `(row, col, value)` with `row ≥ col`; the pattern depends only on the
+    /// mesh (zeros included), not on the state.
+    pub hessian: Vec<(usize, usize, f64)>,
+}
+
+/// The assembled energy of a [`Model`] (precomputed rest quantities).
+#[derive(Debug, Clone)]
+pub struct BaseProblem {
+    triangles: Vec<[u32; 3]>,
+    rest_forms: Vec<[f64; 3]>,
+    rest_areas: Vec<f64>,
+    vertex_areas: Vec<f64>,
+    lame: Lame,
+    thickness: f64,
+    density: f64,
+    gravity: [f64; 3],
+    pressure: f64,
+    /// Rows of the corrected cotan Laplacian.
+    laplacian: Vec<Vec<(u32, f64)>>,
+    bending_coefficient: f64,
+    /// `LᵀM⁻¹L`, lower triangle, merged.
+    bending_matrix: Vec<(u32, u32, f64)>,
+}
+
+type Block9 = [[f64; 9]; 9];
+
+impl BaseProblem {
+    /// Precomputes rest areas, the corrected Laplacian and the bending matrix of `model`.
+    pub fn new(model: &Model, bending_scale: f64) -> BaseProblem {
+        let n = model.positions.len();
+        let rest_areas: Vec<f64> = model
+            .rest_forms
+            .iter()
+            .map(|f| 0.5 * (f[0] * f[2] - f[1] * f[1]).sqrt())
+            .collect();
+        let mut vertex_areas = vec![0.0; n];
+        for (t, a) in model.triangles.iter().zip(&rest_areas) {
+            for &v in t {
+                vertex_areas[v as usize] += a / 3.0;
+            }
+        }
+        let laplacian = corrected_laplacian(n, &model.triangles, &model.rest_corners);
+        let lame = model.material.lame();
+        let h = model.material.thickness;
+        let bending_coefficient = bending_scale * lame.alpha * h * h * h / 24.0;
+        let bending_matrix = normal_matrix(n, &laplacian, &vertex_areas);
+        BaseProblem {
+            triangles: model.triangles.clone(),
+            rest_forms: model.rest_forms.clone(),
+            rest_areas,
+            vertex_areas,
+            lame,
+            thickness: h,
+            density: model.material.density,
+            gravity: model.gravity,
+            pressure: model.pressure,
+            laplacian,
+            bending_coefficient,
+            bending_matrix,
+        }
+    }
+
+    /// The rows of the corrected cotan Laplacian `L` (`(Lx)_i = Σ_j L_ij x_j`); it annihilates
+    /// functions that are affine on a flat panel, at interior and boundary vertices.
+    pub fn laplacian(&self) -> &[Vec<(u32, f64)>] {
+        &self.laplacian
+    }
+
+    /// The bending coefficient `c_b` (J·m⁻²·m² units: energy per squared Laplacian per area).
+    pub fn bending_coefficient(&self) -> f64 {
+        self.bending_coefficient
+    }
+
+    /// The energy terms at positions `x` (`3n`, flat).
+    pub fn term_energies(&self, x: &[f64]) -> TermEnergies {
+        let membrane = (0..self.triangles.len())
+            .into_par_iter()
+            .map(|f| self.membrane_value(f, x))
+            .sum::<f64>();
+        let bending = self.bending_value(x);
+        let volume: f64 = self
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| vec3(x, v));
+                dot(a, cross(b, c)) / 6.0
+            })
+            .sum();
+        let gravity = -self.density
+            * self.thickness
+            * self
+                .vertex_areas
+                .iter()
+                .enumerate()
+                .map(|(i, a)| a * dot(self.gravity, vec3(x, i as u32)))
+                .sum::<f64>();
+        TermEnergies {
+            membrane,
+            bending,
+            pressure: -self.pressure * volume,
+            gravity,
+        }
+    }
+
+    /// The energy of the selected terms at `x`.
+    pub fn energy(&self, x: &[f64], terms: Terms) -> f64 {
+        let e = self.term_energies(x);
+        let pick = |on: bool, v: f64| if on { v } else { 0.0 };
+        pick(terms.membrane, e.membrane)
+            + pick(terms.bending, e.bending)
+            + pick(terms.pressure, e.pressure)
+            + pick(terms.gravity, e.gravity)
+    }
+
+    /// Energy, gradient and Hessian of the selected terms at `x`. The pressure Hessian is
+    /// projected face by face onto the PSD cone unless `exact_pressure`.
+    pub fn evaluate(&self, x: &[f64], terms: Terms, exact_pressure: bool) -> BaseEval {
+        let n3 = x.len();
+        let mut gradient = vec![0.0; n3];
+        let mut hessian = Vec::new();
+        let blocks: Vec<(f64, [f64; 9], Block9)> = (0..self.triangles.len())
+            .into_par_iter()
+            .map(|f| {
+                let mut e = 0.0;
+                let mut g = [0.0; 9];
+                let mut h = [[0.0; 9]; 9];
+                if terms.membrane {
+                    self.membrane_face(f, x, &mut e, &mut g, &mut h);
+                }
+                if terms.pressure && self.pressure != 0.0 {
+                    self.pressure_face(f, x, exact_pressure, &mut e, &mut g, &mut h);
+                }
+                (e, g, h)
+            })
+            .collect();
+        let mut energy = 0.0;
+        for (t, (e, g, h)) in self.triangles.iter().zip(&blocks) {
+            energy += e;
+            let dof = |k: usize| 3 * t[k / 3] as usize + k % 3;
+            for (a, (ga, ha)) in g.iter().zip(h).enumerate() {
+                gradient[dof(a)] += ga;
+                for (b, hab) in ha.iter().enumerate() {
+                    let (r, c) = (dof(a), dof(b));
+                    if r >= c {
+                        hessian.push((r, c, *hab));
+                    }
+                }
+            }
+        }
+        if terms.bending {
+            energy += self.bending_value(x);
+            let c2 = 2.0 * self.bending_coefficient;
+            for &(j, k, v) in &self.bending_matrix {
+                for d in 0..3 {
+                    let (r, c) = (3 * j as usize + d, 3 * k as usize + d);
+                    gradient[r] += c2 * v * x[c];
+                    if r != c {
+                        gradient[c] += c2 * v * x[r];
+                    }
+                    hessian.push((r, c, c2 * v));
+                }
+            }
+        }
+        if terms.gravity {
+            let s = -self.density * self.thickness;
+            for (i, a) in self.vertex_areas.iter().enumerate() {
+                for d in 0..3 {
+                    energy += s * a * self.gravity[d] * x[3 * i + d];
+                    gradient[3 * i + d] += s * a * self.gravity[d];
+                }
+            }
+        }
+        BaseEval {
+            energy,
+            gradient,
+            hessian,
+        }
+    }
+
+    /// Per-face branch counts and area fractions at `x`.
+    pub fn strain_summary(&self, x: &[f64]) -> StrainSummary {
+        let mut s = StrainSummary::default();
+        let total: f64 = self.rest_areas.iter().sum();
+        for (f, t) in self.triangles.iter().enumerate() {
+            let cur = first_form(t.map(|v| vec3(x, v)));
+            let rest = self.rest_forms[f];
+            let det = cur[0] * cur[2] - cur[1] * cur[1];
+            if det <= 1e-12 * (rest[0] * rest[2] - rest[1] * rest[1]) {
+                s.degenerate_faces += 1;
+            }
+            let (l1, l2) = principal_strains(rest, cur);
+            match self.lame.relaxed_density(l1, l2).1 {
+                Branch::Tension => s.tension_faces += 1,
+                Branch::Wrinkled => {
+                    s.wrinkled_faces += 1;
+                    s.wrinkled_area_fraction += self.rest_areas[f] / total;
+                }
+                Branch::Slack => {
+                    s.slack_faces += 1;
+                    s.slack_area_fraction += self.rest_areas[f] / total;
+                }
+            }
+        }
+        s
+    }
+
+    fn membrane_value(&self, f: usize, x: &[f64]) -> f64 {
+        let cur = first_form(self.triangles[f].map(|v| vec3(x, v)));
+        let (l1, l2) = principal_strains(self.rest_forms[f], cur);
+        0.25 * self.thickness * self.rest_areas[f] * self.lame.relaxed_density(l1, l2).0
+    }
+
+    fn bending_value(&self, x: &[f64]) -> f64 {
+        if self.bending_coefficient == 0.0 {
+            return 0.0;
+        }
+        let s: f64 = self
+            .laplacian
+            .iter()
+            .zip(&self.vertex_areas)
+            .map(|(row, a)| {
+                let mut l = [0.0; 3];
+                for &(j, w) in row {
+                    let p = vec3(x, j);
+                    for d in 0..3 {
+                        l[d] += w * p[d];
+                    }
+                }
+                dot(l, l) / a
+            })
+            .sum();
+        self.bending_coefficient * s
+    }
+
+    /// Adds `(h/4) A_f W̃` of face `f` with its gradient and Hessian in the face's 9 DOFs.
+    fn membrane_face(&self, f: usize, x: &[f64], e: &mut f64, g: &mut [f64; 9], h: &mut Block9) {
+        let [x0, x1, x2] = self.triangles[f].map(|v| vec3(x, v));
+        let (e1, e2) = (sub(x1, x0), sub(x2, x0));
+        let cur = [dot(e1, e1), dot(e1, e2), dot(e2, e2)];
+        let d = relaxed_density_in_form(&self.lame, self.rest_forms[f], cur);
+        let k = 0.25 * self.thickness * self.rest_areas[f];
+        *e += k * d.value;
+        if d.branch == Branch::Slack {
+            return;
+        }
+        // ∂p/∂(e1, e2): p0 = e1·e1, p1 = e1·e2, p2 = e2·e2.
+        let zero = [0.0; 3];
+        let dp: [[[f64; 3]; 2]; 3] = [[scale(e1, 2.0), zero], [e2, e1], [zero, scale(e2, 2.0)]];
+        let mut ge = [[0.0; 3]; 2];
+        let mut he = [[[[0.0; 3]; 3]; 2]; 2]; // he[i][j][a][b]: e_i component a, e_j comp. b
+        for m in 0..3 {
+            for i in 0..2 {
+                for a in 0..3 {
+                    ge[i][a] += k * d.grad[m] * dp[m][i][a];
+                }
+            }
+            for n in 0..3 {
+                let c = k * d.hess[m][n];
+                for i in 0..2 {
+                    for j in 0..2 {
+                        for a in 0..3 {
+                            for b in 0..3 {
+                                he[i][j][a][b] += c * dp[m][i][a] * dp[n][j][b];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // Σ_m g_m ∇²p_m: ∇²p0 = 2I on (e1,e1), ∇²p1 = I on (e1,e2),(e2,e1), ∇²p2 = 2I on (e2,e2).
+        #[allow(clippy::needless_range_loop)] // diagonal of four 3×3 blocks
+        for a in 0..3 {
+            he[0][0][a][a] += 2.0 * k * d.grad[0];
+            he[0][1][a][a] += k * d.grad[1];
+            he[1][0][a][a] += k * d.grad[1];
+            he[1][1][a][a] += 2.0 * k * d.grad[2];
+        }
+        // e1 = x1 − x0, e2 = x2 − x0: coefficient of e_i in vertex v.
+        const C: [[f64; 2]; 3] = [[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]];
+        for v in 0..3 {
+            for a in 0..3 {
+                g[3 * v + a] += C[v][0] * ge[0][a] + C[v][1] * ge[1][a];
+                for w in 0..3 {
+                    for b in 0..3 {
+                        let mut s = 0.0;
+                        for i in 0..2 {
+                            for j in 0..2 {
+                                s += C[v][i] * C[w][j] * he[i][j][a][b];
+                            }
+                        }
+                        h[3 * v + a][3 * w + b] += s;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds `−p x0·(x1×x2)/6` of face `f` with its gradient and (projected) Hessian.
+    fn pressure_face(
+        &self,
+        f: usize,
+        x: &[f64],
+        exact: bool,
+        e: &mut f64,
+        g: &mut [f64; 9],
+        h: &mut Block9,
+    ) {
+        let p = self.triangles[f].map(|v| vec3(x, v));
+        let k = -self.pressure / 6.0;
+        *e += k * dot(p[0], cross(p[1], p[2]));
+        let gv = [cross(p[1], p[2]), cross(p[2], p[0]), cross(p[0], p[1])];
+        for v in 0..3 {
+            for a in 0..3 {
+                g[3 * v + a] += k * gv[v][a];
+            }
+        }
+        // ∂²V/∂x_v∂x_w = ε-contraction with the third vertex u: skew(x_u) with sign of (v,w,u).
+        let mut hp = [[0.0; 9]; 9];
+        for (v, w, u) in [(0, 1, 2), (1, 2, 0), (2, 0, 1)] {
+            // ∂(x_v-gradient)/∂x_w = ∂(x_w × x_u)/∂x_w = −skew(x_u)
+            let s = skew(p[u]);
+            for a in 0..3 {
+                for b in 0..3 {
+                    hp[3 * v + a][3 * w + b] = -k * s[a][b];
+                    hp[3 * w + b][3 * v + a] = -k * s[a][b];
+                }
+            }
+        }
+        if !exact {
+            project_psd(&mut hp);
+        }
+        for a in 0..9 {
+            for b in 0..9 {
+                h[a][b] += hp[a][b];
+            }
+        }
+    }
+}
+
+/// Minimizes the base energy of `model` (module docs), applying the Dirichlet motions in
+/// `options.load_steps` increments. `progress` may cancel ([`Error::Cancelled`]). Errors
+/// ([`Error::InvalidArgument`]) on `load_steps == 0` or a non-finite or negative
+/// `bending_scale`; numerical trouble is a [`BaseStatus`], not an error.
+pub fn solve_base(
+    model: &Model,
+    options: &BaseOptions,
+    progress: &mut ProgressFn<'_>,
+) -> Result<BaseResult> {
+    if options.load_steps == 0 {
+        return Err(Error::InvalidArgument(
+            "tfw: load_steps must be >= 1".into(),
+        ));
+    }
+    if !(options.bending_scale >= 0.0 && options.bending_scale.is_finite()) {
+        return Err(Error::InvalidArgument(
+            "tfw: bending_scale must be finite and >= 0".into(),
+        ));
+    }
+    let start = Instant::now();
+    let problem = BaseProblem::new(model, options.bending_scale);
+    let n = model.positions.len();
+    let mut x: Vec<f64> = model.positions.iter().flatten().copied().collect();
+    let mut free = vec![true; 3 * n];
+    for &(v, _) in &model.clamps {
+        for d in 0..3 {
+            free[3 * v as usize + d] = false;
+        }
+    }
+    let mut reduced = vec![usize::MAX; 3 * n];
+    let mut nf = 0;
+    for (i, r) in reduced.iter_mut().enumerate() {
+        if free[i] {
+            *r = nf;
+            nf += 1;
+        }
+    }
+    let mut warnings = model.warnings.clone();
+    let mut history = Vec::new();
+    let mut status = BaseStatus::Converged;
+    let mut relative_gradient = 0.0;
+    let mut analysis: Option<CholeskyAnalysis> = None;
+    let mut last_shift = 0.0;
+    for step in 1..=options.load_steps {
+        let s = step as f64 / options.load_steps as f64;
+        for &(v, m) in &model.clamps {
+            let q = m.apply(model.positions[v as usize], s);
+            x[3 * v as usize..3 * v as usize + 3].copy_from_slice(&q);
+        }
+        if nf == 0 {
+            break;
+        }
+        let mut g0 = 0.0;
+        status = BaseStatus::MaxIterations;
+        for it in 0..options.max_iterations {
+            let fraction = ((step - 1) as f64 + it as f64 / options.max_iterations as f64)
+                / options.load_steps as f64;
+            if !progress(Progress {
+                stage: "tfw base surface",
+                fraction,
+            }) {
+                return Err(Error::Cancelled);
+            }
+            let ev = problem.evaluate(&x, Terms::ALL, false);
+            let g: Vec<f64> = (0..3 * n)
+                .filter(|&i| free[i])
+                .map(|i| ev.gradient[i])
+                .collect();
+            let gn = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            if !gn.is_finite() || !ev.energy.is_finite() {
+                return Err(Error::Numerical(
+                    "tfw base surface: non-finite energy or gradient".into(),
+                ));
+            }
+            if it == 0 {
+                g0 = gn;
+            }
+            relative_gradient = if g0 > 0.0 { gn / g0 } else { 0.0 };
+            if gn == 0.0 || gn <= options.gradient_tolerance * g0 {
+                status = BaseStatus::Converged;
+                break;
+            }
+            let entries: Vec<Entry> = ev
+                .hessian
+                .iter()
+                .filter(|&&(r, c, _)| free[r] && free[c])
+                .map(|&(r, c, v)| Entry::new(reduced[r], reduced[c], v))
+                .chain((0..nf).map(|i| Entry::new(i, i, 0.0)))
+                .collect();
+            let h = assemble(nf, &entries, "tfw base Hessian")?;
+            if analysis.is_none() {
+                analysis = Some(CholeskyAnalysis::new(&h)?);
+            }
+            let an = analysis.as_ref().expect("set above");
+            let mut diag_sum = 0.0;
+            for e in &entries {
+                if e.row == e.col {
+                    diag_sum += e.val.abs();
+                }
+            }
+            let diag_scale = (diag_sum / nf as f64).max(f64::MIN_POSITIVE);
+            let schedule = ShiftSchedule {
+                initial: (1e-10 * diag_scale).max(0.1 * last_shift),
+                growth: 10.0,
+                max_attempts: 24,
+            };
+            let weights = vec![1.0; nf];
+            let (mut d, shift): (Vec<f64>, f64) =
+                match an.factor_with_growing_shift(&h, &weights, schedule, Parallelism::Global) {
+                    Ok(ch) => {
+                        let shift = ch.info().shift;
+                        (ch.solve(&g).into_iter().map(|v| -v).collect(), shift)
+                    }
+                    Err(_) => {
+                        status = BaseStatus::FactorizationFailed;
+                        break;
+                    }
+                };
+            last_shift = shift;
+            let mut slope: f64 = g.iter().zip(&d).map(|(a, b)| a * b).sum();
+            let mut gradient_step = false;
+            let descent = slope < 0.0 && d.iter().all(|v: &f64| v.is_finite());
+            if !descent {
+                d = g.iter().map(|v| -v / diag_scale).collect();
+                slope = g.iter().zip(&d).map(|(a, b)| a * b).sum();
+                gradient_step = true;
+            }
+            // Armijo backtracking (c = 0.2, ρ = 0.5; spec step 2).
+            let slack = 4.0 * f64::EPSILON * ev.energy.abs();
+            let mut t = 1.0;
+            let mut trial = x.clone();
+            let accepted = loop {
+                for i in 0..3 * n {
+                    if free[i] {
+                        trial[i] = x[i] + t * d[reduced[i]];
+                    }
+                }
+                let e = problem.energy(&trial, Terms::ALL);
+                if e.is_finite() && e <= ev.energy + 0.2 * t * slope + slack {
+                    break Some(e);
+                }
+                t *= 0.5;
+                if t < 1e-12 {
+                    break None;
+                }
+            };
+            let Some(e_new) = accepted else {
+                status = BaseStatus::LineSearchFailed;
+                break;
+            };
+            let step_norm = d.iter().fold(0.0f64, |m, v| m.max((t * v).abs()));
+            x = trial;
+            history.push(NewtonIteration {
+                load_step: step,
+                energy: e_new,
+                gradient_norm: gn,
+                step: t,
+                step_norm,
+                shift,
+                gradient_step,
+                seconds: start.elapsed().as_secs_f64(),
+            });
+            if (ev.energy - e_new).abs() <= options.energy_tolerance * ev.energy.abs() {
+                // one more gradient check decides between Converged and EnergyStalled
+                let g_new = problem.evaluate(&x, Terms::ALL, false).gradient;
+                let gn_new = (0..3 * n)
+                    .filter(|&i| free[i])
+                    .fold(0.0f64, |m, i| m.max(g_new[i].abs()));
+                relative_gradient = if g0 > 0.0 { gn_new / g0 } else { 0.0 };
+                status = if gn_new <= options.gradient_tolerance * g0 {
+                    BaseStatus::Converged
+                } else {
+                    BaseStatus::EnergyStalled
+                };
+                break;
+            }
+        }
+    }
+    let strain = problem.strain_summary(&x);
+    if strain.slack_area_fraction > 0.5 {
+        warnings.push(format!(
+            "{:.0}% of the rest area is compressed in every direction: the problem is not \
+             tension-dominated (out of scope, S:588); the base surface is best effort",
+            100.0 * strain.slack_area_fraction
+        ));
+    }
+    if strain.degenerate_faces > 0 {
+        warnings.push(format!(
+            "{} base faces are collapsed (det I ≤ 1e-12 det Ī)",
+            strain.degenerate_faces
+        ));
+    }
+    let positions: Vec<[f64; 3]> = x.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let energies = problem.term_energies(&x);
+    Ok(BaseResult {
+        mesh: TriMesh::new(positions, model.triangles.clone())?,
+        status,
+        history,
+        energies,
+        relative_gradient,
+        strain,
+        warnings,
+    })
+}
+
+/// Rows of the cotan Laplacian of the rest pattern (weights from each face's own rest
+/// corners), plus the Wang et al. 2015 free-boundary correction (spec "Energies"): for every
+/// boundary edge (i, j) of face (i, j, k), rows i and j get `+½cot∠j` at i, `+½cot∠i` at j and
+/// `−½(cot∠i + cot∠j)` at k.
+fn corrected_laplacian(
+    n: usize,
+    tris: &[[u32; 3]],
+    rest: &[[[f64; 2]; 3]],
+) -> Vec<Vec<(u32, f64)>> {
+    let mut entries: Vec<(u32, u32, f64)> = Vec::new();
+    let mut edge_faces: std::collections::HashMap<(u32, u32), usize> = Default::default();
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *edge_faces.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    for (t, c) in tris.iter().zip(rest) {
+        let cot = |k: usize| {
+            let (p, q, r) = (c[k], c[(k + 1) % 3], c[(k + 2) % 3]);
+            let u = [q[0] - p[0], q[1] - p[1]];
+            let v = [r[0] - p[0], r[1] - p[1]];
+            (u[0] * v[0] + u[1] * v[1]) / (u[0] * v[1] - u[1] * v[0]).abs()
+        };
+        let cots = [cot(0), cot(1), cot(2)];
+        for k in 0..3 {
+            // edge opposite corner k: (k+1, k+2)
+            let (i, j) = (t[(k + 1) % 3], t[(k + 2) % 3]);
+            let w = 0.5 * cots[k];
+            entries.extend([(i, j, w), (j, i, w), (i, i, -w), (j, j, -w)]);
+        }
+        for k in 0..3 {
+            let (ci, cj, ck) = (k, (k + 1) % 3, (k + 2) % 3);
+            let (i, j, o) = (t[ci], t[cj], t[ck]);
+            if edge_faces[&(i.min(j), i.max(j))] != 1 {
+                continue;
+            }
+            for r in [i, j] {
+                entries.push((r, i, 0.5 * cots[cj]));
+                entries.push((r, j, 0.5 * cots[ci]));
+                entries.push((r, o, -0.5 * (cots[ci] + cots[cj])));
+            }
+        }
+    }
+    entries.sort_by_key(|a| (a.0, a.1));
+    let mut rows = vec![Vec::new(); n];
+    for (r, c, w) in entries {
+        let row: &mut Vec<(u32, f64)> = &mut rows[r as usize];
+        match row.last_mut() {
+            Some(last) if last.0 == c => last.1 += w,
+            _ => row.push((c, w)),
+        }
+    }
+    rows
+}
+
+/// `K = Lᵀ diag(1/Ā) L`, lower triangle `(j, k, K_jk)`, `j ≥ k`, merged and sorted.
+fn normal_matrix(n: usize, rows: &[Vec<(u32, f64)>], areas: &[f64]) -> Vec<(u32, u32, f64)> {
+    let mut e: Vec<(u32, u32, f64)> = Vec::new();
+    for (row, a) in rows.iter().zip(areas) {
+        for &(j, wj) in row {
+            for &(k, wk) in row {
+                if j >= k {
+                    e.push((j, k, wj * wk / a));
+                }
+            }
+        }
+    }
+    e.sort_by_key(|a| (a.0, a.1));
+    let mut out: Vec<(u32, u32, f64)> = Vec::with_capacity(e.len());
+    for (j, k, v) in e {
+        match out.last_mut() {
+            Some(last) if last.0 == j && last.1 == k => last.2 += v,
+            _ => out.push((j, k, v)),
+        }
+    }
+    debug_assert!(out.iter().all(|&(j, _, _)| (j as usize) < n));
+    out
+}
+
+fn vec3(x: &[f64], v: u32) -> [f64; 3] {
+    let i = 3 * v as usize;
+    [x[i], x[i + 1], x[i + 2]]
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// `skew(v) w = v × w`.
+fn skew(v: [f64; 3]) -> [[f64; 3]; 3] {
+    [[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]]
+}
+
+/// `I = [e1·e1, e1·e2, e2·e2]` of a triangle (A.1).
+fn first_form(p: [[f64; 3]; 3]) -> [f64; 3] {
+    let (e1, e2) = (sub(p[1], p[0]), sub(p[2], p[0]));
+    [dot(e1, e1), dot(e1, e2), dot(e2, e2)]
+}

@@ -1,0 +1,58 @@
+//! Wrinkles from physics: tension-field wrinkle statics (TFW, dissertation ch. 2, appendix A;
+//! implementable spec `shared/specs/tfw.md`, issue 13). Feature `tfw`.
+//!
+//! **Implemented (this first part):**
+//! - [`scene`]: problem setup — flat panels with initial 3D positions, sewn by merging vertices
+//!   within a tolerance (each face keeps its own rest form `Ī_f`, S:2029–2033); material
+//!   (Young, Poisson → Lamé α, β by eq. A.3), thickness, density, gravity, pressure, Dirichlet
+//!   conditions (clamped vertices with a prescribed translation and rotation about an axis);
+//!   a JSON scene format whose errors name the bad field; built-in scenes: the stretched sheet
+//!   (S:714) and the twisted cylinder (S:682).
+//! - [`material`]: `‖M‖²_SV` (eq. 2.4), the relaxed membrane density `W̃` of A.2 with its exact
+//!   gradient and Hessian in the first fundamental form.
+//! - [`base`]: the base surface of §2.4.1 — tension-field membrane + quadratic bending (2.28)
+//!   with the free-boundary correction + pressure + gravity, exact gradients and Hessians,
+//!   Newton with Armijo line search on [`crate::solve`]'s sparse Cholesky (symbolic analysis
+//!   reused), Dirichlet by elimination and load steps; a [`BaseStatus`] says why it stopped.
+//! - [`wfree`]: per-face strain eigenpairs (2.29), the wrinkle-free faces W (text and
+//!   reference rules), and the initialization (A.6.2: amplitudes, face one-forms, sign
+//!   combing, vertex amplitudes, Helmholtz projection to a one-form on pleat's edges that is
+//!   curl-free on every non-W face).
+//!
+//! **Not implemented yet** (spec steps 3–8): irregular Delaunay meshing of panels (spade),
+//! obstacles, the wrinkle energy
+//! E^wf and its SQP (clarabel), curvature by quadric fitting, the `Cwf` output with the `v2`
+//! evaluation term, the C API, the CLI and benchmarks.
+//!
+//! **Departures from the spec, and why:**
+//! - Built-in scenes use structured grids with alternating diagonals and jittered interior
+//!   vertices (±20% of the spacing) instead of Delaunay meshes (not written yet); the jitter
+//!   breaks the grid's direction bias that S:698 warns about, but is not a substitute.
+//! - Hessian regularization: instead of `reg·I` doubled from 1e-8, the crate's
+//!   `factor_with_growing_shift` adds `σI` with σ from `1e-10·mean|H_ii|` (or a tenth of the
+//!   last σ needed) growing ×10: relative to the Hessian's scale, so the same for SI and
+//!   rescaled units. The TFT and bending Hessians are exact (PSD face by face); only the
+//!   pressure blocks are projected, as the spec says.
+//! - The energy-change stop is relative, `|ΔE| ≤ 1e-14|E|` by default (the spec's 1e-12 stops
+//!   Newton before its quadratic phase reaches the 1e-8 gradient), and reports
+//!   [`BaseStatus::EnergyStalled`] unless the gradient test also holds.
+//! - The stretched sheet's stretch is not given by the dissertation: it is a parameter.
+//! - Helmholtz projection: the method of multipliers on one Cholesky factorization instead of
+//!   a KKT/LDLT solve (`crate::solve` has no indefinite factorization); same minimizer, the
+//!   curl constraint met to rounding (see [`wfree`]). Regularization `1e-8·mean diag` instead of
+//!   an absolute 1e-8, so it does not depend on units.
+//! - Sign combing compares the faces' wave vectors embedded in 3D on the base surface (the
+//!   transport between neighbouring faces is the base embedding).
+
+pub mod base;
+mod dense;
+pub mod material;
+pub mod scene;
+pub mod wfree;
+
+pub use base::{
+    solve_base, BaseEval, BaseOptions, BaseProblem, BaseResult, BaseStatus, NewtonIteration,
+    StrainSummary, TermEnergies, Terms,
+};
+pub use material::{Branch, Lame};
+pub use scene::{Dirichlet, Material, Model, Motion, Panel, Rotation, Scene};

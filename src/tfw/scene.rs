@@ -1,0 +1,833 @@
+//! TFW problem setup: a [`Scene`] (flat panels with initial 3D positions, material, loads,
+//! Dirichlet conditions), its JSON format ([`Scene::from_json_str`]), validation that names the
+//! bad field, assembly of the panels into one stitched [`Model`] whose faces keep their own rest
+//! form `Ī_f` (spec "Model and variables"), and the built-in scenes ([`Scene::stretched_sheet`],
+//! [`Scene::twisted_cylinder`]).
+//!
+//! ## JSON format
+//!
+//! ```json
+//! {
+//!   "name": "sheet",
+//!   "material": { "young": 1e6, "poisson": 0.5, "thickness": 1e-4, "density": 0 },
+//!   "loads": { "gravity": [0, 0, -9.81], "pressure": 0 },
+//!   "seam_tolerance": 1e-6,
+//!   "panels": [ { "rest": [[0, 0], [1, 0], [0, 1]], "triangles": [[0, 1, 2]],
+//!                 "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]] } ],
+//!   "dirichlet": [ { "panel": 0, "vertices": [0, 1],
+//!                    "translation": [0, 0, 0],
+//!                    "rotation": { "axis": [0, 0, 1], "origin": [0, 0, 0], "degrees": 10 } } ]
+//! }
+//! ```
+//! SI units. `loads`, `seam_tolerance`, `name`, `dirichlet`, a panel's `positions` (default:
+//! the rest position at z = 0), a condition's `translation` and `rotation`, and
+//! `material.density` (default 0) are optional. Unknown keys are errors. Panels are sewn by
+//! merging vertices whose initial 3D positions lie within `seam_tolerance` (default 1e-6 m) of
+//! each other, in or across panels (R: `Stitch.cpp` merges within 1e-5).
+
+use serde_json::{Map, Value};
+
+use crate::tfw::material::{Form, Lame};
+use crate::{Error, Result};
+
+/// Material of the shell (SI units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Material {
+    /// Young's modulus Y (Pa), > 0.
+    pub young: f64,
+    /// Poisson's ratio ν, in (−1, 1) (plane stress; a warning outside [0, 0.5]).
+    pub poisson: f64,
+    /// Thickness h (m), > 0.
+    pub thickness: f64,
+    /// Density ρ (kg/m³), ≥ 0.
+    pub density: f64,
+}
+
+impl Material {
+    /// The Lamé parameters of eq. A.3.
+    pub fn lame(&self) -> Lame {
+        Lame::from_young_poisson(self.young, self.poisson)
+    }
+}
+
+/// One flat panel of the pattern: rest (2D) coordinates, triangles, initial 3D positions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Panel {
+    /// Rest position of each vertex in the flat pattern (m).
+    pub rest: Vec<[f64; 2]>,
+    /// Triangles indexing `rest` (any orientation; each must have positive rest area).
+    pub triangles: Vec<[u32; 3]>,
+    /// Initial 3D position of each vertex; `None` = `(u, v, 0)`.
+    pub positions: Option<Vec<[f64; 3]>>,
+}
+
+/// A rotation about an axis through a point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rotation {
+    /// Axis direction (any nonzero length).
+    pub axis: [f64; 3],
+    /// A point on the axis.
+    pub origin: [f64; 3],
+    /// Angle in degrees (right-hand rule about `axis`).
+    pub degrees: f64,
+}
+
+/// Prescribed motion of clamped vertices: rotation (about the axis through `origin`) of the
+/// initial position, then translation.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Motion {
+    /// Translation (m) applied after the rotation.
+    pub translation: [f64; 3],
+    /// Optional rotation.
+    pub rotation: Option<Rotation>,
+}
+
+impl Motion {
+    /// The target of a vertex at initial position `p` after the fraction `s ∈ [0, 1]` of the
+    /// motion (angle and translation scaled by `s`; load steps). `s = 0` returns `p`.
+    pub fn apply(&self, p: [f64; 3], s: f64) -> [f64; 3] {
+        let mut q = p;
+        if let Some(r) = self.rotation {
+            let n = (r.axis[0].powi(2) + r.axis[1].powi(2) + r.axis[2].powi(2)).sqrt();
+            let k = [r.axis[0] / n, r.axis[1] / n, r.axis[2] / n];
+            let v = [p[0] - r.origin[0], p[1] - r.origin[1], p[2] - r.origin[2]];
+            let th = (s * r.degrees).to_radians();
+            let (sn, cs) = th.sin_cos();
+            let kv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
+            let kxv = [
+                k[1] * v[2] - k[2] * v[1],
+                k[2] * v[0] - k[0] * v[2],
+                k[0] * v[1] - k[1] * v[0],
+            ];
+            // Rodrigues' formula.
+            q = std::array::from_fn(|i| {
+                r.origin[i] + v[i] * cs + kxv[i] * sn + k[i] * kv * (1.0 - cs)
+            });
+        }
+        std::array::from_fn(|i| q[i] + s * self.translation[i])
+    }
+}
+
+/// A Dirichlet condition: vertices of one panel clamped to a prescribed motion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dirichlet {
+    /// Index of the panel in [`Scene::panels`].
+    pub panel: usize,
+    /// Vertex indices of that panel.
+    pub vertices: Vec<u32>,
+    /// The motion (identity = clamped in place).
+    pub motion: Motion,
+}
+
+/// A TFW problem: pattern, material, loads and boundary conditions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// A name for reports.
+    pub name: String,
+    /// The material.
+    pub material: Material,
+    /// The panels (at least one).
+    pub panels: Vec<Panel>,
+    /// Gravity acceleration (m/s²).
+    pub gravity: [f64; 3],
+    /// Internal pressure (Pa); the load is `−p·V` (enclosed volume, outward = face orientation).
+    pub pressure: f64,
+    /// Dirichlet conditions.
+    pub dirichlet: Vec<Dirichlet>,
+    /// Vertices whose initial positions are closer than this (m) are sewn into one.
+    pub seam_tolerance: f64,
+}
+
+/// The assembled problem: panels stitched into one mesh whose faces keep their rest forms.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// Initial 3D position per (stitched) vertex.
+    pub positions: Vec<[f64; 3]>,
+    /// Triangles of the stitched mesh.
+    pub triangles: Vec<[u32; 3]>,
+    /// Per face, the rest (2D pattern) coordinates of its three corners.
+    pub rest_corners: Vec<[[f64; 2]; 3]>,
+    /// Per face, the rest metric `Ī_f` in its barycentric frame (S:2029–2033), all with
+    /// positive determinant.
+    pub rest_forms: Vec<Form>,
+    /// The material.
+    pub material: Material,
+    /// Gravity (m/s²).
+    pub gravity: [f64; 3],
+    /// Pressure (Pa).
+    pub pressure: f64,
+    /// Clamped vertices with their motion (each stitched vertex at most once; the last
+    /// condition naming a vertex wins).
+    pub clamps: Vec<(u32, Motion)>,
+    /// Per panel, the stitched vertex of each panel vertex.
+    pub panel_vertices: Vec<Vec<u32>>,
+    /// Warnings found during validation (e.g. ν outside [0, 0.5]).
+    pub warnings: Vec<String>,
+}
+
+fn bad(path: &str, msg: impl std::fmt::Display) -> Error {
+    Error::InvalidArgument(format!("scene: {path}: {msg}"))
+}
+
+fn finite(path: &str, x: f64) -> Result<f64> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(bad(path, format!("must be finite, got {x}")))
+    }
+}
+
+fn finite3(path: &str, v: [f64; 3]) -> Result<()> {
+    for (i, x) in v.iter().enumerate() {
+        finite(&format!("{path}[{i}]"), *x)?;
+    }
+    Ok(())
+}
+
+impl Scene {
+    /// Checks every field and returns the warnings. Errors ([`Error::InvalidArgument`],
+    /// message `scene: <field path>: <what>`) on a non-finite number, `young ≤ 0`,
+    /// `thickness ≤ 0`, `density < 0`, `poisson ∉ (−1, 1)`, no panel, a panel without
+    /// triangles, an index out of range, a rest triangle of zero area, a `positions` list of
+    /// the wrong length, a zero rotation axis, or a negative seam tolerance.
+    pub fn validate(&self) -> Result<Vec<String>> {
+        let mut warnings = Vec::new();
+        let m = &self.material;
+        if finite("material.young", m.young)? <= 0.0 {
+            return Err(bad("material.young", "must be > 0"));
+        }
+        let nu = finite("material.poisson", m.poisson)?;
+        if !(nu > -1.0 && nu < 1.0) {
+            return Err(bad(
+                "material.poisson",
+                format!("must be in (-1, 1), got {nu}"),
+            ));
+        }
+        if !(0.0..=0.5).contains(&nu) {
+            warnings.push(format!("material.poisson = {nu} is outside [0, 0.5]"));
+        }
+        if nu == 0.0 {
+            warnings.push(
+                "material.poisson = 0: the quadratic bending (2.28, ∝ α) vanishes; the base \
+                 solve relies on its regularization out of plane"
+                    .into(),
+            );
+        }
+        if finite("material.thickness", m.thickness)? <= 0.0 {
+            return Err(bad("material.thickness", "must be > 0"));
+        }
+        if finite("material.density", m.density)? < 0.0 {
+            return Err(bad("material.density", "must be >= 0"));
+        }
+        finite3("loads.gravity", self.gravity)?;
+        finite("loads.pressure", self.pressure)?;
+        if finite("seam_tolerance", self.seam_tolerance)? < 0.0 {
+            return Err(bad("seam_tolerance", "must be >= 0"));
+        }
+        if self.panels.is_empty() {
+            return Err(bad("panels", "at least one panel is required"));
+        }
+        for (p, panel) in self.panels.iter().enumerate() {
+            validate_panel(&format!("panels[{p}]"), panel)?;
+        }
+        for (k, d) in self.dirichlet.iter().enumerate() {
+            let path = format!("dirichlet[{k}]");
+            let Some(panel) = self.panels.get(d.panel) else {
+                return Err(bad(
+                    &format!("{path}.panel"),
+                    format!("{} is not a panel index (< {})", d.panel, self.panels.len()),
+                ));
+            };
+            if let Some(&v) = d.vertices.iter().find(|&&v| v as usize >= panel.rest.len()) {
+                return Err(bad(
+                    &format!("{path}.vertices"),
+                    format!("vertex {v} out of range (panel has {})", panel.rest.len()),
+                ));
+            }
+            finite3(&format!("{path}.translation"), d.motion.translation)?;
+            if let Some(r) = d.motion.rotation {
+                finite3(&format!("{path}.rotation.axis"), r.axis)?;
+                finite3(&format!("{path}.rotation.origin"), r.origin)?;
+                finite(&format!("{path}.rotation.degrees"), r.degrees)?;
+                if r.axis.iter().all(|&a| a == 0.0) {
+                    return Err(bad(&format!("{path}.rotation.axis"), "must be nonzero"));
+                }
+            }
+        }
+        Ok(warnings)
+    }
+
+    /// Validates and stitches the scene into a [`Model`]. Errors as [`validate`](Self::validate),
+    /// and when sewing collapses a triangle (two corners within the seam tolerance).
+    pub fn assemble(&self) -> Result<Model> {
+        let warnings = self.validate()?;
+        let mut all = Vec::new();
+        let mut offsets = Vec::new();
+        for p in &self.panels {
+            offsets.push(all.len());
+            match &p.positions {
+                Some(x) => all.extend_from_slice(x),
+                None => all.extend(p.rest.iter().map(|r| [r[0], r[1], 0.0])),
+            }
+        }
+        let rep = weld_within(&all, self.seam_tolerance);
+        // compact numbering in order of first appearance of each representative
+        let mut new_index = vec![u32::MAX; all.len()];
+        let mut positions = Vec::new();
+        for i in 0..all.len() {
+            let r = rep[i] as usize;
+            if new_index[r] == u32::MAX {
+                new_index[r] = positions.len() as u32;
+                positions.push(all[r]);
+            }
+            new_index[i] = new_index[r];
+        }
+        let mut triangles = Vec::new();
+        let mut rest_corners = Vec::new();
+        let mut rest_forms = Vec::new();
+        let mut panel_vertices = Vec::new();
+        for (p, panel) in self.panels.iter().enumerate() {
+            let off = offsets[p];
+            panel_vertices.push(
+                (0..panel.rest.len())
+                    .map(|i| new_index[off + i])
+                    .collect::<Vec<_>>(),
+            );
+            for (t, tri) in panel.triangles.iter().enumerate() {
+                let v = tri.map(|i| new_index[off + i as usize]);
+                if v[0] == v[1] || v[1] == v[2] || v[0] == v[2] {
+                    return Err(bad(
+                        &format!("panels[{p}].triangles[{t}]"),
+                        "two corners were sewn together (seam_tolerance too large?)",
+                    ));
+                }
+                let c = tri.map(|i| panel.rest[i as usize]);
+                triangles.push(v);
+                rest_forms.push(rest_form(c));
+                rest_corners.push(c);
+            }
+        }
+        let mut clamp_of: Vec<Option<Motion>> = vec![None; positions.len()];
+        for d in &self.dirichlet {
+            for &v in &d.vertices {
+                clamp_of[panel_vertices[d.panel][v as usize] as usize] = Some(d.motion);
+            }
+        }
+        let clamps = clamp_of
+            .into_iter()
+            .enumerate()
+            .filter_map(|(v, m)| m.map(|m| (v as u32, m)))
+            .collect();
+        Ok(Model {
+            positions,
+            triangles,
+            rest_corners,
+            rest_forms,
+            material: self.material,
+            gravity: self.gravity,
+            pressure: self.pressure,
+            clamps,
+            panel_vertices,
+            warnings,
+        })
+    }
+
+    /// Parses and validates a scene from JSON text (format in the module docs). Errors
+    /// ([`Error::InvalidArgument`]) name the field: `scene: panels[0].rest[3][1]: ...`,
+    /// `scene: unknown key material.yung (allowed: ...)`, or the JSON syntax position.
+    pub fn from_json_str(text: &str) -> Result<Scene> {
+        let v: Value = serde_json::from_str(text)
+            .map_err(|e| Error::InvalidArgument(format!("scene: not valid JSON: {e}")))?;
+        let scene = parse_scene(&v)?;
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// Reads a scene file (see [`from_json_str`](Self::from_json_str)); I/O errors are
+    /// [`Error::Io`].
+    pub fn from_json_file(path: &std::path::Path) -> Result<Scene> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        })?;
+        Scene::from_json_str(&text)
+    }
+
+    /// The scene as JSON text in the format [`from_json_str`](Self::from_json_str) reads
+    /// (numbers are written in the shortest round-trip form; reading them back is exact up to
+    /// an ulp: serde_json's default float parser is not correctly rounded, and enabling its
+    /// `float_roundtrip` feature would change what the `bake` code parses).
+    pub fn to_json_string(&self) -> String {
+        let m = &self.material;
+        let mut o = Map::new();
+        o.insert("name".into(), Value::from(self.name.clone()));
+        o.insert(
+            "material".into(),
+            serde_json::json!({"young": m.young, "poisson": m.poisson,
+                               "thickness": m.thickness, "density": m.density}),
+        );
+        o.insert(
+            "loads".into(),
+            serde_json::json!({"gravity": self.gravity, "pressure": self.pressure}),
+        );
+        o.insert("seam_tolerance".into(), Value::from(self.seam_tolerance));
+        let panels: Vec<Value> = self
+            .panels
+            .iter()
+            .map(|p| {
+                let mut po = Map::new();
+                po.insert("rest".into(), serde_json::json!(p.rest));
+                po.insert("triangles".into(), serde_json::json!(p.triangles));
+                if let Some(x) = &p.positions {
+                    po.insert("positions".into(), serde_json::json!(x));
+                }
+                Value::Object(po)
+            })
+            .collect();
+        o.insert("panels".into(), Value::Array(panels));
+        let dir: Vec<Value> = self
+            .dirichlet
+            .iter()
+            .map(|d| {
+                let mut dm = Map::new();
+                dm.insert("panel".into(), Value::from(d.panel));
+                dm.insert("vertices".into(), serde_json::json!(d.vertices));
+                dm.insert(
+                    "translation".into(),
+                    serde_json::json!(d.motion.translation),
+                );
+                if let Some(r) = d.motion.rotation {
+                    dm.insert(
+                        "rotation".into(),
+                        serde_json::json!({"axis": r.axis, "origin": r.origin,
+                                           "degrees": r.degrees}),
+                    );
+                }
+                Value::Object(dm)
+            })
+            .collect();
+        o.insert("dirichlet".into(), Value::Array(dir));
+        serde_json::to_string_pretty(&Value::Object(o)).expect("JSON values serialize")
+    }
+
+    /// The stretched sheet of S:714: a 0.25 × 0.1 m rectangle, h 0.1 mm, ν 0.5, Y 1 MPa, on a
+    /// structured `nx × ny` vertex grid (alternating diagonals, interior vertices jittered by
+    /// up to 20% of the spacing to break the grid's direction bias, S:698). The initial state
+    /// is the sheet stretched uniformly along x by the factor `1 + stretch` (the dissertation
+    /// does not give the stretch); both short edges are clamped there.
+    pub fn stretched_sheet(nx: usize, ny: usize, stretch: f64) -> Scene {
+        let (lx, ly) = (0.25, 0.1);
+        let (rest, triangles) = grid(nx, ny, lx, ly, true);
+        let positions = rest
+            .iter()
+            .map(|r| [(r[0] - 0.5 * lx) * (1.0 + stretch), r[1] - 0.5 * ly, 0.0])
+            .collect();
+        let edge = |col: usize| (0..ny).map(|j| (j * nx + col) as u32).collect::<Vec<_>>();
+        let mut clamped = edge(0);
+        clamped.extend(edge(nx - 1));
+        Scene {
+            name: format!("stretched sheet {nx}x{ny}, stretch {stretch}"),
+            material: Material {
+                young: 1e6,
+                poisson: 0.5,
+                thickness: 1e-4,
+                density: 0.0,
+            },
+            panels: vec![Panel {
+                rest,
+                triangles,
+                positions: Some(positions),
+            }],
+            gravity: [0.0; 3],
+            pressure: 0.0,
+            dirichlet: vec![Dirichlet {
+                panel: 0,
+                vertices: clamped,
+                motion: Motion::default(),
+            }],
+            seam_tolerance: 1e-6,
+        }
+    }
+
+    /// The twisted cylinder of S:682: radius 1 m, height 5 m, h 0.1 mm, ν 0.44, Y 10 MPa. The
+    /// pattern is the 2π × 5 m rectangle on a structured `n_around + 1` × `n_height` grid
+    /// (jittered interior, see [`stretched_sheet`](Self::stretched_sheet)), rolled into the
+    /// untwisted cylinder (the initial state, S:2226) and sewn along the seam. The bottom ring
+    /// is clamped; the top ring is rotated by `twist_degrees` about the axis (height fixed).
+    pub fn twisted_cylinder(n_around: usize, n_height: usize, twist_degrees: f64) -> Scene {
+        let (r, hgt) = (1.0, 5.0);
+        let nx = n_around + 1;
+        let (rest, triangles) = grid(nx, n_height, 2.0 * std::f64::consts::PI * r, hgt, true);
+        let positions = rest
+            .iter()
+            .map(|p| {
+                let (s, c) = (p[0] / r).sin_cos();
+                [r * c, r * s, p[1]]
+            })
+            .collect();
+        let ring = |row: usize| (0..nx).map(|i| (row * nx + i) as u32).collect::<Vec<_>>();
+        Scene {
+            name: format!("twisted cylinder {n_around}x{n_height}, {twist_degrees} deg"),
+            material: Material {
+                young: 1e7,
+                poisson: 0.44,
+                thickness: 1e-4,
+                density: 0.0,
+            },
+            panels: vec![Panel {
+                rest,
+                triangles,
+                positions: Some(positions),
+            }],
+            gravity: [0.0; 3],
+            pressure: 0.0,
+            dirichlet: vec![
+                Dirichlet {
+                    panel: 0,
+                    vertices: ring(0),
+                    motion: Motion::default(),
+                },
+                Dirichlet {
+                    panel: 0,
+                    vertices: ring(n_height - 1),
+                    motion: Motion {
+                        translation: [0.0; 3],
+                        rotation: Some(Rotation {
+                            axis: [0.0, 0.0, 1.0],
+                            origin: [0.0; 3],
+                            degrees: twist_degrees,
+                        }),
+                    },
+                },
+            ],
+            seam_tolerance: 1e-6,
+        }
+    }
+}
+
+/// `Ī = [[ē1·ē1, ē1·ē2], [ē1·ē2, ē2·ē2]]`, `ēi = c_i − c_0` (S:2029–2033).
+pub fn rest_form(c: [[f64; 2]; 3]) -> Form {
+    let e1 = [c[1][0] - c[0][0], c[1][1] - c[0][1]];
+    let e2 = [c[2][0] - c[0][0], c[2][1] - c[0][1]];
+    [
+        e1[0] * e1[0] + e1[1] * e1[1],
+        e1[0] * e2[0] + e1[1] * e2[1],
+        e2[0] * e2[0] + e2[1] * e2[1],
+    ]
+}
+
+fn validate_panel(path: &str, p: &Panel) -> Result<()> {
+    if p.triangles.is_empty() {
+        return Err(bad(&format!("{path}.triangles"), "a panel needs triangles"));
+    }
+    for (i, r) in p.rest.iter().enumerate() {
+        for (k, x) in r.iter().enumerate() {
+            finite(&format!("{path}.rest[{i}][{k}]"), *x)?;
+        }
+    }
+    if let Some(x) = &p.positions {
+        if x.len() != p.rest.len() {
+            return Err(bad(
+                &format!("{path}.positions"),
+                format!("{} positions for {} rest vertices", x.len(), p.rest.len()),
+            ));
+        }
+        for (i, q) in x.iter().enumerate() {
+            finite3(&format!("{path}.positions[{i}]"), *q)?;
+        }
+    }
+    for (t, tri) in p.triangles.iter().enumerate() {
+        let tp = format!("{path}.triangles[{t}]");
+        if let Some(&v) = tri.iter().find(|&&v| v as usize >= p.rest.len()) {
+            return Err(bad(
+                &tp,
+                format!("vertex {v} out of range ({} vertices)", p.rest.len()),
+            ));
+        }
+        let f = rest_form(tri.map(|i| p.rest[i as usize]));
+        let det = f[0] * f[2] - f[1] * f[1];
+        if det.is_nan() || det <= 1e-24 * (f[0] + f[2]).powi(2) {
+            return Err(bad(&tp, "rest triangle has zero area"));
+        }
+    }
+    Ok(())
+}
+
+/// Structured grid of `nx × ny` vertices on `[0, lx] × [0, ly]` (row-major, `j·nx + i`), two
+/// triangles per cell with alternating diagonals, counter-clockwise. With `jitter`, interior
+/// vertices move by a deterministic pseudo-random offset of up to 20% of the spacing.
+fn grid(nx: usize, ny: usize, lx: f64, ly: f64, jitter: bool) -> (Vec<[f64; 2]>, Vec<[u32; 3]>) {
+    let (dx, dy) = (lx / (nx - 1) as f64, ly / (ny - 1) as f64);
+    let mut rest = Vec::with_capacity(nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            let mut p = [i as f64 * dx, j as f64 * dy];
+            if jitter && i > 0 && i + 1 < nx && j > 0 && j + 1 < ny {
+                let k = (j * nx + i) as u64;
+                p[0] += 0.2 * dx * hash_unit(2 * k);
+                p[1] += 0.2 * dy * hash_unit(2 * k + 1);
+            }
+            rest.push(p);
+        }
+    }
+    let mut tris = Vec::with_capacity(2 * (nx - 1) * (ny - 1));
+    for j in 0..ny - 1 {
+        for i in 0..nx - 1 {
+            let v = |a: usize, b: usize| (b * nx + a) as u32;
+            let (a, b, c, d) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
+            if (i + j) % 2 == 0 {
+                tris.push([a, b, c]);
+                tris.push([a, c, d]);
+            } else {
+                tris.push([a, b, d]);
+                tris.push([b, c, d]);
+            }
+        }
+    }
+    (rest, tris)
+}
+
+/// A deterministic value in [−1, 1) from an integer (splitmix64).
+fn hash_unit(k: u64) -> f64 {
+    let mut z = k.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+}
+
+/// Per vertex, the smallest index of the vertices within `tol` (Euclidean) of it, merged
+/// transitively (union–find over pairs found by a sweep along x).
+fn weld_within(p: &[[f64; 3]], tol: f64) -> Vec<u32> {
+    let mut parent: Vec<u32> = (0..p.len() as u32).collect();
+    fn find(parent: &mut [u32], mut i: u32) -> u32 {
+        while parent[i as usize] != i {
+            parent[i as usize] = parent[parent[i as usize] as usize];
+            i = parent[i as usize];
+        }
+        i
+    }
+    let mut order: Vec<usize> = (0..p.len()).collect();
+    order.sort_by(|&a, &b| p[a][0].total_cmp(&p[b][0]).then(a.cmp(&b)));
+    for (k, &a) in order.iter().enumerate() {
+        for &b in &order[k + 1..] {
+            if p[b][0] - p[a][0] > tol {
+                break;
+            }
+            let d2: f64 = (0..3).map(|c| (p[a][c] - p[b][c]).powi(2)).sum();
+            if d2 <= tol * tol {
+                let (ra, rb) = (find(&mut parent, a as u32), find(&mut parent, b as u32));
+                let (lo, hi) = (ra.min(rb), ra.max(rb));
+                parent[hi as usize] = lo;
+            }
+        }
+    }
+    (0..p.len() as u32).map(|i| find(&mut parent, i)).collect()
+}
+
+// ---------------------------------------------------------------------------------------------
+// JSON reading: every accessor names the field path in its error.
+
+fn object<'a>(v: &'a Value, path: &str, allowed: &[&str]) -> Result<&'a Map<String, Value>> {
+    let m = v
+        .as_object()
+        .ok_or_else(|| bad(path, "expected a JSON object"))?;
+    if let Some(k) = m.keys().find(|k| !allowed.contains(&k.as_str())) {
+        let full = if path.is_empty() {
+            k.clone()
+        } else {
+            format!("{path}.{k}")
+        };
+        return Err(Error::InvalidArgument(format!(
+            "scene: unknown key {full} (allowed: {})",
+            allowed.join(", ")
+        )));
+    }
+    Ok(m)
+}
+
+fn join(path: &str, key: &str) -> String {
+    if path.is_empty() {
+        key.to_string()
+    } else {
+        format!("{path}.{key}")
+    }
+}
+
+fn number(v: &Value, path: &str) -> Result<f64> {
+    v.as_f64()
+        .ok_or_else(|| bad(path, "expected a number"))
+        .and_then(|x| finite(path, x))
+}
+
+fn required<'a>(m: &'a Map<String, Value>, path: &str, key: &str) -> Result<&'a Value> {
+    m.get(key)
+        .ok_or_else(|| bad(&join(path, key), "missing (required)"))
+}
+
+fn opt_number(m: &Map<String, Value>, path: &str, key: &str, default: f64) -> Result<f64> {
+    m.get(key)
+        .map_or(Ok(default), |v| number(v, &join(path, key)))
+}
+
+fn array<'a>(v: &'a Value, path: &str) -> Result<&'a Vec<Value>> {
+    v.as_array().ok_or_else(|| bad(path, "expected an array"))
+}
+
+fn fixed<const N: usize>(v: &Value, path: &str) -> Result<[f64; N]> {
+    let a = array(v, path)?;
+    if a.len() != N {
+        return Err(bad(path, format!("expected {N} numbers, got {}", a.len())));
+    }
+    let mut out = [0.0; N];
+    for (i, x) in a.iter().enumerate() {
+        out[i] = number(x, &format!("{path}[{i}]"))?;
+    }
+    Ok(out)
+}
+
+fn index(v: &Value, path: &str) -> Result<u64> {
+    v.as_u64()
+        .ok_or_else(|| bad(path, "expected a non-negative integer"))
+}
+
+fn parse_scene(v: &Value) -> Result<Scene> {
+    let top = object(
+        v,
+        "",
+        &[
+            "name",
+            "material",
+            "loads",
+            "seam_tolerance",
+            "panels",
+            "dirichlet",
+        ],
+    )?;
+    let name = match top.get("name") {
+        None => String::new(),
+        Some(n) => n
+            .as_str()
+            .ok_or_else(|| bad("name", "expected a string"))?
+            .to_string(),
+    };
+    let mv = required(top, "", "material")?;
+    let mo = object(
+        mv,
+        "material",
+        &["young", "poisson", "thickness", "density"],
+    )?;
+    let material = Material {
+        young: number(required(mo, "material", "young")?, "material.young")?,
+        poisson: number(required(mo, "material", "poisson")?, "material.poisson")?,
+        thickness: number(required(mo, "material", "thickness")?, "material.thickness")?,
+        density: opt_number(mo, "material", "density", 0.0)?,
+    };
+    let (mut gravity, mut pressure) = ([0.0; 3], 0.0);
+    if let Some(l) = top.get("loads") {
+        let lo = object(l, "loads", &["gravity", "pressure"])?;
+        if let Some(g) = lo.get("gravity") {
+            gravity = fixed::<3>(g, "loads.gravity")?;
+        }
+        pressure = opt_number(lo, "loads", "pressure", 0.0)?;
+    }
+    let seam_tolerance = opt_number(top, "", "seam_tolerance", 1e-6)?;
+    let pv = array(required(top, "", "panels")?, "panels")?;
+    let mut panels = Vec::with_capacity(pv.len());
+    for (p, v) in pv.iter().enumerate() {
+        let path = format!("panels[{p}]");
+        let po = object(v, &path, &["rest", "triangles", "positions"])?;
+        let rest = array(required(po, &path, "rest")?, &format!("{path}.rest"))?
+            .iter()
+            .enumerate()
+            .map(|(i, x)| fixed::<2>(x, &format!("{path}.rest[{i}]")))
+            .collect::<Result<Vec<_>>>()?;
+        let triangles = array(
+            required(po, &path, "triangles")?,
+            &format!("{path}.triangles"),
+        )?
+        .iter()
+        .enumerate()
+        .map(|(t, x)| {
+            let tp = format!("{path}.triangles[{t}]");
+            let a = array(x, &tp)?;
+            if a.len() != 3 {
+                return Err(bad(&tp, "expected 3 vertex indices"));
+            }
+            let mut tri = [0u32; 3];
+            for (k, y) in a.iter().enumerate() {
+                let i = index(y, &format!("{tp}[{k}]"))?;
+                tri[k] = u32::try_from(i).map_err(|_| bad(&tp, "index exceeds u32"))?;
+            }
+            Ok(tri)
+        })
+        .collect::<Result<Vec<_>>>()?;
+        let positions = match po.get("positions") {
+            None => None,
+            Some(x) => Some(
+                array(x, &format!("{path}.positions"))?
+                    .iter()
+                    .enumerate()
+                    .map(|(i, y)| fixed::<3>(y, &format!("{path}.positions[{i}]")))
+                    .collect::<Result<Vec<_>>>()?,
+            ),
+        };
+        panels.push(Panel {
+            rest,
+            triangles,
+            positions,
+        });
+    }
+    let mut dirichlet = Vec::new();
+    if let Some(dv) = top.get("dirichlet") {
+        for (k, d) in array(dv, "dirichlet")?.iter().enumerate() {
+            let path = format!("dirichlet[{k}]");
+            let o = object(d, &path, &["panel", "vertices", "translation", "rotation"])?;
+            let panel = index(required(o, &path, "panel")?, &format!("{path}.panel"))? as usize;
+            let vertices = array(required(o, &path, "vertices")?, &format!("{path}.vertices"))?
+                .iter()
+                .enumerate()
+                .map(|(i, x)| {
+                    let vp = format!("{path}.vertices[{i}]");
+                    u32::try_from(index(x, &vp)?).map_err(|_| bad(&vp, "index exceeds u32"))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            let translation = match o.get("translation") {
+                None => [0.0; 3],
+                Some(t) => fixed::<3>(t, &format!("{path}.translation"))?,
+            };
+            let rotation = match o.get("rotation") {
+                None => None,
+                Some(r) => {
+                    let rp = format!("{path}.rotation");
+                    let ro = object(r, &rp, &["axis", "origin", "degrees"])?;
+                    Some(Rotation {
+                        axis: fixed::<3>(required(ro, &rp, "axis")?, &format!("{rp}.axis"))?,
+                        origin: match ro.get("origin") {
+                            None => [0.0; 3],
+                            Some(x) => fixed::<3>(x, &format!("{rp}.origin"))?,
+                        },
+                        degrees: number(required(ro, &rp, "degrees")?, &format!("{rp}.degrees"))?,
+                    })
+                }
+            };
+            dirichlet.push(Dirichlet {
+                panel,
+                vertices,
+                motion: Motion {
+                    translation,
+                    rotation,
+                },
+            });
+        }
+    }
+    Ok(Scene {
+        name,
+        material,
+        panels,
+        gravity,
+        pressure,
+        dirichlet,
+        seam_tolerance,
+    })
+}

@@ -1,0 +1,783 @@
+//! TFW (issue 13, dissertation ch. 2): scene setup, material law and the base surface solve on
+//! small meshes. Finite-difference checks per energy term, analytic solutions and invariants.
+#![cfg(feature = "tfw")]
+
+use pleat::tfw::material::{principal_strains, relaxed_density_in_form, Form};
+use pleat::tfw::scene::rest_form;
+use pleat::tfw::{
+    solve_base, BaseOptions, BaseProblem, BaseStatus, Branch, Dirichlet, Lame, Material, Model,
+    Motion, Panel, Rotation, Scene, Terms,
+};
+
+fn no_progress() -> impl FnMut(pleat::Progress<'_>) -> bool {
+    |_| true
+}
+
+/// A deterministic value in [−1, 1).
+fn noise(k: usize) -> f64 {
+    let mut z = (k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xDEAD_BEEF;
+    z = (z ^ (z >> 29)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z ^= z >> 32;
+    (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+}
+
+#[test]
+fn relaxed_density_branches_are_continuous() {
+    let m = Lame::from_young_poisson(1e6, 0.3);
+    let l1 = 0.05;
+    let l2 = m.relaxed_lambda2(l1);
+    let (a, _) = m.relaxed_density(l1, l2 + 1e-12);
+    let (b, _) = m.relaxed_density(l1, l2 - 1e-12);
+    assert!((a - b).abs() <= 1e-9 * a, "{a} vs {b}");
+    // the wrinkled branch is W_s at the relaxed λ2
+    assert!((m.stvk_density(l1, l2) - m.wrinkled_coefficient() * l1 * l1).abs() < 1e-12 * a);
+}
+
+#[test]
+fn form_density_matches_finite_differences_on_every_branch() {
+    for nu in [0.0, 0.3, 0.5] {
+        let m = Lame::from_young_poisson(1e6, nu);
+        let rest: Form = [1.0, 0.3, 0.8];
+        let states: [Form; 3] = [[1.1, 0.33, 0.9], [1.1, 0.3, 0.7], [0.9, 0.27, 0.7]];
+        let want = [Branch::Tension, Branch::Wrinkled, Branch::Slack];
+        for (cur, want) in states.into_iter().zip(want) {
+            let f = relaxed_density_in_form(&m, rest, cur);
+            assert_eq!(f.branch, want, "ν {nu}, {cur:?}");
+            let h = 1e-6;
+            for k in 0..3 {
+                let (mut p, mut q) = (cur, cur);
+                p[k] += h;
+                q[k] -= h;
+                let (fp, fq) = (
+                    relaxed_density_in_form(&m, rest, p),
+                    relaxed_density_in_form(&m, rest, q),
+                );
+                let g = (fp.value - fq.value) / (2.0 * h);
+                assert!(
+                    (g - f.grad[k]).abs() <= 1e-6 * (1.0 + g.abs()),
+                    "grad {k}: {g} vs {}",
+                    f.grad[k]
+                );
+                for j in 0..3 {
+                    let hh = (fp.grad[j] - fq.grad[j]) / (2.0 * h);
+                    let tol = 1e-5 * (1.0 + hh.abs().max(f.hess[k][j].abs()));
+                    assert!((hh - f.hess[k][j]).abs() <= tol, "hess {k}{j}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn principal_strains_match_a_known_stretch() {
+    let rest = rest_form([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+    // stretch x by 1.1, y by 0.9: Green strains 1.21 − 1 and 0.81 − 1
+    let cur = [1.21, 0.0, 0.81];
+    let (l1, l2) = principal_strains(rest, cur);
+    assert!((l1 - 0.21).abs() < 1e-14 && (l2 + 0.19).abs() < 1e-14);
+}
+
+/// A small jittered sheet as a one-panel scene with no conditions.
+fn small_sheet(nx: usize, ny: usize) -> Scene {
+    let mut s = Scene::stretched_sheet(nx, ny, 0.0);
+    s.dirichlet.clear();
+    s
+}
+
+#[test]
+fn corrected_laplacian_annihilates_affine_functions() {
+    let model = small_sheet(9, 6).assemble().unwrap();
+    let p = BaseProblem::new(&model, 1.0);
+    // rest coordinates per vertex (single panel: any corner gives it)
+    let mut uv = vec![[0.0; 2]; model.positions.len()];
+    for (t, c) in model.triangles.iter().zip(&model.rest_corners) {
+        for k in 0..3 {
+            uv[t[k] as usize] = c[k];
+        }
+    }
+    for (i, row) in p.laplacian().iter().enumerate() {
+        let (mut su, mut sv, mut s1) = (0.0, 0.0, 0.0);
+        for &(j, w) in row {
+            su += w * uv[j as usize][0];
+            sv += w * uv[j as usize][1];
+            s1 += w;
+        }
+        assert!(
+            su.abs() < 1e-12 && sv.abs() < 1e-12 && s1.abs() < 1e-9,
+            "row {i}: {su} {sv} {s1}"
+        );
+    }
+}
+
+/// Sheet positions stretched by (sx, sy) with a small out-of-plane and in-plane noise.
+fn perturbed(model: &Model, sx: f64, sy: f64, amp: f64) -> Vec<f64> {
+    model
+        .positions
+        .iter()
+        .enumerate()
+        .flat_map(|(i, p)| {
+            [
+                p[0] * sx + amp * noise(3 * i),
+                p[1] * sy + amp * noise(3 * i + 1),
+                amp * noise(3 * i + 2),
+            ]
+        })
+        .collect()
+}
+
+fn dense_hessian(n3: usize, entries: &[(usize, usize, f64)]) -> Vec<Vec<f64>> {
+    let mut h = vec![vec![0.0; n3]; n3];
+    for &(r, c, v) in entries {
+        h[r][c] += v;
+        if r != c {
+            h[c][r] += v;
+        }
+    }
+    h
+}
+
+fn check_term(problem: &BaseProblem, x: &[f64], terms: Terms, what: &str) {
+    let ev = problem.evaluate(x, terms, true);
+    assert!(
+        (ev.energy - problem.energy(x, terms)).abs() <= 1e-12 * ev.energy.abs().max(1e-30),
+        "{what}: energy paths disagree"
+    );
+    let h = dense_hessian(x.len(), &ev.hessian);
+    let gscale = ev.gradient.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let hscale = h.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(gscale > 0.0, "{what}: zero gradient, test is vacuous");
+    let step = 1e-7;
+    for k in 0..x.len() {
+        let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
+        xp[k] += step;
+        xm[k] -= step;
+        let fd = (problem.energy(&xp, terms) - problem.energy(&xm, terms)) / (2.0 * step);
+        assert!(
+            (fd - ev.gradient[k]).abs() <= 1e-5 * gscale,
+            "{what}: gradient {k}: fd {fd} vs {}",
+            ev.gradient[k]
+        );
+        let (gp, gm) = (
+            problem.evaluate(&xp, terms, true).gradient,
+            problem.evaluate(&xm, terms, true).gradient,
+        );
+        for j in 0..x.len() {
+            let fd = (gp[j] - gm[j]) / (2.0 * step);
+            assert!(
+                (fd - h[j][k]).abs() <= 1e-5 * hscale,
+                "{what}: Hessian ({j},{k}): fd {fd} vs {}",
+                h[j][k]
+            );
+        }
+    }
+}
+
+#[test]
+fn every_energy_term_matches_finite_differences() {
+    let mut scene = small_sheet(5, 4);
+    scene.pressure = 300.0;
+    scene.material.density = 500.0;
+    scene.gravity = [0.3, -1.0, -9.81];
+    let model = scene.assemble().unwrap();
+    let problem = BaseProblem::new(&model, 1.0);
+    // stretched along x, compressed along y: wrinkled and tension faces both occur
+    let x = perturbed(&model, 1.05, 0.97, 2e-3);
+    let s = problem.strain_summary(&x);
+    assert!(s.wrinkled_faces > 0, "{s:?}");
+    for (terms, what) in [
+        (
+            Terms {
+                membrane: true,
+                ..Terms::NONE
+            },
+            "membrane",
+        ),
+        (
+            Terms {
+                bending: true,
+                ..Terms::NONE
+            },
+            "bending",
+        ),
+        (
+            Terms {
+                pressure: true,
+                ..Terms::NONE
+            },
+            "pressure",
+        ),
+        (
+            Terms {
+                gravity: true,
+                ..Terms::NONE
+            },
+            "gravity",
+        ),
+    ] {
+        check_term(&problem, &x, terms, what);
+    }
+}
+
+#[test]
+fn pure_tension_dilation_is_the_exact_answer_and_relaxed_equals_plain_energy() {
+    // every boundary vertex clamped at 1.03 × its rest position: the uniform dilation is the
+    // equilibrium (affine ⇒ Lx = 0 and constant stress), every face is in pure tension.
+    let mut scene = small_sheet(11, 6);
+    let nx = 11;
+    let ny = 6;
+    let boundary: Vec<u32> = (0..nx * ny)
+        .filter(|&k| k % nx == 0 || k % nx == nx - 1 || k / nx == 0 || k / nx == ny - 1)
+        .map(|k| k as u32)
+        .collect();
+    let s = 1.03;
+    let panel = &mut scene.panels[0];
+    let x0: Vec<[f64; 3]> = panel.positions.clone().unwrap();
+    // interior starts undeformed (and slightly off plane), boundary on the dilated positions
+    let mut init = x0.clone();
+    for (i, p) in init.iter_mut().enumerate() {
+        if boundary.contains(&(i as u32)) {
+            *p = [p[0] * s, p[1] * s, 0.0];
+        } else {
+            p[2] = 1e-4 * noise(i);
+        }
+    }
+    panel.positions = Some(init);
+    scene.dirichlet = vec![Dirichlet {
+        panel: 0,
+        vertices: boundary,
+        motion: Motion::default(),
+    }];
+    let model = scene.assemble().unwrap();
+    let r = solve_base(&model, &BaseOptions::default(), &mut no_progress()).unwrap();
+    assert_eq!(r.status, BaseStatus::Converged, "{:?}", r.history);
+    for (p, q) in r.mesh.positions().iter().zip(&x0) {
+        for d in 0..2 {
+            assert!((p[d] - s * q[d]).abs() < 1e-9, "{p:?} vs {q:?}");
+        }
+        assert!(p[2].abs() < 1e-9);
+    }
+    assert_eq!(r.strain.tension_faces, model.triangles.len());
+    // relaxed energy = plain StVK membrane energy Σ (h/4) A_f W_s
+    let lame = model.material.lame();
+    let h = model.material.thickness;
+    let plain: f64 = model
+        .triangles
+        .iter()
+        .zip(&model.rest_forms)
+        .map(|(t, rest)| {
+            let p = t.map(|v| r.mesh.positions()[v as usize]);
+            let e1 = [p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]];
+            let e2 = [p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]];
+            let d = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            let (l1, l2) = principal_strains(*rest, [d(e1, e1), d(e1, e2), d(e2, e2)]);
+            let area = 0.5 * (rest[0] * rest[2] - rest[1] * rest[1]).sqrt();
+            0.25 * h * area * lame.stvk_density(l1, l2)
+        })
+        .sum();
+    assert!(
+        (r.energies.membrane - plain).abs() <= 1e-12 * plain,
+        "{} vs {plain}",
+        r.energies.membrane
+    );
+}
+
+fn monotone(history: &[pleat::tfw::NewtonIteration], e0: f64) {
+    let mut prev = e0;
+    for it in history {
+        assert!(
+            it.energy <= prev + 8.0 * f64::EPSILON * prev.abs(),
+            "energy rose: {prev} -> {}",
+            it.energy
+        );
+        prev = it.energy;
+    }
+}
+
+#[test]
+fn twisted_cylinder_converges_with_decreasing_energy_and_wrinkled_faces() {
+    let scene = Scene::twisted_cylinder(24, 9, 10.0);
+    let model = scene.assemble().unwrap();
+    // the seam is sewn: 24 columns, not 25
+    assert_eq!(model.positions.len(), 24 * 9);
+    let mut calls = 0;
+    let r = solve_base(&model, &BaseOptions::default(), &mut |_| {
+        calls += 1;
+        true
+    })
+    .unwrap();
+    assert!(calls > 0);
+    assert!(
+        matches!(r.status, BaseStatus::Converged | BaseStatus::EnergyStalled),
+        "{:?} {:?}",
+        r.status,
+        r.history
+    );
+    assert!(r.relative_gradient < 1e-6, "{}", r.relative_gradient);
+    // initial energy: the untwisted cylinder with the top ring rotated
+    let problem = BaseProblem::new(&model, 1.0);
+    let mut x: Vec<f64> = model.positions.iter().flatten().copied().collect();
+    for &(v, m) in &model.clamps {
+        let q = m.apply(model.positions[v as usize], 1.0);
+        x[3 * v as usize..3 * v as usize + 3].copy_from_slice(&q);
+    }
+    monotone(&r.history, problem.energy(&x, Terms::ALL));
+    // shear by twisting: tension along one diagonal, relaxed compression along the other
+    assert!(
+        r.strain.wrinkled_faces > model.triangles.len() / 2,
+        "{:?}",
+        r.strain
+    );
+    assert_eq!(r.strain.degenerate_faces, 0);
+}
+
+#[test]
+fn displacement_driven_base_is_independent_of_young_modulus() {
+    let solve = |young: f64| {
+        let mut scene = Scene::twisted_cylinder(16, 6, 10.0);
+        scene.material.young = young;
+        let r = solve_base(
+            &scene.assemble().unwrap(),
+            &BaseOptions::default(),
+            &mut no_progress(),
+        )
+        .unwrap();
+        (r.mesh.positions().to_vec(), r.energies.membrane)
+    };
+    let (a, ea) = solve(1e7);
+    let (b, eb) = solve(1e11);
+    for (p, q) in a.iter().zip(&b) {
+        for d in 0..3 {
+            assert!((p[d] - q[d]).abs() < 1e-7, "{p:?} vs {q:?}");
+        }
+    }
+    assert!((eb / ea / 1e4 - 1.0).abs() < 1e-6);
+}
+
+#[test]
+fn stretched_sheet_relaxes_to_tension_with_wrinkled_middle() {
+    let scene = Scene::stretched_sheet(21, 9, 0.1);
+    let model = scene.assemble().unwrap();
+    let r = solve_base(&model, &BaseOptions::default(), &mut no_progress()).unwrap();
+    assert!(
+        matches!(r.status, BaseStatus::Converged | BaseStatus::EnergyStalled),
+        "{:?}",
+        r.status
+    );
+    assert!(r.strain.wrinkled_faces > 0, "{:?}", r.strain);
+    assert!(r.strain.slack_area_fraction < 0.5);
+    // the free long edges contract laterally (ν = 0.5, clamped short edges)
+    let mid = r
+        .mesh
+        .positions()
+        .iter()
+        .filter(|p| p[0].abs() < 0.01)
+        .fold(0.0f64, |m, p| m.max(p[1].abs()));
+    assert!(mid < 0.05, "half-width at mid-length {mid}");
+}
+
+#[test]
+fn load_steps_reach_the_same_answer() {
+    let scene = Scene::twisted_cylinder(16, 6, 10.0);
+    let model = scene.assemble().unwrap();
+    let one = solve_base(&model, &BaseOptions::default(), &mut no_progress()).unwrap();
+    let three = solve_base(
+        &model,
+        &BaseOptions {
+            load_steps: 3,
+            ..Default::default()
+        },
+        &mut no_progress(),
+    )
+    .unwrap();
+    assert!(three.history.iter().any(|h| h.load_step == 3));
+    for (p, q) in one.mesh.positions().iter().zip(three.mesh.positions()) {
+        for d in 0..3 {
+            assert!((p[d] - q[d]).abs() < 1e-6, "{p:?} vs {q:?}");
+        }
+    }
+}
+
+#[test]
+fn cancelling_returns_cancelled() {
+    let model = Scene::twisted_cylinder(12, 5, 10.0).assemble().unwrap();
+    let e = solve_base(&model, &BaseOptions::default(), &mut |_| false).unwrap_err();
+    assert_eq!(e, pleat::Error::Cancelled);
+}
+
+#[test]
+fn rotation_motion_follows_the_right_hand_rule() {
+    let m = Motion {
+        translation: [0.0, 0.0, 1.0],
+        rotation: Some(Rotation {
+            axis: [0.0, 0.0, 2.0],
+            origin: [1.0, 0.0, 0.0],
+            degrees: 90.0,
+        }),
+    };
+    let q = m.apply([2.0, 0.0, 0.0], 1.0);
+    for (a, b) in q.iter().zip([1.0, 1.0, 1.0]) {
+        assert!((a - b).abs() < 1e-15, "{q:?}");
+    }
+    assert_eq!(m.apply([2.0, 0.0, 0.0], 0.0), [2.0, 0.0, 0.0]);
+}
+
+#[test]
+fn scene_json_round_trips() {
+    let scene = Scene::twisted_cylinder(8, 4, 10.0);
+    let text = scene.to_json_string();
+    let back = Scene::from_json_str(&text).unwrap();
+    // equal up to an ulp per number (serde_json's default float parsing)
+    let close = |a: f64, b: f64| (a - b).abs() <= 4.0 * f64::EPSILON * a.abs().max(b.abs());
+    let (p, q) = (&back.panels[0], &scene.panels[0]);
+    assert_eq!(p.triangles, q.triangles);
+    for (a, b) in p.rest.iter().zip(&q.rest) {
+        assert!(a.iter().zip(b).all(|(x, y)| close(*x, *y)), "{a:?} {b:?}");
+    }
+    let (pa, qa) = (p.positions.as_ref().unwrap(), q.positions.as_ref().unwrap());
+    for (a, b) in pa.iter().zip(qa) {
+        assert!(a.iter().zip(b).all(|(x, y)| close(*x, *y)), "{a:?} {b:?}");
+    }
+    let strip = |s: &Scene| Scene {
+        panels: vec![],
+        ..s.clone()
+    };
+    assert_eq!(strip(&back), strip(&scene));
+}
+
+fn err_of(text: &str) -> String {
+    Scene::from_json_str(text).unwrap_err().to_string()
+}
+
+const GOOD: &str = r#"{
+  "material": { "young": 1e6, "poisson": 0.3, "thickness": 1e-4 },
+  "panels": [ { "rest": [[0, 0], [1, 0], [0, 1]], "triangles": [[0, 1, 2]] } ],
+  "dirichlet": [ { "panel": 0, "vertices": [0, 1] } ]
+}"#;
+
+#[test]
+fn scene_errors_name_the_field() {
+    assert!(Scene::from_json_str(GOOD).is_ok());
+    let e = err_of(&GOOD.replace("\"young\"", "\"yung\""));
+    assert!(e.contains("unknown key material.yung"), "{e}");
+    let e = err_of(&GOOD.replace("1e-4", "-1e-4"));
+    assert!(e.contains("material.thickness"), "{e}");
+    let e = err_of(&GOOD.replace("1e-4", "NaN"));
+    assert!(e.contains("not valid JSON"), "{e}");
+    let e = err_of(&GOOD.replace("0.3", "1.5"));
+    assert!(e.contains("material.poisson"), "{e}");
+    let e = err_of(&GOOD.replace("\"panels\"", "\"panel\""));
+    assert!(e.contains("unknown key panel"), "{e}");
+    let e = err_of(
+        r#"{"material": { "young": 1e6, "poisson": 0.3, "thickness": 1e-4 }, "panels": []}"#,
+    );
+    assert!(e.contains("panels: at least one panel"), "{e}");
+    let e = err_of(r#"{"material": { "young": 1e6, "poisson": 0.3, "thickness": 1e-4 }}"#);
+    assert!(e.contains("panels: missing"), "{e}");
+    let e = err_of(&GOOD.replace("[0, 1] }", "[0, 7] }"));
+    assert!(e.contains("dirichlet[0].vertices"), "{e}");
+    let e = err_of(&GOOD.replace("[1, 0], [0, 1]]", "[2, 0], [4, 0]]"));
+    assert!(
+        e.contains("panels[0].triangles[0]: rest triangle has zero area"),
+        "{e}"
+    );
+    let e = err_of(&GOOD.replace("[[0, 1, 2]]", "[[0, 1, 3]]"));
+    assert!(e.contains("panels[0].triangles[0]"), "{e}");
+    // programmatic scenes are validated too
+    let mut s = Scene::stretched_sheet(4, 3, 0.1);
+    s.panels[0].rest[5][1] = f64::NAN;
+    let e = s.assemble().unwrap_err().to_string();
+    assert!(e.contains("panels[0].rest[5][1]"), "{e}");
+    let mut s = Scene::stretched_sheet(4, 3, 0.1);
+    s.material = Material {
+        thickness: -1.0,
+        ..s.material
+    };
+    assert!(s.validate().unwrap_err().to_string().contains("thickness"));
+    let mut s = Scene::stretched_sheet(4, 3, 0.1);
+    s.panels.push(Panel {
+        rest: vec![[0.0, 0.0]],
+        triangles: vec![],
+        positions: None,
+    });
+    assert!(s
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("panels[1].triangles"));
+}
+
+#[test]
+fn poisson_zero_warns_and_still_solves() {
+    let mut scene = Scene::twisted_cylinder(12, 5, 10.0);
+    scene.material.poisson = 0.0;
+    let model = scene.assemble().unwrap();
+    assert!(model.warnings.iter().any(|w| w.contains("poisson = 0")));
+    let r = solve_base(&model, &BaseOptions::default(), &mut no_progress()).unwrap();
+    assert!(r.energies.membrane.is_finite());
+    assert!(!r.history.is_empty());
+}
+
+#[test]
+fn has_feature_reports_tfw() {
+    let on = unsafe { pleat::ffi::pleat_has_feature(c"tfw".as_ptr()) };
+    assert_eq!(on, 1);
+}
+
+/// Iterations and wall time of the base solve on the spec's mesh sizes (run with
+/// `cargo test --test tfw -- --ignored --nocapture`).
+#[test]
+#[ignore]
+fn report_base_solve_on_spec_sizes() {
+    for scene in [
+        Scene::stretched_sheet(41, 13, 0.1),
+        Scene::twisted_cylinder(43, 16, 10.0),
+        Scene::twisted_cylinder(63, 21, 10.0),
+    ] {
+        let model = scene.assemble().unwrap();
+        let t = std::time::Instant::now();
+        let r = solve_base(&model, &BaseOptions::default(), &mut no_progress()).unwrap();
+        println!(
+            "{}: {} v, {:?}, {} it, {:.3} s, rel. gradient {:.1e}, {:?}",
+            scene.name,
+            model.positions.len(),
+            r.status,
+            r.history.len(),
+            t.elapsed().as_secs_f64(),
+            r.relative_gradient,
+            r.strain
+        );
+        for h in &r.history {
+            println!(
+                "  E {:.9e} |g| {:.2e} t {} shift {:.1e} {:.3} s",
+                h.energy, h.gradient_norm, h.step, h.shift, h.seconds
+            );
+        }
+    }
+}
+
+mod wrinkle_free {
+    use super::*;
+    use pleat::mesh::TriMesh;
+    use pleat::tfw::wfree::{
+        embedded_wave_vector, face_neighbours, face_strains, helmholtz_projection,
+        initial_face_field, wrinkle_free_faces, WRule,
+    };
+
+    #[test]
+    fn face_strain_directions_of_a_known_stretch() {
+        let rest = rest_form([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+        let base = TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.1, 0.0, 0.0], [0.0, 0.9, 0.0]],
+            vec![[0, 1, 2]],
+        )
+        .unwrap();
+        let s = face_strains(&[rest], &base)[0];
+        assert!((s.lambda_t - 0.21).abs() < 1e-14 && (s.lambda_c + 0.19).abs() < 1e-14);
+        assert!(s.tension_dir[1].abs() < 1e-14 && (s.tension_dir[0].abs() - 1.0).abs() < 1e-14);
+        assert!(
+            s.compression_dir[0].abs() < 1e-14 && (s.compression_dir[1].abs() - 1.0).abs() < 1e-14
+        );
+    }
+
+    /// Grid faces of a small sheet with λ_c = +1 left of x = 0, −1 right of it, and the face
+    /// nearest each of two points given the opposite sign.
+    fn synthetic() -> (Vec<[u32; 3]>, Vec<f64>, Vec<f64>, usize, usize) {
+        let model = small_sheet(13, 7).assemble().unwrap();
+        let cx: Vec<f64> = model
+            .triangles
+            .iter()
+            .map(|t| {
+                t.iter()
+                    .map(|&v| model.positions[v as usize][0])
+                    .sum::<f64>()
+                    / 3.0
+            })
+            .collect();
+        let cy: Vec<f64> = model
+            .triangles
+            .iter()
+            .map(|t| {
+                t.iter()
+                    .map(|&v| model.positions[v as usize][1])
+                    .sum::<f64>()
+                    / 3.0
+            })
+            .collect();
+        let nearest = |x: f64, y: f64| {
+            (0..cx.len())
+                .min_by(|&a, &b| {
+                    let da = (cx[a] - x).powi(2) + (cy[a] - y).powi(2);
+                    let db = (cx[b] - x).powi(2) + (cy[b] - y).powi(2);
+                    da.total_cmp(&db)
+                })
+                .unwrap()
+        };
+        let mut l: Vec<f64> = cx
+            .iter()
+            .map(|&x| if x < 0.0 { 1.0 } else { -1.0 })
+            .collect();
+        let (neg_in_w, pos_out) = (nearest(-0.07, 0.0), nearest(0.07, 0.0));
+        l[neg_in_w] = -1.0;
+        l[pos_out] = 1.0;
+        (model.triangles, l, cx, neg_in_w, pos_out)
+    }
+
+    #[test]
+    fn text_rule_smooths_outliers() {
+        let (tris, l, cx, neg_in_w, pos_out) = synthetic();
+        let w = wrinkle_free_faces(&tris, &l, WRule::Text);
+        assert!(w[neg_in_w], "a compressed face surrounded by W joins W");
+        assert!(!w[pos_out], "an isolated tension face stays out of W");
+        for (f, &x) in cx.iter().enumerate() {
+            if x < -0.03 {
+                assert!(w[f], "face {f} at x {x}");
+            }
+            if x > 0.03 {
+                assert!(!w[f], "face {f} at x {x}");
+            }
+        }
+    }
+
+    #[test]
+    fn reference_rule_fills_by_vertices() {
+        let (tris, l, cx, neg_in_w, pos_out) = synthetic();
+        let w = wrinkle_free_faces(&tris, &l, WRule::Reference);
+        assert!(w[neg_in_w] && w[pos_out]);
+        for (f, &x) in cx.iter().enumerate() {
+            if x < 0.0 {
+                assert!(w[f]);
+            }
+        }
+        // λ_c = 0 exactly: W under the reference's ≥ 0, not under the text's > 0
+        let zero = vec![0.0; tris.len()];
+        assert!(wrinkle_free_faces(&tris, &zero, WRule::Reference)
+            .iter()
+            .all(|&x| x));
+        assert!(wrinkle_free_faces(&tris, &zero, WRule::Text)
+            .iter()
+            .all(|&x| !x));
+        // pure tension: every face in W
+        let pos = vec![0.01; tris.len()];
+        assert!(wrinkle_free_faces(&tris, &pos, WRule::Text)
+            .iter()
+            .all(|&x| x));
+    }
+
+    #[test]
+    fn initialization_on_the_twisted_cylinder() {
+        let model = Scene::twisted_cylinder(24, 9, 10.0).assemble().unwrap();
+        let r = solve_base(&model, &BaseOptions::default(), &mut no_progress()).unwrap();
+        let strains = face_strains(&model.rest_forms, &r.mesh);
+        let lc: Vec<f64> = strains.iter().map(|s| s.lambda_c).collect();
+        let w = wrinkle_free_faces(&model.triangles, &lc, WRule::Text);
+        let mut clamped = vec![false; model.positions.len()];
+        for &(v, _) in &model.clamps {
+            clamped[v as usize] = true;
+        }
+        let k = 0.01;
+        let init = initial_face_field(&r.mesh, &model.rest_forms, &strains, &w, &clamped, k);
+        let max_a = init.face_amplitude.iter().fold(0.0f64, |m, &a| m.max(a));
+        assert!((max_a - k).abs() < 1e-15);
+        assert!(init.vertex_amplitude.iter().all(|&a| a >= 0.0));
+        assert!(clamped
+            .iter()
+            .zip(&init.vertex_amplitude)
+            .all(|(&c, &a)| !c || a == 0.0));
+        let mut active = 0;
+        for (f, s) in strains.iter().enumerate() {
+            let a = init.face_amplitude[f];
+            if a == 0.0 {
+                continue;
+            }
+            active += 1;
+            // eq. 2.8: ½ a² |ω|²_Ī = |λ_c|, |ω|²_Ī = ωᵀ Ī⁻¹ ω
+            let r = model.rest_forms[f];
+            let o = init.face_omega[f];
+            let det = r[0] * r[2] - r[1] * r[1];
+            let n2 = (r[2] * o[0] * o[0] - 2.0 * r[1] * o[0] * o[1] + r[0] * o[1] * o[1]) / det;
+            assert!((0.5 * a * a * n2 - s.lambda_c.abs()).abs() < 1e-12 * s.lambda_c.abs());
+        }
+        assert!(active > model.triangles.len() / 2);
+        // combing: neighbouring wave vectors agree in sign almost everywhere
+        let nb = face_neighbours(&model.triangles);
+        let (mut agree, mut pairs) = (0, 0);
+        for (f, nbf) in nb.iter().enumerate() {
+            for &g in nbf {
+                if f < g && init.face_amplitude[f] > 0.0 && init.face_amplitude[g] > 0.0 {
+                    pairs += 1;
+                    let (a, b) = (
+                        embedded_wave_vector(&r.mesh, f, init.face_omega[f]),
+                        embedded_wave_vector(&r.mesh, g, init.face_omega[g]),
+                    );
+                    if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] >= 0.0 {
+                        agree += 1;
+                    }
+                }
+            }
+        }
+        assert!(agree as f64 >= 0.95 * pairs as f64, "{agree} of {pairs}");
+        // Helmholtz projection: curl-free on every non-W face
+        let p = helmholtz_projection(&r.mesh, &model.rest_forms, &init.face_omega, &w).unwrap();
+        assert!(p.curl_residual <= 1e-10, "{}", p.curl_residual);
+        assert!(p.omega.iter().any(|&x| x.abs() > 1e-3));
+    }
+
+    #[test]
+    fn projection_of_an_exact_differential_returns_it() {
+        let model = small_sheet(9, 6).assemble().unwrap();
+        let base = TriMesh::new(model.positions.clone(), model.triangles.clone()).unwrap();
+        let psi = |v: u32| {
+            let p = model.positions[v as usize];
+            30.0 * p[0] + 50.0 * p[1]
+        };
+        let face_omega: Vec<[f64; 2]> = model
+            .triangles
+            .iter()
+            .map(|t| [psi(t[1]) - psi(t[0]), psi(t[2]) - psi(t[0])])
+            .collect();
+        let w = vec![false; model.triangles.len()];
+        let p = helmholtz_projection(&base, &model.rest_forms, &face_omega, &w).unwrap();
+        assert!(p.curl_residual <= 1e-10, "{}", p.curl_residual);
+        for (e, &o) in base.edges().edges.iter().zip(&p.omega) {
+            let want = psi(e.0[1]) - psi(e.0[0]);
+            assert!(
+                (o - want).abs() <= 1e-6 * want.abs().max(1e-3),
+                "{o} vs {want}"
+            );
+        }
+    }
+}
+
+#[test]
+fn pure_compression_is_reported_out_of_scope_without_panic() {
+    // every boundary vertex pushed inward to 0.97 × its rest position: all faces slack
+    let (nx, ny) = (9, 5);
+    let mut scene = small_sheet(nx, ny);
+    let boundary: Vec<u32> = (0..nx * ny)
+        .filter(|&k| k % nx == 0 || k % nx == nx - 1 || k / nx == 0 || k / nx == ny - 1)
+        .map(|k| k as u32)
+        .collect();
+    let panel = &mut scene.panels[0];
+    let init: Vec<[f64; 3]> = panel
+        .positions
+        .as_ref()
+        .unwrap()
+        .iter()
+        .map(|p| [0.97 * p[0], 0.97 * p[1], 0.0])
+        .collect();
+    panel.positions = Some(init);
+    scene.dirichlet = vec![Dirichlet {
+        panel: 0,
+        vertices: boundary,
+        motion: Motion::default(),
+    }];
+    let model = scene.assemble().unwrap();
+    let r = solve_base(&model, &BaseOptions::default(), &mut no_progress()).unwrap();
+    assert!(r.strain.slack_area_fraction > 0.99, "{:?}", r.strain);
+    assert!(
+        r.warnings.iter().any(|w| w.contains("out of scope")),
+        "{:?}",
+        r.warnings
+    );
+    assert_eq!(r.energies.membrane, 0.0);
+}
