@@ -191,6 +191,9 @@ fn c_programs_pass() {
                 }
             }
         }
+        if stem == "threads" {
+            extra.push("-pthread".into());
+        }
         let exe = out_dir.join(&stem);
         compile(src, &exe, &libdir, cxx, &extra);
         run(&exe, valgrind);
