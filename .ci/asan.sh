@@ -51,6 +51,12 @@ for src in examples_c/*.c examples_c/*.cpp; do
   ran=$((ran + 1))
 done
 echo "=== tsan: threads"
+# libpleat is not instrumented: the hand-off of a call to pleat's pool threads (rayon's latches,
+# plain atomics in uninstrumented code) is invisible to TSan, which then reports the pool
+# thread's memcpy of the caller's parameter struct as a race. Ignore interceptor accesses made
+# from libpleat itself; every access by the C program is still checked.
+printf 'called_from_lib:libpleat.so.0\ncalled_from_lib:libpleat.so\n' >"$out/tsan.supp"
+export TSAN_OPTIONS="$TSAN_OPTIONS:suppressions=$out/tsan.supp"
 cc -std=c99 "${flags[@]}" -fsanitize=thread -pthread examples_c/threads.c -o "$out/threads_tsan" -lpleat -lm
 "$out/threads_tsan" >"$out/threads_tsan.log" 2>&1 || { cat "$out/threads_tsan.log"; echo "FAILED: threads under TSan"; exit 1; }
 tail -1 "$out/threads_tsan.log"
