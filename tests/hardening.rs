@@ -117,9 +117,9 @@ fn base64(data: &[u8]) -> String {
         let n = c
             .iter()
             .enumerate()
-            .fold(0u32, |n, (i, &b)| n | (b as u32) << (16 - 8 * i));
+            .fold(0u32, |n, (i, &b)| n | (u32::from(b) << (16 - 8 * i)));
         for i in 0..=c.len() {
-            s.push(A[(n >> (18 - 6 * i) & 63) as usize] as char);
+            s.push(char::from(A[((n >> (18 - 6 * i)) & 63) as usize]));
         }
         for _ in c.len()..3 {
             s.push('=');
