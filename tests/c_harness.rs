@@ -200,9 +200,14 @@ fn c_programs_pass() {
                 }
             }
         }
+        if stem == "threads" {
+            extra.push("-pthread".into());
+        }
         let exe = out_dir.join(&stem);
         compile(src, &exe, &libdir, cxx, &extra);
-        run(&exe, valgrind);
+        // threads.c bakes 17 LODs on 4 host threads: minutes under memcheck, which serializes
+        // threads. It runs natively here and under ASan and TSan in .ci/asan.sh.
+        run(&exe, valgrind && stem != "threads");
         ran += 1;
     }
     assert!(ran > 0, "no C program ran");

@@ -293,7 +293,7 @@ fn cancellation_is_prompt() {
     assert_eq!(calls, 5);
 }
 
-/// Same bytes for 1, 2 and 3 threads. The first simplification pass evaluates batches of
+/// Same bytes for 1, 2, 3 and 8 threads. The first simplification pass evaluates batches of
 /// collapses in parallel (on offset surfaces of at least 2048 faces, which both cases reach)
 /// and the offset stage is parallel too; a cage exercises the guard's cage checks in batches.
 #[test]
@@ -309,7 +309,7 @@ fn output_does_not_depend_on_thread_count() {
     for (np, cage) in [(100.0, false), (200.0, false), (100.0, true)] {
         let (one, stats) = run(1, np, cage);
         assert!(stats.faces_offset >= 2048);
-        for n in [2, 3] {
+        for n in [2, 3, 8] {
             assert_eq!(
                 one,
                 run(n, np, cage).0,

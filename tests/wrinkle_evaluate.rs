@@ -308,7 +308,7 @@ fn output_bytes_do_not_depend_on_thread_count() {
             .unwrap();
         pool.install(|| cwf.evaluate(4, &with_z()).unwrap().0)
     };
-    let (a, b) = (run(1), run(2));
+    let (a, b, c) = (run(1), run(2), run(8));
     let bits = |e: &Evaluated| {
         let mut v: Vec<u64> = e
             .mesh
@@ -334,9 +334,11 @@ fn output_bytes_do_not_depend_on_thread_count() {
         v
     };
     assert_eq!(bits(&a), bits(&b));
+    assert_eq!(bits(&a), bits(&c));
     assert_eq!(a.mesh.triangles(), b.mesh.triangles());
+    assert_eq!(a.mesh.triangles(), c.mesh.triangles());
     println!(
-        "1 vs 2 threads: {} output values identical bit for bit",
+        "1 vs 2 vs 8 threads: {} output values identical bit for bit",
         bits(&a).len()
     );
 }

@@ -508,7 +508,7 @@ fn deterministic_across_thread_counts() {
     let m = disk(4, 13);
     let a = plane_wave(&m, [2.0 * PI, 0.0, 0.0], 0.01);
     let b = plane_wave(&m, [0.0, 2.0 * PI, 0.0], 0.02);
-    let texts: Vec<String> = [1, 2]
+    let texts: Vec<String> = [1, 2, 8]
         .iter()
         .map(|&n| {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -518,7 +518,10 @@ fn deterministic_across_thread_counts() {
             pool.install(|| animation_to_string(&interpolate(&a, &b, &small_opts()).unwrap().0))
         })
         .collect();
-    assert!(texts[0] == texts[1], "output depends on the thread count");
+    assert!(
+        texts[0] == texts[1] && texts[0] == texts[2],
+        "output depends on the thread count (1, 2, 8)"
+    );
 }
 
 /// The matrix-free trust-region solver (default) and the direct damped Newton solver (exact

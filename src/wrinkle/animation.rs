@@ -82,6 +82,17 @@ impl CwfAnimation {
         if substeps == 0 {
             return crate::invalid_arg!("substeps must be ≥ 1");
         }
+        // `frame_count() = N'·k + 1` must be representable (a `.cwfa` header may claim any k).
+        if (omega.len() - 1)
+            .checked_mul(substeps)
+            .and_then(|n| n.checked_add(1))
+            .is_none()
+        {
+            return crate::invalid_arg!(
+                "{} guide intervals × {substeps} substeps: the frame count overflows",
+                omega.len() - 1
+            );
+        }
         for a in &amplitude {
             if a.len() != nv || a.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
                 return crate::invalid_arg!(

@@ -210,6 +210,7 @@ fn validate(doc: &Document, name: &str) -> Result<()> {
             format!("the file requires glTF extension {ext}, which pleat cannot read"),
         ));
     }
+    check_attribute_indices(root, name)?;
     let mut first_error = None;
     root.validate(root, ::gltf::json::Path::new, &mut |path, error| {
         let path = path();
@@ -218,6 +219,28 @@ fn validate(doc: &Document, name: &str) -> Result<()> {
         }
     });
     first_error.map_or(Ok(()), |e| Err(parse_error(name, e)))
+}
+
+/// Checks that every primitive attribute names an existing accessor. gltf-json 1.4's
+/// validation indexes `accessors` with the POSITION index unchecked and panics on an
+/// out-of-range one (found by `fuzz/fuzz_targets/gltf.rs`), so this runs before it.
+fn check_attribute_indices(root: &::gltf::json::Root, name: &str) -> Result<()> {
+    let n = root.accessors.len();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            if let Some(bad) = prim.attributes.values().find(|a| a.value() >= n) {
+                return Err(parse_error(
+                    name,
+                    format!(
+                        "invalid glTF: mesh {m} primitive {p}: attribute accessor {} does not \
+                         exist ({n} accessors)",
+                        bad.value()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn load_buffers(

@@ -1,0 +1,310 @@
+//! Regression tests for issue 15 (hardening): defects found by fuzzing and while writing the
+//! fuzz targets (fuzz/), and the resource-exhaustion cases — headers claiming huge counts,
+//! deeply nested glTF, coordinates near 1e±300, a screen size that would need 100 GB. Each must
+//! end in a clear status before any large allocation, within seconds, and never panic.
+
+use std::time::{Duration, Instant};
+
+use pleat::mesh::io::{read_mesh_bytes, MeshFormat};
+use pleat::mesh::TriMesh;
+use pleat::Error;
+
+/// Runs `f`, asserting it returns within `secs` seconds.
+fn within<T>(secs: u64, what: &str, f: impl FnOnce() -> T) -> T {
+    let t = Instant::now();
+    let r = f();
+    let dt = t.elapsed();
+    assert!(dt < Duration::from_secs(secs), "{what} took {dt:?}");
+    println!("{what}: {dt:?}");
+    r
+}
+
+fn parse_err(data: &[u8], format: MeshFormat, what: &str) -> String {
+    let r = within(5, what, || read_mesh_bytes(data, format, what));
+    match r {
+        Err(e @ Error::Parse { .. }) => {
+            println!("  {e}");
+            e.to_string()
+        }
+        other => panic!("{what}: expected a parse error, got {other:?}"),
+    }
+}
+
+fn tet_ply_binary(vertex_claim: &str, face_claim: &str) -> Vec<u8> {
+    let mut b = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {vertex_claim}\nproperty double x\n\
+         property double y\nproperty double z\nelement face {face_claim}\n\
+         property list uchar uint vertex_indices\nend_header\n"
+    )
+    .into_bytes();
+    for p in [
+        [0.0f64, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ] {
+        for c in p {
+            b.extend(c.to_le_bytes());
+        }
+    }
+    for t in [[0u32, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]] {
+        b.push(3);
+        for v in t {
+            b.extend(v.to_le_bytes());
+        }
+    }
+    b
+}
+
+#[test]
+fn ply_and_off_headers_claiming_huge_counts_fail_fast() {
+    for (v, f) in [
+        ("4000000000", "4"),
+        ("4", "100000000"),
+        ("18446744073709551615", "4"),
+    ] {
+        parse_err(
+            &tet_ply_binary(v, f),
+            MeshFormat::Ply,
+            &format!("PLY claiming {v}/{f}"),
+        );
+    }
+    let ascii = b"ply\nformat ascii 1.0\nelement vertex 3000000000\nproperty float x\n\
+                  property float y\nproperty float z\nelement face 1\n\
+                  property list uchar int vertex_indices\nend_header\n0 0 0\n";
+    parse_err(ascii, MeshFormat::Ply, "ASCII PLY claiming 3e9 vertices");
+    let off = b"OFF\n4000000000 100000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    parse_err(off, MeshFormat::Off, "OFF claiming 4e9 vertices, 1e8 faces");
+}
+
+#[test]
+fn stl_claiming_100m_triangles_in_a_small_file_fails_fast() {
+    let mut b = vec![b' '; 80];
+    b.extend(100_000_000u32.to_le_bytes());
+    b.extend(vec![0u8; 50 * 4]);
+    // the header does not start with "solid", so this is binary: 50 bytes per claimed facet
+    parse_err(&b, MeshFormat::Stl, "binary STL claiming 1e8 triangles");
+}
+
+/// A minimal glTF JSON document around `accessors`/`nodes`, with one 48-byte buffer of four
+/// float positions... in a data URI.
+fn gltf_doc(accessors: &str, bufferviews: &str, nodes: &str, primitive: &str) -> Vec<u8> {
+    let mut buf = Vec::new();
+    for p in [
+        [0.0f32, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ] {
+        for c in p {
+            buf.extend(c.to_le_bytes());
+        }
+    }
+    let b64 = base64(&buf);
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":{nodes},
+        "meshes":[{{"primitives":[{primitive}]}}],"accessors":{accessors},
+        "bufferViews":{bufferviews},
+        "buffers":[{{"byteLength":48,"uri":"data:application/octet-stream;base64,{b64}"}}]}}"#
+    )
+    .into_bytes()
+}
+
+fn base64(data: &[u8]) -> String {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::new();
+    for c in data.chunks(3) {
+        let n = c
+            .iter()
+            .enumerate()
+            .fold(0u32, |n, (i, &b)| n | (u32::from(b) << (16 - 8 * i)));
+        for i in 0..=c.len() {
+            s.push(char::from(A[((n >> (18 - 6 * i)) & 63) as usize]));
+        }
+        for _ in c.len()..3 {
+            s.push('=');
+        }
+    }
+    s
+}
+
+#[test]
+fn gltf_accessor_counts_beyond_the_data_fail_fast() {
+    // POSITION accessor claiming 1e9 elements in a 48-byte view
+    let doc = gltf_doc(
+        r#"[{"bufferView":0,"componentType":5126,"count":1000000000,"type":"VEC3","min":[0,0,0],"max":[1,1,1]}]"#,
+        r#"[{"buffer":0,"byteLength":48}]"#,
+        r#"[{"mesh":0}]"#,
+        r#"{"attributes":{"POSITION":0}}"#,
+    );
+    parse_err(
+        &doc,
+        MeshFormat::Gltf,
+        "glTF accessor claiming 1e9 positions",
+    );
+    // an index accessor without a buffer view (all zeros by the spec) claiming 4e9 indices
+    let doc = gltf_doc(
+        r#"[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,1]},
+            {"componentType":5125,"count":4000000000,"type":"SCALAR"}]"#,
+        r#"[{"buffer":0,"byteLength":48}]"#,
+        r#"[{"mesh":0}]"#,
+        r#"{"attributes":{"POSITION":0},"indices":1}"#,
+    );
+    parse_err(
+        &doc,
+        MeshFormat::Gltf,
+        "glTF view-less accessor claiming 4e9 indices",
+    );
+}
+
+#[test]
+fn gltf_position_accessor_out_of_range_is_a_parse_error_not_a_panic() {
+    // found by fuzz/fuzz_targets/gltf.rs: gltf-json's validation indexed `accessors` with the
+    // POSITION index unchecked and panicked
+    let doc = gltf_doc(
+        r#"[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,1]}]"#,
+        r#"[{"buffer":0,"byteLength":48}]"#,
+        r#"[{"mesh":0}]"#,
+        r#"{"attributes":{"POSITION":5}}"#,
+    );
+    let msg = parse_err(&doc, MeshFormat::Gltf, "glTF POSITION accessor 5 of 1");
+    assert!(msg.contains("accessor 5 does not exist"), "{msg}");
+    let glb = include_bytes!("../fuzz/seeds/gltf/regress_position_accessor_out_of_range.glb");
+    parse_err(&glb[1..], MeshFormat::Glb, "fuzz crash input (GLB)");
+}
+
+#[test]
+fn deeply_nested_gltf_nodes_are_read_without_recursion() {
+    // a chain of 20 000 nodes, each the only child of the previous, the last holding the mesh
+    let n = 20_000;
+    let mut nodes: Vec<String> = (0..n - 1)
+        .map(|i| format!(r#"{{"children":[{}]}}"#, i + 1))
+        .collect();
+    nodes.push(r#"{"mesh":0}"#.into());
+    let doc = gltf_doc(
+        r#"[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,1]}]"#,
+        r#"[{"buffer":0,"byteLength":48}]"#,
+        &format!("[{}]", nodes.join(",")),
+        r#"{"attributes":{"POSITION":0}}"#,
+    );
+    let m = within(10, "glTF with 20000 nested nodes", || {
+        read_mesh_bytes(&doc, MeshFormat::Gltf, "nested.gltf")
+    })
+    .expect("a deep but valid node tree");
+    assert_eq!(m.vertex_count(), 4);
+    // a node that is its own descendant: an error, not a loop
+    let doc = gltf_doc(
+        r#"[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,1]}]"#,
+        r#"[{"buffer":0,"byteLength":48}]"#,
+        r#"[{"children":[1]},{"children":[0],"mesh":0}]"#,
+        r#"{"attributes":{"POSITION":0}}"#,
+    );
+    within(5, "glTF node cycle", || {
+        read_mesh_bytes(&doc, MeshFormat::Gltf, "cycle.gltf")
+    })
+    .expect_err("a node cycle");
+}
+
+#[test]
+fn deeply_nested_gltf_json_is_an_error_not_a_stack_overflow() {
+    let deep = format!(
+        r#"{{"asset":{{"version":"2.0"}},"extras":{}{}}}"#,
+        "[".repeat(100_000),
+        "]".repeat(100_000)
+    );
+    parse_err(
+        deep.as_bytes(),
+        MeshFormat::Gltf,
+        "glTF JSON nested 1e5 deep",
+    );
+}
+
+#[cfg(feature = "wrinkle")]
+#[test]
+fn cwfa_substeps_that_overflow_the_frame_count_are_rejected() {
+    // found while writing fuzz/fuzz_targets/cwfa.rs: `substeps 18446744073709551615` made frame_count()
+    // overflow (a panic in debug builds, a wrong count in release)
+    use pleat::wrinkle::{parse_animation, Complex, Cwf, CwfAnimation};
+    let base = TriMesh::new(
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        vec![[0, 1, 2]],
+    )
+    .unwrap();
+    let key = Cwf::new(
+        base.clone(),
+        vec![0.0; 3],
+        vec![0.1; 3],
+        vec![Complex::ONE; 3],
+    )
+    .unwrap();
+    let guides = || (vec![vec![0.0; 3]; 3], vec![vec![Complex::ONE; 3]; 3]);
+    let (w, z) = guides();
+    let err = CwfAnimation::from_guides(&key, [vec![0.1; 3], vec![0.1; 3]], w, z, usize::MAX)
+        .unwrap_err();
+    assert!(err.to_string().contains("overflows"), "{err}");
+    let (w, z) = guides();
+    let ok = CwfAnimation::from_guides(&key, [vec![0.1; 3], vec![0.1; 3]], w, z, 7).unwrap();
+    assert_eq!(ok.frame_count(), 15);
+    let text = pleat::wrinkle::animation_to_string(&ok)
+        .replace("substeps 7", &format!("substeps {}", usize::MAX));
+    let err = parse_animation(&text, base, "huge-substeps.cwfa").unwrap_err();
+    println!("{err}");
+}
+
+#[cfg(feature = "lod")]
+mod lod_limits {
+    use super::*;
+    use pleat::lowpoly::{generate, LodParams};
+
+    fn tetra(scale: f64) -> TriMesh {
+        let p = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        TriMesh::new(
+            p.iter().map(|v| v.map(|c| c * scale)).collect(),
+            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        )
+        .unwrap()
+    }
+
+    fn bake(m: &TriMesh, np: f64) -> pleat::Result<TriMesh> {
+        let p = LodParams {
+            screen_size: np,
+            max_rounds: 2,
+            ..LodParams::default()
+        };
+        generate(m, &p, &mut |_| true).map(|(m, _)| m)
+    }
+
+    #[test]
+    fn a_screen_size_needing_100_gb_is_refused_before_allocating() {
+        // (1e5)^3 grid cells: far beyond the default 2 GiB budget
+        let r = within(5, "n_p = 1e5", || bake(&tetra(1.0), 1e5));
+        match r {
+            Err(Error::LimitExceeded(m)) => println!("  {m}"),
+            other => panic!(
+                "expected LimitExceeded, got {:?}",
+                other.map(|m| m.triangle_count())
+            ),
+        }
+    }
+
+    #[test]
+    fn coordinates_near_1e300_and_1e_minus_300_get_a_clear_answer() {
+        for scale in [1e300, 1e-300, 1e-310] {
+            let r = within(
+                30,
+                &format!("LOD of a tetrahedron scaled by {scale:e}"),
+                || bake(&tetra(scale), 8.0),
+            );
+            match r {
+                Ok(m) => assert!(m.positions().iter().flatten().all(|c| c.is_finite())),
+                Err(Error::Internal(m)) => panic!("internal error at scale {scale:e}: {m}"),
+                Err(e) => println!("  scale {scale:e}: {e}"),
+            }
+        }
+    }
+}
