@@ -146,8 +146,12 @@ pub fn rasterize(view: &View, positions: &[[f64; 3]], triangles: &[[u32; 3]]) ->
         for j in lo[1]..hi[1] {
             for i in lo[0]..hi[0] {
                 let c = [i as f64 + 0.5, j as f64 + 0.5, 0.0];
-                let lam = [edge(s[1], s[2], c), edge(s[2], s[0], c), edge(s[0], s[1], c)]
-                    .map(|e| e / area);
+                let lam = [
+                    edge(s[1], s[2], c),
+                    edge(s[2], s[0], c),
+                    edge(s[0], s[1], c),
+                ]
+                .map(|e| e / area);
                 if lam.iter().any(|&l| l < 0.0) {
                     continue;
                 }
@@ -456,10 +460,12 @@ impl Surface for ReferenceSurface<'_> {
     fn base_color(&self, t: usize, b: [f64; 3]) -> [f64; 3] {
         let p = self.point(t, b);
         let mesh = &self.app.mesh;
-        let Some(c) = self
-            .bvh
-            .closest_point(mesh.positions(), mesh.triangles(), p.to_array(), f64::INFINITY)
-        else {
+        let Some(c) = self.bvh.closest_point(
+            mesh.positions(),
+            mesh.triangles(),
+            p.to_array(),
+            f64::INFINITY,
+        ) else {
             return [0.0; 3];
         };
         let tri = c.triangle as usize;
@@ -675,7 +681,10 @@ mod tests {
         let g = rasterize(&v, &pos, &[[0, 1, 2], [3, 4, 5]]);
         let near = g.hit.iter().flatten().filter(|h| h.0 == 1).count();
         let far = g.hit.iter().flatten().filter(|h| h.0 == 0).count();
-        assert!(near > 0 && far > 0, "the far one shows beyond the near one's edge");
+        assert!(
+            near > 0 && far > 0,
+            "the far one shows beyond the near one's edge"
+        );
         // At the screen centre of the near triangle, the near one wins.
         let c = v.project(Vec3::new(0.25, 0.25, 0.5)).unwrap();
         let k = c[1] as usize * 32 + c[0] as usize;
