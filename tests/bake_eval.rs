@@ -41,7 +41,7 @@ fn field(p: Vec3) -> [f64; 3] {
     std::array::from_fn(|k| 0.5 + 0.5 * (PI * f[k] * d[k].dot(p) + k as f64).sin())
 }
 
-/// A UV sphere of about `2 nu (nu/2 − 1)` triangles textured with [`field`] at `w × w/2`,
+/// A UV sphere of `2 nu (nu/2 − 1)` triangles textured with [`field`] at `w × w/2`,
 /// as a one-level GLB written by pleat's own writer (so read back exactly like an asset).
 fn sphere_glb(nu: u32, w: u32) -> Vec<u8> {
     let nv = nu / 2;
@@ -474,7 +474,7 @@ fn the_seam_check_sees_bleeding() {
 fn write_sphere_100k() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/bake_eval");
     std::fs::create_dir_all(&dir).unwrap();
-    let glb = sphere_glb(448, 2048);
+    let glb = sphere_glb(316, 2048);
     let app = read_appearance_bytes(&glb, None, "sphere").unwrap();
     eprintln!("{} faces", app.mesh.triangle_count());
     std::fs::write(dir.join("sphere_100k.glb"), glb).unwrap();
@@ -536,4 +536,60 @@ fn readme_picture() {
     std::fs::create_dir_all(root.join("docs")).unwrap();
     std::fs::write(root.join("docs/bake_lods.png"), &png).unwrap();
     eprintln!("docs/bake_lods.png: {}×{}, {} bytes", w, h, png.len());
+}
+
+/// The speed target: a 1024² bake of a ~1k-face LOD of `target/bake_eval/sphere_100k.glb`
+/// (`write_sphere_100k`), stage by stage, best of 3. The LOD (`PLEAT_NP`, default 400) is
+/// cached as `target/bake_eval/sphere_100k_lod<n_p>.obj`.
+#[test]
+#[ignore = "speed benchmark; run with --release after write_sphere_100k"]
+fn bake_speed() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/bake_eval");
+    let app = read_appearance(&dir.join("sphere_100k.glb")).unwrap();
+    let n_p: f64 = std::env::var("PLEAT_NP")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(400.0);
+    let cache = dir.join(format!("sphere_100k_lod{n_p}.obj"));
+    let lod = match pleat::mesh::io::read_mesh(&cache) {
+        Ok(m) => m,
+        Err(_) => {
+            let params = LodParams {
+                screen_size: n_p,
+                ..LodParams::default()
+            };
+            let (m, _) = pleat::lowpoly::generate(&app.mesh, &params, &mut |_| true).unwrap();
+            pleat::mesh::io::write_mesh(&cache, &m).unwrap();
+            m
+        }
+    };
+    let mut params = BakeParams::default();
+    params.atlas.size = Some(1024);
+    let t = std::time::Instant::now();
+    let index = pleat::bake::InputIndex::new(&app.mesh);
+    eprintln!("input index {:.3} s", t.elapsed().as_secs_f64());
+    for _ in 0..3 {
+        let l = pleat::bake::bake_level(&app, &index, &lod, n_p, &params).unwrap();
+        let r = &l.report;
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        l.material.base_color.as_ref().map(|i| &i.rgba).hash(&mut h);
+        l.material.normal.as_ref().map(|i| &i.rgba).hash(&mut h);
+        format!("{:?}", l.uvs).hash(&mut h);
+        eprintln!("output hash {:016x}", h.finish());
+        eprintln!(
+            "{} → {} faces, {}²: total {:.3} s = atlas {:.3} + tangents {:.3} + raster {:.3} + \
+             sample {:.3} + dilate {:.3} + measure {:.3}",
+            app.mesh.triangle_count(),
+            lod.triangle_count(),
+            r.texture_size,
+            r.total_seconds,
+            r.atlas_seconds,
+            r.tangent_seconds,
+            r.raster_seconds,
+            r.sample_seconds,
+            r.dilate_seconds,
+            r.measure_seconds
+        );
+    }
 }
