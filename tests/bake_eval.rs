@@ -204,8 +204,15 @@ fn publish_targets() {
             .filter(|p| p.extension().is_some_and(|x| x == "glb"))
             .collect();
         files.sort();
+        // `PLEAT_ASSETS=a.glb,b.glb` restricts the table to those files.
+        let only: Option<Vec<String>> = std::env::var("PLEAT_ASSETS")
+            .ok()
+            .map(|s| s.split(',').map(String::from).collect());
         for f in files {
             let name = f.file_name().unwrap().to_string_lossy().to_string();
+            if only.as_ref().is_some_and(|o| !o.contains(&name)) {
+                continue;
+            }
             cases.push((name, read_appearance(&f).unwrap()));
         }
     }
@@ -487,7 +494,7 @@ fn write_sphere_100k() {
 fn readme_picture() {
     let Some(dir) = assets() else { return };
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let rows = ["gen_elephant_sin.glb", "gen_torus_normalmap.glb"];
+    let rows = ["gen_spot_two_materials.glb", "gen_torus_normalmap.glb"];
     let sizes = [200.0, 100.0, 50.0];
     let mut tiles: Vec<Vec<Image8>> = vec![];
     for name in rows {
