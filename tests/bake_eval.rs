@@ -196,7 +196,7 @@ fn shared_torus_normal_map_earns_its_place() {
 #[ignore = "publishes the README numbers; run with --release"]
 fn publish_targets() {
     let mut cases: Vec<(String, Appearance)> =
-        vec![("generated sphere 18k".into(), sphere(96, 512))];
+        vec![("generated sphere 9k".into(), sphere(96, 512))];
     if let Some(dir) = assets() {
         let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
             .unwrap()

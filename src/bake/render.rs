@@ -81,7 +81,7 @@ impl View {
     pub fn project(&self, p: Vec3) -> Option<[f64; 3]> {
         let d = p - self.eye;
         let z = d.dot(self.forward);
-        if !(z > 1e-9) {
+        if z.is_nan() || z <= 1e-9 {
             return None;
         }
         let c = 0.5 * f64::from(self.side);
