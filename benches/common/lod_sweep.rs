@@ -150,6 +150,61 @@ pub struct Row {
     pub faces_offset: u64,
     pub reruns_exact: u64,
     pub stages: Vec<(String, f64)>,
+    /// `--bake`: the textured bake of the output (`pleat::bake::bake_level`, evaluated).
+    pub bake: Option<BakeCols>,
+}
+
+/// The bake columns of a row (`pleat bench lod --bake`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BakeCols {
+    /// Wall seconds of the level's bake (`BakeReport::total_seconds`, evaluation excluded).
+    pub seconds: f64,
+    /// Side of the square textures.
+    pub texture_size: u32,
+    /// Texels covered by charts.
+    pub texels_covered: u64,
+    /// Unlit PSNR of the level against the input over 24 views (`BakeReport::appearance_psnr_db`).
+    pub psnr_db: f64,
+    /// The closest-point reference's PSNR (`BakeReport::appearance_psnr_reference_db`).
+    pub psnr_reference_db: f64,
+    /// Normal-map PSNR gain (`BakeReport::normal_map_gain_db`; NaN without a normal map).
+    pub normal_gain_db: f64,
+}
+
+/// Bake columns of the CSV, in order.
+pub const BAKE_COLUMNS: [&str; 6] = [
+    "bake_s",
+    "texture_size",
+    "texels_covered",
+    "psnr_db",
+    "psnr_reference_db",
+    "normal_gain_db",
+];
+
+impl BakeCols {
+    /// The columns of a [`pleat::bake::BakeReport`] (NaN where not measured).
+    #[cfg(feature = "bake")]
+    pub fn of(r: &pleat::bake::BakeReport) -> BakeCols {
+        BakeCols {
+            seconds: r.total_seconds,
+            texture_size: r.texture_size,
+            texels_covered: r.texels_covered,
+            psnr_db: r.appearance_psnr_db.unwrap_or(f64::NAN),
+            psnr_reference_db: r.appearance_psnr_reference_db.unwrap_or(f64::NAN),
+            normal_gain_db: r.normal_map_gain_db.unwrap_or(f64::NAN),
+        }
+    }
+
+    fn fields(&self) -> [String; 6] {
+        [
+            format!("{:.4}", self.seconds),
+            self.texture_size.to_string(),
+            self.texels_covered.to_string(),
+            num(self.psnr_db),
+            num(self.psnr_reference_db),
+            num(self.normal_gain_db),
+        ]
+    }
 }
 
 impl Row {
@@ -219,6 +274,7 @@ pub fn parse_csv(text: &str) -> Result<(Vec<Row>, bool), String> {
         need("self_intersection_free")?,
     ];
     let cage_cols = col("encloses").zip(col("untouched"));
+    let bake_cols: Option<Vec<usize>> = BAKE_COLUMNS.iter().map(|c| col(c)).collect();
     let cpu = col("cpu_seconds");
     let mut rows = Vec::new();
     for line in lines.filter(|l| !l.trim().is_empty()) {
@@ -257,6 +313,17 @@ pub fn parse_csv(text: &str) -> Result<(Vec<Row>, bool), String> {
                 .and_then(|i| get(i).parse().ok())
                 .unwrap_or(0),
             stages,
+            bake: bake_cols.as_ref().and_then(|b| {
+                let seconds = num(b[0]);
+                seconds.is_finite().then(|| BakeCols {
+                    seconds,
+                    texture_size: get(b[1]).parse().unwrap_or(0),
+                    texels_covered: get(b[2]).parse().unwrap_or(0),
+                    psnr_db: num(b[3]),
+                    psnr_reference_db: num(b[4]),
+                    normal_gain_db: num(b[5]),
+                })
+            }),
         });
     }
     Ok((rows, cage_cols.is_some()))
@@ -435,9 +502,22 @@ pub fn csv_text(rows: &[Row], cage: bool) -> String {
     for st in STAGES {
         let _ = write!(s, ",{st}_s");
     }
+    let bake = rows.iter().any(|r| r.bake.is_some());
+    if bake {
+        for c in BAKE_COLUMNS {
+            let _ = write!(s, ",{c}");
+        }
+    }
     s.push('\n');
     for r in rows {
         s.push_str(&csv_line(r, cage));
+        if bake {
+            let f = r.bake.map_or_else(Default::default, |b| b.fields());
+            for x in f {
+                s.push(',');
+                s.push_str(&x);
+            }
+        }
         s.push('\n');
     }
     s
@@ -501,7 +581,13 @@ fn csv_line(r: &Row, cage: bool) -> String {
 /// One progress line per case.
 pub fn row_line(r: &Row) -> String {
     if r.ok() || r.status.starts_with("ok") {
-        format!(
+        let bake = r.bake.map_or(String::new(), |b| {
+            format!(
+                "  bake {:.2} s {}² PSNR {:.2} dB (ref {:.2}) normal {:+.2} dB",
+                b.seconds, b.texture_size, b.psnr_db, b.psnr_reference_db, b.normal_gain_db
+            )
+        });
+        let line = format!(
             "{:<34} n_p={:<5} {:>6} -> {:>5} faces  {:>7.2} s ({:>6.2} s cpu)  HD/l={:.4}  {}",
             r.mesh,
             r.n_p,
@@ -511,7 +597,8 @@ pub fn row_line(r: &Row) -> String {
             r.cpu_seconds,
             r.hausdorff_over_l,
             if r.valid() { "valid" } else { "INVALID" }
-        )
+        );
+        line + &bake
     } else {
         format!("{:<34} n_p={:<5} {}", r.mesh, r.n_p, r.status)
     }

@@ -79,6 +79,10 @@ pub struct BakeParams {
     /// At most this many texels are compared with the input for the appearance error
     /// (0 skips the measurement). Default 20 000.
     pub error_samples: usize,
+    /// After the bake (outside `total_seconds`), render the input and the level from 24 views
+    /// with [`super::render::evaluate`] and fill the report's `appearance_psnr_db`,
+    /// `appearance_psnr_reference_db` and `normal_map_gain_db`. Default false.
+    pub evaluate: bool,
 }
 
 impl Default for BakeParams {
@@ -88,6 +92,7 @@ impl Default for BakeParams {
             envelope_d: 3.0,
             normal_map: true,
             error_samples: 20_000,
+            evaluate: false,
         }
     }
 }
@@ -128,6 +133,19 @@ pub struct BakeReport {
     pub appearance_error_p95: f64,
     /// Maximum of the same error, in 1/255.
     pub appearance_error_max: f64,
+    /// With [`BakeParams::evaluate`]: unlit PSNR (dB) of the level's render against the
+    /// input's, mean over 24 views at the level's screen size, over pixels both cover
+    /// ([`super::render`]).
+    pub appearance_psnr_db: Option<f64>,
+    /// With [`BakeParams::evaluate`]: the same PSNR for the level's geometry coloured by the
+    /// input at the closest input point (a perfect bake's score; the bake loses
+    /// `appearance_psnr_reference_db − appearance_psnr_db`).
+    pub appearance_psnr_reference_db: Option<f64>,
+    /// With [`BakeParams::evaluate`] and a baked normal map: shaded PSNR with the normal map
+    /// minus shaded PSNR without it, dB (> 0: the map brings the level closer to the input).
+    pub normal_map_gain_db: Option<f64>,
+    /// Seconds spent on the evaluation renders (not in `total_seconds`).
+    pub evaluate_seconds: f64,
 }
 
 /// An 8-bit RGBA image, row-major, row 0 at the top (glTF's v = 0).
@@ -268,7 +286,21 @@ pub fn bake_level_with_progress(
         bake_vertex_colors(app, index, lod, screen_size, &prov, params, &mut steps)?
     };
     level.report.total_seconds = start.elapsed().as_secs_f64();
+    if params.evaluate {
+        evaluate_into(app, &mut level);
+    }
     Ok(level)
+}
+
+/// Fills the report's evaluation fields ([`BakeParams::evaluate`]).
+fn evaluate_into(app: &Appearance, level: &mut BakedLevel) {
+    let t = Instant::now();
+    let e = super::render::evaluate(app, level, &super::render::EvalParams::default());
+    let finite = |x: f64| x.is_finite().then_some(x);
+    level.report.appearance_psnr_db = finite(e.appearance_psnr_db);
+    level.report.appearance_psnr_reference_db = finite(e.reference_psnr_db);
+    level.report.normal_map_gain_db = e.normal_map_gain_db.and_then(finite);
+    level.report.evaluate_seconds = t.elapsed().as_secs_f64();
 }
 
 /// The material fields that are not baked: from the input's first material.

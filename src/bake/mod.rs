@@ -10,6 +10,8 @@
 //! - [`bake`](mod@bake): per-texel sampling, MikkTSpace normal map, dilation; vertex colours
 //!   for untextured inputs.
 //! - [`output`]: a `.glb` with every level (`MSFT_lod`, `MSFT_screencoverage`).
+//! - [`render`]: an independent software rasterizer measuring a bake (PSNR of renders of the
+//!   input and a level, normal-map gain); evaluation only.
 //!
 //! Each level's [`BakeReport`] gives seconds per stage, texels, charts and the appearance
 //! error.
@@ -20,6 +22,7 @@ pub mod atlas;
 pub mod bake;
 pub mod output;
 pub mod provenance;
+pub mod render;
 
 pub use appearance::{
     read_appearance, read_appearance_bytes, Appearance, AppearanceBuffers, BufferMaterial,

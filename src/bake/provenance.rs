@@ -107,25 +107,25 @@ impl<'a> InputIndex<'a> {
         if !(envelope > 0.0 && envelope.is_finite()) {
             return None;
         }
-        let a = p - n * envelope;
-        let b = p + n * envelope;
-        let lo = a.min(b).to_array();
-        let hi = a.max(b).to_array();
+        // The segment is searched in rings of |s| nearest to `p` first ([0, e/3], then
+        // [e/3, 2e/3] on both sides, then [2e/3, e]), each through the BVH boxes of its pieces
+        // (slightly enlarged against rounding): smaller boxes meet far fewer triangles than the
+        // whole segment's box, and once a hit lies inside the rings searched, no later ring can
+        // hold a nearer one. The result is the hit minimising (|s|, triangle) as over the whole
+        // segment.
+        const RINGS: [f64; 4] = [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0];
+        let margin = 1e-6 * envelope;
         let mut best: Option<(f64, u32, [f64; 3])> = None;
-        for t in self.bvh.query_box(lo, hi) {
-            let tri = self.mesh.triangle_positions(t as usize).map(Vec3::from);
-            let Some((s, bary)) = ray_triangle(p, n, &tri) else {
-                continue;
-            };
-            if s.abs() > envelope {
-                continue;
+        for k in 0..3 {
+            let (r0, r1) = (RINGS[k] * envelope, RINGS[k + 1] * envelope);
+            if k == 0 {
+                self.cast_piece(p, n, (-r1, r1), margin, envelope, &mut best);
+            } else {
+                self.cast_piece(p, n, (r0, r1), margin, envelope, &mut best);
+                self.cast_piece(p, n, (-r1, -r0), margin, envelope, &mut best);
             }
-            let better = match best {
-                None => true,
-                Some((bs, bt, _)) => s.abs() < bs.abs() || (s.abs() == bs.abs() && t < bt),
-            };
-            if better {
-                best = Some((s, t, bary));
+            if best.is_some_and(|(bs, ..)| bs.abs() < r1 * (1.0 - 1e-9)) {
+                break;
             }
         }
         let (s, t, bary) = best?;
@@ -138,6 +138,40 @@ impl<'a> InputIndex<'a> {
             distance: s.abs(),
             by_ray: true,
         })
+    }
+
+    /// Updates `best` (lexicographic minimum of `(|s|, triangle)`) with the hits of the ray
+    /// `p + s·n`, `|s| ≤ envelope`, on the triangles whose boxes meet the box of the piece
+    /// `s ∈ [s0, s1]` enlarged by `margin`.
+    fn cast_piece(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        (s0, s1): (f64, f64),
+        margin: f64,
+        envelope: f64,
+        best: &mut Option<(f64, u32, [f64; 3])>,
+    ) {
+        let a = p + n * s0;
+        let b = p + n * s1;
+        let lo = (a.min(b) - Vec3::splat(margin)).to_array();
+        let hi = (a.max(b) + Vec3::splat(margin)).to_array();
+        for t in self.bvh.query_box(lo, hi) {
+            let tri = self.mesh.triangle_positions(t as usize).map(Vec3::from);
+            let Some((s, bary)) = ray_triangle(p, n, &tri) else {
+                continue;
+            };
+            if s.abs() > envelope {
+                continue;
+            }
+            let better = match *best {
+                None => true,
+                Some((bs, bt, _)) => s.abs() < bs.abs() || (s.abs() == bs.abs() && t < bt),
+            };
+            if better {
+                *best = Some((s, t, bary));
+            }
+        }
     }
 
     /// [`query`](Self::query) for many points in parallel; `normals[i]` belongs to

@@ -477,6 +477,7 @@ pub(super) mod imp {
             envelope_d: p.envelope_d,
             normal_map,
             error_samples: p.error_samples as usize,
+            evaluate: false,
         };
         Ok((params, p.screen_size))
     }

@@ -10,6 +10,11 @@
 //! - `lod_bench.svg`: Hausdorff/l against seconds, both log scale, one polyline per mesh
 //!   (points in `n_p` order) and the mean over the meshes.
 //!
+//! With `--bake` (feature `bake`) the folder is one of textured glTF assets (default
+//! `../shared/assets/textured`): each LOD is also baked ([`pleat::bake::bake_level`], with the
+//! evaluation renders of `pleat::bake::render`), adding the columns `bake_s`, `texture_size`,
+//! `texels_covered`, `psnr_db`, `psnr_reference_db` and `normal_gain_db`.
+//!
 //! A failing mesh (unreadable, rejected, error or panic inside the bake) becomes a CSV row with
 //! its status; the sweep always continues.
 //!
@@ -63,6 +68,12 @@ pub struct LodBenchArgs {
     /// write the merged CSV and its SVG to OUT_DIR.
     #[arg(long, value_delimiter = ',')]
     pub from_csv: Vec<PathBuf>,
+    /// Also bake every LOD with the input's materials (glTF inputs only; default folder
+    /// ../shared/assets/textured) and add the bake columns: seconds, texture size, covered
+    /// texels, PSNR of renders against the input and its closest-point reference, normal-map
+    /// gain.
+    #[arg(long, conflicts_with = "cage")]
+    pub bake: bool,
     /// No progress bar and no summary table.
     #[arg(short, long)]
     pub quiet: bool,
@@ -85,12 +96,17 @@ fn sweep(args: &LodBenchArgs) -> Result<(), (u8, String)> {
     if !args.from_csv.is_empty() {
         return replot(args);
     }
+    let default_dir = if args.bake {
+        "../shared/assets/textured"
+    } else {
+        "../shared/meshes"
+    };
     let dir = args
         .dir
         .clone()
-        .unwrap_or_else(|| PathBuf::from("../shared/meshes"));
+        .unwrap_or_else(|| PathBuf::from(default_dir));
     check_arguments(args)?;
-    let files = list_meshes(&dir).map_err(|e| (EXIT_INPUT, e))?;
+    let files = list_meshes(&dir, args.bake).map_err(|e| (EXIT_INPUT, e))?;
     let targets = match &args.faces_from_meshopt {
         Some(p) => read_face_targets(p).map_err(|e| (EXIT_INPUT, e))?,
         None => HashMap::new(),
@@ -114,7 +130,7 @@ fn sweep(args: &LodBenchArgs) -> Result<(), (u8, String)> {
             b.set_position(base);
             b.set_message(format!("{name}: loading"));
         }
-        let mesh = match load(file, args.max_input_faces) {
+        let input = match load(file, args.max_input_faces, args.bake) {
             Ok(m) => m,
             Err(status) => {
                 rows.push(Row {
@@ -126,6 +142,7 @@ fn sweep(args: &LodBenchArgs) -> Result<(), (u8, String)> {
                 continue;
             }
         };
+        let mesh = input.mesh();
         for (j, &n_p) in sizes.iter().enumerate() {
             let job = base + (j * 1000) as u64;
             let mut prog = |p: pleat::Progress<'_>| {
@@ -136,7 +153,10 @@ fn sweep(args: &LodBenchArgs) -> Result<(), (u8, String)> {
                 true
             };
             let target = targets.get(&(name.clone(), n_p.to_bits())).copied();
-            let (row, out) = bake_case(&name, &mesh, n_p, target, args.cage, &mut prog);
+            let (mut row, out) = bake_case(&name, mesh, n_p, target, args.cage, &mut prog);
+            if let (Some(out), true) = (&out, row.ok()) {
+                input.bake(&mut row, out);
+            }
             if let (true, Some(out)) = (args.keep_meshes, out) {
                 keep_mesh(&args.out_dir, &name, n_p, &out);
             }
@@ -218,31 +238,96 @@ fn check_arguments(args: &LodBenchArgs) -> Result<(), (u8, String)> {
             ),
         ));
     }
+    if args.bake && !cfg!(feature = "bake") {
+        return Err((EXIT_INPUT, "--bake needs the `bake` feature".into()));
+    }
     if args.cage && !cfg!(feature = "cage") {
         return Err((EXIT_INPUT, "--cage needs the `cage` feature".into()));
     }
     Ok(())
 }
 
-/// The mesh files of `dir`, sorted by name; an error when there is none.
-fn list_meshes(dir: &Path) -> Result<Vec<PathBuf>, String> {
-    let files = mesh_files(dir, &MESH_EXTENSIONS)?;
+/// The mesh files of `dir` (glTF only with `bake`), sorted by name; an error when there is
+/// none.
+fn list_meshes(dir: &Path, bake: bool) -> Result<Vec<PathBuf>, String> {
+    let ext: &[&str] = if bake {
+        &["glb", "gltf"]
+    } else {
+        &MESH_EXTENSIONS
+    };
+    let files = mesh_files(dir, ext)?;
     if files.is_empty() {
         return Err(format!("no mesh files in {}", dir.display()));
     }
     Ok(files)
 }
 
-/// Reads a mesh; `Err(status)` when it cannot be read or is over the size limit.
-fn load(file: &Path, max_faces: Option<usize>) -> Result<TriMesh, String> {
-    let mesh = read_mesh(file).map_err(|e| format!("load error: {e}"))?;
-    match max_faces {
-        Some(n) if mesh.triangle_count() > n => Err(format!(
-            "skipped: {} input triangles > --max-input-faces {n}",
-            mesh.triangle_count()
-        )),
-        _ => Ok(mesh),
+/// What a case is made from: a mesh, or (`--bake`) a glTF asset's appearance.
+enum Input {
+    Mesh(TriMesh),
+    #[cfg(feature = "bake")]
+    Textured(Box<pleat::bake::Appearance>),
+}
+
+impl Input {
+    fn mesh(&self) -> &TriMesh {
+        match self {
+            Input::Mesh(m) => m,
+            #[cfg(feature = "bake")]
+            Input::Textured(a) => &a.mesh,
+        }
     }
+
+    /// Bakes `out` (a LOD of this input at `row.n_p`) and fills the row's bake columns; a
+    /// failed bake becomes the row's status.
+    fn bake(&self, row: &mut Row, out: &TriMesh) {
+        match self {
+            Input::Mesh(_) => {
+                let _ = (row, out);
+            }
+            #[cfg(feature = "bake")]
+            Input::Textured(app) => {
+                let index = pleat::bake::InputIndex::new(&app.mesh);
+                let params = pleat::bake::BakeParams {
+                    evaluate: true,
+                    ..Default::default()
+                };
+                match pleat::bake::bake_level(app, &index, out, row.n_p, &params) {
+                    Ok(level) => row.bake = Some(lod_sweep::BakeCols::of(&level.report)),
+                    Err(e) => row.status = format!("bake error: {e}"),
+                }
+            }
+        }
+    }
+}
+
+/// Reads a mesh (with `bake`, a glTF asset's appearance); `Err(status)` when it cannot be read
+/// or is over the size limit.
+fn load(file: &Path, max_faces: Option<usize>, bake: bool) -> Result<Input, String> {
+    let input = if bake {
+        read_textured(file)?
+    } else {
+        Input::Mesh(read_mesh(file).map_err(|e| format!("load error: {e}"))?)
+    };
+    match max_faces {
+        Some(n) if input.mesh().triangle_count() > n => Err(format!(
+            "skipped: {} input triangles > --max-input-faces {n}",
+            input.mesh().triangle_count()
+        )),
+        _ => Ok(input),
+    }
+}
+
+#[cfg(feature = "bake")]
+fn read_textured(file: &Path) -> Result<Input, String> {
+    pleat::bake::read_appearance(file)
+        .map(|a| Input::Textured(Box::new(a)))
+        .map_err(|e| format!("load error: {e}"))
+}
+
+#[cfg(not(feature = "bake"))]
+fn read_textured(_file: &Path) -> Result<Input, String> {
+    Err("--bake needs the `bake` feature".into())
 }
 
 /// Writes `out` to `OUT_DIR/meshes/<mesh stem>_<n_p>.obj`, warning on failure.
