@@ -146,6 +146,9 @@ pub struct Row {
     pub self_intersection_free: bool,
     /// Cage mode: `(encloses every input vertex, touches no input triangle)`.
     pub cage: Option<(bool, bool)>,
+    /// Cage mode: `(exact min clearance / d, required clearance / d, kept)` from the report
+    /// (`LodReport::clearance`, measured by `pleat::verify`).
+    pub clearance: Option<(f64, f64, bool)>,
     pub rounds: u64,
     pub faces_offset: u64,
     pub reruns_exact: u64,
@@ -219,6 +222,9 @@ pub fn parse_csv(text: &str) -> Result<(Vec<Row>, bool), String> {
         need("self_intersection_free")?,
     ];
     let cage_cols = col("encloses").zip(col("untouched"));
+    let clearance_cols = col("min_clearance_over_d")
+        .zip(col("clearance_over_d"))
+        .zip(col("clearance_kept"));
     let cpu = col("cpu_seconds");
     let mut rows = Vec::new();
     for line in lines.filter(|l| !l.trim().is_empty()) {
@@ -249,6 +255,7 @@ pub fn parse_csv(text: &str) -> Result<(Vec<Row>, bool), String> {
             manifold: flag(c[8]),
             self_intersection_free: flag(c[9]),
             cage: cage_cols.map(|(e, u)| (flag(e), flag(u))),
+            clearance: clearance_cols.map(|((m, r), k)| (num(m), num(r), flag(k))),
             rounds: col("rounds").and_then(|i| get(i).parse().ok()).unwrap_or(0),
             faces_offset: col("faces_offset")
                 .and_then(|i| get(i).parse().ok())
@@ -378,6 +385,9 @@ fn fill_from_output(row: &mut Row, input: &TriMesh, out: &TriMesh, stats: &LodRe
     row.self_intersection_free = v.self_intersection_free;
     if cage {
         row.cage = Some(cage_flags(out, input));
+        row.clearance = stats
+            .clearance
+            .map(|c| (c.min / stats.d, c.required / stats.d, c.kept));
     }
     if !row.valid() {
         row.status = "ok (INVALID output)".into();
@@ -429,7 +439,7 @@ pub fn csv_text(rows: &[Row], cage: bool) -> String {
          self_intersection_free",
     );
     if cage {
-        s.push_str(",encloses,untouched");
+        s.push_str(",encloses,untouched,min_clearance_over_d,clearance_over_d,clearance_kept");
     }
     s.push_str(",rounds,faces_offset,reruns_exact");
     for st in STAGES {
@@ -487,6 +497,14 @@ fn csv_line(r: &Row, cage: bool) -> String {
         let (e, u) = r.cage.unwrap_or((false, false));
         f.push(flag(e));
         f.push(flag(u));
+        match r.clearance {
+            Some((m, req, k)) if ok => {
+                f.push(num(m));
+                f.push(num(req));
+                f.push(flag(k));
+            }
+            _ => f.extend([String::new(), String::new(), String::new()]),
+        }
     }
     for c in [r.rounds, r.faces_offset, r.reruns_exact] {
         f.push(if ok { c.to_string() } else { String::new() });
