@@ -56,6 +56,10 @@
 // distance measurement per level.
 #define PLEAT_LOD_MEASURE_FLOOR 2
 
+// `PleatLodParams::flags` bit: `PleatLodParams::clearance` is a length in model units
+// instead of a fraction of the offset distance d.
+#define PLEAT_LOD_CLEARANCE_ABSOLUTE 4
+
 // `pleat_mesh_check` flag: skip the self-intersection test (the most expensive part);
 // `self_intersections_checked` is then 0.
 #define PLEAT_CHECK_SKIP_SELF_INTERSECTIONS 1
@@ -293,6 +297,12 @@ typedef struct PleatLodParams {
   // Upper bound on the bake's memory in bytes (default 2 GiB); exceeding the estimate fails
   // with `PLEAT_STATUS_LIMIT_EXCEEDED` before the expensive work.
   uint64_t memory_budget_bytes;
+  // Cages only: the distance the cage keeps from the input, as a fraction of d (default
+  // 0.25: a quarter pixel at the cage's screen size, see README "Cages with clearance"), or
+  // in model units with `PLEAT_LOD_CLEARANCE_ABSOLUTE`. Must be >= 0 and below d; 0 keeps
+  // only "no contact". Appended for issue 12; callers with an older `struct_size` get the
+  // default.
+  double clearance;
 } PleatLodParams;
 
 // Statistics of one baked level, filled when a non-NULL pointer is passed. Set `struct_size`
@@ -351,6 +361,16 @@ typedef struct PleatLodStats {
   // `hausdorff_in_to_out_relative` (input the offset hides). NaN otherwise. Its time is
   // the stats stage `floor` and is included in `seconds_total`.
   double hausdorff_floor_relative;
+  // Cages: the exact minimum distance between the cage's and the input's triangles, in
+  // model units, measured independently of the guard (not sampled). NaN for LODs.
+  double min_clearance;
+  // Cages: `min_clearance / l`. NaN for LODs.
+  double min_clearance_relative;
+  // Cages: the clearance that was required, in model units. NaN for LODs.
+  double clearance_required;
+  // Cages: 1 when `min_clearance >= clearance_required`; 0 when the cage could not keep
+  // the clearance (it still encloses without contact — see `encloses_input`). LODs: 0.
+  uint32_t clearance_kept;
 } PleatLodStats;
 
 // Parameters of `pleat_offset_surface`. Get defaults from `pleat_offset_params_default()` and
@@ -735,8 +755,11 @@ PleatStatus pleat_lod_generate(const struct PleatMesh *input,
                                struct PleatLodStats *stats);
 
 // Bakes a cage of `input` (any triangle soup): watertight, manifold, self-intersection-free,
-// enclosing every input vertex without touching the input, at offset d = l / n_p.
-// Parameters as `pleat_lod_generate`; `stats->encloses_input` reports the verification.
+// enclosing every input vertex without touching the input, at offset d = l / n_p, and keeping
+// `params->clearance` from it. Parameters as `pleat_lod_generate`; `stats->encloses_input`
+// reports the verification, `stats->min_clearance` the exact measured clearance and
+// `stats->clearance_kept` whether the requested one was kept (0 when the start surface was
+// already closer: the call still succeeds — check the flag).
 // Returns `PLEAT_STATUS_UNSUPPORTED` when built without the `cage` feature.
 //
 // # Safety

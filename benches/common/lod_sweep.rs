@@ -304,6 +304,7 @@ pub fn bake_case(
     n_p: f64,
     target: Option<usize>,
     cage: bool,
+    clearance: Option<pleat::lowpoly::Clearance>,
     prog: &mut pleat::report::ProgressFn<'_>,
 ) -> (Row, Option<TriMesh>) {
     let mut row = Row {
@@ -317,6 +318,7 @@ pub fn bake_case(
         screen_size: n_p,
         target_faces: target,
         measure_floor: true,
+        clearance: clearance.unwrap_or_default(),
         ..Default::default()
     };
     let mut run = timed(|| {

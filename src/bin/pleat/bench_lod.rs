@@ -48,6 +48,10 @@ pub struct LodBenchArgs {
     /// Bake cages instead of LODs (adds the enclosure and contact columns).
     #[arg(long)]
     pub cage: bool,
+    /// With --cage: the clearance, `0.25d` (fraction of d, the default) or a length in model
+    /// units (see `pleat cage --clearance`).
+    #[arg(long, value_parser = super::parse_clearance)]
+    pub clearance: Option<pleat::lowpoly::Clearance>,
     /// Face target per (mesh, n_p) from a CSV with columns `mesh`, `n_p`, `meshopt_faces`
     /// (the one `cargo bench --bench lod` writes) [default: target/bench/lod_vs_meshopt.csv].
     #[arg(long, num_args = 0..=1, default_missing_value = "target/bench/lod_vs_meshopt.csv")]
@@ -136,7 +140,15 @@ fn sweep(args: &LodBenchArgs) -> Result<(), (u8, String)> {
                 true
             };
             let target = targets.get(&(name.clone(), n_p.to_bits())).copied();
-            let (row, out) = bake_case(&name, &mesh, n_p, target, args.cage, &mut prog);
+            let (row, out) = bake_case(
+                &name,
+                &mesh,
+                n_p,
+                target,
+                args.cage,
+                args.clearance,
+                &mut prog,
+            );
             if let (true, Some(out)) = (args.keep_meshes, out) {
                 keep_mesh(&args.out_dir, &name, n_p, &out);
             }
