@@ -245,8 +245,16 @@ fn cages_keep_their_clearance() {
             assert_eq!(c.required, frac * s.d, "{what}");
             assert!(c.kept, "{what}: not kept ({c:?})");
             let brute = brute_force_gap(&out, &m);
-            assert_eq!(c.min, brute, "{what}: report {} vs brute force {brute}", c.min);
-            assert!(c.min >= frac * s.d && c.min <= s.d, "{what}: {c:?}, d = {}", s.d);
+            assert_eq!(
+                c.min, brute,
+                "{what}: report {} vs brute force {brute}",
+                c.min
+            );
+            assert!(
+                c.min >= frac * s.d && c.min <= s.d,
+                "{what}: {c:?}, d = {}",
+                s.d
+            );
             assert_eq!(c.min_rel, c.min / m.bbox_diagonal());
             gaps.push(c.min);
         }

@@ -578,7 +578,8 @@ impl<'a> Guard<'a> {
         if new_gap >= c {
             return Ok(());
         }
-        let old_gap = patch_gap(self.input, s.old_patch.iter().copied(), c, false, st).unwrap_or(0.0);
+        let old_gap =
+            patch_gap(self.input, s.old_patch.iter().copied(), c, false, st).unwrap_or(0.0);
         if new_gap >= old_gap {
             Ok(())
         } else {
@@ -630,7 +631,10 @@ fn patch_gap(
         let (lo, hi) = bbox(t);
         let pad = Vec3::splat(best);
         let tv = t.map(Vec3::from);
-        for i in input.bvh.query_box((lo - pad).to_array(), (hi + pad).to_array()) {
+        for i in input
+            .bvh
+            .query_box((lo - pad).to_array(), (hi + pad).to_array())
+        {
             let it = input.triangle(i);
             let gap = box_gap((lo, hi), bbox(it));
             if gap >= best && !(test_contact && gap == 0.0) {

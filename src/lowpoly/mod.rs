@@ -39,6 +39,6 @@ pub use pipeline::{generate, generate_chain, Clearance, LodParams, DEFAULT_CLEAR
 #[cfg(feature = "cage")]
 pub(crate) use pipeline::{run, run_chain, Mode};
 pub use report::{
-    ClearanceMeasure, ExtractionCounts, FeatureCounts, FloorMeasure, GuardCounts, InteriorCounts, LodReport,
-    LodStage, OffsetReport, OffsetStage, OffsetVerification, SimplifyCounts,
+    ClearanceMeasure, ExtractionCounts, FeatureCounts, FloorMeasure, GuardCounts, InteriorCounts,
+    LodReport, LodStage, OffsetReport, OffsetStage, OffsetVerification, SimplifyCounts,
 };

@@ -297,19 +297,24 @@ mod tests {
     #[test]
     fn segment_segment_cases() {
         // Skew perpendicular segments one unit apart.
-        let d = segment_segment_distance(v(-1., 0., 0.), v(1., 0., 0.), v(0., -1., 1.), v(0., 1., 1.));
+        let d =
+            segment_segment_distance(v(-1., 0., 0.), v(1., 0., 0.), v(0., -1., 1.), v(0., 1., 1.));
         assert!((d - 1.0).abs() < 1e-15);
         // Parallel, overlapping: distance between the lines.
-        let d = segment_segment_distance(v(0., 0., 0.), v(2., 0., 0.), v(1., 0.5, 0.), v(3., 0.5, 0.));
+        let d =
+            segment_segment_distance(v(0., 0., 0.), v(2., 0., 0.), v(1., 0.5, 0.), v(3., 0.5, 0.));
         assert!((d - 0.5).abs() < 1e-15);
         // Collinear, apart: endpoint to endpoint.
-        let d = segment_segment_distance(v(0., 0., 0.), v(1., 0., 0.), v(3., 0., 0.), v(4., 0., 0.));
+        let d =
+            segment_segment_distance(v(0., 0., 0.), v(1., 0., 0.), v(3., 0., 0.), v(4., 0., 0.));
         assert!((d - 2.0).abs() < 1e-15);
         // Points.
-        let d = segment_segment_distance(v(0., 0., 0.), v(0., 0., 0.), v(0., 3., 4.), v(0., 3., 4.));
+        let d =
+            segment_segment_distance(v(0., 0., 0.), v(0., 0., 0.), v(0., 3., 4.), v(0., 3., 4.));
         assert!((d - 5.0).abs() < 1e-15);
         // Closest to an endpoint of one, interior of the other.
-        let d = segment_segment_distance(v(0., 0., 0.), v(1., 0., 0.), v(2., -1., 0.), v(2., 1., 0.));
+        let d =
+            segment_segment_distance(v(0., 0., 0.), v(1., 0., 0.), v(2., -1., 0.), v(2., 1., 0.));
         assert!((d - 1.0).abs() < 1e-15);
     }
 
@@ -328,7 +333,10 @@ mod tests {
         let p = [v(0.2, 0.2, 0.7), v(0.2, 0.2, 3.0), v(0.3, 0.4, 3.0)];
         assert!((disjoint_triangle_distance(&t, &p, 0.0) - 0.7).abs() < 1e-15);
         // Symmetric, and the early exit returns something below the threshold.
-        assert_eq!(disjoint_triangle_distance(&p, &t, 0.0), disjoint_triangle_distance(&t, &p, 0.0));
+        assert_eq!(
+            disjoint_triangle_distance(&p, &t, 0.0),
+            disjoint_triangle_distance(&t, &p, 0.0)
+        );
         assert!(disjoint_triangle_distance(&t, &p, 1.0) < 1.0);
         // A degenerate (segment) triangle.
         let seg = [v(0., 0., 2.), v(1., 1., 2.), v(2., 2., 2.)];
