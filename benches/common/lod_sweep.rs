@@ -531,7 +531,12 @@ pub fn row_line(r: &Row) -> String {
             r.cpu_seconds,
             r.hausdorff_over_l,
             if r.valid() { "valid" } else { "INVALID" }
-        )
+        ) + &r.clearance.map_or(String::new(), |(m, req, kept)| {
+            format!(
+                "  clearance {m:.3} d (required {req:.3} d{})",
+                if kept { "" } else { ", NOT KEPT" }
+            )
+        })
     } else {
         format!("{:<34} n_p={:<5} {}", r.mesh, r.n_p, r.status)
     }
