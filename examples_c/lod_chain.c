@@ -113,10 +113,10 @@ static void bake_cage(const PleatMesh *input) {
     if (!cage) return;
     verify("cage n_p=25", cage);
     CHECK(st.encloses_input == 1);
-    /* The default clearance, a quarter of d, measured exactly (not sampled). */
-    CHECK(params.clearance == 0.25);
+    /* The default clearance, a tenth of d, measured exactly (not sampled). */
+    CHECK(params.clearance == 0.1);
     CHECK(st.clearance_kept == 1);
-    CHECK(st.clearance_required == 0.25 * st.offset_distance);
+    CHECK(st.clearance_required == 0.1 * st.offset_distance);
     CHECK(st.min_clearance >= st.clearance_required);
     CHECK(st.min_clearance_relative > 0.0);
     printf("cage n_p=25: %llu triangles, min clearance %.3g d\n",

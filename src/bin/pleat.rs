@@ -144,7 +144,7 @@ struct BakeArgs {
     /// Skip the feature-alignment step.
     #[arg(long)]
     no_align: bool,
-    /// Cages: the distance kept from the input, a fraction of d with a `d` suffix (`0.25d`,
+    /// Cages: the distance kept from the input, a fraction of d with a `d` suffix (`0.1d`,
     /// the default) or a length in model units (`0.002`); below d. `0d` only forbids contact.
     #[arg(long, value_parser = parse_clearance)]
     clearance: Option<pleat::lowpoly::Clearance>,

@@ -61,7 +61,7 @@ pub struct PleatLodParams {
     /// with `PLEAT_STATUS_LIMIT_EXCEEDED` before the expensive work.
     pub memory_budget_bytes: u64,
     /// Cages only: the distance the cage keeps from the input, as a fraction of d (default
-    /// 0.25: a quarter pixel at the cage's screen size, see README "Cages with clearance"), or
+    /// 0.1: a tenth of a pixel at the cage's screen size, see README "Cages with clearance"), or
     /// in model units with `PLEAT_LOD_CLEARANCE_ABSOLUTE`. Must be >= 0 and below d; 0 keeps
     /// only "no contact". Appended for issue 12; callers with an older `struct_size` get the
     /// default.
@@ -196,7 +196,7 @@ pub(super) fn defaults_without_lod() -> PleatLodParams {
         l0: 4,
         flags: 0,
         memory_budget_bytes: 2 << 30,
-        clearance: 0.25,
+        clearance: 0.1,
     }
 }
 

@@ -40,7 +40,7 @@ use super::report::GuardCounts;
 use crate::geom::{bbox_of, normalized, tri_normal, Vec3};
 use crate::mesh::halfedge::{CollapseRecord, FaceData, FaceId, HalfedgeId, VertexId};
 use crate::mesh::HalfEdgeMesh;
-use crate::spatial::closest::disjoint_triangle_distance;
+use crate::spatial::closest::{disjoint_triangle_distance, plane_gap_lower_bound};
 use crate::spatial::solid_angle;
 use crate::spatial::{self as sp, TriangleBvh};
 
@@ -613,6 +613,10 @@ impl<'a> Guard<'a> {
     }
 }
 
+/// Plane separations below this fraction of `l` never skip a candidate of the clearance
+/// check: there, rounding could hide a contact, which the exact test must decide.
+const PLANE_SKIP_MIN: f64 = 1e-9;
+
 /// The distance between the faces `patch` and the input, capped at `cap` (`> 0`): the exact
 /// minimum triangle–triangle distance over the input triangles whose boxes come within `cap`
 /// of a face's box (BVH query), `cap` when there is none. With `test_contact`, `None` when a
@@ -640,11 +644,17 @@ fn patch_gap(
             if gap >= best && !(test_contact && gap == 0.0) {
                 continue;
             }
+            let itv = it.map(Vec3::from);
+            // Far side of the face's plane by at least `best` (and clearly apart: no contact).
+            let plane = plane_gap_lower_bound(&tv, &itv);
+            if plane >= best && plane > PLANE_SKIP_MIN * input.diag {
+                continue;
+            }
             st.exact_tests += 1;
             if test_contact && touches_input_triangle(&t, &it, input.degenerate[i as usize]) {
                 return None;
             }
-            best = best.min(disjoint_triangle_distance(&tv, &it.map(Vec3::from), 0.0));
+            best = best.min(disjoint_triangle_distance(&tv, &itv, 0.0));
         }
     }
     Some(best)

@@ -263,7 +263,7 @@ impl LodReport {
             e.metric_entry("floor_cpu_seconds", f.cpu_seconds);
         }
         if let Some(c) = &self.clearance {
-            e.metric_entry("clearance", c.required);
+            e.metric_entry("clearance_required", c.required);
             e.metric_entry("min_clearance", c.min);
             e.metric_entry("min_clearance_rel", c.min_rel);
             e.count_entry("clearance_kept", c.kept as u64);

@@ -215,6 +215,27 @@ pub fn disjoint_triangle_distance(a: &[Vec3; 3], b: &[Vec3; 3], below: f64) -> f
     best
 }
 
+/// A lower bound of the distance between the triangle `t` and anything on the far side of
+/// the plane of triangle `f`: when all corners of `t` lie on one side of that plane, the
+/// smallest of their distances to it, else 0. Cheap (one normal, three dot products), it
+/// discards most far candidates of a large triangle whose box is big; 0 for a degenerate `f`.
+pub fn plane_gap_lower_bound(f: &[Vec3; 3], t: &[Vec3; 3]) -> f64 {
+    let n = (f[1] - f[0]).cross(f[2] - f[0]);
+    let len = n.length();
+    if len.is_nan() || len <= 0.0 {
+        return 0.0;
+    }
+    let s = t.map(|p| (p - f[0]).dot(n) / len);
+    let (lo, hi) = (s[0].min(s[1]).min(s[2]), s[0].max(s[1]).max(s[2]));
+    if lo > 0.0 {
+        lo
+    } else if hi < 0.0 {
+        -hi
+    } else {
+        0.0
+    }
+}
+
 /// Barycentric sample points of a triangle on a regular grid with `k` subdivisions per edge
 /// (`k = 1`: the three corners; `k ≥ 2` adds edge and interior points; for `k < 3` the centroid
 /// is added), without the corners when `skip_corners`. Calls `f` for each point, in a fixed
@@ -341,6 +362,18 @@ mod tests {
         // A degenerate (segment) triangle.
         let seg = [v(0., 0., 2.), v(1., 1., 2.), v(2., 2., 2.)];
         assert!((disjoint_triangle_distance(&t, &seg, 0.0) - 2.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn plane_gap_bounds_the_distance() {
+        let f = [v(0., 0., 0.), v(1., 0., 0.), v(0., 1., 0.)];
+        let above = [v(5., 5., 0.5), v(6., 5., 0.7), v(5., 6., 2.)];
+        assert!((plane_gap_lower_bound(&f, &above) - 0.5).abs() < 1e-15);
+        assert!(plane_gap_lower_bound(&f, &above) <= disjoint_triangle_distance(&f, &above, 0.0));
+        let below = above.map(|p| v(p.x, p.y, -p.z));
+        assert!((plane_gap_lower_bound(&f, &below) - 0.5).abs() < 1e-15);
+        let across = [v(5., 5., -0.5), v(6., 5., 0.7), v(5., 6., 2.)];
+        assert_eq!(plane_gap_lower_bound(&f, &across), 0.0);
     }
 
     #[test]

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use crate::geom::Vec3;
 use crate::mesh::TriMesh;
 use crate::spatial::bvh::corners_box;
-use crate::spatial::closest::disjoint_triangle_distance;
+use crate::spatial::closest::{disjoint_triangle_distance, plane_gap_lower_bound};
 use crate::spatial::{
     is_collinear, segment_triangle_intersect, triangles_intersect, FastWindingNumber, TriangleBvh,
 };
@@ -146,14 +146,15 @@ impl<'a> CageInput<'a> {
             if gap >= best {
                 continue;
             }
+            let cv = corners.map(Vec3::from);
+            let plane = plane_gap_lower_bound(&tv, &cv);
+            if plane >= best && plane > 0.0 {
+                continue;
+            }
             if self.meets_triangle(tri, t as usize) {
                 return 0.0;
             }
-            best = best.min(disjoint_triangle_distance(
-                &tv,
-                &corners.map(Vec3::from),
-                0.0,
-            ));
+            best = best.min(disjoint_triangle_distance(&tv, &cv, 0.0));
         }
         best
     }
