@@ -113,6 +113,14 @@ static void bake_cage(const PleatMesh *input) {
     if (!cage) return;
     verify("cage n_p=25", cage);
     CHECK(st.encloses_input == 1);
+    /* The default clearance, a tenth of d, measured exactly (not sampled). */
+    CHECK(params.clearance == 0.1);
+    CHECK(st.clearance_kept == 1);
+    CHECK(st.clearance_required == 0.1 * st.offset_distance);
+    CHECK(st.min_clearance >= st.clearance_required);
+    CHECK(st.min_clearance_relative > 0.0);
+    printf("cage n_p=25: %llu triangles, min clearance %.3g d\n",
+           (unsigned long long)st.face_count, st.min_clearance / st.offset_distance);
     pleat_mesh_destroy(cage);
 }
 

@@ -12,10 +12,76 @@
 #include <stddef.h>
 #include <stdint.h>
 
+// `flags` output bit of the provenance calls: the point was found by the cast along its
+// normal (unset: the closest-point fallback).
+#define PLEAT_PROVENANCE_BY_RAY 1
+
+// `PleatBakeMaterial::uv_layout`: one UV per input vertex.
+#define PLEAT_UV_PER_VERTEX 0
+
+// `PleatBakeMaterial::uv_layout`: one UV per triangle corner (`3 t + k`).
+#define PLEAT_UV_PER_CORNER 1
+
+// `PleatBakeMaterial::wrap`: textures repeat (glTF's default).
+#define PLEAT_WRAP_REPEAT 0
+
+// `PleatBakeMaterial::wrap`: texture coordinates clamp to the edge texels.
+#define PLEAT_WRAP_CLAMP 1
+
+// `PleatBakeMaterial::wrap`: textures repeat mirrored.
+#define PLEAT_WRAP_MIRROR 2
+
+// Baked image: base colour (RGB sRGB-encoded, alpha linear).
+#define PLEAT_BAKE_IMAGE_BASE_COLOR 0
+
+// Baked image: metallic-roughness (G roughness, B metallic; glTF layout).
+#define PLEAT_BAKE_IMAGE_METALLIC_ROUGHNESS 1
+
+// Baked image: occlusion (R = G = B).
+#define PLEAT_BAKE_IMAGE_OCCLUSION 2
+
+// Baked image: emissive (sRGB-encoded).
+#define PLEAT_BAKE_IMAGE_EMISSIVE 3
+
+// Baked image: tangent-space normal map in the MikkTSpace frame of the bake's tangents.
+#define PLEAT_BAKE_IMAGE_NORMAL 4
+
+// `PleatBakeStats::flags` bit: the bake is textured (UVs, tangents and images); unset, the
+// input had no texture and the bake holds vertex colours instead.
+#define PLEAT_BAKE_TEXTURED 1
+
+// Largest input image `pleat_bake_lod` reads, in texels (8192²); larger ones fail with
+// `PLEAT_STATUS_LIMIT_EXCEEDED`.
+#define PLEAT_BAKE_MAX_IMAGE_TEXELS (1 << 26)
+
+// Largest `PleatBakeParams::texture_size`.
+#define PLEAT_BAKE_MAX_TEXTURE_SIZE 8192
+
 // Version of the C ABI. Incremented on any incompatible change to a function signature or to
 // the layout of an existing struct field. Adding functions or appending struct fields (behind
 // `struct_size`) does not change it.
 #define PLEAT_ABI_VERSION 1
+
+// Region growth across shared vertices (the dissertation's n-ring; default).
+#define PLEAT_ADJACENCY_VERTEX 0
+
+// Region growth across shared edges (the reference implementation's dilation).
+#define PLEAT_ADJACENCY_EDGE 1
+
+// Phase of an edit (eq. 3.28): compatibility of the unit phase (the dissertation's text).
+#define PLEAT_EDIT_PHASE_UNIT 0
+
+// Phase of an edit: amplitude-weighted compatibility (the reference implementation).
+#define PLEAT_EDIT_PHASE_AMPLITUDE_WEIGHTED 1
+
+// Face label written by `pleat_cwf_edit`: fixed (copied bit for bit).
+#define PLEAT_FACE_FIXED 0
+
+// Face label: inside an edited region.
+#define PLEAT_FACE_EDIT 1
+
+// Face label: in the solved interface band.
+#define PLEAT_FACE_INTERFACE 2
 
 // `PleatWrinkleInterpStats::stop_reason`: the gradient norm reached the tolerance.
 #define PLEAT_INTERP_STOP_CONVERGED 0
@@ -55,6 +121,10 @@
 // metric `hausdorff_floor_rel`, the input-to-offset-surface distance over `l`); one more
 // distance measurement per level.
 #define PLEAT_LOD_MEASURE_FLOOR 2
+
+// `PleatLodParams::flags` bit: `PleatLodParams::clearance` is a length in model units
+// instead of a fraction of the offset distance d.
+#define PLEAT_LOD_CLEARANCE_ABSOLUTE 4
 
 // `pleat_mesh_check` flag: skip the self-intersection test (the most expensive part);
 // `self_intersections_checked` is then 0.
@@ -169,6 +239,11 @@ typedef int32_t PleatStatsKind;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
+// A baked LOD (opaque): the mesh with atlas UVs, normals, tangents and the baked images, or
+// vertex colours for an untextured input. Made by `pleat_bake_lod`, freed by
+// `pleat_bake_free`; immutable, so it may be read from several threads at once.
+typedef struct PleatBake PleatBake;
+
 // A complex wrinkle field on a base mesh (opaque): ω per edge (pleat's edge numbering),
 // amplitude and unit phase z̃ per vertex, and a private copy of the base mesh (the `PleatMesh`
 // passed at creation may be destroyed afterwards). Created by `pleat_cwf_create*` or
@@ -198,6 +273,261 @@ typedef struct PleatStats PleatStats;
 // `pleat_wrinkle_fields_destroy`. Immutable; thread rules as `PleatCwf`.
 typedef struct PleatWrinkleFields PleatWrinkleFields;
 
+// Parameters of the provenance calls. Get the defaults from
+// `pleat_provenance_params_default()`.
+typedef struct PleatProvenanceParams {
+  // `sizeof(PleatProvenanceParams)`.
+  uint32_t struct_size;
+  // Reserved, 0.
+  uint32_t reserved;
+  // Screen size n_p the LOD was made for (default 200): the cast searches within
+  // `envelope_d · l / n_p` of the point along its normal (`l` the input's bounding-box
+  // diagonal). Finite and > 0.
+  double screen_size;
+  // Envelope in units of `d = l / n_p` (default 3). Finite and > 0.
+  double envelope_d;
+  // Envelope in model units; > 0 overrides `envelope_d` (default 0). Finite, >= 0.
+  double envelope;
+} PleatProvenanceParams;
+
+// An RGBA8 image passed in by the caller: row-major, row 0 at the top (glTF's v = 0),
+// `4 · width · height` bytes. All zero (`rgba` NULL, size 0×0) means "no image".
+typedef struct PleatImage {
+  // The texels, or NULL for no image.
+  const uint8_t *rgba;
+  // Width in texels.
+  uint32_t width;
+  // Height in texels.
+  uint32_t height;
+  // 1: the colour channels are sRGB-encoded (glTF: base colour and emissive); 0: linear
+  // (metallic-roughness, occlusion, normal maps).
+  uint32_t srgb;
+  // Reserved, 0.
+  uint32_t reserved;
+} PleatImage;
+
+// The input's appearance for `pleat_bake_lod`: one metallic-roughness material (glTF
+// semantics) over the whole input, its UV set, optional normals and vertex colours. Get the
+// defaults (glTF's default material, no texture) from `pleat_bake_material_default()`.
+//
+// Pointers are borrowed for the call only. Counts follow the input mesh: `normals` holds
+// `3 · vertex_count` floats, `colors` `4 · vertex_count`, `uvs` `2 · uv_count` where
+// `uv_count` is the vertex count (`PLEAT_UV_PER_VERTEX`) or `3 · triangle_count`
+// (`PLEAT_UV_PER_CORNER`).
+typedef struct PleatBakeMaterial {
+  // `sizeof(PleatBakeMaterial)`.
+  uint32_t struct_size;
+  // `PLEAT_UV_PER_VERTEX` or `PLEAT_UV_PER_CORNER`.
+  uint32_t uv_layout;
+  // UVs (u, v pairs), or NULL when no image is given.
+  const float *uvs;
+  // Number of UV pairs at `uvs` (0 with NULL).
+  size_t uv_count;
+  // Per-vertex shading normals (xyz), or NULL for area-weighted vertex normals.
+  const float *normals;
+  // Per-vertex linear RGBA colours multiplying the base colour, or NULL.
+  const float *colors;
+  // Base colour factor, linear RGBA (default 1, 1, 1, 1).
+  double base_color_factor[4];
+  // Base colour image (usually `srgb = 1`).
+  struct PleatImage base_color;
+  // Metallic factor (default 1).
+  double metallic_factor;
+  // Roughness factor (default 1).
+  double roughness_factor;
+  // Metallic-roughness image (G roughness, B metallic).
+  struct PleatImage metallic_roughness;
+  // Tangent-space normal map (glTF convention).
+  struct PleatImage normal;
+  // Normal scale (default 1).
+  double normal_scale;
+  // Occlusion image (R).
+  struct PleatImage occlusion;
+  // Occlusion strength (default 1).
+  double occlusion_strength;
+  // Emissive factor, linear RGB (default 0).
+  double emissive_factor[3];
+  // Emissive image (usually `srgb = 1`).
+  struct PleatImage emissive;
+  // `PLEAT_WRAP_*` for every image, both axes (default `PLEAT_WRAP_REPEAT`).
+  uint32_t wrap;
+  // Reserved, 0.
+  uint32_t reserved;
+} PleatBakeMaterial;
+
+// Parameters of `pleat_bake_lod`. Get the defaults from `pleat_bake_params_default()`.
+typedef struct PleatBakeParams {
+  // `sizeof(PleatBakeParams)`.
+  uint32_t struct_size;
+  // Side of the square textures in texels, or 0 (default) for the screen-size rule
+  // (`texels_per_pixel · n_p / l` texels per unit length, power of two in 32 … 4096).
+  // At most `PLEAT_BAKE_MAX_TEXTURE_SIZE`.
+  uint32_t texture_size;
+  // Screen size n_p the LOD was made for (default 200). Finite and > 0.
+  double screen_size;
+  // Gutter between charts in texels (default 4), at most 64.
+  uint32_t padding;
+  // Worker threads for this call: 0 (default) = the pool of `pleat_set_thread_count`.
+  // At most 256. The output bytes do not depend on it.
+  uint32_t threads;
+  // Texels per screen pixel of the size rule (default 2). Finite and > 0.
+  double texels_per_pixel;
+  // Provenance envelope in units of d = l / n_p (default 3). Finite and > 0.
+  double envelope_d;
+  // 1 (default): bake a tangent-space normal map; 0: none.
+  uint32_t normal_map;
+  // Texels compared with the input for the appearance error (default 20000; 0 skips it).
+  uint32_t error_samples;
+} PleatBakeParams;
+
+// Progress information passed to a [`PleatProgressFn`].
+typedef struct PleatProgress {
+  // Name of the running stage, NUL-terminated, valid during the callback only.
+  const char *stage;
+  // Fraction of the whole operation done, in [0, 1].
+  double fraction;
+} PleatProgress;
+
+// Progress callback of long operations. Called on the calling thread only, with the caller's
+// `user_data`. Return 0 to continue, non-zero to cancel: the operation then returns
+// `PLEAT_STATUS_CANCELLED` promptly and writes no output.
+typedef int32_t (*PleatProgressFn)(void *user_data, const struct PleatProgress *info);
+
+// Statistics of a bake. Set `struct_size` to `sizeof(PleatBakeStats)`; pleat fills that many
+// bytes.
+typedef struct PleatBakeStats {
+  // In: `sizeof(PleatBakeStats)` as the caller knows it. Out: the bytes pleat filled.
+  uint32_t struct_size;
+  // `PLEAT_BAKE_TEXTURED` when textured.
+  uint32_t flags;
+  // Side of the square textures (0 for vertex colours).
+  uint32_t texture_size;
+  // Charts of the atlas.
+  uint32_t charts;
+  // Texels covered by charts.
+  uint64_t texels_covered;
+  // Texel centres where two atlas triangles overlap (0 for a valid atlas).
+  uint64_t overlapping_texels;
+  // Vertices of the baked mesh.
+  uint64_t vertex_count;
+  // Triangles of the baked mesh.
+  uint64_t triangle_count;
+  // Wall seconds of the whole bake.
+  double seconds_total;
+  // Wall seconds of the UV atlas.
+  double seconds_atlas;
+  // Wall seconds of the MikkTSpace tangents.
+  double seconds_tangents;
+  // Wall seconds of the atlas rasterisation.
+  double seconds_rasterise;
+  // Wall seconds of provenance and material sampling.
+  double seconds_sample;
+  // Wall seconds of the dilation into gutters.
+  double seconds_dilate;
+  // Wall seconds of the appearance-error measurement.
+  double seconds_measure;
+  // Fraction of samples found by the closest-point fallback, in [0, 1].
+  double fallback_fraction;
+  // Mean appearance error (baked vs input base colour at the closest input point, max over
+  // RGB, sRGB units of 1/255).
+  double appearance_error_mean;
+  // 95th percentile of the same error.
+  double appearance_error_p95;
+  // Maximum of the same error.
+  double appearance_error_max;
+} PleatBakeStats;
+
+// Parameters of `pleat_cwf_design`. Get the defaults from `pleat_cwf_design_params_default()`;
+// `struct_size` versioned (at least 8).
+typedef struct PleatCwfDesignParams {
+  // `sizeof(PleatCwfDesignParams)`; at least 8.
+  uint32_t struct_size;
+  // `PLEAT_ADJACENCY_VERTEX` (default) or `PLEAT_ADJACENCY_EDGE`.
+  uint32_t adjacency;
+  // 1 (default): the amplitude equals the source's at each source vertex; 0: soft only.
+  uint32_t pin_sources;
+  // Reserved, set to 0.
+  uint32_t reserved;
+  // Heat time in units of the squared mean edge length, finite, > 0; default 1.
+  double heat_time;
+  // κ of eq. 3.25 (amplitude smoothness), finite, ≥ 0; default 1.
+  double kappa;
+  // γ of eq. 3.25 (curl penalty), finite, ≥ 0; default 1.
+  double gamma;
+  // Multiplier of the data weights `A_j / h̄²`, finite, ≥ 0; default 1.
+  double data_weight;
+} PleatCwfDesignParams;
+
+// Parameters of `pleat_cwf_edit`. Get the defaults from `pleat_cwf_edit_params_default()`;
+// `struct_size` versioned (at least 8).
+typedef struct PleatCwfEditParams {
+  // `sizeof(PleatCwfEditParams)`; at least 8.
+  uint32_t struct_size;
+  // `PLEAT_ADJACENCY_VERTEX` (default) or `PLEAT_ADJACENCY_EDGE` (interface growth).
+  uint32_t adjacency;
+  // `PLEAT_EDIT_PHASE_UNIT` (default) or `PLEAT_EDIT_PHASE_AMPLITUDE_WEIGHTED`.
+  uint32_t phase;
+  // Inverse-iteration steps of the phase solve, 1 to 1,000,000; default 200.
+  uint32_t max_iterations;
+  // ε_ω of eq. 3.26, finite, ≥ 0; default 1e-3.
+  double eps_omega;
+  // ε_a of eq. 3.27, finite, ≥ 0; default 1e-3.
+  double eps_amplitude;
+  // γ of eq. 3.27, finite, ≥ 0; default 1.
+  double gamma;
+  // Inverse-iteration tolerance, finite, > 0; default 1e-12.
+  double tolerance;
+} PleatCwfEditParams;
+
+// One wrinkle source of `pleat_cwf_design` (a plain array element, no `struct_size`).
+typedef struct PleatWrinkleSource {
+  // The source vertex of the base mesh.
+  uint32_t vertex;
+  // Region size in rings of faces, ≥ 1 (5 is the dissertation's GUI default).
+  uint32_t rings;
+  // Wave vector in radians per length unit (its tangential part is used); finite.
+  double wave_vector[3];
+  // Target amplitude (length unit), finite, ≥ 0.
+  double amplitude;
+} PleatWrinkleSource;
+
+// Parameters of Knöppel et al.'s phase solve (used when pleat computes z̃ from ω). Get the
+// defaults from `pleat_knoppel_params_default()`; `struct_size` versioned as
+// `PleatWrinkleEvalParams`.
+typedef struct PleatKnoppelParams {
+  // `sizeof(PleatKnoppelParams)`; at least 8.
+  uint32_t struct_size;
+  // `PLEAT_PHASE_WEIGHTS_COTAN` (default) or `PLEAT_PHASE_WEIGHTS_EDGE_AREA`.
+  uint32_t weights;
+  // Maximum inverse-iteration steps, 1 to 1,000,000; default 200.
+  uint32_t max_iterations;
+  // Reserved, set to 0.
+  uint32_t reserved;
+  // Convergence tolerance on the relative residual, finite, ≥ 0; default 1e-12.
+  double tolerance;
+  // Relative shift of the inverse iteration, finite, in [0, 1); default 1e-9.
+  double shift;
+} PleatKnoppelParams;
+
+// One region of `pleat_cwf_edit` (array element; `struct_size` must be
+// `sizeof(PleatCwfRegionEdit)` in every element).
+typedef struct PleatCwfRegionEdit {
+  // `sizeof(PleatCwfRegionEdit)`.
+  uint32_t struct_size;
+  // Interface band width in rings (≥ 1 unless the region covers the mesh); typical 3.
+  uint32_t interface_rings;
+  // The region's triangles (e.g. from `pleat_mesh_grow_faces`); non-NULL.
+  const uint32_t *faces;
+  // Number of `faces`, ≥ 1.
+  size_t face_count;
+  // Counter-clockwise rotation of the wrinkles about the normals, radians, finite.
+  double rotate_radians;
+  // Frequency scale σ, finite, > 0 (1: unchanged).
+  double frequency_scale;
+  // Amplitude scale μ, finite, ≥ 0 (1/σ keeps a·|ω|).
+  double amplitude_scale;
+} PleatCwfRegionEdit;
+
 // Parameters of `pleat_cwf_interpolate`. Get the defaults from
 // `pleat_wrinkle_interp_params_default()`; `struct_size` versioned as
 // `PleatWrinkleEvalParams`.
@@ -221,19 +551,6 @@ typedef struct PleatWrinkleInterpParams {
   // Reserved, set to 0.
   uint32_t reserved;
 } PleatWrinkleInterpParams;
-
-// Progress information passed to a [`PleatProgressFn`].
-typedef struct PleatProgress {
-  // Name of the running stage, NUL-terminated, valid during the callback only.
-  const char *stage;
-  // Fraction of the whole operation done, in [0, 1].
-  double fraction;
-} PleatProgress;
-
-// Progress callback of long operations. Called on the calling thread only, with the caller's
-// `user_data`. Return 0 to continue, non-zero to cancel: the operation then returns
-// `PLEAT_STATUS_CANCELLED` promptly and writes no output.
-typedef int32_t (*PleatProgressFn)(void *user_data, const struct PleatProgress *info);
 
 // What `pleat_cwf_interpolate` did. Set `struct_size = sizeof(PleatWrinkleInterpStats)`
 // before the call; pleat fills at most that many bytes.
@@ -293,6 +610,12 @@ typedef struct PleatLodParams {
   // Upper bound on the bake's memory in bytes (default 2 GiB); exceeding the estimate fails
   // with `PLEAT_STATUS_LIMIT_EXCEEDED` before the expensive work.
   uint64_t memory_budget_bytes;
+  // Cages only: the distance the cage keeps from the input, as a fraction of d (default
+  // 0.1: a tenth of a pixel at the cage's screen size, see README "Cages with clearance"), or
+  // in model units with `PLEAT_LOD_CLEARANCE_ABSOLUTE`. Must be >= 0 and below d; 0 keeps
+  // only "no contact". Appended for issue 12; callers with an older `struct_size` get the
+  // default.
+  double clearance;
 } PleatLodParams;
 
 // Statistics of one baked level, filled when a non-NULL pointer is passed. Set `struct_size`
@@ -351,6 +674,16 @@ typedef struct PleatLodStats {
   // `hausdorff_in_to_out_relative` (input the offset hides). NaN otherwise. Its time is
   // the stats stage `floor` and is included in `seconds_total`.
   double hausdorff_floor_relative;
+  // Cages: the exact minimum distance between the cage's and the input's triangles, in
+  // model units, measured independently of the guard (not sampled). NaN for LODs.
+  double min_clearance;
+  // Cages: `min_clearance / l`. NaN for LODs.
+  double min_clearance_relative;
+  // Cages: the clearance that was required, in model units. NaN for LODs.
+  double clearance_required;
+  // Cages: 1 when `min_clearance >= clearance_required`; 0 when the cage could not keep
+  // the clearance (it still encloses without contact — see `encloses_input`). LODs: 0.
+  uint32_t clearance_kept;
 } PleatLodStats;
 
 // Parameters of `pleat_offset_surface`. Get defaults from `pleat_offset_params_default()` and
@@ -476,24 +809,6 @@ typedef struct PleatWrinkleEvalParams {
   uint64_t max_output_triangles;
 } PleatWrinkleEvalParams;
 
-// Parameters of Knöppel et al.'s phase solve (used when pleat computes z̃ from ω). Get the
-// defaults from `pleat_knoppel_params_default()`; `struct_size` versioned as
-// `PleatWrinkleEvalParams`.
-typedef struct PleatKnoppelParams {
-  // `sizeof(PleatKnoppelParams)`; at least 8.
-  uint32_t struct_size;
-  // `PLEAT_PHASE_WEIGHTS_COTAN` (default) or `PLEAT_PHASE_WEIGHTS_EDGE_AREA`.
-  uint32_t weights;
-  // Maximum inverse-iteration steps, 1 to 1,000,000; default 200.
-  uint32_t max_iterations;
-  // Reserved, set to 0.
-  uint32_t reserved;
-  // Convergence tolerance on the relative residual, finite, ≥ 0; default 1e-12.
-  double tolerance;
-  // Relative shift of the inverse iteration, finite, in [0, 1); default 1e-9.
-  double shift;
-} PleatKnoppelParams;
-
 // Outcome of the Knöppel phase solve of a `PleatCwf` (`pleat_cwf_get_knoppel_report`).
 typedef struct PleatKnoppelReport {
   // In: `sizeof(PleatKnoppelReport)` (≥ 8). Out: bytes filled.
@@ -532,6 +847,197 @@ typedef struct PleatWrinkleEvalStats {
 extern "C" {
 #endif // __cplusplus
 
+// The provenance defaults (n_p = 200, envelope 3 d), with `struct_size` set.
+struct PleatProvenanceParams pleat_provenance_params_default(void);
+
+// glTF's default material with no texture and no UVs, with `struct_size` set.
+struct PleatBakeMaterial pleat_bake_material_default(void);
+
+// The bake defaults (`crate::bake::BakeParams::default()`, n_p = 200), with `struct_size`
+// set.
+struct PleatBakeParams pleat_bake_params_default(void);
+
+// Provenance of every vertex of a LOD on the input: for LOD vertex `i`, the input triangle
+// `tri[i]` and barycentric coordinates `bary[3i .. 3i+3]` (non-negative, summing to 1) of the
+// input point it stands for, found by casting along the LOD's area-weighted vertex normal
+// within the envelope, else the closest input point (`flags[i]` tells which:
+// `PLEAT_PROVENANCE_BY_RAY`). An engine transfers any attribute of its own with these.
+//
+// - `lod`, `input`: mesh handles (the LOD from `pleat_lod_generate*`, the input it was made
+//   from); non-NULL.
+// - `params`: NULL for the defaults, else set the screen size the LOD was made for.
+// - `tri` (`tri_capacity` values), `bary` (`bary_capacity` values): non-NULL, holding at
+//   least `n` and `3 n` values (`n` = LOD vertex count), else `PLEAT_STATUS_LIMIT_EXCEEDED`.
+// - `flags`: NULL, or `flags_capacity >= n` bytes.
+//
+// Deterministic, whatever the thread count. Nothing is written on failure.
+//
+// # Safety
+// Handles are NULL or live; arrays are NULL or hold their stated capacities.
+PleatStatus pleat_lod_provenance(const struct PleatMesh *lod,
+                                 const struct PleatMesh *input,
+                                 const struct PleatProvenanceParams *params,
+                                 uint32_t *tri,
+                                 size_t tri_capacity,
+                                 double *bary,
+                                 size_t bary_capacity,
+                                 uint8_t *flags,
+                                 size_t flags_capacity);
+
+// Provenance of arbitrary points on the input (e.g. an engine's own vertices or samples):
+// as `pleat_lod_provenance` for `count` points `points[3i .. 3i+3]` cast along
+// `normals[3i .. 3i+3]` (need not be unit; a zero normal, or `normals` NULL, takes the
+// closest input point).
+//
+// # Safety
+// `input` is NULL or live; `points` (and `normals`) are NULL or hold `3 count` doubles; the
+// outputs as in `pleat_lod_provenance` with `n = count`.
+PleatStatus pleat_points_provenance(const struct PleatMesh *input,
+                                    const double *points,
+                                    const double *normals,
+                                    size_t count,
+                                    const struct PleatProvenanceParams *params,
+                                    uint32_t *tri,
+                                    size_t tri_capacity,
+                                    double *bary,
+                                    size_t bary_capacity,
+                                    uint8_t *flags,
+                                    size_t flags_capacity);
+
+// Bakes the input's appearance onto a LOD: a UV atlas for the LOD (xatlas; texel density
+// from the screen size unless `params->texture_size` is set), every texel sampled at its
+// provenance on the input (base colour sRGB-correct with alpha, metallic-roughness,
+// occlusion, emissive when the input has them), a tangent-space normal map in the LOD's
+// MikkTSpace frame, charts dilated into their gutters. Without any image the LOD gets
+// vertex colours instead (no UVs). Output bytes do not depend on the thread count.
+//
+// - `lod`: the LOD mesh; `input`: the mesh it was made from (vertex order as the material's
+//   per-vertex arrays); both non-NULL.
+// - `material`: the input's appearance (see `PleatBakeMaterial`); non-NULL.
+// - `params`: NULL for the defaults (n_p = 200).
+// - `progress`, `user_data`: progress and cancel callback (may be NULL); stages
+//   `bake: atlas`, `bake: tangents`, `bake: rasterise`, `bake: texels` (every few thousand
+//   texels: cancel is honoured within about 10 ms of work), `bake: dilation`,
+//   `bake: measure`. Cancelling returns `PLEAT_STATUS_CANCELLED`.
+// - `out`: receives the new `PleatBake` (free with `pleat_bake_free`); non-NULL.
+// - `stats`: NULL, or filled up to its `struct_size`.
+//
+// # Safety
+// Handles are NULL or live; `material`'s pointers hold the counts it documents.
+PleatStatus pleat_bake_lod(const struct PleatMesh *lod,
+                           const struct PleatMesh *input,
+                           const struct PleatBakeMaterial *material,
+                           const struct PleatBakeParams *params,
+                           PleatProgressFn progress,
+                           void *user_data,
+                           struct PleatBake **out,
+                           struct PleatBakeStats *stats);
+
+// Frees a bake (NULL is ignored).
+//
+// # Safety
+// `bake` is NULL or a live bake, not used afterwards.
+void pleat_bake_free(struct PleatBake *bake);
+
+// Number of vertices of the baked mesh (0 for NULL). The atlas splits LOD vertices at chart
+// seams, so it is at least the LOD's.
+//
+// # Safety
+// `bake` is NULL or live.
+size_t pleat_bake_vertex_count(const struct PleatBake *bake);
+
+// Number of triangles of the baked mesh (0 for NULL).
+//
+// # Safety
+// `bake` is NULL or live.
+size_t pleat_bake_triangle_count(const struct PleatBake *bake);
+
+// Fills `stats` (its `struct_size` set by the caller) with the bake's statistics.
+//
+// # Safety
+// `bake` is NULL or live; `stats` is NULL or holds `stats->struct_size` bytes.
+PleatStatus pleat_bake_get_stats(const struct PleatBake *bake, struct PleatBakeStats *stats);
+
+// Copies the vertex positions (xyz doubles) into `dst`, which holds `vertex_capacity`
+// vertices (at least `pleat_bake_vertex_count`, else `PLEAT_STATUS_LIMIT_EXCEEDED`).
+//
+// # Safety
+// `bake` is NULL or live; `dst` is NULL or holds `3 vertex_capacity` doubles.
+PleatStatus pleat_bake_copy_positions(const struct PleatBake *bake,
+                                      double *dst,
+                                      size_t vertex_capacity);
+
+// Copies the triangles (3 indices each) into `dst`, which holds `index_capacity` indices
+// (at least `3 pleat_bake_triangle_count`).
+//
+// # Safety
+// `bake` is NULL or live; `dst` is NULL or holds `index_capacity` values.
+PleatStatus pleat_bake_copy_indices(const struct PleatBake *bake,
+                                    uint32_t *dst,
+                                    size_t index_capacity);
+
+// Copies the atlas UVs (u, v floats in [0, 1], glTF convention: v = 0 is the images' top
+// row) into `dst` holding `vertex_capacity` pairs. `PLEAT_STATUS_INVALID_ARGUMENT` for an
+// untextured bake (vertex colours, no UVs).
+//
+// # Safety
+// `bake` is NULL or live; `dst` is NULL or holds `2 vertex_capacity` floats.
+PleatStatus pleat_bake_copy_uvs(const struct PleatBake *bake, float *dst, size_t vertex_capacity);
+
+// Copies the unit vertex normals (xyz floats) into `dst` holding `vertex_capacity` normals.
+//
+// # Safety
+// `bake` is NULL or live; `dst` is NULL or holds `3 vertex_capacity` floats.
+PleatStatus pleat_bake_copy_normals(const struct PleatBake *bake,
+                                    float *dst,
+                                    size_t vertex_capacity);
+
+// Copies the MikkTSpace tangents (x, y, z, w floats; glTF `TANGENT`, the frame of the
+// normal map) into `dst` holding `vertex_capacity` tangents. Untextured bakes have none.
+//
+// # Safety
+// `bake` is NULL or live; `dst` is NULL or holds `4 vertex_capacity` floats.
+PleatStatus pleat_bake_copy_tangents(const struct PleatBake *bake,
+                                     float *dst,
+                                     size_t vertex_capacity);
+
+// Copies the linear RGBA vertex colours of an untextured bake into `dst` holding
+// `vertex_capacity` colours. Textured bakes have none (`PLEAT_STATUS_INVALID_ARGUMENT`).
+//
+// # Safety
+// `bake` is NULL or live; `dst` is NULL or holds `4 vertex_capacity` floats.
+PleatStatus pleat_bake_copy_colors(const struct PleatBake *bake,
+                                   float *dst,
+                                   size_t vertex_capacity);
+
+// Writes the size of baked image `which` (`PLEAT_BAKE_IMAGE_*`) to `width` and `height`
+// (0 × 0 when the bake has no such image); both non-NULL.
+//
+// # Safety
+// `bake` is NULL or live; `width`, `height` are NULL or valid for a write.
+PleatStatus pleat_bake_image_size(const struct PleatBake *bake,
+                                  uint32_t which,
+                                  uint32_t *width,
+                                  uint32_t *height);
+
+// Copies baked image `which` (RGBA8, row 0 at the top) into `dst` holding `capacity_bytes`
+// bytes (at least `4 · width · height`). `PLEAT_STATUS_INVALID_ARGUMENT` when the bake has
+// no such image (see `pleat_bake_image_size`).
+//
+// # Safety
+// `bake` is NULL or live; `dst` is NULL or holds `capacity_bytes` bytes.
+PleatStatus pleat_bake_copy_image(const struct PleatBake *bake,
+                                  uint32_t which,
+                                  uint8_t *dst,
+                                  size_t capacity_bytes);
+
+// Writes the bake as a `.glb` (one mesh, its material with embedded PNG textures, or vertex
+// colours) at `path` (NUL-terminated UTF-8).
+//
+// # Safety
+// `bake` is NULL or live; `path` is NULL or NUL-terminated.
+PleatStatus pleat_bake_write_glb(const struct PleatBake *bake, const char *path);
+
 // Sets the number of worker threads pleat uses for subsequent calls from any thread.
 //
 // `n = 0` means one per core (rayon's global pool, the default). Results do not depend on the
@@ -563,11 +1069,79 @@ const char *pleat_version(void);
 uint32_t pleat_abi_version(void);
 
 // 1 when this build includes the capability `name` ("lod", "cage", "wrinkle", "io-gltf",
-// "tfw"), 0 otherwise or when `name` is NULL or unknown.
+// "bake", "tfw"), 0 otherwise or when `name` is NULL or unknown.
 //
 // # Safety
 // `name` is NULL or a NUL-terminated string.
 uint32_t pleat_has_feature(const char *name);
+
+// The default design parameters (vertex rings, sources pinned, heat time 1, κ = γ = 1, data
+// weight 1), with `struct_size` set. Available in every build.
+struct PleatCwfDesignParams pleat_cwf_design_params_default(void);
+
+// The default edit parameters (vertex rings, unit phase, 200 iterations, ε_ω = ε_a = 1e-3,
+// γ = 1, tolerance 1e-12), with `struct_size` set. Available in every build.
+struct PleatCwfEditParams pleat_cwf_edit_params_default(void);
+
+// Designs a keyframe from wrinkle sources (§3.6.1): wave vectors extended from the sources by
+// the vector heat method, amplitude by eq. 3.25, phase by Knöppel; ω = 0 and a = 0 outside the
+// sources' regions.
+//
+// - `base`: non-NULL, a consistently oriented manifold; pleat keeps its own copy.
+// - `sources`, `source_count`: at least one source; vertices in range, distinct.
+// - `params`: NULL = `pleat_cwf_design_params_default()`.
+// - `knoppel_params`: the final phase solve; NULL = `pleat_knoppel_params_default()`.
+// - `out`: receives the new field; non-NULL; written only on success.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes described above.
+PleatStatus pleat_cwf_design(const struct PleatMesh *base,
+                             const struct PleatWrinkleSource *sources,
+                             size_t source_count,
+                             const struct PleatCwfDesignParams *params,
+                             const struct PleatKnoppelParams *knoppel_params,
+                             struct PleatCwf **out);
+
+// Edits regions of a keyframe (§3.6.2): per region rotate by `rotate_radians`, scale the
+// frequency by σ and the amplitude by μ; the interface band is solved (eqs. 3.26–3.28) and the
+// rest copied bit for bit. Regions must not share a vertex, and the interface must separate
+// edited from fixed vertices (the message names the vertex).
+//
+// - `cwf`: the keyframe; non-NULL.
+// - `regions`, `region_count`: at least one region.
+// - `params`: NULL = `pleat_cwf_edit_params_default()`.
+// - `out`: receives the edited keyframe (same base mesh); non-NULL.
+// - `face_labels_out`: NULL, or `pleat_cwf_triangle_count(cwf)` bytes receiving
+//   `PLEAT_FACE_FIXED` / `_EDIT` / `_INTERFACE` per triangle.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes described above.
+PleatStatus pleat_cwf_edit(const struct PleatCwf *cwf,
+                           const struct PleatCwfRegionEdit *regions,
+                           size_t region_count,
+                           const struct PleatCwfEditParams *params,
+                           struct PleatCwf **out,
+                           uint8_t *face_labels_out);
+
+// A region of `mesh`: the seed triangles and the triangles of the seed vertices (ring 1),
+// grown by `rings − 1` more rings across `adjacency`. Writes 1 (in the region) or 0 per
+// triangle to `flags_out` (`pleat_mesh_triangle_count(mesh)` bytes) and the number of region
+// triangles to `count_out` (NULL allowed).
+//
+// - `seed_faces` / `seed_vertices`: NULL only when their count is 0; ids in range.
+// - `rings` ≥ 1; `adjacency`: `PLEAT_ADJACENCY_VERTEX` or `PLEAT_ADJACENCY_EDGE`.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes described above.
+PleatStatus pleat_mesh_grow_faces(const struct PleatMesh *mesh,
+                                  const uint32_t *seed_faces,
+                                  size_t seed_face_count,
+                                  const uint32_t *seed_vertices,
+                                  size_t seed_vertex_count,
+                                  uint32_t rings,
+                                  uint32_t adjacency,
+                                  uint8_t *flags_out,
+                                  size_t *count_out);
 
 // Number of unique undirected edges of `mesh` (0 when `mesh` is NULL). Degenerate corners
 // (a triangle repeating a vertex) contribute no edge.
@@ -735,8 +1309,11 @@ PleatStatus pleat_lod_generate(const struct PleatMesh *input,
                                struct PleatLodStats *stats);
 
 // Bakes a cage of `input` (any triangle soup): watertight, manifold, self-intersection-free,
-// enclosing every input vertex without touching the input, at offset d = l / n_p.
-// Parameters as `pleat_lod_generate`; `stats->encloses_input` reports the verification.
+// enclosing every input vertex without touching the input, at offset d = l / n_p, and keeping
+// `params->clearance` from it. Parameters as `pleat_lod_generate`; `stats->encloses_input`
+// reports the verification, `stats->min_clearance` the exact measured clearance and
+// `stats->clearance_kept` whether the requested one was kept (0 when the start surface was
+// already closer: the call still succeeds — check the flag).
 // Returns `PLEAT_STATUS_UNSUPPORTED` when built without the `cage` feature.
 //
 // # Safety

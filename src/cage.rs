@@ -10,6 +10,13 @@
 //!   box swept by the operation, computed from the solid angles of the patch before and after,
 //!   must be 0.
 //!
+//! - **clearance** (issue 12 part 3): no modified face comes closer to the input than
+//!   [`crate::lowpoly::LodParams::clearance`] (default a tenth of `d`; exact
+//!   triangle–triangle distances), so the cage does not merely avoid contact but keeps a real
+//!   gap. The independent verification measures the exact minimum distance between cage and
+//!   input triangles ([`LodReport::clearance`], `min_clearance`) and says when the requested
+//!   clearance could not be kept (only where the start surface was already closer).
+//!
 //! The offset surface encloses the input at distance `d`, and each accepted operation keeps
 //! both properties, so the result encloses every input vertex (and, as nothing touches, every
 //! input point). The input may be any soup: non-manifold, open, self-intersecting.
@@ -39,9 +46,11 @@ pub fn generate(
     run(input, params, Mode::Cage, progress)
 }
 
-/// One cage per screen size, coarser cages derived from finer ones (see
-/// [`crate::lowpoly::generate_chain`]). A coarser cage starts from the finer cage, which
-/// already encloses the input without touching it.
+/// One cage per screen size (see [`crate::lowpoly::generate_chain`]). With a clearance (the
+/// default) every level is baked from its own offset surface — a coarser cage needs a larger
+/// clearance than the finer cage keeps — so the chain costs the sum of its levels; with
+/// `Clearance::FractionOfD(0.0)` a coarser cage starts from the finer cage, which already
+/// encloses the input without touching it.
 pub fn generate_chain(
     input: &TriMesh,
     screen_sizes: &[f64],

@@ -199,6 +199,104 @@ fn cages_enclose_and_do_not_touch() {
     }
 }
 
+/// Brute-force exact distance between two meshes: every pair of triangles, 0 on contact
+/// (exact test), else the closed-form distance of disjoint triangles — no BVH, no pruning.
+#[cfg(feature = "cage")]
+fn brute_force_gap(a: &TriMesh, b: &TriMesh) -> f64 {
+    use pleat::geom::Vec3;
+    use pleat::spatial::closest::disjoint_triangle_distance;
+    let tri = |m: &TriMesh, t: usize| m.triangle_positions(t);
+    let mut best = f64::INFINITY;
+    for i in 0..a.triangle_count() {
+        for j in 0..b.triangle_count() {
+            let (ta, tb) = (tri(a, i), tri(b, j));
+            if pleat::spatial::triangles_intersect(&ta, &tb) {
+                return 0.0;
+            }
+            let d = disjoint_triangle_distance(&ta.map(Vec3::from), &tb.map(Vec3::from), 0.0);
+            best = best.min(d);
+        }
+    }
+    best
+}
+
+/// Issue 12 part 3, analytic: the cage of a box and of a sphere keeps the requested clearance
+/// `c·d` (exact minimum distance, checked by brute force over all triangle pairs) and stays
+/// within the offset distance where it is closest: `c·d ≤ min_clearance ≤ d`. Without a
+/// clearance the cage comes closer than any of them.
+#[cfg(feature = "cage")]
+#[test]
+fn cages_keep_their_clearance() {
+    use pleat::lowpoly::Clearance;
+    for (name, m) in [
+        ("sphere", shapes::icosphere(1.0, 3)),
+        ("box", shapes::box_grid(1.0, 0.6, 0.3, 8)),
+    ] {
+        let mut gaps = Vec::new();
+        for frac in [0.0, 0.25, 0.5] {
+            let p = LodParams {
+                clearance: Clearance::FractionOfD(frac),
+                ..params(25.0)
+            };
+            let (out, s) = bake(&m, &p, true).unwrap();
+            let what = format!("{name} cage, clearance {frac} d");
+            assert_valid(&out, &s, &what);
+            let c = s.clearance.expect("a cage reports its clearance");
+            assert_eq!(c.required, frac * s.d, "{what}");
+            assert!(c.kept, "{what}: not kept ({c:?})");
+            let brute = brute_force_gap(&out, &m);
+            assert_eq!(
+                c.min, brute,
+                "{what}: report {} vs brute force {brute}",
+                c.min
+            );
+            assert!(
+                c.min >= frac * s.d && c.min <= s.d,
+                "{what}: {c:?}, d = {}",
+                s.d
+            );
+            assert_eq!(c.min_rel, c.min / m.bbox_diagonal());
+            gaps.push(c.min);
+        }
+        assert!(gaps[0] < gaps[1] && gaps[1] < gaps[2], "{name}: {gaps:?}");
+    }
+}
+
+/// A clearance at or above `d`, negative or NaN is refused before any work; an absolute
+/// clearance is kept in model units.
+#[cfg(feature = "cage")]
+#[test]
+fn clearance_parameter_is_checked_and_absolute_works() {
+    use pleat::lowpoly::Clearance;
+    let m = shapes::icosphere(1.0, 3);
+    for bad in [
+        Clearance::FractionOfD(1.0),
+        Clearance::FractionOfD(-0.1),
+        Clearance::FractionOfD(f64::NAN),
+        Clearance::Absolute(1.0),
+    ] {
+        let p = LodParams {
+            clearance: bad,
+            ..params(25.0)
+        };
+        assert!(
+            matches!(bake(&m, &p, true), Err(Error::InvalidArgument(_))),
+            "{bad:?}"
+        );
+    }
+    let d = m.bbox_diagonal() / 25.0;
+    let p = LodParams {
+        clearance: Clearance::Absolute(0.4 * d),
+        ..params(25.0)
+    };
+    let (_, s) = bake(&m, &p, true).unwrap();
+    let c = s.clearance.unwrap();
+    assert!(c.kept && c.min >= 0.4 * d && c.required == 0.4 * d, "{c:?}");
+    // LODs ignore it and report none.
+    let (_, s) = bake(&m, &p, false).unwrap();
+    assert!(s.clearance.is_none());
+}
+
 #[test]
 fn chain_levels_are_valid_and_coarser() {
     let m = shapes::torus(1.0, 0.3, 64, 24);

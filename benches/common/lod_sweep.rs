@@ -146,6 +146,9 @@ pub struct Row {
     pub self_intersection_free: bool,
     /// Cage mode: `(encloses every input vertex, touches no input triangle)`.
     pub cage: Option<(bool, bool)>,
+    /// Cage mode: `(exact min clearance / d, required clearance / d, kept)` from the report
+    /// (`LodReport::clearance`, measured by `pleat::verify`).
+    pub clearance: Option<(f64, f64, bool)>,
     pub rounds: u64,
     pub faces_offset: u64,
     pub reruns_exact: u64,
@@ -275,6 +278,9 @@ pub fn parse_csv(text: &str) -> Result<(Vec<Row>, bool), String> {
     ];
     let cage_cols = col("encloses").zip(col("untouched"));
     let bake_cols: Option<Vec<usize>> = BAKE_COLUMNS.iter().map(|c| col(c)).collect();
+    let clearance_cols = col("min_clearance_over_d")
+        .zip(col("clearance_over_d"))
+        .zip(col("clearance_kept"));
     let cpu = col("cpu_seconds");
     let mut rows = Vec::new();
     for line in lines.filter(|l| !l.trim().is_empty()) {
@@ -305,6 +311,7 @@ pub fn parse_csv(text: &str) -> Result<(Vec<Row>, bool), String> {
             manifold: flag(c[8]),
             self_intersection_free: flag(c[9]),
             cage: cage_cols.map(|(e, u)| (flag(e), flag(u))),
+            clearance: clearance_cols.map(|((m, r), k)| (num(m), num(r), flag(k))),
             rounds: col("rounds").and_then(|i| get(i).parse().ok()).unwrap_or(0),
             faces_offset: col("faces_offset")
                 .and_then(|i| get(i).parse().ok())
@@ -364,6 +371,7 @@ pub fn bake_case(
     n_p: f64,
     target: Option<usize>,
     cage: bool,
+    clearance: Option<pleat::lowpoly::Clearance>,
     prog: &mut pleat::report::ProgressFn<'_>,
 ) -> (Row, Option<TriMesh>) {
     let mut row = Row {
@@ -377,6 +385,7 @@ pub fn bake_case(
         screen_size: n_p,
         target_faces: target,
         measure_floor: true,
+        clearance: clearance.unwrap_or_default(),
         ..Default::default()
     };
     let mut run = timed(|| {
@@ -445,6 +454,9 @@ fn fill_from_output(row: &mut Row, input: &TriMesh, out: &TriMesh, stats: &LodRe
     row.self_intersection_free = v.self_intersection_free;
     if cage {
         row.cage = Some(cage_flags(out, input));
+        row.clearance = stats
+            .clearance
+            .map(|c| (c.min / stats.d, c.required / stats.d, c.kept));
     }
     if !row.valid() {
         row.status = "ok (INVALID output)".into();
@@ -496,7 +508,7 @@ pub fn csv_text(rows: &[Row], cage: bool) -> String {
          self_intersection_free",
     );
     if cage {
-        s.push_str(",encloses,untouched");
+        s.push_str(",encloses,untouched,min_clearance_over_d,clearance_over_d,clearance_kept");
     }
     s.push_str(",rounds,faces_offset,reruns_exact");
     for st in STAGES {
@@ -567,6 +579,14 @@ fn csv_line(r: &Row, cage: bool) -> String {
         let (e, u) = r.cage.unwrap_or((false, false));
         f.push(flag(e));
         f.push(flag(u));
+        match r.clearance {
+            Some((m, req, k)) if ok => {
+                f.push(num(m));
+                f.push(num(req));
+                f.push(flag(k));
+            }
+            _ => f.extend([String::new(), String::new(), String::new()]),
+        }
     }
     for c in [r.rounds, r.faces_offset, r.reruns_exact] {
         f.push(if ok { c.to_string() } else { String::new() });
@@ -597,7 +617,12 @@ pub fn row_line(r: &Row) -> String {
             r.cpu_seconds,
             r.hausdorff_over_l,
             if r.valid() { "valid" } else { "INVALID" }
-        );
+        ) + &r.clearance.map_or(String::new(), |(m, req, kept)| {
+            format!(
+                "  clearance {m:.3} d (required {req:.3} d{})",
+                if kept { "" } else { ", NOT KEPT" }
+            )
+        });
         line + &bake
     } else {
         format!("{:<34} n_p={:<5} {}", r.mesh, r.n_p, r.status)

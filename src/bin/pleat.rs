@@ -158,6 +158,10 @@ struct BakeArgs {
     /// Skip the feature-alignment step.
     #[arg(long)]
     no_align: bool,
+    /// Cages: the distance kept from the input, a fraction of d with a `d` suffix (`0.1d`,
+    /// the default) or a length in model units (`0.002`); below d. `0d` only forbids contact.
+    #[arg(long, value_parser = parse_clearance)]
+    clearance: Option<pleat::lowpoly::Clearance>,
     /// No progress bar and no summary.
     #[arg(short, long)]
     quiet: bool,
@@ -475,6 +479,7 @@ fn lod_params(args: &BakeArgs, sizes: &[f64], faces: Option<usize>) -> LodParams
         target_faces: faces,
         max_rounds: args.rounds,
         align: !args.no_align,
+        clearance: args.clearance.unwrap_or_default(),
         ..LodParams::default()
     }
 }
@@ -500,6 +505,28 @@ fn bake_levels(
         #[cfg(not(feature = "cage"))]
         (_, true) => unreachable!("the cage subcommand needs the cage feature"),
     }
+}
+
+/// `--clearance`: `0.25d` (a fraction of d) or `0.002` (model units); finite and `>= 0`.
+#[cfg(feature = "lod")]
+fn parse_clearance(s: &str) -> Result<pleat::lowpoly::Clearance, String> {
+    use pleat::lowpoly::Clearance;
+    let (num, relative) = match s.trim().strip_suffix('d') {
+        Some(n) => (n, true),
+        None => (s.trim(), false),
+    };
+    let v: f64 = num
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number, or a number followed by `d`"))?;
+    if !(v.is_finite() && v >= 0.0) {
+        return Err(format!("the clearance must be finite and >= 0, got {s}"));
+    }
+    Ok(if relative {
+        Clearance::FractionOfD(v)
+    } else {
+        Clearance::Absolute(v)
+    })
 }
 
 /// An indicatif bar on a terminal (stderr), nothing otherwise.
@@ -566,6 +593,20 @@ fn print_bake_summary(
             "NO"
         }
     );
+    if let Some(c) = &s.clearance {
+        println!(
+            "  clearance: exact minimum {:.3e} ({:.2} d), required {:.3e} ({:.2} d){}",
+            c.min,
+            c.min / s.d,
+            c.required,
+            c.required / s.d,
+            if c.kept {
+                ""
+            } else {
+                " — NOT KEPT: the start surface was closer; try a smaller --clearance"
+            }
+        );
+    }
 }
 
 /// Exit code for errors reading input or bad arguments.

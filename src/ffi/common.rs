@@ -272,7 +272,7 @@ pub unsafe extern "C" fn pleat_has_feature(name: *const c_char) -> u32 {
     let Ok(name) = c_str_arg(name, "name") else {
         return 0;
     };
-    const BUILT: [(&str, bool); 5] = [
+    const BUILT: [(&str, bool); 6] = [
         ("lod", cfg!(feature = "lod")),
         ("cage", cfg!(feature = "cage")),
         ("wrinkle", cfg!(feature = "wrinkle")),

@@ -24,6 +24,10 @@ pub const PLEAT_LOD_NO_ALIGN: u32 = 1;
 /// distance measurement per level.
 pub const PLEAT_LOD_MEASURE_FLOOR: u32 = 2;
 
+/// `PleatLodParams::flags` bit: `PleatLodParams::clearance` is a length in model units
+/// instead of a fraction of the offset distance d.
+pub const PLEAT_LOD_CLEARANCE_ABSOLUTE: u32 = 4;
+
 /// Parameters of `pleat_lod_generate`, `pleat_lod_generate_chain` and `pleat_cage_generate`.
 /// Get the defaults from `pleat_lod_params_default()` and change what you need; the defaults
 /// are the dissertation's (n_p = 200, N = 50, r = 1/8, ε = 1e-4, θ0 = 120°, l0 = 4).
@@ -56,6 +60,12 @@ pub struct PleatLodParams {
     /// Upper bound on the bake's memory in bytes (default 2 GiB); exceeding the estimate fails
     /// with `PLEAT_STATUS_LIMIT_EXCEEDED` before the expensive work.
     pub memory_budget_bytes: u64,
+    /// Cages only: the distance the cage keeps from the input, as a fraction of d (default
+    /// 0.1: a tenth of a pixel at the cage's screen size, see README "Cages with clearance"), or
+    /// in model units with `PLEAT_LOD_CLEARANCE_ABSOLUTE`. Must be >= 0 and below d; 0 keeps
+    /// only "no contact". Appended for issue 12; callers with an older `struct_size` get the
+    /// default.
+    pub clearance: f64,
 }
 
 /// Statistics of one baked level, filled when a non-NULL pointer is passed. Set `struct_size`
@@ -116,6 +126,16 @@ pub struct PleatLodStats {
     /// `hausdorff_in_to_out_relative` (input the offset hides). NaN otherwise. Its time is
     /// the stats stage `floor` and is included in `seconds_total`.
     pub hausdorff_floor_relative: f64,
+    /// Cages: the exact minimum distance between the cage's and the input's triangles, in
+    /// model units, measured independently of the guard (not sampled). NaN for LODs.
+    pub min_clearance: f64,
+    /// Cages: `min_clearance / l`. NaN for LODs.
+    pub min_clearance_relative: f64,
+    /// Cages: the clearance that was required, in model units. NaN for LODs.
+    pub clearance_required: f64,
+    /// Cages: 1 when `min_clearance >= clearance_required`; 0 when the cage could not keep
+    /// the clearance (it still encloses without contact — see `encloses_input`). LODs: 0.
+    pub clearance_kept: u32,
 }
 
 /// The defaults, with `struct_size = sizeof(PleatLodParams)`.
@@ -132,6 +152,9 @@ versioned!(PleatLodParams, 16, pleat_lod_params_default);
 versioned!(PleatLodStats, 8);
 
 #[cfg(feature = "lod")]
+use crate::lowpoly::Clearance;
+
+#[cfg(feature = "lod")]
 impl From<&crate::lowpoly::LodParams> for PleatLodParams {
     fn from(p: &crate::lowpoly::LodParams) -> Self {
         let flag = |on: bool, bit: u32| if on { bit } else { 0 };
@@ -145,8 +168,15 @@ impl From<&crate::lowpoly::LodParams> for PleatLodParams {
             theta0_deg: p.theta0_deg,
             l0: p.l0,
             flags: flag(!p.align, PLEAT_LOD_NO_ALIGN)
-                | flag(p.measure_floor, PLEAT_LOD_MEASURE_FLOOR),
+                | flag(p.measure_floor, PLEAT_LOD_MEASURE_FLOOR)
+                | flag(
+                    matches!(p.clearance, Clearance::Absolute(_)),
+                    PLEAT_LOD_CLEARANCE_ABSOLUTE,
+                ),
             memory_budget_bytes: p.memory_budget_bytes,
+            clearance: match p.clearance {
+                Clearance::FractionOfD(c) | Clearance::Absolute(c) => c,
+            },
         }
     }
 }
@@ -166,6 +196,7 @@ pub(super) fn defaults_without_lod() -> PleatLodParams {
         l0: 4,
         flags: 0,
         memory_budget_bytes: 2 << 30,
+        clearance: 0.1,
     }
 }
 
@@ -186,7 +217,7 @@ pub(super) mod imp {
         };
         check_flags(
             p.flags,
-            PLEAT_LOD_NO_ALIGN | PLEAT_LOD_MEASURE_FLOOR,
+            PLEAT_LOD_NO_ALIGN | PLEAT_LOD_MEASURE_FLOOR | PLEAT_LOD_CLEARANCE_ABSOLUTE,
             "params->flags",
         )?;
         Ok(LodParams {
@@ -200,6 +231,11 @@ pub(super) mod imp {
             memory_budget_bytes: p.memory_budget_bytes,
             align: p.flags & PLEAT_LOD_NO_ALIGN == 0,
             measure_floor: p.flags & PLEAT_LOD_MEASURE_FLOOR != 0,
+            clearance: if p.flags & PLEAT_LOD_CLEARANCE_ABSOLUTE != 0 {
+                Clearance::Absolute(p.clearance)
+            } else {
+                Clearance::FractionOfD(p.clearance)
+            },
         })
     }
 
@@ -259,6 +295,10 @@ pub(super) mod imp {
             hausdorff_in_to_out_relative: s.hausdorff_in_to_out_rel,
             hausdorff_out_to_in_relative: s.hausdorff_out_to_in_rel,
             hausdorff_floor_relative: s.floor.map_or(f64::NAN, |f| f.rel),
+            min_clearance: s.clearance.map_or(f64::NAN, |c| c.min),
+            min_clearance_relative: s.clearance.map_or(f64::NAN, |c| c.min_rel),
+            clearance_required: s.clearance.map_or(f64::NAN, |c| c.required),
+            clearance_kept: s.clearance.is_some_and(|c| c.kept) as u32,
         }
     }
 }
@@ -328,8 +368,11 @@ pub unsafe extern "C" fn pleat_lod_generate(
 }
 
 /// Bakes a cage of `input` (any triangle soup): watertight, manifold, self-intersection-free,
-/// enclosing every input vertex without touching the input, at offset d = l / n_p.
-/// Parameters as `pleat_lod_generate`; `stats->encloses_input` reports the verification.
+/// enclosing every input vertex without touching the input, at offset d = l / n_p, and keeping
+/// `params->clearance` from it. Parameters as `pleat_lod_generate`; `stats->encloses_input`
+/// reports the verification, `stats->min_clearance` the exact measured clearance and
+/// `stats->clearance_kept` whether the requested one was kept (0 when the start surface was
+/// already closer: the call still succeeds — check the flag).
 /// Returns `PLEAT_STATUS_UNSUPPORTED` when built without the `cage` feature.
 ///
 /// # Safety

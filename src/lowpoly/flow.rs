@@ -1,7 +1,8 @@
 //! Mesh flow — dissertation Alg. 3 lines 7–11 with the local update of Alg. 4.
 //!
 //! Every vertex `v` is pushed a fraction `r` (default 1/8, §4.4.3) of the way to its closest
-//! input point `v*`: `d_v = r (v* − v)`. The [`local_update`] line search halves the step
+//! input point `v*`: `d_v = r (v* − v)` (for a cage with clearance `c`, to the point at
+//! distance `c` from `v*` on the segment `v* v`). The [`local_update`] line search halves the step
 //! until the move passes the [`Guard`], and applies `0.95 α d_v` — the 0.95 safety factor of
 //! Alg. 4. Unlike the pseudo-code, the position actually applied (`v + 0.95 α d_v`) is the one
 //! the guard checks, so no unchecked position is ever written.
@@ -63,7 +64,18 @@ pub(crate) fn flow_sweep(
         .collect();
     let input = g.input();
     let positions: Vec<[f64; 3]> = verts.iter().map(|&v| g.mesh().position(v)).collect();
-    let targets: Vec<[f64; 3]> = positions.par_iter().map(|&p| input.closest(p).0).collect();
+    let c = g.clearance();
+    let targets: Vec<[f64; 3]> = positions
+        .par_iter()
+        .map(|&p| {
+            let q = input.closest(p).0;
+            if c > 0.0 {
+                target_at_clearance(p, q, c)
+            } else {
+                q
+            }
+        })
+        .collect();
     let mut rep = MoveReport::default();
     for (i, &v) in verts.iter().enumerate() {
         if i % 1024 == 0 && !keep_going(i as f64 / verts.len() as f64) {
@@ -80,6 +92,18 @@ pub(crate) fn flow_sweep(
         );
     }
     Ok(rep)
+}
+
+/// Cage with clearance `c`: the flow target of a vertex at `p` whose closest input point is
+/// `q` is the point at distance `c` from `q` towards `p` (the closest place the guard accepts
+/// on that line), or `p` itself (no motion) when it is already within `c`.
+fn target_at_clearance(p: [f64; 3], q: [f64; 3], c: f64) -> [f64; 3] {
+    let (p, q) = (Vec3::from(p), Vec3::from(q));
+    let dist = p.distance(q);
+    if dist <= c {
+        return p.to_array();
+    }
+    (q + (p - q) * (c / dist)).to_array()
 }
 
 pub(crate) fn record(rep: &mut MoveReport, moved: f64) {

@@ -29,11 +29,18 @@
 //!    the closed mesh changes only through `M_e`, so for input vertices `q` in the box swept by
 //!    the operation, `Δw(q) = (Σ_{new M_e} Ω_f(q) − Σ_{old M_e} Ω_f(q)) / 4π` (solid angles) must
 //!    round to 0. Together with "no touching", every input point stays strictly inside.
+//! 5. **A cage with clearance** (cage mode with a clearance `c > 0`, issue 12 part 3) — the
+//!    exact distance between `M_e` and the input (triangle–triangle distances of
+//!    `spatial::closest::disjoint_triangle_distance` on the candidates of the input's BVH within
+//!    `c` of each face) is at least `c`, or — where the start surface already was closer — at
+//!    least the distance of the patch `M_e` replaces: no operation brings a cage face closer to
+//!    the input than `c`, and none makes an existing shortfall worse.
 
 use super::report::GuardCounts;
 use crate::geom::{bbox_of, normalized, tri_normal, Vec3};
 use crate::mesh::halfedge::{CollapseRecord, FaceData, FaceId, HalfedgeId, VertexId};
 use crate::mesh::HalfEdgeMesh;
+use crate::spatial::closest::{disjoint_triangle_distance, plane_gap_lower_bound};
 use crate::spatial::solid_angle;
 use crate::spatial::{self as sp, TriangleBvh};
 
@@ -142,6 +149,9 @@ pub(crate) enum Reject {
     TouchesInput,
     /// Cage mode: an input vertex would leave the enclosed volume.
     Uncovers,
+    /// Cage mode with a clearance: a modified face would come closer to the input than the
+    /// clearance (and closer than the faces it replaces).
+    Clearance,
 }
 
 /// The corners of face `f` as raw vertex indices (the BVH's triangle boundary).
@@ -184,6 +194,9 @@ pub(crate) struct Guard<'a> {
     bvh: TriangleBvh,
     input: &'a InputModel,
     cage: bool,
+    /// Cage mode: the smallest distance to the input a modified face may have (model units;
+    /// 0 = only "no contact").
+    clearance: f64,
     exact_only: bool,
     cone_cos: f64,
     scratch: GuardScratch,
@@ -210,6 +223,7 @@ impl<'a> Guard<'a> {
             bvh,
             input,
             cage,
+            clearance: 0.0,
             exact_only: false,
             cone_cos: CONE_HALF_ANGLE.cos(),
             scratch: GuardScratch::default(),
@@ -221,6 +235,21 @@ impl<'a> Guard<'a> {
     /// Disables the normal-cone fast path: every pair is tested exactly.
     pub fn set_exact_only(&mut self, on: bool) {
         self.exact_only = on;
+    }
+
+    /// Sets the clearance `c` (model units, `≥ 0`) kept in cage mode (check 5 of the module
+    /// docs); 0, the initial value, only forbids contact.
+    pub fn set_clearance(&mut self, c: f64) {
+        self.clearance = c;
+    }
+
+    /// The clearance kept in cage mode (0 outside cage mode or when none was set).
+    pub fn clearance(&self) -> f64 {
+        if self.cage {
+            self.clearance
+        } else {
+            0.0
+        }
     }
 
     /// The working mesh (read-only: modify it through the guard).
@@ -449,6 +478,7 @@ impl<'a> Guard<'a> {
             Err(Reject::SelfIntersection) => st.rejected_intersection += 1,
             Err(Reject::TouchesInput) => st.rejected_touch += 1,
             Err(Reject::Uncovers) => st.rejected_uncover += 1,
+            Err(Reject::Clearance) => st.rejected_clearance += 1,
         }
         r
     }
@@ -467,7 +497,11 @@ impl<'a> Guard<'a> {
         check_within_m1(s, cone_ok, st)?;
         self.check_against_rest(s, st)?;
         if self.cage {
-            self.check_input_untouched(s, st)?;
+            if self.clearance > 0.0 {
+                self.check_clearance(s, st)?;
+            } else {
+                self.check_input_untouched(s, st)?;
+            }
             self.check_enclosure(s)?;
         }
         Ok(())
@@ -535,6 +569,24 @@ impl<'a> Guard<'a> {
         Ok(())
     }
 
+    /// Cage mode with clearance `c`: `M_e` does not touch the input, and its distance to the
+    /// input is at least `c` or at least the distance of the patch it replaces.
+    fn check_clearance(&self, s: &GuardScratch, st: &mut GuardCounts) -> Result<(), Reject> {
+        let c = self.clearance;
+        let new_patch = s.m_1[..s.n_e].iter().map(|f| f.t);
+        let new_gap = patch_gap(self.input, new_patch, c, true, st).ok_or(Reject::TouchesInput)?;
+        if new_gap >= c {
+            return Ok(());
+        }
+        let old_gap =
+            patch_gap(self.input, s.old_patch.iter().copied(), c, false, st).unwrap_or(0.0);
+        if new_gap >= old_gap {
+            Ok(())
+        } else {
+            Err(Reject::Clearance)
+        }
+    }
+
     /// Cage mode: no input vertex in the swept box changes winding number.
     fn check_enclosure(&self, s: &GuardScratch) -> Result<(), Reject> {
         let Some((pts, pbvh)) = &self.input.points else {
@@ -559,6 +611,60 @@ impl<'a> Guard<'a> {
         }
         Ok(())
     }
+}
+
+/// Plane separations below this fraction of `l` never skip a candidate of the clearance
+/// check: there, rounding could hide a contact, which the exact test must decide.
+const PLANE_SKIP_MIN: f64 = 1e-9;
+
+/// The distance between the faces `patch` and the input, capped at `cap` (`> 0`): the exact
+/// minimum triangle–triangle distance over the input triangles whose boxes come within `cap`
+/// of a face's box (BVH query), `cap` when there is none. With `test_contact`, `None` when a
+/// face touches or intersects an input triangle (exact test on every candidate whose box
+/// meets the face's); without, the patch must be known not to touch the input (the patch an
+/// operation replaces).
+fn patch_gap(
+    input: &InputModel,
+    patch: impl Iterator<Item = [[f64; 3]; 3]>,
+    cap: f64,
+    test_contact: bool,
+    st: &mut GuardCounts,
+) -> Option<f64> {
+    let mut best = cap;
+    for t in patch {
+        let (lo, hi) = bbox(t);
+        let pad = Vec3::splat(best);
+        let tv = t.map(Vec3::from);
+        for i in input
+            .bvh
+            .query_box((lo - pad).to_array(), (hi + pad).to_array())
+        {
+            let it = input.triangle(i);
+            let gap = box_gap((lo, hi), bbox(it));
+            if gap >= best && !(test_contact && gap == 0.0) {
+                continue;
+            }
+            let itv = it.map(Vec3::from);
+            // Far side of the face's plane by at least `best` (and clearly apart: no contact).
+            let plane = plane_gap_lower_bound(&tv, &itv);
+            if plane >= best && plane > PLANE_SKIP_MIN * input.diag {
+                continue;
+            }
+            st.exact_tests += 1;
+            if test_contact && touches_input_triangle(&t, &it, input.degenerate[i as usize]) {
+                return None;
+            }
+            best = best.min(disjoint_triangle_distance(&tv, &itv, 0.0));
+        }
+    }
+    Some(best)
+}
+
+/// Euclidean distance between two axis-aligned boxes (0 when they overlap): a lower bound of
+/// the distance between anything inside them.
+pub(crate) fn box_gap(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> f64 {
+    let gap = (b.0 - a.1).max(a.0 - b.1).max(Vec3::ZERO);
+    gap.length()
 }
 
 /// `M_1` is intersection-free given it was before: pairs (f ∈ M_e, g ∈ M_1), each once. Pairs
@@ -781,5 +887,43 @@ pub(crate) mod tests {
         assert!(g.try_move(VertexId::new(7), [1.1, 1.1, 1.1]).is_ok());
         assert_eq!(g.stats.rejected_uncover, 1);
         assert_eq!(g.stats.rejected_touch, 1);
+    }
+
+    /// The guard's clearance decision agrees with the independent exact measurement
+    /// (`verify::min_distance`) on the result: a move of the outer cube's corner along the
+    /// diagonal is accepted iff the moved cage keeps the clearance.
+    #[test]
+    fn clearance_matches_the_independent_measurement() {
+        let inner = cube(1.0, 0.0);
+        let outer = cube(3.0, -1.0);
+        let input = InputModel::new(&inner, true);
+        let c = 0.5;
+        for t in [2.5, 2.0, 1.8, 1.6, 1.4, 1.2, 1.1] {
+            let mut g = guard_for(&outer, &input, true);
+            g.set_clearance(c);
+            let r = g.try_move(VertexId::new(7), [t, t, t]);
+            let mut moved = outer.positions().to_vec();
+            moved[7] = [t, t, t];
+            let m = TriMesh::new(moved, outer.triangles().to_vec()).unwrap();
+            let gap = crate::verify::min_distance(&m, &inner);
+            assert_eq!(r.is_ok(), gap >= c, "t = {t}: guard {r:?}, exact gap {gap}");
+        }
+    }
+
+    /// Where the start is already closer than the clearance, moves that do not lower the
+    /// patch's distance are accepted and moves that lower it are refused.
+    #[test]
+    fn clearance_shortfall_is_never_made_worse() {
+        let inner = cube(1.0, 0.0);
+        let outer = cube(3.0, -1.0);
+        let input = InputModel::new(&inner, true);
+        let mut g = guard_for(&outer, &input, true);
+        g.set_clearance(2.0);
+        assert!(g.try_move(VertexId::new(7), [2.5, 2.5, 2.5]).is_ok());
+        assert_eq!(
+            g.try_move(VertexId::new(7), [1.5, 1.5, 1.5]),
+            Err(Reject::Clearance)
+        );
+        assert_eq!(g.stats.rejected_clearance, 1);
     }
 }

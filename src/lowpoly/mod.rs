@@ -35,10 +35,10 @@ mod simplify;
 
 pub use guard::CONE_HALF_ANGLE;
 pub use offset::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};
-pub use pipeline::{generate, generate_chain, LodParams};
+pub use pipeline::{generate, generate_chain, Clearance, LodParams, DEFAULT_CLEARANCE_FRACTION};
 #[cfg(feature = "cage")]
 pub(crate) use pipeline::{run, run_chain, Mode};
 pub use report::{
-    ExtractionCounts, FeatureCounts, FloorMeasure, GuardCounts, InteriorCounts, LodReport,
-    LodStage, OffsetReport, OffsetStage, OffsetVerification, SimplifyCounts,
+    ClearanceMeasure, ExtractionCounts, FeatureCounts, FloorMeasure, GuardCounts, InteriorCounts,
+    LodReport, LodStage, OffsetReport, OffsetStage, OffsetVerification, SimplifyCounts,
 };

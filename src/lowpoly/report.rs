@@ -26,6 +26,8 @@ pub enum LodStage {
     Measure,
     /// Measurement of the error floor, only with `LodParams::measure_floor` (`floor`).
     Floor,
+    /// Cages: exact measurement of the clearance (`clearance`).
+    Clearance,
 }
 
 impl Stage for LodStage {
@@ -39,6 +41,7 @@ impl Stage for LodStage {
             LodStage::Verify => "verify",
             LodStage::Measure => "measure",
             LodStage::Floor => "floor",
+            LodStage::Clearance => "clearance",
         })
     }
 }
@@ -92,6 +95,9 @@ pub struct GuardCounts {
     pub rejected_touch: u64,
     /// Rejected (cage): an input vertex would leave the cage.
     pub rejected_uncover: u64,
+    /// Rejected (cage with clearance): a face would come closer to the input than the
+    /// clearance.
+    pub rejected_clearance: u64,
     /// Patches whose normal cone allowed skipping the shared-vertex pairs.
     pub cone_fast_path: u64,
     /// Exact triangle–triangle tests run.
@@ -108,6 +114,7 @@ impl GuardCounts {
         self.rejected_intersection += o.rejected_intersection;
         self.rejected_touch += o.rejected_touch;
         self.rejected_uncover += o.rejected_uncover;
+        self.rejected_clearance += o.rejected_clearance;
         self.cone_fast_path += o.cone_fast_path;
         self.exact_tests += o.exact_tests;
     }
@@ -122,6 +129,23 @@ pub struct FloorMeasure {
     pub rel: f64,
     /// CPU seconds (all threads) of that measurement.
     pub cpu_seconds: f64,
+}
+
+/// A cage's clearance: required and measured (issue 12 part 3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClearanceMeasure {
+    /// The clearance the guard kept, in model units (`LodParams::clearance` resolved).
+    pub required: f64,
+    /// The exact minimum distance between output and input triangles, in model units,
+    /// measured by `crate::verify` (`CageInput::min_distance`, no samples).
+    pub min: f64,
+    /// `min / l` (dimensionless).
+    pub min_rel: f64,
+    /// `min ≥ required` (and `min > 0`). False only when the start surface was already closer
+    /// than the clearance somewhere (the guard never lowers a patch's distance below the
+    /// clearance, nor below what it was): the cage then still encloses without contact but
+    /// does not keep the requested clearance — a larger screen size or smaller clearance does.
+    pub kept: bool,
 }
 
 /// What one LOD (or cage) level of [`super::generate`] / [`super::generate_chain`] /
@@ -163,6 +187,8 @@ pub struct LodReport {
     pub reruns_exact: u64,
     /// The error floor, when measured.
     pub floor: Option<FloorMeasure>,
+    /// Cages: the required and the measured clearance; `None` for LODs.
+    pub clearance: Option<ClearanceMeasure>,
     /// Two-sided sampled Hausdorff distance between output and input (model units;
     /// `crate::verify::hausdorff_to_input`).
     pub hausdorff: f64,
@@ -220,6 +246,9 @@ impl LodReport {
         e.count_entry("guard_rejected_intersection", g.rejected_intersection);
         e.count_entry("guard_rejected_touch", g.rejected_touch);
         e.count_entry("guard_rejected_uncover", g.rejected_uncover);
+        if self.clearance.is_some() {
+            e.count_entry("guard_rejected_clearance", g.rejected_clearance);
+        }
         e.count_entry("guard_cone_fast_path", g.cone_fast_path);
         e.count_entry("guard_exact_tests", g.exact_tests);
         e.count_entry("target_met", self.target_met as u64);
@@ -232,6 +261,12 @@ impl LodReport {
         if let Some(f) = &self.floor {
             e.metric_entry("hausdorff_floor_rel", f.rel);
             e.metric_entry("floor_cpu_seconds", f.cpu_seconds);
+        }
+        if let Some(c) = &self.clearance {
+            e.metric_entry("clearance_required", c.required);
+            e.metric_entry("min_clearance", c.min);
+            e.metric_entry("min_clearance_rel", c.min_rel);
+            e.count_entry("clearance_kept", c.kept as u64);
         }
         e.metric_entry("hausdorff", self.hausdorff);
         e.metric_entry("hausdorff_rel", self.hausdorff_rel);

@@ -1,7 +1,8 @@
 //! Cage checks of any mesh against any input soup: **contact** (exact triangle–triangle tests
 //! on Shewchuk's predicates, BVH candidates), **enclosure** (hierarchical fast winding numbers,
-//! Barill et al. 2018, of every referenced input vertex) and **clearance** (the gap between the
-//! two surfaces measured at their vertices).
+//! Barill et al. 2018, of every referenced input vertex) and **clearance**: the exact minimum
+//! distance between cage triangles and input triangles ([`CageInput::min_distance`]), and the
+//! cheaper vertex-based upper bound [`clearance`].
 //!
 //! This is the verification of what the cage pipeline produces; it shares no code with the
 //! guard that keeps those properties during the cage's construction.
@@ -11,7 +12,10 @@
 
 use rayon::prelude::*;
 
+use crate::geom::Vec3;
 use crate::mesh::TriMesh;
+use crate::spatial::bvh::corners_box;
+use crate::spatial::closest::{disjoint_triangle_distance, plane_gap_lower_bound};
 use crate::spatial::{
     is_collinear, segment_triangle_intersect, triangles_intersect, FastWindingNumber, TriangleBvh,
 };
@@ -95,6 +99,66 @@ impl<'a> CageInput<'a> {
         fwn.winding_numbers(&self.points).iter().all(|&w| w > 0.5)
     }
 
+    /// The exact minimum distance between the triangles of `cage` and the input's triangles, in
+    /// model units (0 on contact; `∞` when either is empty). Not sampled: an upper bound `u`
+    /// (the smallest distance from a cage vertex to the input) limits the candidates to the
+    /// input triangles whose boxes come within `u` of a cage triangle's box (BVH), and each
+    /// candidate pair is decided exactly — 0 when they touch or intersect (exact predicates),
+    /// else the minimum of its 6 corner–triangle and 9 edge–edge distances, the closed-form
+    /// distance of two disjoint triangles. This is the `min_clearance` of a cage's report.
+    pub fn min_distance(&self, cage: &TriMesh) -> f64 {
+        let pos = cage.positions();
+        let upper = referenced_points(pos, cage.triangles())
+            .par_iter()
+            .map(|&p| {
+                self.bvh
+                    .closest_point(self.positions, self.tris, p, f64::INFINITY)
+                    .map_or(f64::INFINITY, |c| c.distance)
+            })
+            .reduce(|| f64::INFINITY, f64::min);
+        if !upper.is_finite() {
+            return upper;
+        }
+        cage.triangles()
+            .par_iter()
+            .map(|t| self.triangle_gap(&t.map(|v| pos[v as usize]), upper))
+            .reduce(|| upper, f64::min)
+    }
+
+    /// Smallest distance from the cage triangle `tri` to the input, or `upper` if that is
+    /// smaller (candidates farther than the running minimum are skipped by their boxes).
+    fn triangle_gap(&self, tri: &[[f64; 3]; 3], upper: f64) -> f64 {
+        let (lo, hi) = corners_box(tri);
+        let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
+        let pad = Vec3::splat(upper);
+        let tv = tri.map(Vec3::from);
+        let mut best = upper;
+        for t in self
+            .bvh
+            .query_box((lo - pad).to_array(), (hi + pad).to_array())
+        {
+            let corners = self.tris[t as usize].map(|v| self.positions[v as usize]);
+            let (clo, chi) = corners_box(&corners);
+            let gap = (Vec3::from(clo) - hi)
+                .max(lo - Vec3::from(chi))
+                .max(Vec3::ZERO)
+                .length();
+            if gap >= best {
+                continue;
+            }
+            let cv = corners.map(Vec3::from);
+            let plane = plane_gap_lower_bound(&tv, &cv);
+            if plane >= best && plane > 0.0 {
+                continue;
+            }
+            if self.meets_triangle(tri, t as usize) {
+                return 0.0;
+            }
+            best = best.min(disjoint_triangle_distance(&tv, &cv, 0.0));
+        }
+        best
+    }
+
     /// Whether the cage triangle `tri` meets input triangle `t`: a triangle–triangle test, or
     /// for a degenerate input triangle a test of each of its edges against `tri`.
     fn meets_triangle(&self, tri: &[[f64; 3]; 3], t: usize) -> bool {
@@ -111,6 +175,11 @@ impl<'a> CageInput<'a> {
 /// tests, other cage generators).
 pub fn check_cage(cage: &TriMesh, input: &TriMesh) -> CageCheck {
     CageInput::new(input).check(cage)
+}
+
+/// The exact minimum distance between `cage` and `input` (see [`CageInput::min_distance`]).
+pub fn min_distance(cage: &TriMesh, input: &TriMesh) -> f64 {
+    CageInput::new(input).min_distance(cage)
 }
 
 /// Clearance between `cage` and `input` in model units: the smallest distance from a
@@ -194,5 +263,22 @@ mod tests {
         let touching = cube(2.0, 0.0);
         assert!(!check_cage(&touching, &inner).untouched);
         assert_eq!(clearance(&touching, &inner), 0.0);
+        assert_eq!(min_distance(&touching, &inner), 0.0);
+        assert_eq!(min_distance(&outer, &inner), 1.0);
+    }
+
+    /// The exact gap is found where vertex distances overestimate it: a cage triangle whose
+    /// bottom edge passes 0.25 above the unit cube's top face, all corners far from it.
+    #[test]
+    fn exact_gap_not_vertex_samples() {
+        let inner = cube(1.0, 0.0);
+        let outer = TriMesh::new(
+            vec![[-5.0, 0.5, 1.25], [5.0, 0.5, 1.25], [0.0, 0.5, 9.0]],
+            vec![[0, 1, 2]],
+        )
+        .unwrap();
+        let exact = min_distance(&outer, &inner);
+        assert!((exact - 0.25).abs() < 1e-15, "{exact}");
+        assert!(clearance(&outer, &inner) > 0.25 + 1e-3);
     }
 }

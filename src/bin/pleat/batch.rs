@@ -646,9 +646,9 @@ fn cache_key(input: &[u8], a: &Asset, args: &BakeArgs, cmd: &str) -> String {
     for n in &a.sizes {
         field(&format!("n_p={:016x}", n.to_bits()));
     }
-    field(&format!("faces={:?}", a.faces));
-    field(&format!("rounds={}", args.rounds));
-    field(&format!("align={}", !args.no_align));
+    // Every LOD parameter the bake will use (its `Debug` form prints each field, f64s exactly),
+    // so a parameter added to `lod_params` can never be left out of the key.
+    field(&format!("{:?}", lod_params(args, &a.sizes, a.faces)));
     for o in &a.outputs {
         field(&format!("format={}", extension(o)));
     }

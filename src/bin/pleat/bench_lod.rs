@@ -53,6 +53,10 @@ pub struct LodBenchArgs {
     /// Bake cages instead of LODs (adds the enclosure and contact columns).
     #[arg(long)]
     pub cage: bool,
+    /// With --cage: the clearance, `0.1d` (fraction of d, the default) or a length in model
+    /// units (see `pleat cage --clearance`).
+    #[arg(long, value_parser = super::parse_clearance)]
+    pub clearance: Option<pleat::lowpoly::Clearance>,
     /// Face target per (mesh, n_p) from a CSV with columns `mesh`, `n_p`, `meshopt_faces`
     /// (the one `cargo bench --bench lod` writes) [default: target/bench/lod_vs_meshopt.csv].
     #[arg(long, num_args = 0..=1, default_missing_value = "target/bench/lod_vs_meshopt.csv")]
@@ -153,7 +157,15 @@ fn sweep(args: &LodBenchArgs) -> Result<(), (u8, String)> {
                 true
             };
             let target = targets.get(&(name.clone(), n_p.to_bits())).copied();
-            let (mut row, out) = bake_case(&name, mesh, n_p, target, args.cage, &mut prog);
+            let (mut row, out) = bake_case(
+                &name,
+                mesh,
+                n_p,
+                target,
+                args.cage,
+                args.clearance,
+                &mut prog,
+            );
             if let (Some(out), true) = (&out, row.ok()) {
                 input.bake(&mut row, out);
             }
