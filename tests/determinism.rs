@@ -9,7 +9,6 @@
 #![cfg(all(feature = "cli", feature = "cage", feature = "wrinkle"))]
 
 #[path = "common/shapes.rs"]
-#[allow(dead_code)]
 mod shapes;
 
 use std::ffi::CString;
