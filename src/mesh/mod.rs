@@ -5,6 +5,8 @@
 
 pub mod halfedge;
 pub mod io;
+#[cfg(test)]
+pub(crate) mod test_shapes;
 mod trimesh;
 mod weld;
 

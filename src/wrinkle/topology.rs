@@ -571,22 +571,9 @@ fn corner_angle(p: &[[f64; 3]], t: [u32; 3], v: u32) -> f64 {
 mod tests {
     use super::*;
 
-    fn grid(n: usize) -> TriMesh {
-        let mut p = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                p.push([i as f64, j as f64, 0.0]);
-            }
-        }
-        let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-        let mut t = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
-        TriMesh::new(p, t).unwrap()
+    /// The crate's test grid, `n × n` squares.
+    fn grid(n: u32) -> TriMesh {
+        crate::mesh::test_shapes::grid(n, n)
     }
 
     #[test]

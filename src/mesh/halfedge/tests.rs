@@ -1,6 +1,7 @@
 use std::collections::HashMap;
 
 use super::*;
+use crate::mesh::test_shapes::grid;
 use crate::mesh::TriMesh;
 
 fn vid(i: u32) -> VertexId {
@@ -115,24 +116,6 @@ fn icosphere(level: u32) -> TriMesh {
             .collect();
     }
     TriMesh::new(p, f).unwrap()
-}
-
-/// Flat `nx × ny` grid of squares, two triangles each: a disk with one boundary loop.
-fn grid(nx: u32, ny: u32) -> TriMesh {
-    let id = |i: u32, j: u32| j * (nx + 1) + i;
-    let mut p = Vec::new();
-    for j in 0..=ny {
-        for i in 0..=nx {
-            p.push([i as f64, j as f64, 0.0]);
-        }
-    }
-    let mut quads = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            quads.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    TriMesh::new(p, quads_to_tris(&quads)).unwrap()
 }
 
 /// Torus with `nu × nv` squares (two triangles each).
