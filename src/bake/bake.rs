@@ -28,8 +28,9 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::appearance::{linear_to_srgb, AlphaMode, Appearance, MaterialSample};
+use super::appearance::{linear_to_srgb, Appearance, MaterialSample};
 use super::atlas::{build_atlas, Atlas, AtlasParams};
+use super::level::{BakeReport, BakedLevel, BakedMaterial, Image8};
 use super::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 use crate::geom::{normalized, Vec3};
 use crate::mesh::TriMesh;
@@ -95,134 +96,6 @@ impl Default for BakeParams {
             evaluate: false,
         }
     }
-}
-
-/// Timing, sizes and the appearance error of one baked level.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct BakeReport {
-    /// Seconds spent building the UV atlas (xatlas).
-    pub atlas_seconds: f64,
-    /// Seconds spent on MikkTSpace tangents.
-    pub tangent_seconds: f64,
-    /// Seconds spent rasterising the atlas into texels.
-    pub raster_seconds: f64,
-    /// Seconds spent on provenance and material sampling (texels or vertices).
-    pub sample_seconds: f64,
-    /// Seconds spent dilating the images into their gutters.
-    pub dilate_seconds: f64,
-    /// Seconds spent measuring the appearance error.
-    pub measure_seconds: f64,
-    /// Wall seconds of the whole level bake (the LOD geometry not included).
-    pub total_seconds: f64,
-    /// Side of the square textures in texels (0 when vertex colours were baked instead).
-    pub texture_size: u32,
-    /// Texels covered by charts (sampled from the input), the rest being gutter.
-    pub texels_covered: u64,
-    /// Charts of the atlas.
-    pub charts: u32,
-    /// Texel centres where two non-adjacent atlas triangles overlap (0 for a valid atlas;
-    /// xatlas occasionally leaves a folded chart, see `atlas::overlapping_texels`).
-    pub overlapping_texels: u64,
-    /// Fraction of samples whose provenance came from the closest-point fallback, in [0, 1].
-    pub fallback_fraction: f64,
-    /// Mean appearance error: |baked base colour − input base colour at the closest input
-    /// point|, max over R, G, B, in sRGB units of 1/255, over up to
-    /// [`BakeParams::error_samples`] covered texels (vertices for vertex colours).
-    pub appearance_error_mean: f64,
-    /// 95th percentile of the same error, in 1/255.
-    pub appearance_error_p95: f64,
-    /// Maximum of the same error, in 1/255.
-    pub appearance_error_max: f64,
-    /// With [`BakeParams::evaluate`]: unlit PSNR (dB) of the level's render against the
-    /// input's, mean over 24 views at the level's screen size, over pixels both cover
-    /// ([`super::render`]).
-    pub appearance_psnr_db: Option<f64>,
-    /// With [`BakeParams::evaluate`]: the same PSNR for the level's geometry coloured by the
-    /// input at the closest input point (a perfect bake's score; the bake loses
-    /// `appearance_psnr_reference_db − appearance_psnr_db`).
-    pub appearance_psnr_reference_db: Option<f64>,
-    /// With [`BakeParams::evaluate`] and a baked normal map: shaded PSNR with the normal map
-    /// minus shaded PSNR without it, dB (> 0: the map brings the level closer to the input).
-    pub normal_map_gain_db: Option<f64>,
-    /// Seconds spent on the evaluation renders (not in `total_seconds`).
-    pub evaluate_seconds: f64,
-}
-
-/// An 8-bit RGBA image, row-major, row 0 at the top (glTF's v = 0).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Image8 {
-    /// Width in texels.
-    pub width: u32,
-    /// Height in texels.
-    pub height: u32,
-    /// `4 · width · height` bytes, RGBA.
-    pub rgba: Vec<u8>,
-}
-
-impl Image8 {
-    /// The RGBA texel at column `i`, row `j`.
-    pub fn texel(&self, i: u32, j: u32) -> [u8; 4] {
-        let k = 4 * (j as usize * self.width as usize + i as usize);
-        [
-            self.rgba[k],
-            self.rgba[k + 1],
-            self.rgba[k + 2],
-            self.rgba[k + 3],
-        ]
-    }
-}
-
-/// The material of a baked level (glTF metallic-roughness).
-#[derive(Debug, Clone, PartialEq)]
-pub struct BakedMaterial {
-    /// baseColorFactor (linear).
-    pub base_color_factor: [f64; 4],
-    /// baseColorTexture (sRGB RGB, linear alpha).
-    pub base_color: Option<Image8>,
-    /// metallicFactor.
-    pub metallic_factor: f64,
-    /// roughnessFactor.
-    pub roughness_factor: f64,
-    /// metallicRoughnessTexture (G roughness, B metallic).
-    pub metallic_roughness: Option<Image8>,
-    /// occlusionTexture (R).
-    pub occlusion: Option<Image8>,
-    /// emissiveFactor (linear).
-    pub emissive_factor: [f64; 3],
-    /// emissiveTexture (sRGB).
-    pub emissive: Option<Image8>,
-    /// normalTexture (tangent space, MikkTSpace of the level's TANGENTs).
-    pub normal: Option<Image8>,
-    /// Alpha mode (of the input's first material).
-    pub alpha_mode: AlphaMode,
-    /// Alpha cutoff.
-    pub alpha_cutoff: f64,
-    /// Double-sided.
-    pub double_sided: bool,
-}
-
-/// One baked LOD level: a mesh with normals, optional tangents, UVs and colours, and its
-/// material.
-#[derive(Debug, Clone, PartialEq)]
-pub struct BakedLevel {
-    /// Screen size `n_p` the level was made for.
-    pub screen_size: f64,
-    /// Vertex positions (split at chart seams and tangent discontinuities).
-    pub positions: Vec<[f64; 3]>,
-    /// Unit vertex normals.
-    pub normals: Vec<[f32; 3]>,
-    /// MikkTSpace tangents `(x, y, z, w)` when textured.
-    pub tangents: Option<Vec<[f32; 4]>>,
-    /// glTF texture coordinates (0 … 1) when textured.
-    pub uvs: Option<Vec<[f32; 2]>>,
-    /// Linear RGBA vertex colours (the untextured path).
-    pub colors: Option<Vec<[f32; 4]>>,
-    /// Triangles.
-    pub triangles: Vec<[u32; 3]>,
-    /// Material.
-    pub material: BakedMaterial,
-    /// Timing and error.
-    pub report: BakeReport,
 }
 
 /// Bakes `app`'s appearance onto `lod`, a LOD of `app.mesh` made for screen size `screen_size`.

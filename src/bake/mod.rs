@@ -9,6 +9,7 @@
 //! - [`atlas`]: xatlas charts and packing with a texel density rule from the screen size.
 //! - [`bake`](mod@bake): per-texel sampling, MikkTSpace normal map, dilation; vertex colours
 //!   for untextured inputs.
+//! - [`level`]: the baked result (mesh, material, images, report), plain data.
 //! - [`output`]: a `.glb` with every level (`MSFT_lod`, `MSFT_screencoverage`).
 //! - [`render`]: an independent software rasterizer measuring a bake (PSNR of renders of the
 //!   input and a level, normal-map gain); evaluation only.
@@ -20,6 +21,7 @@ pub mod appearance;
 pub mod atlas;
 #[allow(clippy::module_inception)]
 pub mod bake;
+pub mod level;
 pub mod output;
 pub mod provenance;
 pub mod render;
@@ -29,9 +31,8 @@ pub use appearance::{
     ImageBuffer, MaterialSample, UvBuffer,
 };
 pub use atlas::{build_atlas, Atlas, AtlasParams};
-pub use bake::{
-    bake_level, bake_level_with_progress, BakeParams, BakeReport, BakedLevel, BakedMaterial, Image8,
-};
+pub use bake::{bake_level, bake_level_with_progress, BakeParams};
+pub use level::{BakeReport, BakedLevel, BakedMaterial, Image8};
 pub use output::{chain_glb, screen_coverage};
 pub use provenance::{provenance, InputIndex, Provenance, ProvenanceParams};
 

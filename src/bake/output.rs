@@ -12,7 +12,7 @@
 
 use serde_json::{json, Value};
 
-use super::bake::{BakedLevel, Image8};
+use super::level::{BakedLevel, Image8};
 use crate::{Error, Result};
 
 /// Reference viewport height in pixels for [`screen_coverage`].

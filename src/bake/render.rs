@@ -33,7 +33,7 @@
 use rayon::prelude::*;
 
 use super::appearance::{linear_to_srgb, srgb_to_linear, Appearance};
-use super::bake::{BakedLevel, Image8};
+use super::level::{BakedLevel, Image8};
 use super::provenance::barycentric;
 use crate::geom::{normalized, Vec3};
 use crate::spatial::TriangleBvh;
