@@ -451,7 +451,10 @@ fn chart_gutters_hold_down_to_the_rule_mip_level() {
     let app = sphere(64, 256);
     for n_p in [50.0, 200.0] {
         let level = bake_one(&app, n_p, &BakeParams::default());
-        check_seams(&format!("sphere n_p {n_p}"), &level, 0.0);
+        // xatlas's packer can place a chart closer than the padding (the same tolerance as the
+        // assets below): since the atlas packs at a planned density (issue 11), the n_p = 50
+        // level has 1 of 630 mip-1 samples reading the neighbour chart.
+        check_seams(&format!("sphere n_p {n_p}"), &level, 0.005);
     }
     let Some(dir) = assets() else { return };
     for name in ["gen_elephant_sin.glb", "gen_torus_normalmap.glb"] {

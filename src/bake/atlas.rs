@@ -85,8 +85,10 @@ pub struct Atlas {
 }
 
 /// Builds the atlas of `mesh` with side `side` (see [`AtlasParams::side`]) and `padding` texels
-/// between charts. When the charts do not fit one atlas at xatlas's estimated density, the
-/// density is lowered by 10 % steps until they do.
+/// between charts. xatlas computes and parameterises the charts once; they are packed at the
+/// density planned from the total chart area and the gutters (`pack_density`), and only when they
+/// still do not fit one atlas is the density lowered (by 15 % steps) and the same charts
+/// packed again. Deterministic: the same mesh gives the same atlas bytes.
 ///
 /// Errors: `InvalidArgument` for a zero side; `Internal` when xatlas drops a face or produces
 /// a non-finite UV.
@@ -101,25 +103,15 @@ pub fn build_atlas(mesh: &TriMesh, side: u32, padding: u32) -> Result<Atlas> {
         .collect();
     let indices: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
     let area = mesh.surface_area().max(f64::MIN_POSITIVE);
-    // xatlas's own estimate for a given resolution (75 % utilisation), lowered until one atlas
-    // holds every chart. xatlas (this version) can leave a chart whose LSCM boundary
-    // self-intersects; such atlases are detected by rasterisation and recomputed with a lower
-    // chart-growth threshold (smaller charts), keeping the one with the fewest overlaps.
-    let estimate = (f64::from(side) * f64::from(side) * 0.75 / area).sqrt();
+    // xatlas (this version) can leave a chart whose LSCM boundary self-intersects; such
+    // atlases are detected by rasterisation and recomputed with a lower chart-growth threshold
+    // (smaller charts), keeping the one with the fewest overlaps.
     let mut best: Option<Atlas> = None;
     for threshold in [2.0f32, 1.0, 0.5, 0.25] {
-        let mut scale = 1.0;
-        let mut found = None;
-        for _ in 0..12 {
-            let density = (estimate * scale) as f32;
-            if let Some(a) = run_xatlas(&positions, &indices, side, padding, density, threshold)? {
-                check_atlas(&a, &indices)?;
-                found = Some(a);
-                break;
-            }
-            scale *= 0.9;
-        }
-        let Some(mut a) = found else { continue };
+        let Some(mut a) = charts_packed(&positions, &indices, area, side, padding, threshold)?
+        else {
+            continue;
+        };
         a.overlapping_texels = overlapping_texels(&a);
         let done = a.overlapping_texels == 0;
         if best
@@ -138,6 +130,178 @@ pub fn build_atlas(mesh: &TriMesh, side: u32, padding: u32) -> Result<Atlas> {
             mesh.triangle_count()
         ))
     })
+}
+
+/// Fraction of the atlas the charts and their gutters are planned to cover (xatlas's packer
+/// reaches ~0.7 on LOD charts; planning a little below leaves room for its rounding).
+const PACK_FILL: f64 = 0.65;
+
+/// Largest density factor of a retry: a retry lowers the density by at least 15 %.
+const RETRY_SCALE: f64 = 0.85;
+
+/// Share of a full atlas's utilisation a retry plans for (see [`retry_scale`]).
+const RETRY_FILL: f64 = 0.9;
+
+/// Density factor for the retry after a packing spilled over into further atlases: `spill` is
+/// the summed utilisation of all atlases over that of the first (full) one, so the charts
+/// need `spill` full atlases at the tried density; scaling their area by `RETRY_FILL / spill`
+/// plans them into [`RETRY_FILL`] of one, at most [`RETRY_SCALE`] of the tried density.
+fn retry_scale(spill: f64) -> f64 {
+    if spill.is_finite() && spill > 0.0 {
+        (RETRY_FILL / spill).sqrt().min(RETRY_SCALE)
+    } else {
+        RETRY_SCALE
+    }
+}
+
+/// Texels per unit length at which `charts` charts of total surface area `area` fill
+/// [`PACK_FILL`] of a `side`² atlas together with their gutters. A chart of area `a_c` at
+/// density `d` covers `a_c d²` texels; its gutter (`padding` texels plus up to one of extent
+/// rounding, `g = padding + 1`) adds about `4 g √(a_c) d + 4 g²` (a square chart's ring), and
+/// `Σ √(a_c) ≤ √(charts · area)`. With `x = d √area` the plan is
+/// `x² + 4 g √charts · x + 4 g² charts = PACK_FILL · side²`, a quadratic in `x`.
+fn pack_density(area: f64, charts: u32, side: u32, padding: u32) -> f64 {
+    let s2 = PACK_FILL * f64::from(side) * f64::from(side);
+    let g = f64::from(padding) + 1.0;
+    let n = f64::from(charts.max(1));
+    let b = 2.0 * g * n.sqrt(); // half the linear coefficient
+    let c = 4.0 * g * g * n - s2;
+    // Positive root of x² + 2 b x + c = 0; when the gutters alone exceed the plan, fall back
+    // to a quarter of the gutter-free density (the retries lower it further if needed).
+    let x = if c < 0.0 {
+        -b + (b * b - c).sqrt()
+    } else {
+        0.25 * s2.sqrt()
+    };
+    x / area.max(f64::MIN_POSITIVE).sqrt()
+}
+
+/// The charts of one xatlas chart computation at `max_threshold`, packed into one `side`²
+/// atlas: first at [`pack_density`], then at densities lowered by [`RETRY_SCALE`]; `None`
+/// when no density tried fits.
+fn charts_packed(
+    positions: &[f32],
+    indices: &[u32],
+    area: f64,
+    side: u32,
+    padding: u32,
+    max_threshold: f32,
+) -> Result<Option<Atlas>> {
+    let atlas = parameterised_charts(positions, indices, max_threshold)?;
+    // SAFETY: `atlas` is live; ParameterizeCharts has set its chart count.
+    let charts = unsafe { (*atlas.0).chart_count };
+    let mut density = pack_density(area, charts, side, padding);
+    for _ in 0..12 {
+        match pack(&atlas, side, padding, density as f32)? {
+            Packed::One(a) => {
+                check_atlas(&a, indices)?;
+                return Ok(Some(a));
+            }
+            Packed::Spilled(spill) => {
+                density *= retry_scale(spill);
+            }
+        }
+    }
+    Ok(None)
+}
+
+/// An xatlas atlas holding `positions`/`indices` with its charts computed (chart-growth
+/// threshold `max_threshold`) and parameterised, ready for [`pack`].
+fn parameterised_charts(
+    positions: &[f32],
+    indices: &[u32],
+    max_threshold: f32,
+) -> Result<ffi::Handle> {
+    let decl = ffi::MeshDecl {
+        vertex_count: (positions.len() / 3) as u32,
+        vertex_position_data: positions.as_ptr().cast(),
+        vertex_position_stride: 12,
+        vertex_normal_data: std::ptr::null(),
+        vertex_normal_stride: 0,
+        vertex_uv_data: std::ptr::null(),
+        vertex_uv_stride: 0,
+        index_count: indices.len() as u32,
+        index_data: indices.as_ptr().cast(),
+        index_offset: 0,
+        index_format: ffi::INDEX_FORMAT_UINT32,
+        face_ignore_data: std::ptr::null(),
+    };
+    // SAFETY: a null print function silences xatlas's warnings on stdout; the realloc
+    // function is a valid realloc (see `realloc_or_free`).
+    unsafe {
+        ffi::set_print(None, false);
+        ffi::set_realloc(Some(realloc_or_free));
+    }
+    let atlas = ffi::Handle::new()?;
+    // SAFETY: `atlas` is a live atlas; `decl` points into `positions` and `indices`, which
+    // outlive the call (xatlas copies the mesh in AddMesh).
+    let status = unsafe { ffi::add_mesh(atlas.0, &decl) };
+    if status != 0 {
+        return Err(Error::Internal(format!(
+            "xatlas AddMesh failed with status {status}"
+        )));
+    }
+    // SAFETY: live atlas with its mesh added, plain-data options, no callbacks; the default
+    // (null) parameterisation is xatlas's LSCM.
+    unsafe {
+        ffi::compute_charts(
+            atlas.0,
+            ffi::ChartOptions {
+                max_threshold,
+                ..ffi::ChartOptions::default()
+            },
+            None,
+            std::ptr::null_mut(),
+        );
+        ffi::parameterize_charts(atlas.0, None, None, std::ptr::null_mut());
+    }
+    Ok(atlas)
+}
+
+/// Outcome of one packing.
+enum Packed {
+    /// Every chart in one atlas.
+    One(Atlas),
+    /// The charts spilled over into further atlases: their summed utilisation over that of
+    /// the first atlas.
+    Spilled(f64),
+}
+
+/// One packing of the parameterised charts of `atlas` at `texels_per_unit`. xatlas restores the charts' parameterisation before
+/// each packing, so packings of the same atlas are independent.
+fn pack(atlas: &ffi::Handle, side: u32, padding: u32, texels_per_unit: f32) -> Result<Packed> {
+    let pack = ffi::PackOptions {
+        attempts: 4096,
+        texels_per_unit,
+        resolution: side,
+        max_chart_size: side,
+        block_align: false,
+        conservative: padding > 0,
+        padding,
+    };
+    // SAFETY: live atlas whose charts are computed and parameterised; no callbacks.
+    unsafe { ffi::pack_charts(atlas.0, pack, None, std::ptr::null_mut()) };
+    // SAFETY: after PackCharts, the atlas's arrays are valid until the next PackCharts or
+    // Destroy; the copy is taken before either.
+    let raw = unsafe { &*atlas.0 };
+    if raw.atlas_count > 1 {
+        return Ok(Packed::Spilled(spill(raw)));
+    }
+    // SAFETY: as above.
+    let out = unsafe { copy_output(raw, side) }?;
+    out.map(Packed::One)
+        .ok_or_else(|| Error::Internal("xatlas returned no atlas".into()))
+}
+
+/// Summed utilisation of all atlases of a packing over that of the first; infinite when
+/// xatlas reports none.
+fn spill(a: &ffi::RawAtlas) -> f64 {
+    if a.utilization.is_null() || a.atlas_count == 0 {
+        return f64::INFINITY;
+    }
+    // SAFETY: PackCharts allocates `atlas_count` utilisations.
+    let u = unsafe { std::slice::from_raw_parts(a.utilization, a.atlas_count as usize) };
+    u.iter().map(|&x| f64::from(x)).sum::<f64>() / f64::from(u[0])
 }
 
 /// Texel centres inside two atlas triangles that share no atlas vertex (edge-adjacent and
@@ -178,73 +342,6 @@ pub fn overlapping_texels(a: &Atlas) -> u64 {
         }
     }
     count
-}
-
-/// One xatlas run; `None` when the charts spill over into a second atlas.
-fn run_xatlas(
-    positions: &[f32],
-    indices: &[u32],
-    side: u32,
-    padding: u32,
-    texels_per_unit: f32,
-    max_threshold: f32,
-) -> Result<Option<Atlas>> {
-    let decl = ffi::MeshDecl {
-        vertex_count: (positions.len() / 3) as u32,
-        vertex_position_data: positions.as_ptr().cast(),
-        vertex_position_stride: 12,
-        vertex_normal_data: std::ptr::null(),
-        vertex_normal_stride: 0,
-        vertex_uv_data: std::ptr::null(),
-        vertex_uv_stride: 0,
-        index_count: indices.len() as u32,
-        index_data: indices.as_ptr().cast(),
-        index_offset: 0,
-        index_format: ffi::INDEX_FORMAT_UINT32,
-        face_ignore_data: std::ptr::null(),
-    };
-    let pack = ffi::PackOptions {
-        attempts: 4096,
-        texels_per_unit,
-        resolution: side,
-        max_chart_size: side,
-        block_align: false,
-        conservative: padding > 0,
-        padding,
-    };
-    // SAFETY: a null print function silences xatlas's warnings on stdout; the realloc
-    // function is a valid realloc (see `realloc_or_free`).
-    unsafe {
-        ffi::set_print(None, false);
-        ffi::set_realloc(Some(realloc_or_free));
-    }
-    let atlas = ffi::Handle::new()?;
-    // SAFETY: `atlas` is a live atlas; `decl` points into `positions` and `indices`, which
-    // outlive the call (xatlas copies the mesh in AddMesh).
-    let status = unsafe { ffi::add_mesh(atlas.0, &decl) };
-    if status != 0 {
-        return Err(Error::Internal(format!(
-            "xatlas AddMesh failed with status {status}"
-        )));
-    }
-    // SAFETY: live atlas, plain-data options, no callbacks.
-    unsafe {
-        ffi::generate(
-            atlas.0,
-            ffi::ChartOptions {
-                max_threshold,
-                ..ffi::ChartOptions::default()
-            },
-            None,
-            pack,
-            None,
-            std::ptr::null_mut(),
-        );
-    }
-    // SAFETY: after Generate, the atlas's arrays are valid until Destroy (when `atlas` drops,
-    // after the copies below).
-    let out = unsafe { copy_output(&*atlas.0, side) }?;
-    Ok(out)
 }
 
 /// Copies xatlas's single output mesh; `None` when it produced more than one atlas.
@@ -461,11 +558,23 @@ mod ffi {
         pub fn destroy(atlas: *mut RawAtlas);
         #[link_name = "_ZN6xatlas7AddMeshEPNS_5AtlasERKNS_8MeshDeclE"]
         pub fn add_mesh(atlas: *mut RawAtlas, decl: *const MeshDecl) -> c_int;
-        #[link_name = "_ZN6xatlas8GenerateEPNS_5AtlasENS_12ChartOptionsEPFvPKfPfjPKjjbENS_11PackOptionsEPFvNS_16ProgressCategory4EnumEiPvESD_"]
-        pub fn generate(
+        #[link_name = "_ZN6xatlas13ComputeChartsEPNS_5AtlasENS_12ChartOptionsEPFvNS_16ProgressCategory4EnumEiPvES5_"]
+        pub fn compute_charts(
             atlas: *mut RawAtlas,
             chart: ChartOptions,
+            progress: ProgressFunc,
+            user: *mut c_void,
+        );
+        #[link_name = "_ZN6xatlas18ParameterizeChartsEPNS_5AtlasEPFvPKfPfjPKjjbEPFvNS_16ProgressCategory4EnumEiPvESB_"]
+        pub fn parameterize_charts(
+            atlas: *mut RawAtlas,
             param: ParameterizeFunc,
+            progress: ProgressFunc,
+            user: *mut c_void,
+        );
+        #[link_name = "_ZN6xatlas10PackChartsEPNS_5AtlasENS_11PackOptionsEPFvNS_16ProgressCategory4EnumEiPvES5_"]
+        pub fn pack_charts(
+            atlas: *mut RawAtlas,
             pack: PackOptions,
             progress: ProgressFunc,
             user: *mut c_void,
@@ -491,5 +600,46 @@ mod ffi {
             // SAFETY: created by `create`, destroyed once.
             unsafe { destroy(self.0) }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Without gutters the plan is the charts' area alone: `A d² = PACK_FILL · side²`.
+    #[test]
+    fn pack_density_without_gutter_fills_the_plan() {
+        let (area, side) = (3.0, 512u32);
+        let d = pack_density(area, 1, side, 0);
+        // g = 1 even without padding (extent rounding): solve the quadratic's residual.
+        let x = d * area.sqrt();
+        let plan = PACK_FILL * f64::from(side * side);
+        assert!((x * x + 4.0 * x + 4.0 - plan).abs() < 1e-6 * plan);
+    }
+
+    /// The planned density satisfies the gutter quadratic, falls as charts or padding grow,
+    /// and stays positive when the gutters alone would overflow the plan.
+    #[test]
+    fn pack_density_solves_the_gutter_quadratic() {
+        let (area, side, n, p) = (2.0, 1024u32, 60u32, 4u32);
+        let d = pack_density(area, n, side, p);
+        let (x, g, nf) = (d * area.sqrt(), f64::from(p) + 1.0, f64::from(n));
+        let plan = PACK_FILL * f64::from(side * side);
+        let lhs = x * x + 4.0 * g * nf.sqrt() * x + 4.0 * g * g * nf;
+        assert!((lhs - plan).abs() < 1e-6 * plan, "{lhs} vs {plan}");
+        assert!(pack_density(area, 2 * n, side, p) < d);
+        assert!(pack_density(area, n, side, 2 * p) < d);
+        assert!(pack_density(area, 1_000_000, 64, 8) > 0.0);
+    }
+
+    /// A retry plans the spilled charts into `RETRY_FILL` of one atlas, lowers the density by
+    /// at least `1 - RETRY_SCALE`, and falls back to that step when xatlas reports nothing.
+    #[test]
+    fn retry_scale_plans_the_spill_into_one_atlas() {
+        assert!((retry_scale(2.0) - (RETRY_FILL / 2.0).sqrt()).abs() < 1e-12);
+        assert_eq!(retry_scale(1.01), RETRY_SCALE);
+        assert_eq!(retry_scale(f64::INFINITY), RETRY_SCALE);
+        assert_eq!(retry_scale(f64::NAN), RETRY_SCALE);
     }
 }
