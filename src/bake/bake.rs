@@ -344,14 +344,25 @@ fn bake_vertex_colors(
     if params.error_samples > 0 {
         steps.check("bake: measure", 0.9)?;
         let t = Instant::now();
-        let stride = lod.vertex_count().div_ceil(params.error_samples).max(1);
-        let errs: Vec<f64> = (0..lod.vertex_count())
+        // Errors over the surface (the fit's quadrature points), where the fit is optimal, not
+        // at the vertices only.
+        let stride = fit.samples.len().div_ceil(params.error_samples).max(1);
+        let errs: Vec<f64> = fit
+            .samples
+            .iter()
             .step_by(stride)
             .collect::<Vec<_>>()
             .par_iter()
-            .map(|&v| {
-                let baked = colors[v].map(f64::from);
-                color_error(app, index, Vec3::from(lod.positions()[v]), baked)
+            .map(|&&(t, b)| {
+                let tri = lod.triangles()[t];
+                let at = |k: usize| Vec3::from(lod.positions()[tri[k] as usize]);
+                let p = at(0) * b[0] + at(1) * b[1] + at(2) * b[2];
+                let baked: [f64; 4] = std::array::from_fn(|j| {
+                    (0..3)
+                        .map(|k| b[k] * f64::from(colors[tri[k] as usize][j]))
+                        .sum()
+                });
+                color_error(app, index, p, baked)
             })
             .collect();
         set_errors(&mut report, errs);
@@ -381,6 +392,8 @@ struct VertexColorFit {
     colors: Vec<[f64; 4]>,
     /// Fraction of samples not found by the cast along the normal.
     fallback_fraction: f64,
+    /// The quadrature points: LOD triangle and barycentric coordinates.
+    samples: Vec<(usize, [f64; 3])>,
 }
 
 /// Least-squares vertex colours (issue 11, "vertex colours transfer as vertex colours"): the
@@ -461,6 +474,7 @@ fn fit_vertex_colors(
     VertexColorFit {
         colors,
         fallback_fraction: fallback(found.iter().flatten().map(|f| f.0)),
+        samples: samples.iter().map(|&(t, b, _)| (t, b)).collect(),
     }
 }
 
