@@ -508,8 +508,12 @@ fn untextured_input_gives_vertex_colours() {
     .levels;
     let b = &levels[0].baked;
     assert!(b.colors.is_some() && b.uvs.is_none());
+    // The error is measured over the LOD surface (not only at its vertices, where the old
+    // point samples were exact by construction): a 25-pixel LOD cannot carry this 2–3 period
+    // field in vertex colours. Measured: 31.47 with point samples at the vertices, 30.85 with
+    // the least-squares fit.
     assert!(
-        b.report.appearance_error_mean < 6.0,
+        b.report.appearance_error_mean < 31.2,
         "{}",
         b.report.appearance_error_mean
     );
