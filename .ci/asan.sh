@@ -30,6 +30,8 @@ trap 'rm -rf "$out"' EXIT
 flags=(-g -O1 -fno-omit-frame-pointer -Wall -Wextra -Werror -pedantic
        -I"$root/include" -I"$root/bindings/cpp" -L"$libdir" -Wl,-rpath,"$libdir")
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:halt_on_error=1:detect_stack_use_after_return=1}
+# xatlas (vendored C++) leaks inside its packer; see examples_c/lsan.supp.
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/examples_c/lsan.supp:print_suppressions=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1}
 assimp=$(pkg-config --cflags --libs assimp 2>/dev/null || true)
