@@ -136,7 +136,8 @@ _PROGRESS_FN = _c.CFUNCTYPE(_c.c_int32, _c.c_void_p, _c.POINTER(_Progress))
 
 _LodParams = _struct("PleatLodParams", _u32s("struct_size", "max_rounds") + _f64s("screen_size")
                      + _u64s("target_faces") + _f64s("flow_ratio", "epsilon", "theta0_deg")
-                     + _u32s("l0", "flags") + _u64s("memory_budget_bytes"))
+                     + _u32s("l0", "flags") + _u64s("memory_budget_bytes")
+                     + _f64s("clearance"))
 _LodStats = _struct("PleatLodStats", _u32s("struct_size", "rounds")
                     + _u64s("face_count", "vertex_count", "start_face_count", "collapse_count")
                     + _f64s("seconds_total", "seconds_offset", "seconds_simplify", "seconds_flow",
@@ -145,7 +146,9 @@ _LodStats = _struct("PleatLodStats", _u32s("struct_size", "rounds")
                     + _u32s("watertight", "manifold", "self_intersection_free", "encloses_input",
                             "exact_rerun", "target_met")
                     + _f64s("hausdorff_in_to_out_relative", "hausdorff_out_to_in_relative",
-                            "hausdorff_floor_relative"))
+                            "hausdorff_floor_relative", "min_clearance",
+                            "min_clearance_relative", "clearance_required")
+                    + _u32s("clearance_kept"))
 _OffsetParams = _struct("PleatOffsetParams", _u32s("struct_size", "use_absolute_distance")
                         + _f64s("screen_size", "distance", "voxel_scale", "theta0_deg")
                         + _u32s("l0", "features", "remove_interior", "iso_refinement_steps")
