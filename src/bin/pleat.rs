@@ -398,6 +398,16 @@ const EXIT_FAILED: u8 = 1;
 #[cfg(feature = "lod")]
 const SIZE_PLACEHOLDERS: [&str; 2] = ["{n}", "{np}"];
 
+/// The exit code of a failed bake: `EXIT_INPUT` when the caller's arguments or input are
+/// at fault (`InvalidArgument`), `EXIT_FAILED` otherwise.
+#[cfg(feature = "lod")]
+fn failure_code(e: &pleat::Error) -> u8 {
+    match e {
+        pleat::Error::InvalidArgument(_) => EXIT_INPUT,
+        _ => EXIT_FAILED,
+    }
+}
+
 /// The output path of screen size `n_p`.
 #[cfg(feature = "lod")]
 fn output_path(pattern: &std::path::Path, n_p: f64) -> PathBuf {
@@ -447,11 +457,7 @@ fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
         Ok(l) => l,
         Err(e) => {
             eprintln!("pleat {cmd}: {e}");
-            let code = match e {
-                pleat::Error::InvalidArgument(_) => EXIT_INPUT,
-                _ => EXIT_FAILED,
-            };
-            return ExitCode::from(code);
+            return ExitCode::from(failure_code(&e));
         }
     };
     for ((out, stats), &n_p) in levels.iter().zip(sizes) {
@@ -702,10 +708,7 @@ fn offset(
         Ok(r) => r,
         Err(e) => {
             eprintln!("pleat offset: {e}");
-            return ExitCode::from(match e {
-                pleat::Error::InvalidArgument(_) => EXIT_INPUT,
-                _ => EXIT_FAILED,
-            });
+            return ExitCode::from(failure_code(&e));
         }
     };
     if let Err(e) = pleat::mesh::io::write_mesh(output, &out) {

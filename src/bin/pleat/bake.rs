@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use pleat::bake::{bake_chain, chain_glb, read_appearance, AtlasParams, BakeParams, BakedLevel};
 use pleat::lowpoly::LodParams;
 
-use super::{progress_bar, show_progress, BakeArgs, EXIT_FAILED, EXIT_INPUT};
+use super::{failure_code, progress_bar, show_progress, BakeArgs, EXIT_FAILED, EXIT_INPUT};
 
 /// Options of the textured bake (flattened into `lod`'s options).
 #[derive(clap::Args)]
@@ -69,11 +69,7 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
         Ok(l) => l,
         Err(e) => {
             eprintln!("pleat {cmd}: {e}");
-            let code = match e {
-                pleat::Error::InvalidArgument(_) => EXIT_INPUT,
-                _ => EXIT_FAILED,
-            };
-            return ExitCode::from(code);
+            return ExitCode::from(failure_code(&e));
         }
     };
     let levels = &chain.levels;
