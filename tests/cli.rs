@@ -425,6 +425,29 @@ fn lod_bake_writes_one_glb_chain() {
     let (doc, _, images) = gltf::import(&out).unwrap();
     assert_eq!(doc.meshes().count(), 2);
     assert!(images.len() >= 2);
+
+    // A face target applies to a single-level bake (it used to be refused with --bake).
+    let one = dir.join("one.glb");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_pleat"))
+        .args(["lod", asset.to_str().unwrap(), "--screen-size", "50"])
+        .args(["--faces", "60", "--bake", "-q", "-o"])
+        .arg(&one)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let (doc, buffers, _) = gltf::import(&one).unwrap();
+    let prim = doc.meshes().next().unwrap().primitives().next().unwrap();
+    let reader = prim.reader(|b| Some(&buffers[b.index()]));
+    let triangles = reader.read_indices().unwrap().into_u32().count() / 3;
+    assert!(triangles <= 60, "{triangles} faces for --faces 60");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pleat"))
+        .args(["lod", asset.to_str().unwrap(), "--screen-size", "25,50"])
+        .args(["--faces", "60", "--bake", "-q", "-o"])
+        .arg(&one)
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--faces needs a single screen size"));
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -64,7 +64,9 @@ pub struct BakedChain {
 }
 
 /// LODs of `app.mesh` at every screen size (`lowpoly::generate_chain`), each baked with
-/// [`bake_level`]. Levels are returned in the order of `screen_sizes`. `progress` sees the
+/// [`bake_level`]. Levels are returned in the order of `screen_sizes`. With one screen size and
+/// `lod_params.target_faces` set, the level is `lowpoly::generate` with that face target (a
+/// chain ignores face targets). `progress` sees the
 /// geometry stages in the first [`GEOMETRY_SHARE`] of the range, then each level's bake stages
 /// ([`bake_level_with_progress`]) in an equal share of the rest; returning `false` cancels
 /// with `Error::Cancelled` (within a texel chunk during the bake).
@@ -83,7 +85,19 @@ pub fn bake_chain(
                 fraction: GEOMETRY_SHARE * p.fraction,
             })
         };
-        crate::lowpoly::generate_chain(&app.mesh, screen_sizes, lod_params, &mut geometry)?
+        match (screen_sizes, lod_params.target_faces) {
+            // One level with a face target: the chain ignores targets (they are per level).
+            ([n_p], Some(_)) => {
+                let p = LodParams {
+                    screen_size: *n_p,
+                    ..lod_params.clone()
+                };
+                vec![crate::lowpoly::generate(&app.mesh, &p, &mut geometry)?]
+            }
+            _ => {
+                crate::lowpoly::generate_chain(&app.mesh, screen_sizes, lod_params, &mut geometry)?
+            }
+        }
     };
     let geometry_seconds = t.elapsed().as_secs_f64();
     let t = std::time::Instant::now();

@@ -6,7 +6,6 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use pleat::bake::{bake_chain, chain_glb, read_appearance, AtlasParams, BakeParams, BakedLevel};
-use pleat::lowpoly::LodParams;
 
 use super::{failure_code, progress_bar, show_progress, BakeArgs, EXIT_FAILED, EXIT_INPUT};
 
@@ -30,8 +29,8 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
         eprintln!("pleat {cmd}: --bake is only available for `pleat lod`");
         return ExitCode::from(EXIT_INPUT);
     }
-    if args.faces.is_some() {
-        eprintln!("pleat {cmd}: --faces cannot be combined with --bake");
+    if args.screen_size.len() > 1 && args.faces.is_some() {
+        eprintln!("pleat {cmd}: --faces needs a single screen size");
         return ExitCode::from(EXIT_INPUT);
     }
     if let Some(s) = args.textures.texture_size {
@@ -47,11 +46,7 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
             return ExitCode::from(EXIT_INPUT);
         }
     };
-    let lod_params = LodParams {
-        max_rounds: args.rounds,
-        align: !args.no_align,
-        ..LodParams::default()
-    };
+    let lod_params = super::lod_params(args, &args.screen_size, args.faces);
     let params = BakeParams {
         atlas: AtlasParams {
             size: args.textures.texture_size,
