@@ -274,7 +274,8 @@ fn manifests_give_per_asset_screen_sizes_and_budgets() {
         Some(8.0)
     );
 
-    // The same as JSON; a missing input is a failed row, not the end of the batch.
+    // The same as JSON; a missing input is a failed row, not the end of the batch. Every row
+    // names its output, so no -o is needed.
     std::fs::write(
         dir.join("assets.json"),
         r#"[{"input": "torus.obj", "screen_size": [20, 10], "output": "json/t_{np}.obj"},
@@ -287,8 +288,6 @@ fn manifests_give_per_asset_screen_sizes_and_budgets() {
         s(&dir.join("assets.json")),
         "--rounds",
         "3",
-        "-o",
-        s(&default_out),
         "--report",
         s(&dir.join("rj.json")),
     ]);

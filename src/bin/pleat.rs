@@ -149,9 +149,10 @@ struct BakeArgs {
     faces: Option<usize>,
     // clap turns `{n}` into a line break anywhere in help text, so the help names `{np}`,
     // which works the same (see `output_path`).
-    /// Output file; `{np}` is replaced by the screen size (required with several sizes).
-    #[arg(short, long)]
-    output: PathBuf,
+    /// Output file; `{np}` is replaced by the screen size (required with several sizes). In a
+    /// batch: the pattern for the manifest rows that name no output (optional when all do).
+    #[arg(short, long, required_unless_present = "manifest")]
+    output: Option<PathBuf>,
     /// Maximum optimization rounds N.
     #[arg(long, default_value_t = 50)]
     rounds: u32,
@@ -426,9 +427,13 @@ fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
     if args.textures.bake {
         return bake_cmd::run(input, args, cmd);
     }
+    let Some(output) = args.output.as_deref() else {
+        eprintln!("pleat {cmd}: no output file (give -o)");
+        return ExitCode::from(EXIT_INPUT);
+    };
     let sizes = &args.screen_size;
     let many = sizes.len() > 1;
-    let pattern = args.output.to_string_lossy();
+    let pattern = output.to_string_lossy();
     if many && !SIZE_PLACEHOLDERS.iter().any(|p| pattern.contains(p)) {
         eprintln!(
             "pleat {cmd}: with several screen sizes the output needs a {{n}} or {{np}} placeholder"
@@ -461,7 +466,7 @@ fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
         }
     };
     for ((out, stats), &n_p) in levels.iter().zip(sizes) {
-        let path = output_path(&args.output, n_p);
+        let path = output_path(output, n_p);
         if let Err(e) = write_mesh(&path, out) {
             eprintln!("pleat {cmd}: {e}");
             return ExitCode::from(EXIT_FAILED);

@@ -29,6 +29,10 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
         eprintln!("pleat {cmd}: --bake is only available for `pleat lod`");
         return ExitCode::from(EXIT_INPUT);
     }
+    let Some(output) = args.output.as_deref() else {
+        eprintln!("pleat {cmd}: no output file (give -o)");
+        return ExitCode::from(EXIT_INPUT);
+    };
     if args.screen_size.len() > 1 && args.faces.is_some() {
         eprintln!("pleat {cmd}: --faces needs a single screen size");
         return ExitCode::from(EXIT_INPUT);
@@ -76,8 +80,8 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
             return ExitCode::from(EXIT_FAILED);
         }
     };
-    if let Err(e) = std::fs::write(&args.output, bytes) {
-        eprintln!("pleat {cmd}: cannot write '{}': {e}", args.output.display());
+    if let Err(e) = std::fs::write(output, bytes) {
+        eprintln!("pleat {cmd}: cannot write '{}': {e}", output.display());
         return ExitCode::from(EXIT_FAILED);
     }
     if !args.quiet {
@@ -106,7 +110,7 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
             "geometry {:.2} s, bake {:.2} s; wrote {}",
             chain.geometry_seconds,
             chain.bake_seconds,
-            args.output.display()
+            output.display()
         );
     }
     ExitCode::SUCCESS

@@ -209,7 +209,9 @@ impl Spec {
         if sizes.len() > 1 && faces.is_some() {
             return Err(format!("{name}: a face budget needs a single screen size"));
         }
-        let pattern = self.output.unwrap_or_else(|| args.output.clone());
+        let pattern = self.output.or_else(|| args.output.clone()).ok_or_else(|| {
+            format!("{name}: no output (give -o or an output column in the manifest)")
+        })?;
         let text = pattern.to_string_lossy();
         if sizes.len() > 1 && !SIZE_PLACEHOLDERS.iter().any(|p| text.contains(p)) {
             return Err(format!(
