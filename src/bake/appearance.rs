@@ -34,7 +34,7 @@ use crate::{Error, Result};
 pub const MAX_TEXTURE_TEXELS: u64 = 1 << 26;
 
 /// How texture coordinates outside `[0, 1]` are mapped (the glTF sampler's `wrapS`/`wrapT`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Wrap {
     /// Repeat (`u − floor(u)`), the glTF default.
     Repeat,
@@ -690,9 +690,28 @@ impl Appearance {
     }
 }
 
-/// Reads a `.glb`/`.gltf` file's appearance (external buffers and images relative to its
-/// folder). See the [module docs](self).
+/// Reads a file's appearance, by extension (case-insensitive): `.obj` through
+/// [`read_obj_appearance`](super::obj::read_obj_appearance) (OBJ + MTL), `.ply`, `.off` and
+/// `.stl` are refused (`InvalidArgument`: they carry no material), anything else is read as
+/// glTF/GLB (external buffers and images relative to its folder; see the
+/// [module docs](self)).
 pub fn read_appearance(path: &Path) -> Result<Appearance> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match ext.as_str() {
+        "obj" => return super::obj::read_obj_appearance(path),
+        "ply" | "off" | "stl" => {
+            return Err(Error::InvalidArgument(format!(
+                "'{}': a .{ext} file has no materials to bake; textured bakes read glTF \
+                 (.glb, .gltf) or OBJ + MTL (.obj)",
+                path.display()
+            )))
+        }
+        _ => {}
+    }
     let name = path.display().to_string();
     let data = std::fs::read(path).map_err(|e| crate::mesh::io::io_error(&name, &e))?;
     let base = path.parent().unwrap_or(Path::new("."));
@@ -736,19 +755,39 @@ fn raw_json(data: &[u8]) -> Option<serde_json::Value> {
     serde_json::from_slice(json).ok()
 }
 
+/// An [`Appearance`] under construction, one primitive (or OBJ group) after another: every
+/// per-vertex vector grows with `positions`, every per-triangle one with `triangles`.
 #[derive(Default)]
-struct Builder {
-    positions: Vec<[f64; 3]>,
-    triangles: Vec<[u32; 3]>,
-    triangle_material: Vec<u32>,
-    triangle_flat: Vec<bool>,
-    normals: Vec<[f64; 3]>,
-    tangents: Vec<[f64; 4]>,
-    uvs: Vec<Vec<[f64; 2]>>,
-    colors: Vec<[f64; 4]>,
-    any_color: bool,
-    materials: Vec<Material>,
-    textures: Vec<Texture>,
+pub(super) struct Builder {
+    pub(super) positions: Vec<[f64; 3]>,
+    pub(super) triangles: Vec<[u32; 3]>,
+    pub(super) triangle_material: Vec<u32>,
+    pub(super) triangle_flat: Vec<bool>,
+    pub(super) normals: Vec<[f64; 3]>,
+    pub(super) tangents: Vec<[f64; 4]>,
+    pub(super) uvs: Vec<Vec<[f64; 2]>>,
+    pub(super) colors: Vec<[f64; 4]>,
+    pub(super) any_color: bool,
+    pub(super) materials: Vec<Material>,
+    pub(super) textures: Vec<Texture>,
+}
+
+impl Builder {
+    /// The appearance (its mesh checked by `TriMesh::new`; errors name `name`).
+    pub(super) fn finish(self, name: &str) -> Result<Appearance> {
+        let mesh = io_build(name, self.positions, self.triangles)?;
+        Ok(Appearance {
+            mesh,
+            triangle_material: self.triangle_material,
+            triangle_flat: self.triangle_flat,
+            normals: self.normals,
+            tangents: self.tangents,
+            uvs: self.uvs,
+            colors: self.any_color.then_some(self.colors),
+            materials: self.materials,
+            textures: self.textures,
+        })
+    }
 }
 
 struct Reader<'a> {
@@ -1113,25 +1152,13 @@ impl Reader<'_> {
     }
 
     fn finish(self) -> Result<Appearance> {
-        let b = self.out;
-        let mesh = io_build(self.name, b.positions, b.triangles)?;
-        Ok(Appearance {
-            mesh,
-            triangle_material: b.triangle_material,
-            triangle_flat: b.triangle_flat,
-            normals: b.normals,
-            tangents: b.tangents,
-            uvs: b.uvs,
-            colors: b.any_color.then_some(b.colors),
-            materials: b.materials,
-            textures: b.textures,
-        })
+        self.out.finish(self.name)
     }
 }
 
 impl Material {
     /// Every texture reference of the material.
-    fn refs(&self) -> impl Iterator<Item = &TextureRef> {
+    pub(super) fn refs(&self) -> impl Iterator<Item = &TextureRef> {
         [
             &self.base_color,
             &self.metallic_roughness,
@@ -1232,7 +1259,7 @@ pub fn linear_to_srgb(c: f64) -> f64 {
 
 /// Decodes a PNG or JPEG into `(width, height, linear RGBA texels)`; `srgb` decodes the colour
 /// channels' sRGB transfer (alpha is always linear).
-fn decode_image(
+pub(super) fn decode_image(
     bytes: &[u8],
     srgb: bool,
 ) -> std::result::Result<(u32, u32, Vec<[f32; 4]>), String> {
