@@ -267,6 +267,18 @@ fn sphere_point(u: f64, v: f64) -> Vec3 {
 
 /// A UV sphere (longitude seam duplicated) textured with `field` at 256×128.
 fn sphere_glb() -> Vec<u8> {
+    sphere_glb_with(
+        |u, v| [u, v],
+        |u, v| field(sphere_point(u, v)).map(|c| (255.0 * c).round() as u8),
+    )
+}
+
+/// The UV sphere with texture coordinates `uv_of(u, v)` at its grid point (u, v) and the
+/// 256×128 image's sRGB texel at texel centre (u, v) given by `texel`.
+fn sphere_glb_with(
+    uv_of: impl Fn(f64, f64) -> [f64; 2],
+    texel: impl Fn(f64, f64) -> [u8; 3],
+) -> Vec<u8> {
     let (nu, nv) = (48u32, 24u32);
     let (mut pos, mut nrm, mut uv, mut tris) = (vec![], vec![], vec![], vec![]);
     for j in 0..=nv {
@@ -275,7 +287,7 @@ fn sphere_glb() -> Vec<u8> {
             let p = sphere_point(u, v);
             pos.push(p.to_array().map(|c| c as f32));
             nrm.push(p.to_array().map(|c| c as f32));
-            uv.push([u as f32, v as f32]);
+            uv.push(uv_of(u, v).map(|c| c as f32));
         }
     }
     let id = |i: u32, j: u32| j * (nu + 1) + i;
@@ -302,17 +314,11 @@ fn sphere_glb() -> Vec<u8> {
     let mut rgba = Vec::new();
     for j in 0..h {
         for i in 0..w {
-            let p = sphere_point(
+            let c = texel(
                 (f64::from(i) + 0.5) / f64::from(w),
                 (f64::from(j) + 0.5) / f64::from(h),
             );
-            let c = field(p);
-            rgba.extend_from_slice(&[
-                (255.0 * c[0]).round() as u8,
-                (255.0 * c[1]).round() as u8,
-                (255.0 * c[2]).round() as u8,
-                255,
-            ]);
+            rgba.extend_from_slice(&[c[0], c[1], c[2], 255]);
         }
     }
     textured_glb(
@@ -407,16 +413,7 @@ fn field_errors_where(
 fn sphere_bake_matches_the_analytic_field_and_rereads() {
     let data = sphere_glb();
     let app = read_appearance_bytes(&data, None, "sphere").unwrap();
-    let sizes = [25.0, 50.0];
-    let levels = bake_chain(
-        &app,
-        &sizes,
-        &LodParams::default(),
-        &BakeParams::default(),
-        &mut |_| true,
-    )
-    .unwrap()
-    .levels;
+    let levels = bake_default(&app, &[25.0, 50.0]);
     for l in &levels {
         let r = &l.baked.report;
         eprintln!(
@@ -476,6 +473,19 @@ fn sphere_bake_matches_the_analytic_field_and_rereads() {
     assert_eq!(out, chain_glb(&refs).unwrap());
 }
 
+/// The chain of `app` at `sizes` with default LOD and bake parameters.
+fn bake_default(app: &Appearance, sizes: &[f64]) -> Vec<pleat::bake::ChainLevel> {
+    bake_chain(
+        app,
+        sizes,
+        &LodParams::default(),
+        &BakeParams::default(),
+        &mut |_| true,
+    )
+    .unwrap()
+    .levels
+}
+
 /// The output re-reads with the `gltf` crate (validated, images decoded) and with pleat.
 fn check_output(out: &[u8], n_levels: usize) {
     let (doc, buffers, images) = gltf::import_slice(out).expect("gltf crate reads the output");
@@ -511,15 +521,7 @@ fn untextured_input_gives_vertex_colours() {
             .map(|c| [c[0], c[1], c[2], 1.0])
             .collect(),
     );
-    let levels = bake_chain(
-        &app,
-        &[25.0],
-        &LodParams::default(),
-        &BakeParams::default(),
-        &mut |_| true,
-    )
-    .unwrap()
-    .levels;
+    let levels = bake_default(&app, &[25.0]);
     let b = &levels[0].baked;
     assert!(b.colors.is_some() && b.uvs.is_none());
     // The error is measured over the LOD surface (not only at its vertices, where the old
@@ -651,15 +653,7 @@ fn shared_torus_bakes_with_normal_map() {
     let name = "gen_torus_normalmap.glb";
     let app = read_appearance(&dir.join(name)).unwrap();
     let spec = sidecar(&dir, name);
-    let levels = bake_chain(
-        &app,
-        &[50.0],
-        &LodParams::default(),
-        &BakeParams::default(),
-        &mut |_| true,
-    )
-    .unwrap()
-    .levels;
+    let levels = bake_default(&app, &[50.0]);
     let b = &levels[0].baked;
     assert!(b.material.normal.is_some());
     let (mean, max) = field_errors(
@@ -1088,15 +1082,7 @@ fn obj_mtl_bakes_through_the_cli_and_matches_the_field() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     check_output(&std::fs::read(&out).unwrap(), 2);
     let app = read_appearance(&obj).unwrap();
-    let levels = bake_chain(
-        &app,
-        &[50.0],
-        &LodParams::default(),
-        &BakeParams::default(),
-        &mut |_| true,
-    )
-    .unwrap()
-    .levels;
+    let levels = bake_default(&app, &[50.0]);
     let l = &levels[0].baked;
     let d = app.mesh.bbox_diagonal() / 50.0;
     let (mean, max) = field_errors_where(l, &app.mesh, obj_field, &app, |p| p.y.abs() > 3.0 * d);
@@ -1193,4 +1179,98 @@ fn obj_mtl_bad_inputs_are_clear_errors() {
     let e = err(&dir.join("x.ply"));
     assert!(e.contains("no materials"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+// --------------------------------------------------------------- bad-input checklist --
+
+/// `data` (a GLB) with its JSON chunk edited by `edit`.
+fn edit_glb(data: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
+    let len = u32::from_le_bytes(data[12..16].try_into().unwrap()) as usize;
+    let mut doc: serde_json::Value = serde_json::from_slice(&data[20..20 + len]).unwrap();
+    let bin = &data[20 + len + 8..];
+    edit(&mut doc);
+    glb(&doc, bin)
+}
+
+/// Issue 11's bad inputs on the glTF reader: a missing external image, non-finite UVs, and
+/// non-triangle primitives (points and lines skipped as the geometry reader skips them,
+/// strips and fans decoded: the appearance's mesh stays the geometry reader's).
+#[test]
+fn gltf_bad_inputs_are_clear_or_documented() {
+    let dir = scratch("gltfbad");
+    // Missing external image: an error naming it.
+    let data = edit_glb(&quad_glb(json!({}), json!({}), 0.0), |d| {
+        d["images"][0] = json!({"uri": "nothere.png"});
+    });
+    let path = dir.join("quad.glb");
+    std::fs::write(&path, &data).unwrap();
+    let e = read_appearance(&path).unwrap_err().to_string();
+    assert!(e.contains("nothere.png"), "{e}");
+    // Non-finite UV.
+    let (w, h, rgba) = tiny_image();
+    let data = textured_glb(
+        &[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        &[[0.0, 0.0, 1.0]; 3],
+        &[[0.0; 2], [f32::NAN, 0.0], [0.0, 1.0]],
+        &[[0, 1, 2]],
+        &png(w, h, &rgba),
+        json!({}),
+        json!({}),
+    );
+    let e = read_appearance_bytes(&data, None, "nanuv")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("TEXCOORD_0") && e.contains("not finite"), "{e}");
+    // Points, lines and a strip next to the indexed triangles.
+    let data = edit_glb(&quad_glb(json!({}), json!({}), 0.0), |d| {
+        let prim = d["meshes"][0]["primitives"][0].clone();
+        let mut with_mode = |mode: u32, indexed: bool| {
+            let mut p = prim.clone();
+            p["mode"] = json!(mode);
+            if !indexed {
+                p.as_object_mut().unwrap().remove("indices");
+            }
+            d["meshes"][0]["primitives"].as_array_mut().unwrap().push(p);
+        };
+        with_mode(0, true);
+        with_mode(1, false);
+        with_mode(5, false);
+        with_mode(6, false);
+    });
+    let app = read_appearance_bytes(&data, None, "modes").unwrap();
+    let geometry = pleat::mesh::io::gltf::read_gltf_bytes(&data, None, "modes").unwrap();
+    assert_eq!(app.mesh.positions(), geometry.positions());
+    assert_eq!(app.mesh.triangles(), geometry.triangles());
+    // 2 indexed triangles + 2 of the 4-vertex strip + 2 of the fan.
+    assert_eq!(app.mesh.triangle_count(), 6);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Mirrored, overlapping input UVs still bake correctly: the lower hemisphere of the
+/// analytic-field sphere reuses the upper one's texels mirrored (v ↦ 1 − v), the image's lower
+/// half is magenta garbage that nothing samples, and the baked colour is the field mirrored
+/// into the upper hemisphere (away from the equator, where bilinear filtering reaches the
+/// garbage rows).
+#[test]
+fn mirrored_overlapping_uvs_bake_correctly() {
+    let data = sphere_glb_with(
+        |u, v| [u, v.min(1.0 - v)],
+        |u, v| {
+            if v < 0.5 {
+                field(sphere_point(u, v)).map(|c| (255.0 * c).round() as u8)
+            } else {
+                [255, 0, 255]
+            }
+        },
+    );
+    let app = read_appearance_bytes(&data, None, "mirrored").unwrap();
+    let levels = bake_default(&app, &[50.0]);
+    let d = app.mesh.bbox_diagonal() / 50.0;
+    let mirrored = |p: Vec3, _| field(Vec3::new(p.x, p.y.abs(), p.z));
+    let (mean, max) = field_errors_where(&levels[0].baked, &app.mesh, mirrored, &app, |p| {
+        p.y.abs() > 3.0 * d
+    });
+    let bound = 1.0 + 300.0 / (4.0 * 50.0);
+    eprintln!("mirrored UVs vs field: mean {mean:.2} max {max:.2} /255 (bound {bound:.2})");
+    assert!(mean < bound && max < 8.0 * bound, "mean {mean} max {max}");
 }
