@@ -54,6 +54,9 @@ pub fn read_obj_appearance(path: &Path) -> Result<Appearance> {
     let text = std::fs::read(path).map_err(|e| io_error(&name, &e))?;
     let libraries = RefCell::new(Vec::<(PathBuf, usize)>::new());
     let mtl_error = RefCell::new(None::<Error>);
+    // `..default()` keeps this compiling if tobj's optional features (which add fields) get
+    // enabled elsewhere in the dependency graph.
+    #[allow(clippy::needless_update)]
     let options = tobj::LoadOptions {
         single_index: true,
         triangulate: true,
