@@ -114,6 +114,23 @@ int main() {
         EXPECT(e.status() == PLEAT_STATUS_CANCELLED);
         std::printf("  ok: cancelled -> %s\n", e.what());
     }
+    {
+        // Two materials: the checker and an untextured green, one per half of the triangles.
+        PleatBakeMaterial green = pleat_bake_material_default();
+        green.base_color_factor[0] = green.base_color_factor[2] = 0.0;
+        std::vector<uint32_t> tm(input.triangle_count());
+        for (size_t i = 0; i < tm.size(); i++) tm[i] = i < tm.size() / 2 ? 0 : 1;
+        pleat::Bake two = pleat::Bake::make(lod, input, {m, green}, tm, bp);
+        EXPECT(two && two.textured());
+        tm[0] = 2;
+        try {
+            pleat::Bake::make(lod, input, {m, green}, tm, bp);
+            EXPECT(false);
+        } catch (const pleat::Error &e) {
+            EXPECT(e.status() == PLEAT_STATUS_INVALID_ARGUMENT);
+            std::printf("  ok: material index out of range -> %s\n", e.what());
+        }
+    }
     try {
         m.uv_count = 3;
         pleat::Bake::make(lod, input, m, bp);

@@ -54,6 +54,9 @@
 // `PLEAT_STATUS_LIMIT_EXCEEDED`.
 #define PLEAT_BAKE_MAX_IMAGE_TEXELS (1 << 26)
 
+// Most materials `pleat_bake_lod_multi` takes (65536).
+#define PLEAT_BAKE_MAX_MATERIALS (1 << 16)
+
 // Largest `PleatBakeParams::texture_size`.
 #define PLEAT_BAKE_MAX_TEXTURE_SIZE 8192
 
@@ -932,6 +935,35 @@ PleatStatus pleat_bake_lod(const struct PleatMesh *lod,
                            void *user_data,
                            struct PleatBake **out,
                            struct PleatBakeStats *stats);
+
+// `pleat_bake_lod` with several materials: input triangle `t` takes
+// `materials[triangle_material[t]]`. The mesh arrays (`uv_layout`, `uvs`, `uv_count`,
+// `normals`, `colors`) come from `materials[0]` and are shared by all; the other materials
+// set only factors, images and `wrap` (their array fields NULL/0). One atlas and one baked
+// material hold every input material. `pleat_bake_lod` is this call with one material.
+//
+// - `materials`: `material_count` structs (1 … `PLEAT_BAKE_MAX_MATERIALS`), each with the
+//   same `struct_size` (the array's stride); non-NULL.
+// - `triangle_material`: `triangle_count` indices, `triangle_count` = the input's triangle
+//   count, each `< material_count`; NULL (with `triangle_count` 0) puts every triangle in
+//   material 0.
+// - The rest as in `pleat_bake_lod`. Any invalid index, count or struct is
+//   `PLEAT_STATUS_INVALID_ARGUMENT` naming it, before any work.
+//
+// # Safety
+// Handles are NULL or live; the arrays hold their stated counts; every material's pointers
+// hold the counts `PleatBakeMaterial` documents.
+PleatStatus pleat_bake_lod_multi(const struct PleatMesh *lod,
+                                 const struct PleatMesh *input,
+                                 const struct PleatBakeMaterial *materials,
+                                 size_t material_count,
+                                 const uint32_t *triangle_material,
+                                 size_t triangle_count,
+                                 const struct PleatBakeParams *params,
+                                 PleatProgressFn progress,
+                                 void *user_data,
+                                 struct PleatBake **out,
+                                 struct PleatBakeStats *stats);
 
 // Frees a bake (NULL is ignored).
 //

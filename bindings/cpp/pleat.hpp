@@ -660,6 +660,24 @@ class Bake {
         return Bake(b);
     }
 
+    /// Bakes several materials onto `lod` (pleat_bake_lod_multi): input triangle `t` takes
+    /// `materials[triangle_material[t]]`; the mesh arrays (UVs, normals, colours) come from
+    /// `materials[0]`, the others set only factors, images and wrap.
+    static Bake make(const Mesh &lod, const Mesh &input,
+                     const std::vector<PleatBakeMaterial> &materials,
+                     const std::vector<uint32_t> &triangle_material,
+                     const PleatBakeParams &params = pleat_bake_params_default(),
+                     const Progress &progress = {}) {
+        PleatBake *b = nullptr;
+        detail::ProgressRelay relay(progress);
+        relay.finish(pleat_bake_lod_multi(
+            lod.get(), input.get(), materials.data(), materials.size(),
+            triangle_material.empty() ? nullptr : triangle_material.data(),
+            triangle_material.size(), &params, relay.callback(), relay.user_data(), &b,
+            nullptr));
+        return Bake(b);
+    }
+
     size_t vertex_count() const noexcept { return pleat_bake_vertex_count(raw_); }
     size_t triangle_count() const noexcept { return pleat_bake_triangle_count(raw_); }
     /// Statistics (seconds per stage, texels, charts, appearance error).

@@ -20,7 +20,6 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use ::gltf::accessor::Dimensions;
-use ::gltf::mesh::Mode;
 use ::gltf::texture::WrappingMode;
 use ::gltf::{Document, Semantic};
 
@@ -34,7 +33,7 @@ use crate::{Error, Result};
 pub const MAX_TEXTURE_TEXELS: u64 = 1 << 26;
 
 /// How texture coordinates outside `[0, 1]` are mapped (the glTF sampler's `wrapS`/`wrapT`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Wrap {
     /// Repeat (`u − floor(u)`), the glTF default.
     Repeat,
@@ -570,7 +569,41 @@ impl Appearance {
     /// colour, a texture without UVs, or a zero-sized image; `LimitExceeded` for an image over
     /// [`MAX_TEXTURE_TEXELS`].
     pub fn from_buffers(b: &AppearanceBuffers<'_>) -> Result<Appearance> {
+        let nt = b.mesh.triangle_count();
+        Self::from_buffers_multi(b, std::slice::from_ref(&b.material), &vec![0; nt])
+    }
+
+    /// [`from_buffers`](Self::from_buffers) with several materials: triangle `t` takes
+    /// `materials[triangle_material[t]]` (`b.material` is not used; the mesh attributes of `b`
+    /// are shared by every material). The single-material call is this with one material.
+    /// Triangle order is kept, so [`Appearance::triangle_material`] equals
+    /// `triangle_material`.
+    ///
+    /// Errors as [`from_buffers`](Self::from_buffers), naming `materials[i]` when there are
+    /// several, plus `InvalidArgument` for no material, a `triangle_material` whose length is
+    /// not the triangle count, or an index `>= materials.len()`.
+    pub fn from_buffers_multi(
+        b: &AppearanceBuffers<'_>,
+        materials: &[BufferMaterial<'_>],
+        triangle_material: &[u32],
+    ) -> Result<Appearance> {
         let (nv, nt) = (b.mesh.vertex_count(), b.mesh.triangle_count());
+        if materials.is_empty() {
+            return Err(Error::InvalidArgument(
+                "no material given (at least one is needed)".into(),
+            ));
+        }
+        check_len(triangle_material, nt, "triangle_material", "triangle")?;
+        if let Some(t) = triangle_material
+            .iter()
+            .position(|&m| m as usize >= materials.len())
+        {
+            return Err(Error::InvalidArgument(format!(
+                "triangle_material[{t}] is {}; there are {} materials",
+                triangle_material[t],
+                materials.len()
+            )));
+        }
         if let Some(n) = b.normals {
             check_len(n, nv, "normals", "vertex")?;
             check_finite(n, "normals")?;
@@ -587,53 +620,19 @@ impl Appearance {
         if let Some(UvBuffer::PerVertex(uv) | UvBuffer::PerCorner(uv)) = b.uvs {
             check_finite(uv, "uvs")?;
         }
-        let m = &b.material;
-        for (v, name) in [
-            (m.metallic_factor, "metallic_factor"),
-            (m.roughness_factor, "roughness_factor"),
-            (m.normal_scale, "normal_scale"),
-            (m.occlusion_strength, "occlusion_strength"),
-        ] {
-            if !v.is_finite() {
-                return Err(Error::InvalidArgument(format!(
-                    "{name} is {v}; must be finite"
-                )));
-            }
-        }
-        check_finite(&[m.base_color_factor], "base_color_factor")?;
-        check_finite(&[m.emissive_factor], "emissive_factor")?;
-
         let mut textures = Vec::new();
-        let mut slot = |img: Option<ImageBuffer<'_>>, name: &str, scale: f64| {
-            img.map(|img| -> Result<TextureRef> {
-                if b.uvs.is_none() {
-                    return Err(Error::InvalidArgument(format!(
-                        "{name} is given but there are no UVs to sample it with"
-                    )));
-                }
-                textures.push(img.to_texture(name, m.wrap)?);
-                Ok(TextureRef {
-                    texture: textures.len() - 1,
-                    tex_coord: 0,
-                    transform: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
-                    scale,
-                })
+        let converted = materials
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let prefix = if materials.len() > 1 {
+                    format!("materials[{i}].")
+                } else {
+                    String::new()
+                };
+                buffer_material(m, &prefix, b.uvs.is_some(), &mut textures)
             })
-            .transpose()
-        };
-        let material = Material {
-            base_color_factor: m.base_color_factor,
-            base_color: slot(m.base_color, "base_color", 1.0)?,
-            metallic_factor: m.metallic_factor,
-            roughness_factor: m.roughness_factor,
-            metallic_roughness: slot(m.metallic_roughness, "metallic_roughness", 1.0)?,
-            normal: slot(m.normal, "normal", m.normal_scale)?,
-            occlusion: slot(m.occlusion, "occlusion", m.occlusion_strength)?,
-            emissive_factor: m.emissive_factor,
-            emissive: slot(m.emissive, "emissive", 1.0)?,
-            ..Material::default()
-        };
-
+            .collect::<Result<Vec<_>>>()?;
         let normals: Vec<[f64; 3]> = match b.normals {
             Some(n) => n
                 .iter()
@@ -677,22 +676,98 @@ impl Appearance {
         };
         let n = mesh.vertex_count();
         Ok(Appearance {
-            triangle_material: vec![0; nt],
+            triangle_material: triangle_material.to_vec(),
             triangle_flat: vec![false; nt],
             normals: per_vertex(&normals),
             tangents: vec![[0.0; 4]; n],
             uvs,
             colors,
-            materials: vec![material],
+            materials: converted,
             textures,
             mesh,
         })
     }
 }
 
-/// Reads a `.glb`/`.gltf` file's appearance (external buffers and images relative to its
-/// folder). See the [module docs](self).
+/// One caller material as a [`Material`], its images decoded into `textures` (checks of
+/// [`Appearance::from_buffers`]; `prefix` is prepended to the names in messages).
+fn buffer_material(
+    m: &BufferMaterial<'_>,
+    prefix: &str,
+    has_uvs: bool,
+    textures: &mut Vec<Texture>,
+) -> Result<Material> {
+    for (v, name) in [
+        (m.metallic_factor, "metallic_factor"),
+        (m.roughness_factor, "roughness_factor"),
+        (m.normal_scale, "normal_scale"),
+        (m.occlusion_strength, "occlusion_strength"),
+    ] {
+        if !v.is_finite() {
+            return Err(Error::InvalidArgument(format!(
+                "{prefix}{name} is {v}; must be finite"
+            )));
+        }
+    }
+    check_finite(
+        &[m.base_color_factor],
+        &format!("{prefix}base_color_factor"),
+    )?;
+    check_finite(&[m.emissive_factor], &format!("{prefix}emissive_factor"))?;
+    let mut slot = |img: Option<ImageBuffer<'_>>, name: &str, scale: f64| {
+        img.map(|img| -> Result<TextureRef> {
+            let name = format!("{prefix}{name}");
+            if !has_uvs {
+                return Err(Error::InvalidArgument(format!(
+                    "{name} is given but there are no UVs to sample it with"
+                )));
+            }
+            textures.push(img.to_texture(&name, m.wrap)?);
+            Ok(TextureRef {
+                texture: textures.len() - 1,
+                tex_coord: 0,
+                transform: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                scale,
+            })
+        })
+        .transpose()
+    };
+    Ok(Material {
+        base_color_factor: m.base_color_factor,
+        base_color: slot(m.base_color, "base_color", 1.0)?,
+        metallic_factor: m.metallic_factor,
+        roughness_factor: m.roughness_factor,
+        metallic_roughness: slot(m.metallic_roughness, "metallic_roughness", 1.0)?,
+        normal: slot(m.normal, "normal", m.normal_scale)?,
+        occlusion: slot(m.occlusion, "occlusion", m.occlusion_strength)?,
+        emissive_factor: m.emissive_factor,
+        emissive: slot(m.emissive, "emissive", 1.0)?,
+        ..Material::default()
+    })
+}
+
+/// Reads a file's appearance, by extension (case-insensitive): `.obj` through
+/// [`read_obj_appearance`](super::obj::read_obj_appearance) (OBJ + MTL), `.ply`, `.off` and
+/// `.stl` are refused (`InvalidArgument`: they carry no material), anything else is read as
+/// glTF/GLB (external buffers and images relative to its folder; see the
+/// [module docs](self)).
 pub fn read_appearance(path: &Path) -> Result<Appearance> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match ext.as_str() {
+        "obj" => return super::obj::read_obj_appearance(path),
+        "ply" | "off" | "stl" => {
+            return Err(Error::InvalidArgument(format!(
+                "'{}': a .{ext} file has no materials to bake; textured bakes read glTF \
+                 (.glb, .gltf) or OBJ + MTL (.obj)",
+                path.display()
+            )))
+        }
+        _ => {}
+    }
     let name = path.display().to_string();
     let data = std::fs::read(path).map_err(|e| crate::mesh::io::io_error(&name, &e))?;
     let base = path.parent().unwrap_or(Path::new("."));
@@ -736,19 +811,39 @@ fn raw_json(data: &[u8]) -> Option<serde_json::Value> {
     serde_json::from_slice(json).ok()
 }
 
+/// An [`Appearance`] under construction, one primitive (or OBJ group) after another: every
+/// per-vertex vector grows with `positions`, every per-triangle one with `triangles`.
 #[derive(Default)]
-struct Builder {
-    positions: Vec<[f64; 3]>,
-    triangles: Vec<[u32; 3]>,
-    triangle_material: Vec<u32>,
-    triangle_flat: Vec<bool>,
-    normals: Vec<[f64; 3]>,
-    tangents: Vec<[f64; 4]>,
-    uvs: Vec<Vec<[f64; 2]>>,
-    colors: Vec<[f64; 4]>,
-    any_color: bool,
-    materials: Vec<Material>,
-    textures: Vec<Texture>,
+pub(super) struct Builder {
+    pub(super) positions: Vec<[f64; 3]>,
+    pub(super) triangles: Vec<[u32; 3]>,
+    pub(super) triangle_material: Vec<u32>,
+    pub(super) triangle_flat: Vec<bool>,
+    pub(super) normals: Vec<[f64; 3]>,
+    pub(super) tangents: Vec<[f64; 4]>,
+    pub(super) uvs: Vec<Vec<[f64; 2]>>,
+    pub(super) colors: Vec<[f64; 4]>,
+    pub(super) any_color: bool,
+    pub(super) materials: Vec<Material>,
+    pub(super) textures: Vec<Texture>,
+}
+
+impl Builder {
+    /// The appearance (its mesh checked by `TriMesh::new`; errors name `name`).
+    pub(super) fn finish(self, name: &str) -> Result<Appearance> {
+        let mesh = io_build(name, self.positions, self.triangles)?;
+        Ok(Appearance {
+            mesh,
+            triangle_material: self.triangle_material,
+            triangle_flat: self.triangle_flat,
+            normals: self.normals,
+            tangents: self.tangents,
+            uvs: self.uvs,
+            colors: self.any_color.then_some(self.colors),
+            materials: self.materials,
+            textures: self.textures,
+        })
+    }
 }
 
 struct Reader<'a> {
@@ -769,56 +864,13 @@ impl Reader<'_> {
         parse_error(self.name, reason)
     }
 
-    /// Depth-first over the default scene (else the first; else every mesh untransformed), as
-    /// the geometry reader does.
+    /// Every primitive the geometry reader instantiates, in its order (one walker:
+    /// [`io::for_each_primitive`]).
     fn read_scene(&mut self) -> Result<()> {
-        let doc = self.doc;
-        let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
-            for mesh in doc.meshes() {
-                self.add_mesh(&mesh, &io::MAT_IDENTITY)?;
-            }
-            return Ok(());
-        };
-        let mut visited = vec![false; doc.nodes().count()];
-        let mut stack: Vec<(::gltf::Node, Matrix4)> =
-            scene.nodes().map(|n| (n, io::MAT_IDENTITY)).collect();
-        stack.reverse();
-        while let Some((node, parent)) = stack.pop() {
-            if std::mem::replace(&mut visited[node.index()], true) {
-                return Err(self.err(format!(
-                    "node {} is reached twice: the node hierarchy is not a tree",
-                    node.index()
-                )));
-            }
-            let world = io::mat_mul(&parent, &io::node_matrix(&node));
-            if let Some(mesh) = node.mesh() {
-                self.add_mesh(&mesh, &world)?;
-            }
-            let first = stack.len();
-            stack.extend(node.children().map(|c| (c, world)));
-            stack[first..].reverse();
-        }
-        Ok(())
-    }
-
-    fn add_mesh(&mut self, mesh: &::gltf::Mesh, world: &Matrix4) -> Result<()> {
-        for prim in mesh.primitives() {
-            let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
-            let Some(pos) = prim.get(&Semantic::Positions) else {
-                continue;
-            };
-            if !matches!(
-                prim.mode(),
-                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-            ) {
-                continue;
-            }
-            if pos.dimensions() != Dimensions::Vec3 {
-                return Err(self.err(format!("{what}: POSITION is not VEC3")));
-            }
-            self.add_primitive(&prim, &pos, world, &what)?;
-        }
-        Ok(())
+        let (doc, name) = (self.doc, self.name);
+        io::for_each_primitive(doc, name, &mut |prim, pos, world, what| {
+            self.add_primitive(prim, pos, world, what)
+        })
     }
 
     fn values(&self, acc: &::gltf::Accessor, what: &str) -> Result<Vec<f64>> {
@@ -1113,25 +1165,13 @@ impl Reader<'_> {
     }
 
     fn finish(self) -> Result<Appearance> {
-        let b = self.out;
-        let mesh = io_build(self.name, b.positions, b.triangles)?;
-        Ok(Appearance {
-            mesh,
-            triangle_material: b.triangle_material,
-            triangle_flat: b.triangle_flat,
-            normals: b.normals,
-            tangents: b.tangents,
-            uvs: b.uvs,
-            colors: b.any_color.then_some(b.colors),
-            materials: b.materials,
-            textures: b.textures,
-        })
+        self.out.finish(self.name)
     }
 }
 
 impl Material {
     /// Every texture reference of the material.
-    fn refs(&self) -> impl Iterator<Item = &TextureRef> {
+    pub(super) fn refs(&self) -> impl Iterator<Item = &TextureRef> {
         [
             &self.base_color,
             &self.metallic_roughness,
@@ -1232,7 +1272,7 @@ pub fn linear_to_srgb(c: f64) -> f64 {
 
 /// Decodes a PNG or JPEG into `(width, height, linear RGBA texels)`; `srgb` decodes the colour
 /// channels' sRGB transfer (alpha is always linear).
-fn decode_image(
+pub(super) fn decode_image(
     bytes: &[u8],
     srgb: bool,
 ) -> std::result::Result<(u32, u32, Vec<[f32; 4]>), String> {

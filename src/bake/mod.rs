@@ -4,6 +4,7 @@
 //!
 //! - [`appearance`]: glTF materials, textures (sRGB-correct), UV sets, texture transforms,
 //!   vertex colours, normals and tangents, in world space.
+//! - [`obj`]: the same from a Wavefront OBJ + MTL (`Kd`, `map_Kd`, `vt`, several materials).
 //! - [`provenance`]: LOD point → input triangle and barycentric coordinates (cast along the
 //!   LOD normal within an envelope of a few `d`, closest point as fallback).
 //! - [`atlas`]: xatlas charts and packing with a texel density rule from the screen size.
@@ -22,6 +23,7 @@ pub mod atlas;
 #[allow(clippy::module_inception)]
 pub mod bake;
 pub mod level;
+pub mod obj;
 pub mod output;
 pub mod provenance;
 pub mod render;
@@ -33,6 +35,7 @@ pub use appearance::{
 pub use atlas::{build_atlas, Atlas, AtlasParams};
 pub use bake::{bake_level, bake_level_with_progress, BakeParams};
 pub use level::{BakeReport, BakedLevel, BakedMaterial, Image8};
+pub use obj::read_obj_appearance;
 pub use output::{chain_glb, screen_coverage};
 pub use provenance::{provenance, InputIndex, Provenance, ProvenanceParams};
 

@@ -50,6 +50,9 @@ pub const PLEAT_BAKE_TEXTURED: u32 = 1;
 /// `PLEAT_STATUS_LIMIT_EXCEEDED`.
 pub const PLEAT_BAKE_MAX_IMAGE_TEXELS: u64 = 1 << 26;
 
+/// Most materials `pleat_bake_lod_multi` takes (65536).
+pub const PLEAT_BAKE_MAX_MATERIALS: u32 = 1 << 16;
+
 /// Largest `PleatBakeParams::texture_size`.
 pub const PLEAT_BAKE_MAX_TEXTURE_SIZE: u32 = 8192;
 
@@ -491,8 +494,8 @@ pub(super) mod imp {
         if img.rgba.is_null() {
             if img.width != 0 || img.height != 0 {
                 return Err(Error::InvalidArgument(format!(
-                    "material->{name}.rgba is NULL but its size is {}×{} (set width = height = \
-                     0 for no image)",
+                    "{name}.rgba is NULL but its size is {}×{} (set width = height = 0 for no \
+                     image)",
                     img.width, img.height
                 )));
             }
@@ -501,23 +504,19 @@ pub(super) mod imp {
         let texels = u64::from(img.width) * u64::from(img.height);
         if texels == 0 {
             return Err(Error::InvalidArgument(format!(
-                "material->{name} has zero size ({}×{})",
+                "{name} has zero size ({}×{})",
                 img.width, img.height
             )));
         }
         if texels > PLEAT_BAKE_MAX_IMAGE_TEXELS {
             return Err(Error::LimitExceeded(format!(
-                "material->{name} of {}×{} texels exceeds the budget of \
+                "{name} of {}×{} texels exceeds the budget of \
                  {PLEAT_BAKE_MAX_IMAGE_TEXELS} texels",
                 img.width, img.height
             )));
         }
-        let srgb = bool_field(img.srgb, &format!("material->{name}.srgb"))?;
-        let rgba = arg_slice(
-            img.rgba,
-            4 * texels as usize,
-            &format!("material->{name}.rgba"),
-        )?;
+        let srgb = bool_field(img.srgb, &format!("{name}.srgb"))?;
+        let rgba = arg_slice(img.rgba, 4 * texels as usize, &format!("{name}.rgba"))?;
         Ok(Some(ImageBuffer {
             width: img.width,
             height: img.height,
@@ -546,6 +545,8 @@ pub(super) mod imp {
         }
         Ok(out)
     }
+
+    const MAX_MATERIALS: usize = PLEAT_BAKE_MAX_MATERIALS as usize;
 
     /// The caller's arrays of a material, owned (the `AppearanceBuffers` borrow them).
     pub(in crate::ffi) struct MaterialArrays {
@@ -605,6 +606,39 @@ pub(super) mod imp {
         })
     }
 
+    /// The factors and images of `m` (`name` prefixes field names in messages:
+    /// `material->` or `materials[i].`).
+    ///
+    /// # Safety
+    /// `m`'s images are NULL or hold `4 · width · height` bytes.
+    unsafe fn buffer_material<'a>(m: &PleatBakeMaterial, name: &str) -> Result<BufferMaterial<'a>> {
+        let wrap = match m.wrap {
+            PLEAT_WRAP_REPEAT => Wrap::Repeat,
+            PLEAT_WRAP_CLAMP => Wrap::Clamp,
+            PLEAT_WRAP_MIRROR => Wrap::Mirror,
+            w => {
+                return Err(Error::InvalidArgument(format!(
+                    "{name}wrap is {w}; use a PLEAT_WRAP_* value (0 to 2)"
+                )))
+            }
+        };
+        let img = |i: &PleatImage, field: &str| image(i, &format!("{name}{field}"));
+        Ok(BufferMaterial {
+            base_color_factor: m.base_color_factor,
+            base_color: img(&m.base_color, "base_color")?,
+            metallic_factor: m.metallic_factor,
+            roughness_factor: m.roughness_factor,
+            metallic_roughness: img(&m.metallic_roughness, "metallic_roughness")?,
+            normal: img(&m.normal, "normal")?,
+            normal_scale: m.normal_scale,
+            occlusion: img(&m.occlusion, "occlusion")?,
+            occlusion_strength: m.occlusion_strength,
+            emissive_factor: m.emissive_factor,
+            emissive: img(&m.emissive, "emissive")?,
+            wrap,
+        })
+    }
+
     /// The appearance buffers of `m` over `input` with the arrays `a`.
     ///
     /// # Safety
@@ -614,30 +648,7 @@ pub(super) mod imp {
         input: &'a TriMesh,
         a: &'a MaterialArrays,
     ) -> Result<AppearanceBuffers<'a>> {
-        let wrap = match m.wrap {
-            PLEAT_WRAP_REPEAT => Wrap::Repeat,
-            PLEAT_WRAP_CLAMP => Wrap::Clamp,
-            PLEAT_WRAP_MIRROR => Wrap::Mirror,
-            w => {
-                return Err(Error::InvalidArgument(format!(
-                    "material->wrap is {w}; use a PLEAT_WRAP_* value (0 to 2)"
-                )))
-            }
-        };
-        let material = BufferMaterial {
-            base_color_factor: m.base_color_factor,
-            base_color: image(&m.base_color, "base_color")?,
-            metallic_factor: m.metallic_factor,
-            roughness_factor: m.roughness_factor,
-            metallic_roughness: image(&m.metallic_roughness, "metallic_roughness")?,
-            normal: image(&m.normal, "normal")?,
-            normal_scale: m.normal_scale,
-            occlusion: image(&m.occlusion, "occlusion")?,
-            occlusion_strength: m.occlusion_strength,
-            emissive_factor: m.emissive_factor,
-            emissive: image(&m.emissive, "emissive")?,
-            wrap,
-        };
+        let material = buffer_material(m, "material->")?;
         let uvs = a.uvs.as_deref().map(|uv| {
             if m.uv_layout == PLEAT_UV_PER_CORNER {
                 UvBuffer::PerCorner(uv)
@@ -652,6 +663,79 @@ pub(super) mod imp {
             colors: a.colors.as_deref(),
             material,
         })
+    }
+
+    /// Reads the caller's array of `count` materials: the stride is `materials[0].struct_size`
+    /// (every element must carry the same), each read like a single versioned struct.
+    ///
+    /// # Safety
+    /// `p` is NULL or holds `count` structs of `p->struct_size` bytes each.
+    pub(in crate::ffi) unsafe fn material_array(
+        p: *const PleatBakeMaterial,
+        count: usize,
+    ) -> Result<Vec<PleatBakeMaterial>> {
+        if p.is_null() {
+            return Err(crate::ffi::common::null_arg("materials"));
+        }
+        if count == 0 || count > MAX_MATERIALS {
+            return Err(Error::InvalidArgument(format!(
+                "material_count is {count}; it must be in 1..={MAX_MATERIALS}"
+            )));
+        }
+        let first = read_versioned(p, "materials[0]")?;
+        let stride = std::ptr::read_unaligned(p as *const u32) as usize;
+        (0..count)
+            .map(|i| {
+                let q = (p as *const u8).add(i * stride) as *const PleatBakeMaterial;
+                let size = std::ptr::read_unaligned(q as *const u32) as usize;
+                if size != stride {
+                    return Err(Error::InvalidArgument(format!(
+                        "materials[{i}].struct_size is {size} but materials[0]'s is {stride}: \
+                         every element of the array needs the same sizeof(PleatBakeMaterial)"
+                    )));
+                }
+                let m = if i == 0 {
+                    first
+                } else {
+                    read_versioned(q, &format!("materials[{i}]"))?
+                };
+                if i > 0
+                    && (!m.uvs.is_null()
+                        || m.uv_count != 0
+                        || !m.normals.is_null()
+                        || !m.colors.is_null())
+                {
+                    return Err(Error::InvalidArgument(format!(
+                        "materials[{i}] sets uvs, uv_count, normals or colors: the mesh's \
+                         arrays come from materials[0] only (leave them NULL/0 in the others)"
+                    )));
+                }
+                Ok(m)
+            })
+            .collect()
+    }
+
+    /// The input's appearance from the caller's materials (`materials[0]` holds the mesh
+    /// arrays) and the material of every triangle (`None`: all material 0).
+    ///
+    /// # Safety
+    /// As [`material_arrays`] and [`buffer_material`] for every material.
+    pub(in crate::ffi) unsafe fn appearance(
+        materials: &[PleatBakeMaterial],
+        triangle_material: Option<&[u32]>,
+        input: &TriMesh,
+    ) -> Result<crate::bake::Appearance> {
+        let arrays = material_arrays(&materials[0], input)?;
+        let buffers = appearance_buffers(&materials[0], input, &arrays)?;
+        let Some(tm) = triangle_material else {
+            return crate::bake::Appearance::from_buffers(&buffers);
+        };
+        let converted = materials
+            .iter()
+            .enumerate()
+            .map(|(i, m)| buffer_material(m, &format!("materials[{i}].")))
+            .collect::<Result<Vec<_>>>()?;
+        crate::bake::Appearance::from_buffers_multi(&buffers, &converted, tm)
     }
 
     /// Bakes `app` onto `lod`.
@@ -943,14 +1027,7 @@ pub unsafe extern "C" fn pleat_bake_lod(
         {
             // The thread count is needed before the fence (it picks the pool); an invalid
             // struct is reported from inside.
-            let threads = read_versioned(params, "params").map_or(0, |p| {
-                if p.threads <= 256 {
-                    p.threads
-                } else {
-                    0
-                }
-            });
-            guard_progress_threads(threads, progress, user_data, |prog| {
+            guard_progress_threads(params_threads(params), progress, user_data, |prog| {
                 let lod = mesh_ref(lod, "lod")?;
                 let input = mesh_ref(input, "input")?;
                 if material.is_null() {
@@ -958,18 +1035,129 @@ pub unsafe extern "C" fn pleat_bake_lod(
                 }
                 let m = read_versioned(material, "material")?;
                 let p = read_versioned(params, "params")?;
-                let (bp, screen_size) = imp::bake_params(&p)?;
                 let out = arg_out(out, "out")?;
                 let stats = versioned_out(stats, "stats")?;
-                let arrays = imp::material_arrays(&m, input)?;
-                let buffers = imp::appearance_buffers(&m, input, &arrays)?;
-                let app = crate::bake::Appearance::from_buffers(&buffers)?;
-                let level = imp::bake(lod, &app, &bp, screen_size, prog)?;
-                if let Some(s) = &stats {
-                    s.write(imp::stats(&level));
-                }
-                out.put_boxed(PleatBake { level });
-                Ok(())
+                bake_checked(lod, input, &[m], None, &p, prog, out, stats)
+            })
+        }
+    )
+}
+
+/// The thread count of `params` (0, the global pool, when it is NULL, invalid or out of
+/// range: the error is reported from inside the guard).
+///
+/// # Safety
+/// `params` is NULL or readable for its `struct_size`.
+#[cfg(feature = "bake")]
+unsafe fn params_threads(params: *const PleatBakeParams) -> u32 {
+    read_versioned(params, "params").map_or(0, |p| if p.threads <= 256 { p.threads } else { 0 })
+}
+
+/// The body shared by `pleat_bake_lod` and `pleat_bake_lod_multi`, after their arguments are
+/// read: the appearance, the bake, the outputs.
+///
+/// # Safety
+/// The materials' pointers hold the counts they document.
+#[cfg(feature = "bake")]
+#[allow(clippy::too_many_arguments)]
+unsafe fn bake_checked(
+    lod: &crate::mesh::TriMesh,
+    input: &crate::mesh::TriMesh,
+    materials: &[PleatBakeMaterial],
+    triangle_material: Option<&[u32]>,
+    p: &PleatBakeParams,
+    prog: &mut crate::report::ProgressFn<'_>,
+    out: super::boundary::Out<*mut PleatBake>,
+    stats: Option<super::boundary::VersionedOut<PleatBakeStats>>,
+) -> crate::Result<()> {
+    let (bp, screen_size) = imp::bake_params(p)?;
+    let app = imp::appearance(materials, triangle_material, input)?;
+    let level = imp::bake(lod, &app, &bp, screen_size, prog)?;
+    if let Some(s) = &stats {
+        s.write(imp::stats(&level));
+    }
+    out.put_boxed(PleatBake { level });
+    Ok(())
+}
+
+/// `pleat_bake_lod` with several materials: input triangle `t` takes
+/// `materials[triangle_material[t]]`. The mesh arrays (`uv_layout`, `uvs`, `uv_count`,
+/// `normals`, `colors`) come from `materials[0]` and are shared by all; the other materials
+/// set only factors, images and `wrap` (their array fields NULL/0). One atlas and one baked
+/// material hold every input material. `pleat_bake_lod` is this call with one material.
+///
+/// - `materials`: `material_count` structs (1 … `PLEAT_BAKE_MAX_MATERIALS`), each with the
+///   same `struct_size` (the array's stride); non-NULL.
+/// - `triangle_material`: `triangle_count` indices, `triangle_count` = the input's triangle
+///   count, each `< material_count`; NULL (with `triangle_count` 0) puts every triangle in
+///   material 0.
+/// - The rest as in `pleat_bake_lod`. Any invalid index, count or struct is
+///   `PLEAT_STATUS_INVALID_ARGUMENT` naming it, before any work.
+///
+/// # Safety
+/// Handles are NULL or live; the arrays hold their stated counts; every material's pointers
+/// hold the counts `PleatBakeMaterial` documents.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_bake_lod_multi(
+    lod: *const PleatMesh,
+    input: *const PleatMesh,
+    materials: *const PleatBakeMaterial,
+    material_count: usize,
+    triangle_material: *const u32,
+    triangle_count: usize,
+    params: *const PleatBakeParams,
+    progress: PleatProgressFn,
+    user_data: *mut std::ffi::c_void,
+    out: *mut *mut PleatBake,
+    stats: *mut PleatBakeStats,
+) -> PleatStatus {
+    requires!(
+        "bake",
+        [
+            lod,
+            input,
+            materials,
+            material_count,
+            triangle_material,
+            triangle_count,
+            params,
+            progress,
+            user_data,
+            out,
+            stats
+        ],
+        {
+            guard_progress_threads(params_threads(params), progress, user_data, |prog| {
+                let lod = mesh_ref(lod, "lod")?;
+                let input = mesh_ref(input, "input")?;
+                let ms = imp::material_array(materials, material_count)?;
+                let tm = if triangle_material.is_null() && triangle_count == 0 {
+                    None
+                } else {
+                    if triangle_count != input.triangle_count() {
+                        return Err(Error::InvalidArgument(format!(
+                            "triangle_count is {triangle_count}; the input has {} triangles",
+                            input.triangle_count()
+                        )));
+                    }
+                    let tm = super::boundary::arg_slice(
+                        triangle_material,
+                        triangle_count,
+                        "triangle_material",
+                    )?;
+                    if let Some(t) = tm.iter().position(|&m| m as usize >= ms.len()) {
+                        return Err(Error::InvalidArgument(format!(
+                            "triangle_material[{t}] is {}; material_count is {}",
+                            tm[t],
+                            ms.len()
+                        )));
+                    }
+                    Some(tm)
+                };
+                let p = read_versioned(params, "params")?;
+                let out = arg_out(out, "out")?;
+                let stats = versioned_out(stats, "stats")?;
+                bake_checked(lod, input, &ms, tm, &p, prog, out, stats)
             })
         }
     )

@@ -1015,6 +1015,9 @@ for _name, _res, _args in [
                                       _sz, _B, _sz)),
     ("pleat_bake_lod", _st, (_P, _P, _c.POINTER(_BakeMaterial), _c.POINTER(_BakeParams))
      + _PROGRESS_ARGS + (_PP, _c.POINTER(_BakeStats))),
+    ("pleat_bake_lod_multi", _st, (_P, _P, _c.POINTER(_BakeMaterial), _sz, _U, _sz,
+                                   _c.POINTER(_BakeParams))
+     + _PROGRESS_ARGS + (_PP, _c.POINTER(_BakeStats))),
     ("pleat_bake_free", None, (_P,)),
     ("pleat_bake_vertex_count", _sz, (_P,)),
     ("pleat_bake_triangle_count", _sz, (_P,)),
@@ -1193,13 +1196,39 @@ class Bake(_Handle):
         return f"<pleat.Bake {self.vertex_count} vertices, {self.triangle_count} triangles>"
 
 
+#: The per-material keywords of ``bake`` (also the keys of its ``materials`` dicts).
+_MATERIAL_KEYS = ("base_color", "base_color_factor", "metallic_factor", "roughness_factor",
+                  "metallic_roughness", "normal", "normal_scale", "occlusion",
+                  "occlusion_strength", "emissive", "emissive_factor", "wrap")
+
+
+def _fill_material(m, keep, base_color=None, base_color_factor=(1.0, 1.0, 1.0, 1.0),
+                   metallic_factor=1.0, roughness_factor=1.0, metallic_roughness=None,
+                   normal=None, normal_scale=1.0, occlusion=None, occlusion_strength=1.0,
+                   emissive=None, emissive_factor=(0.0, 0.0, 0.0), wrap="repeat"):
+    """Sets the factors, images and wrap mode of a PleatBakeMaterial (arrays kept alive in
+    ``keep``)."""
+    m.base_color_factor[:] = [float(x) for x in base_color_factor]
+    m.emissive_factor[:] = [float(x) for x in emissive_factor]
+    m.metallic_factor, m.roughness_factor = float(metallic_factor), float(roughness_factor)
+    m.normal_scale, m.occlusion_strength = float(normal_scale), float(occlusion_strength)
+    m.base_color = _image(base_color, True, keep)
+    m.emissive = _image(emissive, True, keep)
+    m.metallic_roughness = _image(metallic_roughness, False, keep)
+    m.occlusion = _image(occlusion, False, keep)
+    m.normal = _image(normal, False, keep)
+    if wrap not in _WRAP:
+        raise PleatError(1, f"wrap must be one of {sorted(_WRAP)}, got {wrap!r}")
+    m.wrap = _WRAP[wrap]
+
+
 def bake(lod, input, uvs=None, base_color=None, *, uv_layout="vertex", normals=None,
          colors=None, base_color_factor=(1.0, 1.0, 1.0, 1.0), metallic_factor=1.0,
          roughness_factor=1.0, metallic_roughness=None, normal=None, normal_scale=1.0,
          occlusion=None, occlusion_strength=1.0, emissive=None, emissive_factor=(0.0, 0.0, 0.0),
          wrap="repeat", screen_size=200.0, texture_size=0, padding=4, threads=0,
          texels_per_pixel=2.0, envelope_d=3.0, normal_map=True, error_samples=20000,
-         progress=None):
+         progress=None, materials=None, triangle_material=None):
     """Bakes ``input``'s appearance onto ``lod`` (a Mesh made from it at ``screen_size``):
     returns a Bake.
 
@@ -1211,6 +1240,10 @@ def bake(lod, input, uvs=None, base_color=None, *, uv_layout="vertex", normals=N
     - ``normals`` (n, 3), ``colors`` (n, 4 linear RGBA): optional per input vertex.
     - ``texture_size``: 0 for the screen-size rule; ``threads``: 0 for the global setting.
     - ``progress(stage, fraction)``: return True to cancel (raises PleatError CANCELLED).
+    - Several materials (``pleat_bake_lod_multi``): ``materials`` a list of dicts with the
+      per-material keywords above (``base_color``, ``base_color_factor``, ..., ``wrap``) and
+      ``triangle_material`` (m,) indices into it; the call's own material keywords are then
+      not used (passing ``base_color`` too is an error). UVs, normals and colours are shared.
     """
     nv, nt = input.vertex_count, input.triangle_count
     m = _lib.pleat_bake_material_default()
@@ -1228,18 +1261,6 @@ def bake(lod, input, uvs=None, base_color=None, *, uv_layout="vertex", normals=N
         if a is not None:
             keep.append(a)
             setattr(m, field, _ptr(a, _c.c_float))
-    m.base_color_factor[:] = [float(x) for x in base_color_factor]
-    m.emissive_factor[:] = [float(x) for x in emissive_factor]
-    m.metallic_factor, m.roughness_factor = float(metallic_factor), float(roughness_factor)
-    m.normal_scale, m.occlusion_strength = float(normal_scale), float(occlusion_strength)
-    m.base_color = _image(base_color, True, keep)
-    m.emissive = _image(emissive, True, keep)
-    m.metallic_roughness = _image(metallic_roughness, False, keep)
-    m.occlusion = _image(occlusion, False, keep)
-    m.normal = _image(normal, False, keep)
-    if wrap not in _WRAP:
-        raise PleatError(1, f"wrap must be one of {sorted(_WRAP)}, got {wrap!r}")
-    m.wrap = _WRAP[wrap]
     p = _lib.pleat_bake_params_default()
     p.screen_size, p.texture_size, p.padding = float(screen_size), int(texture_size), \
         int(padding)
@@ -1249,8 +1270,31 @@ def bake(lod, input, uvs=None, base_color=None, *, uv_layout="vertex", normals=N
     stats = _BakeStats()
     stats.struct_size = _c.sizeof(_BakeStats)
     relay, out = _Relay(progress), _P()
-    st = _lib.pleat_bake_lod(lod._h, input._h, _c.byref(m), _c.byref(p), relay.fn, None,
-                             _c.byref(out), _c.byref(stats))
+    if materials is None:
+        if triangle_material is not None:
+            raise PleatError(1, "triangle_material needs materials")
+        _fill_material(m, keep, base_color, base_color_factor, metallic_factor,
+                       roughness_factor, metallic_roughness, normal, normal_scale, occlusion,
+                       occlusion_strength, emissive, emissive_factor, wrap)
+        st = _lib.pleat_bake_lod(lod._h, input._h, _c.byref(m), _c.byref(p), relay.fn, None,
+                                 _c.byref(out), _c.byref(stats))
+    else:
+        if base_color is not None:
+            raise PleatError(1, "pass base_color inside materials when materials is given")
+        if triangle_material is None:
+            raise PleatError(1, "materials needs triangle_material (one index per triangle)")
+        arr = (_BakeMaterial * max(len(materials), 1))()
+        for i, fields in enumerate(materials):
+            unknown = set(fields) - set(_MATERIAL_KEYS)
+            if unknown:
+                raise PleatError(1, f"materials[{i}]: unknown keys {sorted(unknown)}")
+            arr[i] = m if i == 0 else _lib.pleat_bake_material_default()
+            _fill_material(arr[i], keep, **fields)
+        tm = _np.ascontiguousarray(triangle_material, dtype=_np.uint32).reshape(-1)
+        keep.append(tm)
+        st = _lib.pleat_bake_lod_multi(lod._h, input._h, arr, len(materials),
+                                       _ptr(tm, _c.c_uint32), tm.size, _c.byref(p), relay.fn,
+                                       None, _c.byref(out), _c.byref(stats))
     relay.finish(st)
     del keep
     return Bake(out, _as_dict(stats))

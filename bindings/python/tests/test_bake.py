@@ -110,3 +110,26 @@ def test_bake_vertex_colours_and_misuse(sphere_and_lod):
         assert e.value.status == status, kwargs
     with pytest.raises(pleat.PleatError):
         pleat.bake(lod, mesh, UV[:-1], checker())
+
+
+@needs("bake")
+def test_bake_several_materials(sphere_and_lod):
+    mesh, lod, UV = sphere_and_lod
+    V = mesh.positions()
+    F = mesh.triangles()
+    lower = (V[F].mean(axis=1)[:, 2] < 0).astype(np.uint32)
+    b = pleat.bake(lod, mesh, UV, screen_size=50, texture_size=64, error_samples=0,
+                   materials=[dict(base_color=checker()),
+                              dict(base_color_factor=(0.0, 1.0, 0.0, 1.0))],
+                   triangle_material=lower)
+    img = b.image("base_color")
+    green = (img[..., 0] < 20) & (img[..., 1] > 240) & (img[..., 2] < 20)
+    assert b.textured and green.sum() > 50
+    for kwargs in [dict(triangle_material=np.full(len(F), 2, np.uint32)),
+                   dict(triangle_material=lower[:-1]),
+                   dict(materials=[dict(colour=1)], triangle_material=lower * 0)]:
+        args = dict(materials=[dict(base_color=checker()), dict()], triangle_material=lower)
+        args.update(kwargs)
+        with pytest.raises(pleat.PleatError) as e:
+            pleat.bake(lod, mesh, UV, screen_size=50, texture_size=64, **args)
+        assert e.value.status == "INVALID_ARGUMENT", kwargs

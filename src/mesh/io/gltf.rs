@@ -69,17 +69,9 @@ pub fn read_gltf_bytes(data: &[u8], base_dir: Option<&Path>, name: &str) -> Resu
         buffers: &buffers,
         name,
     };
-    match document
-        .default_scene()
-        .or_else(|| document.scenes().next())
-    {
-        Some(scene) => instantiate_scene(&document, scene, &ctx, &mut soup)?,
-        None => {
-            for mesh in document.meshes() {
-                add_mesh(&mesh, &IDENTITY, &ctx, &mut soup)?;
-            }
-        }
-    }
+    for_each_primitive(&document, name, &mut |prim, pos, world, what| {
+        add_primitive(prim, pos, world, what, &ctx, &mut soup)
+    })?;
     build_mesh(name, soup.positions, soup.triangles)
 }
 
@@ -323,26 +315,60 @@ fn read_external(uri: &str, length: usize, base: Option<&Path>, name: &str) -> R
     Ok(data)
 }
 
-fn instantiate_scene(
+/// Visits every mesh primitive the document instantiates, in the reader's order (see the
+/// [module docs](self)): the default scene (else the first) depth-first with each node's world
+/// transform, or every mesh once untransformed when there is no scene. Primitives without
+/// `POSITION` or of a mode other than `TRIANGLES`, `TRIANGLE_STRIP`, `TRIANGLE_FAN` are
+/// skipped; a non-`VEC3` `POSITION` or a node reached twice is an error naming `name`.
+/// `visit` gets the primitive, its `POSITION` accessor, the world matrix and a
+/// "mesh M primitive P" label. The geometry reader and `bake::appearance` both walk with this.
+pub(crate) fn for_each_primitive(
     doc: &Document,
-    scene: ::gltf::Scene,
-    ctx: &Ctx,
-    soup: &mut Soup,
+    name: &str,
+    visit: &mut dyn FnMut(&::gltf::Primitive, &Accessor, &Mat4, &str) -> Result<()>,
 ) -> Result<()> {
+    let mut mesh_primitives = |mesh: &::gltf::Mesh, world: &Mat4| -> Result<()> {
+        for prim in mesh.primitives() {
+            let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+            let Some(pos) = prim.get(&Semantic::Positions) else {
+                continue;
+            };
+            if !matches!(
+                prim.mode(),
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                continue;
+            }
+            if pos.dimensions() != Dimensions::Vec3 {
+                return Err(parse_error(name, format!("{what}: POSITION is not VEC3")));
+            }
+            visit(&prim, &pos, world, &what)?;
+        }
+        Ok(())
+    };
+    let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
+        for mesh in doc.meshes() {
+            mesh_primitives(&mesh, &IDENTITY)?;
+        }
+        return Ok(());
+    };
     let mut visited = vec![false; doc.nodes().len()];
     let mut stack: Vec<(::gltf::Node, Mat4)> = scene.nodes().map(|n| (n, IDENTITY)).collect();
     stack.reverse();
     while let Some((node, parent)) = stack.pop() {
         if std::mem::replace(&mut visited[node.index()], true) {
-            return Err(ctx.err(format!(
-                "node {} is reached twice from scene {}: the node hierarchy is not a tree",
-                node.index(),
-                scene.index()
-            )));
+            return Err(parse_error(
+                name,
+                format!(
+                    "node {} is reached twice from scene {}: the node hierarchy is not a tree",
+                    node.index(),
+                    scene.index()
+                ),
+            ));
         }
         let world = mul(&parent, &to_f64(node.transform().matrix()));
         if let Some(mesh) = node.mesh() {
-            add_mesh(&mesh, &world, ctx, soup)?;
+            mesh_primitives(&mesh, &world)?;
         }
         let first_child = stack.len();
         stack.extend(node.children().map(|c| (c, world)));
@@ -351,48 +377,40 @@ fn instantiate_scene(
     Ok(())
 }
 
-fn add_mesh(mesh: &::gltf::Mesh, world: &Mat4, ctx: &Ctx, soup: &mut Soup) -> Result<()> {
-    for prim in mesh.primitives() {
-        let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
-        let Some(pos) = prim.get(&Semantic::Positions) else {
-            continue;
-        };
-        if !matches!(
-            prim.mode(),
-            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-        ) {
-            continue;
-        }
-        if pos.dimensions() != Dimensions::Vec3 {
-            return Err(ctx.err(format!("{what}: POSITION is not VEC3")));
-        }
-        let values = read_accessor(&pos, ctx, &what)?;
-        let base = soup.positions.len();
-        let n_indices = prim.indices().map_or(pos.count(), |a| a.count());
-        if base + pos.count() + soup.triangles.len() + n_indices > MAX_INSTANCED {
-            return Err(ctx.err(format!(
-                "{what}: instancing would create more than {MAX_INSTANCED} vertices and \
-                 triangles"
-            )));
-        }
-        for (i, p) in values.chunks_exact(3).enumerate() {
-            let q = transform(world, [p[0], p[1], p[2]]);
-            push_vertex(&mut soup.positions, q, ctx.name, || {
-                format!("{what} vertex {i}")
-            })?;
-        }
-        let indices = match prim.indices() {
-            Some(acc) => read_indices(&acc, pos.count(), ctx, &what)?,
-            None => (0..pos.count() as u32).collect(),
-        };
-        let flip = det3(world) < 0.0;
-        let offset = base as u32;
-        triangulate(prim.mode(), &indices, |t| {
-            let [a, b, c] = t.map(|i| i + offset);
-            soup.triangles
-                .push(if flip { [a, c, b] } else { [a, b, c] });
-        });
+/// Appends one primitive (world transform applied) to the soup.
+fn add_primitive(
+    prim: &::gltf::Primitive,
+    pos: &Accessor,
+    world: &Mat4,
+    what: &str,
+    ctx: &Ctx,
+    soup: &mut Soup,
+) -> Result<()> {
+    let values = read_accessor(pos, ctx, what)?;
+    let base = soup.positions.len();
+    let n_indices = prim.indices().map_or(pos.count(), |a| a.count());
+    if base + pos.count() + soup.triangles.len() + n_indices > MAX_INSTANCED {
+        return Err(ctx.err(format!(
+            "{what}: instancing would create more than {MAX_INSTANCED} vertices and triangles"
+        )));
     }
+    for (i, p) in values.chunks_exact(3).enumerate() {
+        let q = transform(world, [p[0], p[1], p[2]]);
+        push_vertex(&mut soup.positions, q, ctx.name, || {
+            format!("{what} vertex {i}")
+        })?;
+    }
+    let indices = match prim.indices() {
+        Some(acc) => read_indices(&acc, pos.count(), ctx, what)?,
+        None => (0..pos.count() as u32).collect(),
+    };
+    let flip = det3(world) < 0.0;
+    let offset = base as u32;
+    triangulate(prim.mode(), &indices, |t| {
+        let [a, b, c] = t.map(|i| i + offset);
+        soup.triangles
+            .push(if flip { [a, c, b] } else { [a, b, c] });
+    });
     Ok(())
 }
 
@@ -707,18 +725,6 @@ pub(crate) fn external_bytes(
     read_external(uri, (len as usize).min(limit), Some(base), name)
 }
 
-/// The node's local matrix (column-major) as `f64`.
-#[cfg(feature = "bake")]
-pub(crate) fn node_matrix(node: &::gltf::Node) -> Mat4 {
-    to_f64(node.transform().matrix())
-}
-
-/// `a · b` for column-major matrices.
-#[cfg(feature = "bake")]
-pub(crate) fn mat_mul(a: &Mat4, b: &Mat4) -> Mat4 {
-    mul(a, b)
-}
-
 /// `m · (p, 1)`.
 #[cfg(feature = "bake")]
 pub(crate) fn mat_point(m: &Mat4, p: [f64; 3]) -> [f64; 3] {
@@ -730,10 +736,6 @@ pub(crate) fn mat_point(m: &Mat4, p: [f64; 3]) -> [f64; 3] {
 pub(crate) fn mat_det3(m: &Mat4) -> f64 {
     det3(m)
 }
-
-/// The identity matrix.
-#[cfg(feature = "bake")]
-pub(crate) const MAT_IDENTITY: Mat4 = IDENTITY;
 
 /// Column-major 4×4 matrix, `m[column][row]` (for the appearance reader).
 #[cfg(feature = "bake")]
