@@ -538,3 +538,413 @@ fn edited_keyframe_animates_and_evaluates() {
         assert!(ev.mesh.positions().iter().flatten().all(|c| c.is_finite()));
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// corpus meshes (skipped without ../shared/meshes)
+
+/// A mesh of the shared corpus: `$PLEAT_MESHES`, `../shared/meshes` from the crate root or
+/// `../../shared/meshes` (a worktree); `None` (the test skips) when absent.
+fn corpus_mesh(name: &str) -> Option<TriMesh> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = [
+        std::env::var_os("PLEAT_MESHES").map(std::path::PathBuf::from),
+        Some(root.join("../shared/meshes")),
+        Some(root.join("../../shared/meshes")),
+    ]
+    .into_iter()
+    .flatten()
+    .find(|d| d.join(name).is_file());
+    match dir {
+        Some(d) => Some(pleat::mesh::io::read_mesh(&d.join(name)).unwrap()),
+        None => {
+            eprintln!("skipping: {name} not found (../shared/meshes)");
+            None
+        }
+    }
+}
+
+/// The exactly compatible plane wave `e^{i k·x}` (ω = k·e on every edge), as `pleat wrinkle
+/// plane-wave` builds it.
+fn exact_plane_wave(base: TriMesh, k: [f64; 3], a: f64) -> Cwf {
+    let x = base.positions().to_vec();
+    let omega = base
+        .edges()
+        .edges
+        .iter()
+        .map(|e| dot(k, x[e.0[1] as usize]) - dot(k, x[e.0[0] as usize]))
+        .collect();
+    let zeta = x.iter().map(|p| Complex::cis(dot(k, *p))).collect();
+    let n = base.vertex_count();
+    Cwf::new(base, omega, vec![a; n], zeta).unwrap()
+}
+
+/// The demo script's corpus edits (`examples_c/wrinkle_edit_demo.sh`): name, mesh, wave
+/// vector, regions `(seed vertex, rings, interface, rotate, σ, coupled)`, reference options.
+#[allow(clippy::type_complexity)]
+fn corpus_edits() -> Vec<(
+    &'static str,
+    &'static str,
+    [f64; 3],
+    Vec<(u32, usize, usize, f64, f64, bool)>,
+    bool,
+)> {
+    vec![
+        (
+            "spot rot90",
+            "coarse_spot_1k.obj",
+            [7.0, 0.0, 0.0],
+            vec![(500, 5, 3, FRAC_PI_2, 1.0, false)],
+            false,
+        ),
+        (
+            "spot ×2.5 + rot90",
+            "coarse_spot_1k.obj",
+            [7.0, 0.0, 0.0],
+            vec![
+                (500, 4, 2, 0.0, 2.5, true),
+                (100, 4, 2, FRAC_PI_2, 1.0, false),
+            ],
+            false,
+        ),
+        (
+            "fertility ×3 ÷3",
+            "coarse_fertility_1500.obj",
+            [0.06, 0.0, 0.0],
+            vec![(700, 5, 3, 0.0, 3.0, true)],
+            false,
+        ),
+        (
+            "torus rot90 ref",
+            "coarse_torus.obj",
+            [4.0, 0.0, 0.0],
+            vec![(200, 5, 3, FRAC_PI_2, 1.0, false)],
+            true,
+        ),
+        (
+            "torus rot90",
+            "coarse_torus.obj",
+            [4.0, 0.0, 0.0],
+            vec![(200, 5, 3, FRAC_PI_2, 1.0, false)],
+            false,
+        ),
+    ]
+}
+
+fn run_corpus_edit(
+    mesh: &TriMesh,
+    k: [f64; 3],
+    regions: &[(u32, usize, usize, f64, f64, bool)],
+    opts: &EditOptions,
+) -> (Cwf, Cwf, pleat::wrinkle::EditReport) {
+    let k0 = exact_plane_wave(mesh.clone(), k, 0.01);
+    let edits: Vec<RegionEdit> = regions
+        .iter()
+        .map(|&(v, rings, inter, rot, sigma, couple)| {
+            let faces = grow_faces(mesh, &[], &[v], rings, opts.adjacency).unwrap();
+            let mut r = RegionEdit::new(faces);
+            r.interface_rings = inter;
+            r.rotate = rot;
+            r.frequency_scale = sigma;
+            if couple {
+                r = r.coupled();
+            }
+            r
+        })
+        .collect();
+    let (k1, rep) = edit(&k0, &edits, opts).unwrap();
+    (k0, k1, rep)
+}
+
+/// Diagnostic (ignored): where the compatibility residual of the corpus edits comes from.
+#[test]
+#[ignore]
+fn corpus_compat_diagnostic() {
+    for (name, file, k, regions, reference) in corpus_edits() {
+        let Some(mesh) = corpus_mesh(file) else {
+            return;
+        };
+        let mut opts = if reference {
+            EditOptions::reference()
+        } else {
+            EditOptions::default()
+        };
+        if let Ok(w) = std::env::var("EDIT_WEIGHT") {
+            opts.edit_weight = w.parse().unwrap();
+        }
+        let (k0, k1, rep) = run_corpus_edit(&mesh, k, &regions, &opts);
+        let ec = edge_classes(&k0, &rep.face_class);
+        let dec = k1.decompose_omega();
+        let curls = face_curls(&k1, &dec.compatible);
+        let curl1 = face_curls(&k1, k1.omega());
+        let el = mesh.edges();
+        let mut singular_edge = vec![false; ec.len()];
+        let mut n_sing = 0;
+        for (f, c) in curls.iter().enumerate() {
+            if (c / std::f64::consts::TAU).round() != 0.0 {
+                n_sing += 1;
+                for &e in &el.face_edges[f] {
+                    singular_edge[e as usize] = true;
+                }
+            }
+        }
+        let amax = k1.amplitude().iter().cloned().fold(0.0, f64::max);
+        let mut rows: Vec<(FaceClass, f64, f64, bool)> = vec![];
+        for (e, &[a, b]) in k1.edges().iter().enumerate() {
+            if ec[e] == FaceClass::Fixed {
+                continue;
+            }
+            let am = 0.5 * (k1.amplitude()[a as usize] + k1.amplitude()[b as usize]) / amax;
+            rows.push((ec[e], dec.residual[e], am, singular_edge[e]));
+        }
+        let rms = |f: &dyn Fn(&(FaceClass, f64, f64, bool)) -> bool| {
+            let v: Vec<f64> = rows.iter().filter(|r| f(r)).map(|r| r.1 * r.1).collect();
+            (
+                (v.iter().sum::<f64>() / v.len().max(1) as f64).sqrt(),
+                v.len(),
+            )
+        };
+        let wrms = {
+            let (s, w) = rows.iter().fold((0.0, 0.0), |(s, w), r| {
+                (s + r.2 * r.2 * r.1 * r.1, w + r.2 * r.2)
+            });
+            (s / w).sqrt()
+        };
+        eprintln!(
+            "   report: by class {:?}, floor {:.3}",
+            rep.compat_rms_by_class, rep.compat_floor
+        );
+        eprintln!("== {name}: report compat_rms {:.3}, λ {:.3e}, |s| {:.3}, singular faces {n_sing}, clamped {}", rep.compat_rms, rep.eigenvalue, rep.s.abs(), rep.clamped);
+        eprintln!("  all {:?}", rms(&|_| true));
+        eprintln!(
+            "  edit {:?}  interface {:?}",
+            rms(&|r| r.0 == FaceClass::Edit),
+            rms(&|r| r.0 == FaceClass::Interface)
+        );
+        eprintln!(
+            "  non-singular {:?}  singular {:?}",
+            rms(&|r| !r.3),
+            rms(&|r| r.3)
+        );
+        for (lo, hi) in [(0.0, 0.25), (0.25, 0.5), (0.5, 0.75), (0.75, 1.01)] {
+            eprintln!(
+                "  a/amax in [{lo}, {hi}) {:?}",
+                rms(&|r| r.2 >= lo && r.2 < hi)
+            );
+        }
+        eprintln!("  amplitude-weighted {wrms:.3}");
+        // curl of ω¹ on edit / interface faces
+        let mut cs = [(0.0, 0usize); 3];
+        for (f, c) in curl1.iter().enumerate() {
+            let i = rep.face_class[f] as usize;
+            cs[i].0 += c * c;
+            cs[i].1 += 1;
+        }
+        eprintln!(
+            "  RMS curl ω¹ fixed {:.3} edit {:.3} interface {:.3}",
+            (cs[0].0 / cs[0].1 as f64).sqrt(),
+            (cs[1].0 / cs[1].1.max(1) as f64).sqrt(),
+            (cs[2].0 / cs[2].1.max(1) as f64).sqrt()
+        );
+        // lower bound: min ‖δ‖ over non-fixed edges with curl δ = curl ω¹ on non-fixed faces
+        for only_edit in [false, true] {
+            let keep_e = |e: usize| {
+                if only_edit {
+                    ec[e] == FaceClass::Edit
+                } else {
+                    ec[e] != FaceClass::Fixed
+                }
+            };
+            let nonfixed_f: Vec<usize> = (0..curl1.len())
+                .filter(|&f| {
+                    if only_edit {
+                        rep.face_class[f] == FaceClass::Edit
+                    } else {
+                        rep.face_class[f] != FaceClass::Fixed
+                    }
+                })
+                .collect();
+            let sign = |f: usize, i: usize| -> f64 {
+                let e = el.face_edges[f][i] as usize;
+                if k1.edges()[e][0] == mesh.triangles()[f][i] {
+                    1.0
+                } else {
+                    -1.0
+                }
+            };
+            let dt = |y: &[f64]| -> Vec<f64> {
+                let mut d = vec![0.0; ec.len()];
+                for (i, &f) in nonfixed_f.iter().enumerate() {
+                    for j in 0..3 {
+                        let e = el.face_edges[f][j] as usize;
+                        if keep_e(e) {
+                            d[e] += sign(f, j) * y[i];
+                        }
+                    }
+                }
+                d
+            };
+            let dd = |d: &[f64]| -> Vec<f64> {
+                nonfixed_f
+                    .iter()
+                    .map(|&f| {
+                        (0..3)
+                            .map(|j| sign(f, j) * d[el.face_edges[f][j] as usize])
+                            .sum()
+                    })
+                    .collect()
+            };
+            let c: Vec<f64> = nonfixed_f.iter().map(|&f| curl1[f]).collect();
+            let (mut y, mut r) = (vec![0.0; c.len()], c.clone());
+            let mut p = r.clone();
+            let mut rr: f64 = r.iter().map(|v| v * v).sum();
+            for _ in 0..2000 {
+                let ap = dd(&dt(&p));
+                let alpha = rr / p.iter().zip(&ap).map(|(a, b)| a * b).sum::<f64>();
+                y.iter_mut().zip(&p).for_each(|(a, b)| *a += alpha * b);
+                r.iter_mut().zip(&ap).for_each(|(a, b)| *a -= alpha * b);
+                let rn: f64 = r.iter().map(|v| v * v).sum();
+                if rn < 1e-28 {
+                    break;
+                }
+                p = r.iter().zip(&p).map(|(a, b)| a + rn / rr * b).collect();
+                rr = rn;
+            }
+            let delta = dt(&y);
+            let chk = dd(&delta);
+            let err: f64 = chk
+                .iter()
+                .zip(&c)
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum::<f64>()
+                .sqrt();
+            let cn: f64 = c.iter().map(|v| v * v).sum::<f64>().sqrt();
+            eprintln!("  CG: |Dδ − c| {err:.2e}, |c| {cn:.3}, faces {}", c.len());
+            let lb: f64 = delta.iter().map(|v| v * v).sum::<f64>();
+            let signed: [f64; 3] = [0, 1, 2].map(|k| {
+                curl1
+                    .iter()
+                    .enumerate()
+                    .filter(|(f, _)| rep.face_class[*f] as usize == k)
+                    .map(|(_, c)| c)
+                    .sum()
+            });
+            let ne = (0..ec.len()).filter(|&e| keep_e(e)).count();
+            eprintln!("  only_edit {only_edit}: curl-forced lower bound RMS {:.3}; Σcurl ω¹ edit {:.3} interface {:.3}", (lb / ne as f64).sqrt(), signed[1], signed[2]);
+        }
+        // |ω| per edge in edit region (resolution)
+        let om: Vec<f64> = (0..ec.len())
+            .filter(|&e| ec[e] != FaceClass::Fixed)
+            .map(|e| k1.omega()[e].abs())
+            .collect();
+        eprintln!(
+            "  max |ω| {:.2}, mean {:.2}",
+            om.iter().cloned().fold(0.0, f64::max),
+            om.iter().sum::<f64>() / om.len() as f64
+        );
+    }
+}
+
+/// Singular faces of `c` (index `round(curl ω_com / 2π)` ≠ 0) among the faces `keep`: `(face,
+/// index)`.
+fn singular_faces(c: &Cwf, keep: &dyn Fn(usize) -> bool) -> Vec<(usize, i64)> {
+    let d = c.decompose_omega();
+    face_curls(c, &d.compatible)
+        .iter()
+        .enumerate()
+        .filter(|&(f, _)| keep(f))
+        .map(|(f, v)| (f, (v / std::f64::consts::TAU).round() as i64))
+        .filter(|&(_, i)| i != 0)
+        .collect()
+}
+
+/// Interface smoothness, C5/C8: on every edit the RMS compatibility residual over edit +
+/// interface edges is ≤ 0.3 rad or within 1.5× the floor that the requested `ω¹` forces on any
+/// phase without singularities (`EditReport::compat_floor`); singularities that appear come in
+/// ± pairs (net index over the edited area unchanged), and the upsampled amplitude |z| vanishes
+/// at each of them.
+fn check_interface(name: &str, k0: &Cwf, k1: &Cwf, rep: &pleat::wrinkle::EditReport) {
+    eprintln!(
+        "{name}: compat RMS {:.3} (edit {:.3}, interface {:.3}), floor {:.3}",
+        rep.compat_rms, rep.compat_rms_by_class[0], rep.compat_rms_by_class[1], rep.compat_floor
+    );
+    assert!(
+        rep.compat_rms <= 0.3f64.max(1.5 * rep.compat_floor),
+        "{name}: RMS {} vs floor {}",
+        rep.compat_rms,
+        rep.compat_floor
+    );
+    let edited = |f: usize| rep.face_class[f] != FaceClass::Fixed;
+    let before = singular_faces(k0, &edited);
+    let after = singular_faces(k1, &edited);
+    let net = |s: &[(usize, i64)]| s.iter().map(|p| p.1).sum::<i64>();
+    assert_eq!(net(&after), net(&before), "{name}: net index {after:?}");
+    // the upsampled |z| = a|z̃| goes to 0 inside (near) every singular face
+    let (ev, _) = k1
+        .evaluate(
+            3,
+            &EvalOptions {
+                displacement_scale: 0.0,
+                want_z: true,
+                ..EvalOptions::default()
+            },
+        )
+        .unwrap();
+    let z = ev.z.as_ref().unwrap();
+    let p = ev.mesh.positions();
+    let amax = k1.amplitude().iter().cloned().fold(0.0, f64::max);
+    let x = k1.base().positions();
+    for &(f, idx) in &after {
+        let t = k1.base().triangles()[f];
+        let c: [f64; 3] =
+            std::array::from_fn(|i| t.iter().map(|&v| x[v as usize][i]).sum::<f64>() / 3.0);
+        let r = t
+            .iter()
+            .map(|&v| dot(edge_vec_p(x[v as usize], c), edge_vec_p(x[v as usize], c)).sqrt())
+            .fold(0.0, f64::max);
+        let near = (0..p.len())
+            .filter(|&i| dot(edge_vec_p(p[i], c), edge_vec_p(p[i], c)).sqrt() <= 1.5 * r)
+            .map(|i| z[i].abs())
+            .fold(f64::INFINITY, f64::min);
+        eprintln!(
+            "  singular face {f} index {idx}: min |z| nearby {:.3} max a",
+            near / amax
+        );
+        assert!(
+            near <= 0.1 * amax,
+            "{name}: face {f}: |z| {near} near a singularity"
+        );
+    }
+}
+
+fn edge_vec_p(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [b[0] - a[0], b[1] - a[1], b[2] - a[2]]
+}
+
+#[test]
+fn corpus_interfaces_are_smooth_and_singularities_pair() {
+    for (name, file, k, regions, reference) in corpus_edits() {
+        let Some(mesh) = corpus_mesh(file) else {
+            return;
+        };
+        let opts = if reference {
+            EditOptions::reference()
+        } else {
+            EditOptions::default()
+        };
+        let (k0, k1, rep) = run_corpus_edit(&mesh, k, &regions, &opts);
+        check_interface(name, &k0, &k1, &rep);
+    }
+}
+
+#[test]
+fn curved_generated_interfaces_are_smooth_and_singularities_pair() {
+    let m = wrinkle_common::torus(48, 24, 3);
+    for (theta, sigma) in [(FRAC_PI_2, 1.0), (0.0, 3.0), (FRAC_PI_4, 2.0)] {
+        let k0 = exact_plane_wave(m.clone(), [9.0, 0.0, 0.0], 0.01);
+        let mut r = RegionEdit::new(grow_faces(&m, &[], &[300], 5, Adjacency::Vertex).unwrap());
+        r.rotate = theta;
+        r.frequency_scale = sigma;
+        let (k1, rep) = edit(&k0, &[r.coupled()], &EditOptions::default()).unwrap();
+        check_interface(&format!("torus θ {theta} σ {sigma}"), &k0, &k1, &rep);
+    }
+}
