@@ -671,6 +671,10 @@ fn corpus_compat_diagnostic() {
         if let Ok(w) = std::env::var("EDIT_WEIGHT") {
             opts.edit_weight = w.parse().unwrap();
         }
+        let mut regions = regions;
+        if let Ok(m) = std::env::var("INTERFACE_RINGS") {
+            regions.iter_mut().for_each(|r| r.2 = m.parse().unwrap());
+        }
         let (k0, k1, rep) = run_corpus_edit(&mesh, k, &regions, &opts);
         let ec = edge_classes(&k0, &rep.face_class);
         let dec = k1.decompose_omega();
@@ -947,4 +951,162 @@ fn curved_generated_interfaces_are_smooth_and_singularities_pair() {
         let (k1, rep) = edit(&k0, &[r.coupled()], &EditOptions::default()).unwrap();
         check_interface(&format!("torus θ {theta} σ {sigma}"), &k0, &k1, &rep);
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// issue 14 "Bad input": each a clear status (exit 2 + message), nothing written — from the CLI
+
+/// Runs the `pleat` binary; returns (exit code, stderr).
+fn pleat_cli(args: &[&str]) -> (Option<i32>, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pleat"))
+        .args(args)
+        .output()
+        .expect("run pleat");
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// `m` as OBJ text.
+fn obj_text(m: &TriMesh) -> String {
+    let mut s = String::new();
+    for p in m.positions() {
+        s += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for t in m.triangles() {
+        s += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    s
+}
+
+#[test]
+fn cli_bad_input_is_refused_and_writes_nothing() {
+    let dir = std::env::temp_dir().join(format!("pleat-edit14-bad-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_owned();
+    let base = dir.join("grid.obj");
+    let m = irregular_grid(12, 0.2, 1);
+    std::fs::write(&base, obj_text(&m)).unwrap();
+    let a = dir.join("a.cwf");
+    let (code, err) = pleat_cli(&[
+        "wrinkle",
+        "plane-wave",
+        &s(&base),
+        "--k",
+        "25,0,0",
+        "-o",
+        &s(&a),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let centre = nearest(&m, [0.5, 0.5]).to_string();
+    let out = dir.join("out.cwf");
+    let edit_case = |region: &str| {
+        pleat_cli(&[
+            "wrinkle",
+            "edit",
+            &s(&base),
+            "--cwf",
+            &s(&a),
+            "--region",
+            region,
+            "-o",
+            &s(&out),
+        ])
+    };
+    let v = format!("vertex={centre},rings=2,interface=2");
+    let cases: Vec<(String, &str)> = vec![
+        (format!("{v},rotate=nan"), "rotation"),
+        (format!("{v},scale=0"), "frequency scale"),
+        (format!("{v},scale=-2"), "frequency scale"),
+        (format!("{v},amplitude=-1"), "amplitude scale"),
+        (format!("{v},scale=nan"), "frequency scale"),
+        ("vertex=99999,rings=2".to_string(), "99999"),
+        ("rings=2".to_string(), "no seed"),
+        (format!("vertex={centre},rings=0"), "rings = 0"),
+        (format!("vertex={centre},rings=3,interface=0"), "too thin"),
+    ];
+    for (region, want) in &cases {
+        let (code, err) = edit_case(region);
+        assert_eq!(code, Some(2), "{region}: {err}");
+        assert!(err.contains(want), "{region}: {err}");
+        assert!(!out.exists(), "{region}: output written");
+    }
+    // two overlapping regions
+    let (code, err) = pleat_cli(&[
+        "wrinkle",
+        "edit",
+        &s(&base),
+        "--cwf",
+        &s(&a),
+        "--region",
+        &v,
+        "--region",
+        &v,
+        "-o",
+        &s(&out),
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("overlap"), "{err}");
+    assert!(!out.exists());
+    // design: NaN wave vector, negative amplitude, zero rings, out-of-range vertex
+    for (src, want) in [
+        (format!("{centre},nan,0,0,0.01,3"), "source 0"),
+        (format!("{centre},5,0,0,-0.01,3"), "source 0"),
+        (format!("{centre},5,0,0,0.01,0"), "source 0"),
+        ("99999,5,0,0,0.01,3".to_string(), "99999"),
+    ] {
+        let (code, err) = pleat_cli(&[
+            "wrinkle",
+            "design",
+            &s(&base),
+            "--source",
+            &src,
+            "-o",
+            &s(&out),
+        ]);
+        assert_eq!(code, Some(2), "{src}: {err}");
+        assert!(err.contains(want), "{src}: {err}");
+        assert!(!out.exists(), "{src}: output written");
+    }
+    // a base that is not an oriented manifold: three triangles on one edge
+    let bad = dir.join("fin.obj");
+    std::fs::write(
+        &bad,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n",
+    )
+    .unwrap();
+    let (code, err) = pleat_cli(&[
+        "wrinkle",
+        "design",
+        &s(&bad),
+        "--source",
+        "0,5,0,0,0.01,1",
+        "-o",
+        &s(&out),
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("manifold"), "{err}");
+    assert!(!out.exists());
+    let (code, err) = pleat_cli(&[
+        "wrinkle",
+        "edit",
+        &s(&bad),
+        "--cwf",
+        &s(&a),
+        "--region",
+        "vertex=0,rings=1,interface=1,rotate=90",
+        "-o",
+        &s(&out),
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(!err.is_empty());
+    assert!(!out.exists());
+    // a region covering the whole mesh is a global edit: plain Knöppel phase, said so
+    let (code, err) = edit_case(&format!("vertex={centre},rings=40,interface=0,rotate=90"));
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("global edit: Knöppel"), "{err}");
+    assert!(out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
 }
