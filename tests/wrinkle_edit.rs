@@ -1110,3 +1110,307 @@ fn cli_bad_input_is_refused_and_writes_nothing() {
     assert!(out.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+// ---------------------------------------------------------------------------------------------
+// issue part 4 / C10: edit → interpolate → evaluate → rendered frames (README pictures)
+
+/// A shaded surface for the project's rasterizer: smooth area-weighted vertex normals.
+#[cfg(feature = "bake")]
+struct Shaded {
+    mesh: TriMesh,
+    normals: Vec<pleat::geom::Vec3>,
+}
+
+#[cfg(feature = "bake")]
+impl Shaded {
+    fn new(mesh: TriMesh) -> Shaded {
+        use pleat::geom::Vec3;
+        let p = mesh.positions();
+        let mut n = vec![Vec3::ZERO; p.len()];
+        for t in mesh.triangles() {
+            let [a, b, c] = t.map(|v| Vec3::from(p[v as usize]));
+            let fnrm = (b - a).cross(c - a);
+            for &v in t {
+                n[v as usize] += fnrm;
+            }
+        }
+        let normals = n
+            .into_iter()
+            .map(|v| pleat::geom::normalized(v).unwrap_or(Vec3::Z))
+            .collect();
+        Shaded { mesh, normals }
+    }
+}
+
+#[cfg(feature = "bake")]
+impl pleat::bake::render::Surface for Shaded {
+    fn positions(&self) -> &[[f64; 3]] {
+        self.mesh.positions()
+    }
+    fn triangles(&self) -> &[[u32; 3]] {
+        self.mesh.triangles()
+    }
+    fn base_color(&self, _: usize, _: [f64; 3]) -> [f64; 3] {
+        [1.0; 3]
+    }
+    fn normal(&self, t: usize, b: [f64; 3]) -> pleat::geom::Vec3 {
+        let tri = self.mesh.triangles()[t];
+        let n: pleat::geom::Vec3 = (0..3).map(|k| self.normals[tri[k] as usize] * b[k]).sum();
+        pleat::geom::normalized(n).unwrap_or(pleat::geom::Vec3::Z)
+    }
+}
+
+/// Vertices at least `rings` vertex rings away from every non-fixed vertex.
+fn far_fixed_vertices(c: &Cwf, face_class: &[FaceClass], rings: usize) -> Vec<usize> {
+    let n = c.base().vertex_count();
+    let mut dist = vec![usize::MAX; n];
+    let mut front = vec![];
+    for (f, t) in c.base().triangles().iter().enumerate() {
+        if face_class[f] != FaceClass::Fixed {
+            for &v in t {
+                if dist[v as usize] != 0 {
+                    dist[v as usize] = 0;
+                    front.push(v as usize);
+                }
+            }
+        }
+    }
+    let mut nbr = vec![vec![]; n];
+    for &[a, b] in c.edges() {
+        nbr[a as usize].push(b as usize);
+        nbr[b as usize].push(a as usize);
+    }
+    for d in 1..=rings {
+        let mut next = vec![];
+        for &v in &front {
+            for &w in &nbr[v] {
+                if dist[w] == usize::MAX {
+                    dist[w] = d;
+                    next.push(w);
+                }
+            }
+        }
+        front = next;
+    }
+    (0..n).filter(|&v| dist[v] == usize::MAX).collect()
+}
+
+/// The dissertation's three edits (Figs. 3.7, 3.6, 3.19) on corpus meshes: edit → interpolate
+/// (40 guide frames, 41 frames; `GUIDE=n` changes it) → evaluate (3 levels, displacement ×2.5) → one PNG strip of 7 shaded frames per edit under `docs/`,
+/// from one fixed camera facing the edited area. Prints per frame step the RMS change of the
+/// displacement `Re z` (a temporal discontinuity shows as a spike) and, C10, the largest drift
+/// `|z̃(t) − z̃⁰|` over the fixed vertices ≥ 2 rings from the interface (no locality weights).
+/// `cargo test --release --test wrinkle_edit readme_frames -- --ignored --nocapture`
+#[cfg(feature = "bake")]
+#[test]
+#[ignore]
+fn readme_frames() {
+    use pleat::bake::render::{rasterize, shade, Mode, View};
+    use pleat::geom::Vec3;
+    type Reg = (u32, usize, usize, f64, f64, bool);
+    let cases: [(&str, &str, [f64; 3], f64, Vec<Reg>); 3] = [
+        (
+            "wrinkle_edit_rot90",
+            "coarse_spot_1k.obj",
+            [25.0, 0.0, 0.0],
+            0.01,
+            vec![(500, 5, 5, FRAC_PI_2, 1.0, false)],
+        ),
+        (
+            "wrinkle_edit_x3",
+            "coarse_fertility_1500.obj",
+            [0.14, 0.0, 0.0],
+            1.2,
+            vec![(700, 5, 5, 0.0, 3.0, true)],
+        ),
+        (
+            "wrinkle_edit_two",
+            "coarse_spot_1k.obj",
+            [12.0, 0.0, 0.0],
+            0.02,
+            vec![
+                (500, 4, 4, FRAC_PI_2, 1.0, false),
+                (100, 4, 4, 0.0, 2.5, true),
+            ],
+        ),
+    ];
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (name, file, k, amp, regions) in cases {
+        let Some(mesh) = corpus_mesh(file) else {
+            return;
+        };
+        let k0 = exact_plane_wave(mesh.clone(), k, amp);
+        let edits: Vec<RegionEdit> = regions
+            .iter()
+            .map(|&(v, rings, inter, rot, sigma, couple)| {
+                let mut r = RegionEdit::new(
+                    grow_faces(&mesh, &[], &[v], rings, Adjacency::Vertex).unwrap(),
+                );
+                r.interface_rings = inter;
+                r.rotate = rot;
+                r.frequency_scale = sigma;
+                if couple {
+                    r = r.coupled();
+                }
+                r
+            })
+            .collect();
+        let t0 = std::time::Instant::now();
+        let (k1, rep) = edit(&k0, &edits, &EditOptions::default()).unwrap();
+        let t_edit = t0.elapsed().as_secs_f64();
+        let guide = std::env::var("GUIDE").map_or(40, |g| g.parse().unwrap());
+        let iopts = InterpOptions {
+            guide_frames: guide,
+            substeps: 1,
+            ..InterpOptions::default()
+        };
+        let t0 = std::time::Instant::now();
+        let (anim, irep) = interpolate(&k0, &k1, &iopts).unwrap();
+        let t_interp = t0.elapsed().as_secs_f64();
+        eprintln!(
+            "{name}: edit {t_edit:.3} s (compat RMS {:.3}, floor {:.3}), interpolate {t_interp:.2} s ({:?}), {} frames",
+            rep.compat_rms,
+            rep.compat_floor,
+            irep.stop,
+            anim.frame_count()
+        );
+        // C10: drift of the far fixed vertices
+        let far = far_fixed_vertices(&k0, &rep.face_class, 2);
+        let mut drift: f64 = 0.0;
+        for i in 0..anim.frame_count() {
+            let f = anim.frame(i).unwrap();
+            for &v in &far {
+                drift = drift.max((f.zeta()[v] - k0.zeta()[v]).abs());
+            }
+        }
+        eprintln!(
+            "  C10: max |z̃(t) − z̃⁰| over {} fixed vertices ≥ 2 rings from the interface: {drift:.2e}",
+            far.len()
+        );
+        // camera facing the edited area
+        let x = mesh.positions();
+        let active: Vec<usize> = {
+            let mut on = vec![false; x.len()];
+            for (f, t) in mesh.triangles().iter().enumerate() {
+                if rep.face_class[f] != FaceClass::Fixed {
+                    t.iter().for_each(|&v| on[v as usize] = true);
+                }
+            }
+            (0..x.len()).filter(|&v| on[v]).collect()
+        };
+        let c: Vec3 = active.iter().map(|&v| Vec3::from(x[v])).sum::<Vec3>() / active.len() as f64;
+        let mut nrm = Vec3::ZERO;
+        for (f, t) in mesh.triangles().iter().enumerate() {
+            if rep.face_class[f] != FaceClass::Fixed {
+                let [a, b, d] = t.map(|v| Vec3::from(x[v as usize]));
+                nrm += (b - a).cross(d - a);
+            }
+        }
+        let nrm = pleat::geom::normalized(nrm).unwrap();
+        let r = active
+            .iter()
+            .map(|&v| (Vec3::from(x[v]) - c).length())
+            .fold(0.0, f64::max)
+            * 0.8;
+        let side = 240u32;
+        let dist = 4.0 * r;
+        let view = View::look_at(c + nrm * dist, c, f64::from(side) * dist / (2.6 * r), side);
+        let n_tiles = 7;
+        let eopts = EvalOptions {
+            want_z: true,
+            displacement_scale: 2.5,
+            ..EvalOptions::default()
+        };
+        let mut tiles = vec![];
+        let mut last: Option<Vec<f64>> = None;
+        let mut steps = vec![];
+        for i in 0..anim.frame_count() {
+            let f = anim.frame(i).unwrap();
+            let (ev, _) = f.evaluate(3, &eopts).unwrap();
+            let re: Vec<f64> = ev.z.as_ref().unwrap().iter().map(|z| z.re).collect();
+            if let Some(prev) = &last {
+                let d = (re
+                    .iter()
+                    .zip(prev)
+                    .map(|(a, b)| (a - b).powi(2))
+                    .sum::<f64>()
+                    / re.len() as f64)
+                    .sqrt();
+                steps.push(d / amp);
+            }
+            last = Some(re);
+            if i > 0 {
+                let p = anim.frame(i - 1).unwrap();
+                let mut dz = [0.0f64; 3];
+                for (j, c) in rep_vertex_class(&k0, &rep.face_class).iter().enumerate() {
+                    dz[*c as usize] = dz[*c as usize].max((f.zeta()[j] - p.zeta()[j]).abs());
+                }
+                let dw = f
+                    .omega()
+                    .iter()
+                    .zip(p.omega())
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max);
+                eprintln!("    step {i}: max |Δz̃| fixed/edit/interface {dz:.3?}, max |Δω| {dw:.3}");
+            }
+            let tiles_at: Vec<usize> = (0..n_tiles)
+                .map(|j| {
+                    ((j * (anim.frame_count() - 1)) as f64 / (n_tiles - 1) as f64).round() as usize
+                })
+                .collect();
+            if tiles_at.contains(&i) {
+                let s = Shaded::new(ev.mesh);
+                let g = rasterize(&view, s.mesh.positions(), s.mesh.triangles());
+                tiles.push(shade(&g, &view, &s, Mode::Shaded).to_image([255, 255, 255]));
+            }
+        }
+        eprintln!(
+            "  RMS change of Re z per frame step / amplitude: {}",
+            steps
+                .iter()
+                .map(|s| format!("{s:.3}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
+        let sd = side as usize;
+        let w = sd * tiles.len();
+        let mut rgba = vec![255u8; 4 * w * sd];
+        for (c, img) in tiles.iter().enumerate() {
+            for j in 0..sd {
+                let dst = 4 * (j * w + c * sd);
+                rgba[dst..dst + 4 * sd].copy_from_slice(&img.rgba[4 * j * sd..4 * (j + 1) * sd]);
+            }
+        }
+        let img = pleat::bake::Image8 {
+            width: w as u32,
+            height: sd as u32,
+            rgba,
+        };
+        let png = pleat::bake::output::png_bytes(&img).unwrap();
+        std::fs::create_dir_all(root.join("docs")).unwrap();
+        let path = root.join(format!("docs/{name}.png"));
+        std::fs::write(&path, &png).unwrap();
+        eprintln!("  {}: {w}×{sd}, {} bytes", path.display(), png.len());
+    }
+}
+
+/// Per vertex: fixed, edit or interface (edit > fixed > interface), from the face classes.
+fn rep_vertex_class(c: &Cwf, face_class: &[FaceClass]) -> Vec<FaceClass> {
+    let fixed = vertex_fixed(c, face_class);
+    let mut cls: Vec<FaceClass> = fixed
+        .iter()
+        .map(|&f| {
+            if f {
+                FaceClass::Fixed
+            } else {
+                FaceClass::Interface
+            }
+        })
+        .collect();
+    for (f, t) in c.base().triangles().iter().enumerate() {
+        if face_class[f] == FaceClass::Edit {
+            t.iter().for_each(|&v| cls[v as usize] = FaceClass::Edit);
+        }
+    }
+    cls
+}
