@@ -658,6 +658,7 @@ fn run_corpus_edit(
 /// Diagnostic (ignored): where the compatibility residual of the corpus edits comes from.
 #[test]
 #[ignore]
+#[allow(clippy::type_complexity)]
 fn corpus_compat_diagnostic() {
     for (name, file, k, regions, reference) in corpus_edits() {
         let Some(mesh) = corpus_mesh(file) else {
@@ -1216,6 +1217,7 @@ fn far_fixed_vertices(c: &Cwf, face_class: &[FaceClass], rings: usize) -> Vec<us
 #[cfg(feature = "bake")]
 #[test]
 #[ignore]
+#[allow(clippy::type_complexity)]
 fn readme_frames() {
     use pleat::bake::render::{rasterize, shade, Mode, View};
     use pleat::geom::Vec3;

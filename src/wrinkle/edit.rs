@@ -816,8 +816,8 @@ fn compat_floor(topo: &Topology, omega: &[f64], labels: &Labels) -> Result<f64> 
     let curl = topo.face_curls(omega);
     // per non-fixed edge: its (row, sign) entries of D
     let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); topo.n_edges()];
-    for f in 0..topo.n_faces() {
-        if row[f] == u32::MAX {
+    for (f, &r) in row.iter().enumerate() {
+        if r == u32::MAX {
             continue;
         }
         for i in 0..3 {
@@ -828,7 +828,7 @@ fn compat_floor(topo: &Topology, omega: &[f64], labels: &Labels) -> Result<f64> 
                 } else {
                     -1.0
                 };
-                cols[e].push((row[f] as usize, sign));
+                cols[e].push((r as usize, sign));
             }
         }
     }
