@@ -538,3 +538,893 @@ fn edited_keyframe_animates_and_evaluates() {
         assert!(ev.mesh.positions().iter().flatten().all(|c| c.is_finite()));
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// corpus meshes (skipped without ../shared/meshes)
+
+/// A mesh of the shared corpus: `$PLEAT_MESHES`, `../shared/meshes` from the crate root or
+/// `../../shared/meshes` (a worktree); `None` (the test skips) when absent.
+fn corpus_mesh(name: &str) -> Option<TriMesh> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = [
+        std::env::var_os("PLEAT_MESHES").map(std::path::PathBuf::from),
+        Some(root.join("../shared/meshes")),
+        Some(root.join("../../shared/meshes")),
+    ]
+    .into_iter()
+    .flatten()
+    .find(|d| d.join(name).is_file());
+    match dir {
+        Some(d) => Some(pleat::mesh::io::read_mesh(&d.join(name)).unwrap()),
+        None => {
+            eprintln!("skipping: {name} not found (../shared/meshes)");
+            None
+        }
+    }
+}
+
+/// The exactly compatible plane wave `e^{i k·x}` (ω = k·e on every edge), as `pleat wrinkle
+/// plane-wave` builds it.
+fn exact_plane_wave(base: TriMesh, k: [f64; 3], a: f64) -> Cwf {
+    let x = base.positions().to_vec();
+    let omega = base
+        .edges()
+        .edges
+        .iter()
+        .map(|e| dot(k, x[e.0[1] as usize]) - dot(k, x[e.0[0] as usize]))
+        .collect();
+    let zeta = x.iter().map(|p| Complex::cis(dot(k, *p))).collect();
+    let n = base.vertex_count();
+    Cwf::new(base, omega, vec![a; n], zeta).unwrap()
+}
+
+/// The demo script's corpus edits (`examples_c/wrinkle_edit_demo.sh`): name, mesh, wave
+/// vector, regions `(seed vertex, rings, interface, rotate, σ, coupled)`, reference options.
+#[allow(clippy::type_complexity)]
+fn corpus_edits() -> Vec<(
+    &'static str,
+    &'static str,
+    [f64; 3],
+    Vec<(u32, usize, usize, f64, f64, bool)>,
+    bool,
+)> {
+    vec![
+        (
+            "spot rot90",
+            "coarse_spot_1k.obj",
+            [7.0, 0.0, 0.0],
+            vec![(500, 5, 3, FRAC_PI_2, 1.0, false)],
+            false,
+        ),
+        (
+            "spot ×2.5 + rot90",
+            "coarse_spot_1k.obj",
+            [7.0, 0.0, 0.0],
+            vec![
+                (500, 4, 2, 0.0, 2.5, true),
+                (100, 4, 2, FRAC_PI_2, 1.0, false),
+            ],
+            false,
+        ),
+        (
+            "fertility ×3 ÷3",
+            "coarse_fertility_1500.obj",
+            [0.06, 0.0, 0.0],
+            vec![(700, 5, 3, 0.0, 3.0, true)],
+            false,
+        ),
+        (
+            "torus rot90 ref",
+            "coarse_torus.obj",
+            [4.0, 0.0, 0.0],
+            vec![(200, 5, 3, FRAC_PI_2, 1.0, false)],
+            true,
+        ),
+        (
+            "torus rot90",
+            "coarse_torus.obj",
+            [4.0, 0.0, 0.0],
+            vec![(200, 5, 3, FRAC_PI_2, 1.0, false)],
+            false,
+        ),
+    ]
+}
+
+fn run_corpus_edit(
+    mesh: &TriMesh,
+    k: [f64; 3],
+    regions: &[(u32, usize, usize, f64, f64, bool)],
+    opts: &EditOptions,
+) -> (Cwf, Cwf, pleat::wrinkle::EditReport) {
+    let k0 = exact_plane_wave(mesh.clone(), k, 0.01);
+    let edits: Vec<RegionEdit> = regions
+        .iter()
+        .map(|&(v, rings, inter, rot, sigma, couple)| {
+            let faces = grow_faces(mesh, &[], &[v], rings, opts.adjacency).unwrap();
+            let mut r = RegionEdit::new(faces);
+            r.interface_rings = inter;
+            r.rotate = rot;
+            r.frequency_scale = sigma;
+            if couple {
+                r = r.coupled();
+            }
+            r
+        })
+        .collect();
+    let (k1, rep) = edit(&k0, &edits, opts).unwrap();
+    (k0, k1, rep)
+}
+
+/// Diagnostic (ignored): where the compatibility residual of the corpus edits comes from.
+#[test]
+#[ignore]
+#[allow(clippy::type_complexity)]
+fn corpus_compat_diagnostic() {
+    for (name, file, k, regions, reference) in corpus_edits() {
+        let Some(mesh) = corpus_mesh(file) else {
+            return;
+        };
+        let mut opts = if reference {
+            EditOptions::reference()
+        } else {
+            EditOptions::default()
+        };
+        if let Ok(w) = std::env::var("EDIT_WEIGHT") {
+            opts.edit_weight = w.parse().unwrap();
+        }
+        let mut regions = regions;
+        if let Ok(m) = std::env::var("INTERFACE_RINGS") {
+            regions.iter_mut().for_each(|r| r.2 = m.parse().unwrap());
+        }
+        let (k0, k1, rep) = run_corpus_edit(&mesh, k, &regions, &opts);
+        let ec = edge_classes(&k0, &rep.face_class);
+        let dec = k1.decompose_omega();
+        let curls = face_curls(&k1, &dec.compatible);
+        let curl1 = face_curls(&k1, k1.omega());
+        let el = mesh.edges();
+        let mut singular_edge = vec![false; ec.len()];
+        let mut n_sing = 0;
+        for (f, c) in curls.iter().enumerate() {
+            if (c / std::f64::consts::TAU).round() != 0.0 {
+                n_sing += 1;
+                for &e in &el.face_edges[f] {
+                    singular_edge[e as usize] = true;
+                }
+            }
+        }
+        let amax = k1.amplitude().iter().cloned().fold(0.0, f64::max);
+        let mut rows: Vec<(FaceClass, f64, f64, bool)> = vec![];
+        for (e, &[a, b]) in k1.edges().iter().enumerate() {
+            if ec[e] == FaceClass::Fixed {
+                continue;
+            }
+            let am = 0.5 * (k1.amplitude()[a as usize] + k1.amplitude()[b as usize]) / amax;
+            rows.push((ec[e], dec.residual[e], am, singular_edge[e]));
+        }
+        let rms = |f: &dyn Fn(&(FaceClass, f64, f64, bool)) -> bool| {
+            let v: Vec<f64> = rows.iter().filter(|r| f(r)).map(|r| r.1 * r.1).collect();
+            (
+                (v.iter().sum::<f64>() / v.len().max(1) as f64).sqrt(),
+                v.len(),
+            )
+        };
+        let wrms = {
+            let (s, w) = rows.iter().fold((0.0, 0.0), |(s, w), r| {
+                (s + r.2 * r.2 * r.1 * r.1, w + r.2 * r.2)
+            });
+            (s / w).sqrt()
+        };
+        eprintln!(
+            "   report: by class {:?}, floor {:.3}",
+            rep.compat_rms_by_class, rep.compat_floor
+        );
+        eprintln!("== {name}: report compat_rms {:.3}, λ {:.3e}, |s| {:.3}, singular faces {n_sing}, clamped {}", rep.compat_rms, rep.eigenvalue, rep.s.abs(), rep.clamped);
+        eprintln!("  all {:?}", rms(&|_| true));
+        eprintln!(
+            "  edit {:?}  interface {:?}",
+            rms(&|r| r.0 == FaceClass::Edit),
+            rms(&|r| r.0 == FaceClass::Interface)
+        );
+        eprintln!(
+            "  non-singular {:?}  singular {:?}",
+            rms(&|r| !r.3),
+            rms(&|r| r.3)
+        );
+        for (lo, hi) in [(0.0, 0.25), (0.25, 0.5), (0.5, 0.75), (0.75, 1.01)] {
+            eprintln!(
+                "  a/amax in [{lo}, {hi}) {:?}",
+                rms(&|r| r.2 >= lo && r.2 < hi)
+            );
+        }
+        eprintln!("  amplitude-weighted {wrms:.3}");
+        // curl of ω¹ on edit / interface faces
+        let mut cs = [(0.0, 0usize); 3];
+        for (f, c) in curl1.iter().enumerate() {
+            let i = rep.face_class[f] as usize;
+            cs[i].0 += c * c;
+            cs[i].1 += 1;
+        }
+        eprintln!(
+            "  RMS curl ω¹ fixed {:.3} edit {:.3} interface {:.3}",
+            (cs[0].0 / cs[0].1 as f64).sqrt(),
+            (cs[1].0 / cs[1].1.max(1) as f64).sqrt(),
+            (cs[2].0 / cs[2].1.max(1) as f64).sqrt()
+        );
+        // lower bound: min ‖δ‖ over non-fixed edges with curl δ = curl ω¹ on non-fixed faces
+        for only_edit in [false, true] {
+            let keep_e = |e: usize| {
+                if only_edit {
+                    ec[e] == FaceClass::Edit
+                } else {
+                    ec[e] != FaceClass::Fixed
+                }
+            };
+            let nonfixed_f: Vec<usize> = (0..curl1.len())
+                .filter(|&f| {
+                    if only_edit {
+                        rep.face_class[f] == FaceClass::Edit
+                    } else {
+                        rep.face_class[f] != FaceClass::Fixed
+                    }
+                })
+                .collect();
+            let sign = |f: usize, i: usize| -> f64 {
+                let e = el.face_edges[f][i] as usize;
+                if k1.edges()[e][0] == mesh.triangles()[f][i] {
+                    1.0
+                } else {
+                    -1.0
+                }
+            };
+            let dt = |y: &[f64]| -> Vec<f64> {
+                let mut d = vec![0.0; ec.len()];
+                for (i, &f) in nonfixed_f.iter().enumerate() {
+                    for j in 0..3 {
+                        let e = el.face_edges[f][j] as usize;
+                        if keep_e(e) {
+                            d[e] += sign(f, j) * y[i];
+                        }
+                    }
+                }
+                d
+            };
+            let dd = |d: &[f64]| -> Vec<f64> {
+                nonfixed_f
+                    .iter()
+                    .map(|&f| {
+                        (0..3)
+                            .map(|j| sign(f, j) * d[el.face_edges[f][j] as usize])
+                            .sum()
+                    })
+                    .collect()
+            };
+            let c: Vec<f64> = nonfixed_f.iter().map(|&f| curl1[f]).collect();
+            let (mut y, mut r) = (vec![0.0; c.len()], c.clone());
+            let mut p = r.clone();
+            let mut rr: f64 = r.iter().map(|v| v * v).sum();
+            for _ in 0..2000 {
+                let ap = dd(&dt(&p));
+                let alpha = rr / p.iter().zip(&ap).map(|(a, b)| a * b).sum::<f64>();
+                y.iter_mut().zip(&p).for_each(|(a, b)| *a += alpha * b);
+                r.iter_mut().zip(&ap).for_each(|(a, b)| *a -= alpha * b);
+                let rn: f64 = r.iter().map(|v| v * v).sum();
+                if rn < 1e-28 {
+                    break;
+                }
+                p = r.iter().zip(&p).map(|(a, b)| a + rn / rr * b).collect();
+                rr = rn;
+            }
+            let delta = dt(&y);
+            let chk = dd(&delta);
+            let err: f64 = chk
+                .iter()
+                .zip(&c)
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum::<f64>()
+                .sqrt();
+            let cn: f64 = c.iter().map(|v| v * v).sum::<f64>().sqrt();
+            eprintln!("  CG: |Dδ − c| {err:.2e}, |c| {cn:.3}, faces {}", c.len());
+            let lb: f64 = delta.iter().map(|v| v * v).sum::<f64>();
+            let signed: [f64; 3] = [0, 1, 2].map(|k| {
+                curl1
+                    .iter()
+                    .enumerate()
+                    .filter(|(f, _)| rep.face_class[*f] as usize == k)
+                    .map(|(_, c)| c)
+                    .sum()
+            });
+            let ne = (0..ec.len()).filter(|&e| keep_e(e)).count();
+            eprintln!("  only_edit {only_edit}: curl-forced lower bound RMS {:.3}; Σcurl ω¹ edit {:.3} interface {:.3}", (lb / ne as f64).sqrt(), signed[1], signed[2]);
+        }
+        // |ω| per edge in edit region (resolution)
+        let om: Vec<f64> = (0..ec.len())
+            .filter(|&e| ec[e] != FaceClass::Fixed)
+            .map(|e| k1.omega()[e].abs())
+            .collect();
+        eprintln!(
+            "  max |ω| {:.2}, mean {:.2}",
+            om.iter().cloned().fold(0.0, f64::max),
+            om.iter().sum::<f64>() / om.len() as f64
+        );
+    }
+}
+
+/// Singular faces of `c` (index `round(curl ω_com / 2π)` ≠ 0) among the faces `keep`: `(face,
+/// index)`.
+fn singular_faces(c: &Cwf, keep: &dyn Fn(usize) -> bool) -> Vec<(usize, i64)> {
+    let d = c.decompose_omega();
+    face_curls(c, &d.compatible)
+        .iter()
+        .enumerate()
+        .filter(|&(f, _)| keep(f))
+        .map(|(f, v)| (f, (v / std::f64::consts::TAU).round() as i64))
+        .filter(|&(_, i)| i != 0)
+        .collect()
+}
+
+/// Interface smoothness, C5/C8: on every edit the RMS compatibility residual over edit +
+/// interface edges is ≤ 0.3 rad or within 1.5× the floor that the requested `ω¹` forces on any
+/// phase without singularities (`EditReport::compat_floor`); singularities that appear come in
+/// ± pairs (net index over the edited area unchanged), and the upsampled amplitude |z| vanishes
+/// at each of them.
+fn check_interface(name: &str, k0: &Cwf, k1: &Cwf, rep: &pleat::wrinkle::EditReport) {
+    eprintln!(
+        "{name}: compat RMS {:.3} (edit {:.3}, interface {:.3}), floor {:.3}",
+        rep.compat_rms, rep.compat_rms_by_class[0], rep.compat_rms_by_class[1], rep.compat_floor
+    );
+    assert!(
+        rep.compat_rms <= 0.3f64.max(1.5 * rep.compat_floor),
+        "{name}: RMS {} vs floor {}",
+        rep.compat_rms,
+        rep.compat_floor
+    );
+    let edited = |f: usize| rep.face_class[f] != FaceClass::Fixed;
+    let before = singular_faces(k0, &edited);
+    let after = singular_faces(k1, &edited);
+    let net = |s: &[(usize, i64)]| s.iter().map(|p| p.1).sum::<i64>();
+    assert_eq!(net(&after), net(&before), "{name}: net index {after:?}");
+    // the upsampled |z| = a|z̃| goes to 0 inside (near) every singular face
+    let (ev, _) = k1
+        .evaluate(
+            3,
+            &EvalOptions {
+                displacement_scale: 0.0,
+                want_z: true,
+                ..EvalOptions::default()
+            },
+        )
+        .unwrap();
+    let z = ev.z.as_ref().unwrap();
+    let p = ev.mesh.positions();
+    let amax = k1.amplitude().iter().cloned().fold(0.0, f64::max);
+    let x = k1.base().positions();
+    for &(f, idx) in &after {
+        let t = k1.base().triangles()[f];
+        let c: [f64; 3] =
+            std::array::from_fn(|i| t.iter().map(|&v| x[v as usize][i]).sum::<f64>() / 3.0);
+        let r = t
+            .iter()
+            .map(|&v| dot(edge_vec_p(x[v as usize], c), edge_vec_p(x[v as usize], c)).sqrt())
+            .fold(0.0, f64::max);
+        let near = (0..p.len())
+            .filter(|&i| dot(edge_vec_p(p[i], c), edge_vec_p(p[i], c)).sqrt() <= 1.5 * r)
+            .map(|i| z[i].abs())
+            .fold(f64::INFINITY, f64::min);
+        eprintln!(
+            "  singular face {f} index {idx}: min |z| nearby {:.3} max a",
+            near / amax
+        );
+        assert!(
+            near <= 0.1 * amax,
+            "{name}: face {f}: |z| {near} near a singularity"
+        );
+    }
+}
+
+fn edge_vec_p(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [b[0] - a[0], b[1] - a[1], b[2] - a[2]]
+}
+
+#[test]
+fn corpus_interfaces_are_smooth_and_singularities_pair() {
+    for (name, file, k, regions, reference) in corpus_edits() {
+        let Some(mesh) = corpus_mesh(file) else {
+            return;
+        };
+        let opts = if reference {
+            EditOptions::reference()
+        } else {
+            EditOptions::default()
+        };
+        let (k0, k1, rep) = run_corpus_edit(&mesh, k, &regions, &opts);
+        check_interface(name, &k0, &k1, &rep);
+        // with 5 interface rings (about half a wavelength of these waves) the issue's 0.3 rad
+        // holds over edit + interface edges on spot and fertility (the torus's curl floor is
+        // 0.28 there, its RMS 0.34)
+        let wide: Vec<_> = regions
+            .iter()
+            .map(|r| (r.0, r.1, 5, r.3, r.4, r.5))
+            .collect();
+        let (k0, k1, rep) = run_corpus_edit(&mesh, k, &wide, &opts);
+        check_interface(&format!("{name}, 5 interface rings"), &k0, &k1, &rep);
+        if !file.contains("torus") {
+            assert!(rep.compat_rms <= 0.3, "{name}: {}", rep.compat_rms);
+        }
+    }
+}
+
+#[test]
+fn curved_generated_interfaces_are_smooth_and_singularities_pair() {
+    let m = wrinkle_common::torus(48, 24, 3);
+    for (theta, sigma) in [(FRAC_PI_2, 1.0), (0.0, 3.0), (FRAC_PI_4, 2.0)] {
+        let k0 = exact_plane_wave(m.clone(), [9.0, 0.0, 0.0], 0.01);
+        let mut r = RegionEdit::new(grow_faces(&m, &[], &[300], 5, Adjacency::Vertex).unwrap());
+        r.rotate = theta;
+        r.frequency_scale = sigma;
+        let (k1, rep) = edit(&k0, &[r.coupled()], &EditOptions::default()).unwrap();
+        check_interface(&format!("torus θ {theta} σ {sigma}"), &k0, &k1, &rep);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// issue 14 "Bad input": each a clear status (exit 2 + message), nothing written — from the CLI
+
+/// Runs the `pleat` binary; returns (exit code, stderr).
+fn pleat_cli(args: &[&str]) -> (Option<i32>, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pleat"))
+        .args(args)
+        .output()
+        .expect("run pleat");
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// `m` as OBJ text.
+fn obj_text(m: &TriMesh) -> String {
+    let mut s = String::new();
+    for p in m.positions() {
+        s += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for t in m.triangles() {
+        s += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    s
+}
+
+#[test]
+fn cli_bad_input_is_refused_and_writes_nothing() {
+    let dir = std::env::temp_dir().join(format!("pleat-edit14-bad-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_owned();
+    let base = dir.join("grid.obj");
+    let m = irregular_grid(12, 0.2, 1);
+    std::fs::write(&base, obj_text(&m)).unwrap();
+    let a = dir.join("a.cwf");
+    let (code, err) = pleat_cli(&[
+        "wrinkle",
+        "plane-wave",
+        &s(&base),
+        "--k",
+        "25,0,0",
+        "-o",
+        &s(&a),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let centre = nearest(&m, [0.5, 0.5]).to_string();
+    let out = dir.join("out.cwf");
+    let edit_case = |region: &str| {
+        pleat_cli(&[
+            "wrinkle",
+            "edit",
+            &s(&base),
+            "--cwf",
+            &s(&a),
+            "--region",
+            region,
+            "-o",
+            &s(&out),
+        ])
+    };
+    let v = format!("vertex={centre},rings=2,interface=2");
+    let cases: Vec<(String, &str)> = vec![
+        (format!("{v},rotate=nan"), "rotation"),
+        (format!("{v},scale=0"), "frequency scale"),
+        (format!("{v},scale=-2"), "frequency scale"),
+        (format!("{v},amplitude=-1"), "amplitude scale"),
+        (format!("{v},scale=nan"), "frequency scale"),
+        ("vertex=99999,rings=2".to_string(), "99999"),
+        ("rings=2".to_string(), "no seed"),
+        (format!("vertex={centre},rings=0"), "rings = 0"),
+        (format!("vertex={centre},rings=3,interface=0"), "too thin"),
+    ];
+    for (region, want) in &cases {
+        let (code, err) = edit_case(region);
+        assert_eq!(code, Some(2), "{region}: {err}");
+        assert!(err.contains(want), "{region}: {err}");
+        assert!(!out.exists(), "{region}: output written");
+    }
+    // two overlapping regions
+    let (code, err) = pleat_cli(&[
+        "wrinkle",
+        "edit",
+        &s(&base),
+        "--cwf",
+        &s(&a),
+        "--region",
+        &v,
+        "--region",
+        &v,
+        "-o",
+        &s(&out),
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("overlap"), "{err}");
+    assert!(!out.exists());
+    // design: NaN wave vector, negative amplitude, zero rings, out-of-range vertex
+    for (src, want) in [
+        (format!("{centre},nan,0,0,0.01,3"), "source 0"),
+        (format!("{centre},5,0,0,-0.01,3"), "source 0"),
+        (format!("{centre},5,0,0,0.01,0"), "source 0"),
+        ("99999,5,0,0,0.01,3".to_string(), "99999"),
+    ] {
+        let (code, err) = pleat_cli(&[
+            "wrinkle",
+            "design",
+            &s(&base),
+            "--source",
+            &src,
+            "-o",
+            &s(&out),
+        ]);
+        assert_eq!(code, Some(2), "{src}: {err}");
+        assert!(err.contains(want), "{src}: {err}");
+        assert!(!out.exists(), "{src}: output written");
+    }
+    // a base that is not an oriented manifold: three triangles on one edge
+    let bad = dir.join("fin.obj");
+    std::fs::write(
+        &bad,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n",
+    )
+    .unwrap();
+    let (code, err) = pleat_cli(&[
+        "wrinkle",
+        "design",
+        &s(&bad),
+        "--source",
+        "0,5,0,0,0.01,1",
+        "-o",
+        &s(&out),
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("manifold"), "{err}");
+    assert!(!out.exists());
+    let (code, err) = pleat_cli(&[
+        "wrinkle",
+        "edit",
+        &s(&bad),
+        "--cwf",
+        &s(&a),
+        "--region",
+        "vertex=0,rings=1,interface=1,rotate=90",
+        "-o",
+        &s(&out),
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(!err.is_empty());
+    assert!(!out.exists());
+    // a region covering the whole mesh is a global edit: plain Knöppel phase, said so
+    let (code, err) = edit_case(&format!("vertex={centre},rings=40,interface=0,rotate=90"));
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("global edit: Knöppel"), "{err}");
+    assert!(out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// ---------------------------------------------------------------------------------------------
+// issue part 4 / C10: edit → interpolate → evaluate → rendered frames (README pictures)
+
+/// A shaded surface for the project's rasterizer: smooth area-weighted vertex normals.
+#[cfg(feature = "bake")]
+struct Shaded {
+    mesh: TriMesh,
+    normals: Vec<pleat::geom::Vec3>,
+}
+
+#[cfg(feature = "bake")]
+impl Shaded {
+    fn new(mesh: TriMesh) -> Shaded {
+        use pleat::geom::Vec3;
+        let p = mesh.positions();
+        let mut n = vec![Vec3::ZERO; p.len()];
+        for t in mesh.triangles() {
+            let [a, b, c] = t.map(|v| Vec3::from(p[v as usize]));
+            let fnrm = (b - a).cross(c - a);
+            for &v in t {
+                n[v as usize] += fnrm;
+            }
+        }
+        let normals = n
+            .into_iter()
+            .map(|v| pleat::geom::normalized(v).unwrap_or(Vec3::Z))
+            .collect();
+        Shaded { mesh, normals }
+    }
+}
+
+#[cfg(feature = "bake")]
+impl pleat::bake::render::Surface for Shaded {
+    fn positions(&self) -> &[[f64; 3]] {
+        self.mesh.positions()
+    }
+    fn triangles(&self) -> &[[u32; 3]] {
+        self.mesh.triangles()
+    }
+    fn base_color(&self, _: usize, _: [f64; 3]) -> [f64; 3] {
+        [1.0; 3]
+    }
+    fn normal(&self, t: usize, b: [f64; 3]) -> pleat::geom::Vec3 {
+        let tri = self.mesh.triangles()[t];
+        let n: pleat::geom::Vec3 = (0..3).map(|k| self.normals[tri[k] as usize] * b[k]).sum();
+        pleat::geom::normalized(n).unwrap_or(pleat::geom::Vec3::Z)
+    }
+}
+
+/// Vertices at least `rings` vertex rings away from every non-fixed vertex.
+fn far_fixed_vertices(c: &Cwf, face_class: &[FaceClass], rings: usize) -> Vec<usize> {
+    let n = c.base().vertex_count();
+    let mut dist = vec![usize::MAX; n];
+    let mut front = vec![];
+    for (f, t) in c.base().triangles().iter().enumerate() {
+        if face_class[f] != FaceClass::Fixed {
+            for &v in t {
+                if dist[v as usize] != 0 {
+                    dist[v as usize] = 0;
+                    front.push(v as usize);
+                }
+            }
+        }
+    }
+    let mut nbr = vec![vec![]; n];
+    for &[a, b] in c.edges() {
+        nbr[a as usize].push(b as usize);
+        nbr[b as usize].push(a as usize);
+    }
+    for d in 1..=rings {
+        let mut next = vec![];
+        for &v in &front {
+            for &w in &nbr[v] {
+                if dist[w] == usize::MAX {
+                    dist[w] = d;
+                    next.push(w);
+                }
+            }
+        }
+        front = next;
+    }
+    (0..n).filter(|&v| dist[v] == usize::MAX).collect()
+}
+
+/// The dissertation's three edits (Figs. 3.7, 3.6, 3.19) on corpus meshes: edit → interpolate
+/// (40 guide frames, 41 frames; `GUIDE=n` changes it) → evaluate (3 levels, displacement ×2.5) → one PNG strip of 7 shaded frames per edit under `docs/`,
+/// from one fixed camera facing the edited area. Prints per frame step the RMS change of the
+/// displacement `Re z` (a temporal discontinuity shows as a spike) and, C10, the largest drift
+/// `|z̃(t) − z̃⁰|` over the fixed vertices ≥ 2 rings from the interface (no locality weights).
+/// `cargo test --release --test wrinkle_edit readme_frames -- --ignored --nocapture`
+#[cfg(feature = "bake")]
+#[test]
+#[ignore]
+#[allow(clippy::type_complexity)]
+fn readme_frames() {
+    use pleat::bake::render::{rasterize, shade, Mode, View};
+    use pleat::geom::Vec3;
+    type Reg = (u32, usize, usize, f64, f64, bool);
+    let cases: [(&str, &str, [f64; 3], f64, Vec<Reg>); 3] = [
+        (
+            "wrinkle_edit_rot90",
+            "coarse_spot_1k.obj",
+            [25.0, 0.0, 0.0],
+            0.01,
+            vec![(500, 5, 5, FRAC_PI_2, 1.0, false)],
+        ),
+        (
+            "wrinkle_edit_x3",
+            "coarse_fertility_1500.obj",
+            [0.14, 0.0, 0.0],
+            1.2,
+            vec![(700, 5, 5, 0.0, 3.0, true)],
+        ),
+        (
+            "wrinkle_edit_two",
+            "coarse_spot_1k.obj",
+            [12.0, 0.0, 0.0],
+            0.02,
+            vec![
+                (500, 4, 4, FRAC_PI_2, 1.0, false),
+                (100, 4, 4, 0.0, 2.5, true),
+            ],
+        ),
+    ];
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (name, file, k, amp, regions) in cases {
+        let Some(mesh) = corpus_mesh(file) else {
+            return;
+        };
+        let k0 = exact_plane_wave(mesh.clone(), k, amp);
+        let edits: Vec<RegionEdit> = regions
+            .iter()
+            .map(|&(v, rings, inter, rot, sigma, couple)| {
+                let mut r = RegionEdit::new(
+                    grow_faces(&mesh, &[], &[v], rings, Adjacency::Vertex).unwrap(),
+                );
+                r.interface_rings = inter;
+                r.rotate = rot;
+                r.frequency_scale = sigma;
+                if couple {
+                    r = r.coupled();
+                }
+                r
+            })
+            .collect();
+        let t0 = std::time::Instant::now();
+        let (k1, rep) = edit(&k0, &edits, &EditOptions::default()).unwrap();
+        let t_edit = t0.elapsed().as_secs_f64();
+        let guide = std::env::var("GUIDE").map_or(40, |g| g.parse().unwrap());
+        let iopts = InterpOptions {
+            guide_frames: guide,
+            substeps: 1,
+            ..InterpOptions::default()
+        };
+        let t0 = std::time::Instant::now();
+        let (anim, irep) = interpolate(&k0, &k1, &iopts).unwrap();
+        let t_interp = t0.elapsed().as_secs_f64();
+        eprintln!(
+            "{name}: edit {t_edit:.3} s (compat RMS {:.3}, floor {:.3}), interpolate {t_interp:.2} s ({:?}), {} frames",
+            rep.compat_rms,
+            rep.compat_floor,
+            irep.stop,
+            anim.frame_count()
+        );
+        // C10: drift of the far fixed vertices
+        let far = far_fixed_vertices(&k0, &rep.face_class, 2);
+        let mut drift: f64 = 0.0;
+        for i in 0..anim.frame_count() {
+            let f = anim.frame(i).unwrap();
+            for &v in &far {
+                drift = drift.max((f.zeta()[v] - k0.zeta()[v]).abs());
+            }
+        }
+        eprintln!(
+            "  C10: max |z̃(t) − z̃⁰| over {} fixed vertices ≥ 2 rings from the interface: {drift:.2e}",
+            far.len()
+        );
+        // camera facing the edited area
+        let x = mesh.positions();
+        let active: Vec<usize> = {
+            let mut on = vec![false; x.len()];
+            for (f, t) in mesh.triangles().iter().enumerate() {
+                if rep.face_class[f] != FaceClass::Fixed {
+                    t.iter().for_each(|&v| on[v as usize] = true);
+                }
+            }
+            (0..x.len()).filter(|&v| on[v]).collect()
+        };
+        let c: Vec3 = active.iter().map(|&v| Vec3::from(x[v])).sum::<Vec3>() / active.len() as f64;
+        let mut nrm = Vec3::ZERO;
+        for (f, t) in mesh.triangles().iter().enumerate() {
+            if rep.face_class[f] != FaceClass::Fixed {
+                let [a, b, d] = t.map(|v| Vec3::from(x[v as usize]));
+                nrm += (b - a).cross(d - a);
+            }
+        }
+        let nrm = pleat::geom::normalized(nrm).unwrap();
+        let r = active
+            .iter()
+            .map(|&v| (Vec3::from(x[v]) - c).length())
+            .fold(0.0, f64::max)
+            * 0.8;
+        let side = 240u32;
+        let dist = 4.0 * r;
+        let view = View::look_at(c + nrm * dist, c, f64::from(side) * dist / (2.6 * r), side);
+        let n_tiles = 7;
+        let eopts = EvalOptions {
+            want_z: true,
+            displacement_scale: 2.5,
+            ..EvalOptions::default()
+        };
+        let mut tiles = vec![];
+        let mut last: Option<Vec<f64>> = None;
+        let mut steps = vec![];
+        for i in 0..anim.frame_count() {
+            let f = anim.frame(i).unwrap();
+            let (ev, _) = f.evaluate(3, &eopts).unwrap();
+            let re: Vec<f64> = ev.z.as_ref().unwrap().iter().map(|z| z.re).collect();
+            if let Some(prev) = &last {
+                let d = (re
+                    .iter()
+                    .zip(prev)
+                    .map(|(a, b)| (a - b).powi(2))
+                    .sum::<f64>()
+                    / re.len() as f64)
+                    .sqrt();
+                steps.push(d / amp);
+            }
+            last = Some(re);
+            if i > 0 {
+                let p = anim.frame(i - 1).unwrap();
+                let mut dz = [0.0f64; 3];
+                for (j, c) in rep_vertex_class(&k0, &rep.face_class).iter().enumerate() {
+                    dz[*c as usize] = dz[*c as usize].max((f.zeta()[j] - p.zeta()[j]).abs());
+                }
+                let dw = f
+                    .omega()
+                    .iter()
+                    .zip(p.omega())
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max);
+                eprintln!("    step {i}: max |Δz̃| fixed/edit/interface {dz:.3?}, max |Δω| {dw:.3}");
+            }
+            let tiles_at: Vec<usize> = (0..n_tiles)
+                .map(|j| {
+                    ((j * (anim.frame_count() - 1)) as f64 / (n_tiles - 1) as f64).round() as usize
+                })
+                .collect();
+            if tiles_at.contains(&i) {
+                let s = Shaded::new(ev.mesh);
+                let g = rasterize(&view, s.mesh.positions(), s.mesh.triangles());
+                tiles.push(shade(&g, &view, &s, Mode::Shaded).to_image([255, 255, 255]));
+            }
+        }
+        eprintln!(
+            "  RMS change of Re z per frame step / amplitude: {}",
+            steps
+                .iter()
+                .map(|s| format!("{s:.3}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
+        let sd = side as usize;
+        let w = sd * tiles.len();
+        let mut rgba = vec![255u8; 4 * w * sd];
+        for (c, img) in tiles.iter().enumerate() {
+            for j in 0..sd {
+                let dst = 4 * (j * w + c * sd);
+                rgba[dst..dst + 4 * sd].copy_from_slice(&img.rgba[4 * j * sd..4 * (j + 1) * sd]);
+            }
+        }
+        let img = pleat::bake::Image8 {
+            width: w as u32,
+            height: sd as u32,
+            rgba,
+        };
+        let png = pleat::bake::output::png_bytes(&img).unwrap();
+        std::fs::create_dir_all(root.join("docs")).unwrap();
+        let path = root.join(format!("docs/{name}.png"));
+        std::fs::write(&path, &png).unwrap();
+        eprintln!("  {}: {w}×{sd}, {} bytes", path.display(), png.len());
+    }
+}
+
+/// Per vertex: fixed, edit or interface (edit > fixed > interface), from the face classes.
+fn rep_vertex_class(c: &Cwf, face_class: &[FaceClass]) -> Vec<FaceClass> {
+    let fixed = vertex_fixed(c, face_class);
+    let mut cls: Vec<FaceClass> = fixed
+        .iter()
+        .map(|&f| {
+            if f {
+                FaceClass::Fixed
+            } else {
+                FaceClass::Interface
+            }
+        })
+        .collect();
+    for (f, t) in c.base().triangles().iter().enumerate() {
+        if face_class[f] == FaceClass::Edit {
+            t.iter().for_each(|&v| cls[v as usize] = FaceClass::Edit);
+        }
+    }
+    cls
+}

@@ -306,6 +306,7 @@ pub(super) mod imp {
             eps_amplitude: p.eps_amplitude,
             gamma: p.gamma,
             tolerance: p.tolerance,
+            ..EditOptions::default()
         })
     }
 

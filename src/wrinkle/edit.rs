@@ -101,6 +101,13 @@ pub struct EditOptions {
     pub gamma: f64,
     /// Phase energy; default [`PhaseCoupling::Unit`].
     pub phase: PhaseCoupling,
+    /// Weight of the edit edges' compatibility terms in the phase solve (eq. 3.28) relative to
+    /// the interface edges' (≥ 1). The text asks for `z̃` consistent with `ω¹` on the edit
+    /// edges; a weight above 1 keeps the interface's mismatch (the curl of the blended `ω`) in
+    /// the interface, where singularities can absorb it, instead of spreading it into the
+    /// edited region at the cost of a larger interface residual (measured in the README). Default 1
+    /// (the literal eq. 3.28, as the reference).
+    pub edit_weight: f64,
     /// Inverse-iteration steps of the phase solve; default 200.
     pub max_iterations: usize,
     /// Inverse-iteration tolerance; default 1e-12.
@@ -115,6 +122,7 @@ impl Default for EditOptions {
             eps_amplitude: 1e-3,
             gamma: 1.0,
             phase: PhaseCoupling::Unit,
+            edit_weight: 1.0,
             max_iterations: 200,
             tolerance: 1e-12,
         }
@@ -128,6 +136,7 @@ impl EditOptions {
             adjacency: Adjacency::Edge,
             gamma: 0.25,
             phase: PhaseCoupling::AmplitudeWeighted,
+            edit_weight: 1.0,
             ..EditOptions::default()
         }
     }
@@ -164,6 +173,15 @@ pub struct EditReport {
     pub clamped: usize,
     /// RMS over edit and interface edges of `|wrap(ω¹ − Δarg z̃¹)|` (radians).
     pub compat_rms: f64,
+    /// The same RMS over the edit edges only and over the interface-only edges only.
+    pub compat_rms_by_class: [f64; 2],
+    /// The smallest RMS over edit and interface edges that *any* phase without singularities
+    /// can reach for this `ω¹`: the minimum-norm residual `δ` with `curl δ = curl ω¹` on every
+    /// non-fixed face and `δ = 0` on fixed edges. A phase can only beat it by placing
+    /// singularities (each absorbs 2π of curl). It measures how incompatible the requested
+    /// field is (a rotated wave on a curved patch, the frequency blend of eq. 3.26), not the
+    /// phase solve.
+    pub compat_floor: f64,
     /// Wall seconds: `[labels + ω¹, eq. 3.26, eq. 3.27, eq. 3.28]`.
     pub seconds: [f64; 4],
 }
@@ -228,7 +246,12 @@ pub fn edit(cwf: &Cwf, regions: &[RegionEdit], opts: &EditOptions) -> Result<(Cw
         phase_fallback: phase.fallback,
         global: phase.global,
         clamped,
-        compat_rms: compat_rms(&out, &labels),
+        compat_rms: compat_rms(&out, &labels, &[FaceClass::Edit, FaceClass::Interface]),
+        compat_rms_by_class: [
+            compat_rms(&out, &labels, &[FaceClass::Edit]),
+            compat_rms(&out, &labels, &[FaceClass::Interface]),
+        ],
+        compat_floor: compat_floor(topo, out.omega(), &labels)?,
         seconds: [
             (t1 - t0).as_secs_f64(),
             (t2 - t1).as_secs_f64(),
@@ -268,6 +291,9 @@ fn check_inputs(regions: &[RegionEdit], opts: &EditOptions) -> Result<()> {
         if !(v.is_finite() && v >= 0.0) {
             return crate::invalid_arg!("{name} = {v} must be finite and ≥ 0");
         }
+    }
+    if !(opts.edit_weight.is_finite() && opts.edit_weight >= 1.0) {
+        return crate::invalid_arg!("edit_weight = {} must be finite and ≥ 1", opts.edit_weight);
     }
     if !(opts.tolerance.is_finite() && opts.tolerance > 0.0) {
         return crate::invalid_arg!("tolerance = {} must be finite and > 0", opts.tolerance);
@@ -551,7 +577,11 @@ fn solve_phase(
             PhaseCoupling::Unit => (1.0, 1.0),
             PhaseCoupling::AmplitudeWeighted => (amp[l], amp[k]),
         };
-        let w = edge_area[e];
+        let w = if labels.edge[e] == FaceClass::Edit {
+            edge_area[e] * opts.edit_weight
+        } else {
+            edge_area[e]
+        };
         let tr = Complex::cis(omega[e]);
         // energy w|α_k t x_k − α_l x_l|²: H_kk = wα_k², H_ll = wα_l², H_lk = −wα_kα_l t
         let h_kk = w * ak * ak;
@@ -748,12 +778,12 @@ fn index_of_not(class: &[FaceClass], not: FaceClass) -> (Vec<u32>, usize) {
     (idx, n as usize)
 }
 
-/// RMS of `|wrap(ω − Δarg z̃)|` over non-fixed edges with non-zero endpoints.
-fn compat_rms(cwf: &Cwf, labels: &Labels) -> f64 {
+/// RMS of `|wrap(ω − Δarg z̃)|` over the edges of the classes `which` with non-zero endpoints.
+fn compat_rms(cwf: &Cwf, labels: &Labels, which: &[FaceClass]) -> f64 {
     let dec = cwf.decompose_omega();
     let (mut sum, mut n) = (0.0, 0usize);
     for (e, &[k, l]) in cwf.edges().iter().enumerate() {
-        if labels.edge[e] == FaceClass::Fixed {
+        if !which.contains(&labels.edge[e]) {
             continue;
         }
         if cwf.zeta()[k as usize] == Complex::ZERO || cwf.zeta()[l as usize] == Complex::ZERO {
@@ -768,4 +798,56 @@ fn compat_rms(cwf: &Cwf, labels: &Labels) -> f64 {
     } else {
         (sum / n as f64).sqrt()
     }
+}
+
+/// [`EditReport::compat_floor`]: `min ‖δ‖²` over non-fixed edges subject to `D δ = D ω` on the
+/// non-fixed faces (`D` the face curl, fixed edges held at 0), by the normal equations
+/// `D Dᵀ y = D ω`, `δ = Dᵀ y`; returns `‖δ‖ / √(non-fixed edges)`.
+fn compat_floor(topo: &Topology, omega: &[f64], labels: &Labels) -> Result<f64> {
+    let (row, n_rows) = index_of_not(&labels.face, FaceClass::Fixed);
+    let n_edges = labels
+        .edge
+        .iter()
+        .filter(|&&c| c != FaceClass::Fixed)
+        .count();
+    if n_rows == 0 || n_edges == 0 {
+        return Ok(0.0);
+    }
+    let curl = topo.face_curls(omega);
+    // per non-fixed edge: its (row, sign) entries of D
+    let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); topo.n_edges()];
+    for (f, &r) in row.iter().enumerate() {
+        if r == u32::MAX {
+            continue;
+        }
+        for i in 0..3 {
+            let e = topo.face_edges[f][i] as usize;
+            if labels.edge[e] != FaceClass::Fixed {
+                let sign = if topo.edges[e][0] == topo.faces[f][i] {
+                    1.0
+                } else {
+                    -1.0
+                };
+                cols[e].push((r as usize, sign));
+            }
+        }
+    }
+    let mut t = Vec::new();
+    for c in &cols {
+        push_outer_lower(&mut t, c);
+    }
+    // a row of D without a free edge (a face whose edges are all fixed) has curl 0 here
+    for r in 0..n_rows {
+        t.push(Entry::new(r, r, 1e-12));
+    }
+    let rhs: Vec<f64> = (0..topo.n_faces())
+        .filter(|&f| row[f] != u32::MAX)
+        .map(|f| curl[f])
+        .collect();
+    let (y, _) = solve_spd(n_rows, &t, &rhs, "the compatibility floor")?;
+    let norm2: f64 = cols
+        .iter()
+        .map(|c| c.iter().map(|&(r, s)| s * y[r]).sum::<f64>().powi(2))
+        .sum();
+    Ok((norm2 / n_edges as f64).sqrt())
 }

@@ -246,8 +246,9 @@ pub fn run_edit(
         }
     );
     eprintln!(
-        "  compatibility RMS on edit + interface edges {:.3} rad",
-        rep.compat_rms
+        "  compatibility RMS on edit + interface edges {:.3} rad (edit {:.3}, interface {:.3}; \
+         floor without singularities {:.3})",
+        rep.compat_rms, rep.compat_rms_by_class[0], rep.compat_rms_by_class[1], rep.compat_floor
     );
     if let Some(path) = labels {
         let text: String = rep
