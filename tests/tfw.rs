@@ -781,3 +781,187 @@ fn pure_compression_is_reported_out_of_scope_without_panic() {
     );
     assert_eq!(r.energies.membrane, 0.0);
 }
+
+mod wrinkle_energy {
+    use super::*;
+    use pleat::mesh::TriMesh;
+    use pleat::tfw::curvature::tension_curvature;
+    use pleat::tfw::energy::{HessianMode, WfTerms, WrinkleEnergy};
+    use pleat::tfw::wfree::face_strains;
+
+    /// A stretched, compressed and slightly curved small sheet, its energy and a state
+    /// `[a | ω]` with `a > 0`.
+    fn fixture() -> (WrinkleEnergy, Vec<f64>) {
+        let model = small_sheet(5, 4).assemble().unwrap();
+        let x = perturbed(&model, 1.05, 0.95, 2e-3);
+        let pos: Vec<[f64; 3]> = x.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let base = TriMesh::new(pos, model.triangles.clone()).unwrap();
+        let strains = face_strains(&model.rest_forms, &base);
+        let kappa = tension_curvature(&base, &strains);
+        assert!(kappa.iter().any(|k| k.abs() > 1e-3));
+        let lame = model.material.lame();
+        let e = WrinkleEnergy::new(
+            &base,
+            &model.rest_forms,
+            &strains,
+            &kappa,
+            lame,
+            model.material.thickness,
+        );
+        let nv = e.vertex_count();
+        let state: Vec<f64> = (0..e.dimension())
+            .map(|k| {
+                if k < nv {
+                    0.02 * (1.5 + noise(100 + k))
+                } else {
+                    3.0 * noise(100 + k)
+                }
+            })
+            .collect();
+        (e, state)
+    }
+
+    fn check(e: &WrinkleEnergy, x: &[f64], terms: WfTerms, what: &str) {
+        let ev = e.evaluate(x, terms, HessianMode::Exact);
+        assert!(
+            (ev.energy - e.energy(x, terms)).abs() <= 1e-12 * ev.energy.abs(),
+            "{what}: energy paths disagree"
+        );
+        assert!(ev.energy > 0.0, "{what}: zero energy, test is vacuous");
+        let h = dense_hessian(x.len(), &ev.hessian);
+        let gscale = ev.gradient.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let hscale = h.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        let nv = e.vertex_count();
+        for k in 0..x.len() {
+            let step = if k < nv { 1e-6 } else { 1e-5 };
+            let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
+            xp[k] += step;
+            xm[k] -= step;
+            let fd = (e.energy(&xp, terms) - e.energy(&xm, terms)) / (2.0 * step);
+            assert!(
+                (fd - ev.gradient[k]).abs() <= 1e-6 * gscale,
+                "{what}: gradient {k}: fd {fd} vs {}",
+                ev.gradient[k]
+            );
+            let gp = e.evaluate(&xp, terms, HessianMode::Exact).gradient;
+            let gm = e.evaluate(&xm, terms, HessianMode::Exact).gradient;
+            for j in 0..x.len() {
+                let fd = (gp[j] - gm[j]) / (2.0 * step);
+                assert!(
+                    (fd - h[j][k]).abs() <= 1e-6 * hscale,
+                    "{what}: Hessian ({j},{k}): fd {fd} vs {}",
+                    h[j][k]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn every_wrinkle_energy_term_matches_finite_differences() {
+        let (e, x) = fixture();
+        let one = |f: fn(&mut WfTerms)| {
+            let mut t = WfTerms::NONE;
+            f(&mut t);
+            t
+        };
+        check(&e, &x, one(|t| t.stretch1 = true), "W_s1 (2.21)");
+        check(&e, &x, one(|t| t.stretch2 = true), "W_s2 (2.22)");
+        check(&e, &x, one(|t| t.stretch3 = true), "W_s3 (2.23)");
+        check(&e, &x, one(|t| t.stretch4 = true), "W_s4 (2.24)");
+        check(&e, &x, one(|t| t.bend2 = true), "W_b2 (2.26)");
+        let all = e.energy(&x, WfTerms::ALL);
+        let parts: f64 = [
+            one(|t| t.stretch1 = true),
+            one(|t| t.stretch2 = true),
+            one(|t| t.stretch3 = true),
+            one(|t| t.stretch4 = true),
+            one(|t| t.bend2 = true),
+        ]
+        .iter()
+        .map(|&t| e.energy(&x, t))
+        .sum();
+        assert!((all - parts).abs() <= 1e-12 * all);
+    }
+
+    #[test]
+    fn projected_hessian_is_positive_semidefinite_per_face_and_keeps_the_gradient() {
+        let (e, x) = fixture();
+        let ex = e.evaluate(&x, WfTerms::ALL, HessianMode::Exact);
+        let pr = e.evaluate(&x, WfTerms::ALL, HessianMode::ProjectedPerFace);
+        assert_eq!(ex.gradient, pr.gradient);
+        let h = dense_hessian(x.len(), &pr.hessian);
+        // vᵀHv ≥ 0 on a few pseudo-random directions
+        for s in 0..20 {
+            let v: Vec<f64> = (0..x.len()).map(|k| noise(1000 * s + k)).collect();
+            let q: f64 = (0..x.len())
+                .map(|i| v[i] * (0..x.len()).map(|j| h[i][j] * v[j]).sum::<f64>())
+                .sum();
+            assert!(q >= -1e-12 * h.iter().flatten().fold(0.0f64, |m, y| m.max(y.abs())));
+        }
+    }
+
+    /// The spec's uniform-patch optimum (da = 0): `|ω|* = (48β(α+β)/(α+2β)²)^{1/4}
+    /// √(κ(1+λ_t)/h)` and `½[α(λ_t+λ_c+P/2) + 2β(λ_c+P/2)] = −(h²/6)(α+2β)s`, `s = |ω|²`,
+    /// `P = a²s`, reproduced by Newton on `(a, w)` with the code's gradient and Hessian.
+    #[test]
+    fn uniform_patch_closed_form() {
+        let (lt, lc, kappa, h) = (0.02, -0.03, 2.0, 1e-4);
+        let lame = Lame::from_young_poisson(1e6, 0.3);
+        let (al, be) = (lame.alpha, lame.beta);
+        let rest = rest_form([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+        let base = TriMesh::new(
+            vec![
+                [0.0, 0.0, 0.0],
+                [(1.0f64 + lt).sqrt(), 0.0, 0.0],
+                [0.0, (1.0f64 + lc).sqrt(), 0.0],
+            ],
+            vec![[0, 1, 2]],
+        )
+        .unwrap();
+        let strains = face_strains(&[rest], &base);
+        let e = WrinkleEnergy::new(&base, &[rest], &strains, &[kappa], lame, h);
+        // edges (0,1), (0,2), (1,2): ω(0→1) = 0, ω(0→2) = w, ω(1→2) = w
+        let state = |a: f64, w: f64| vec![a, a, a, 0.0, w, w];
+        // chain rule to (a, w): J = [[1,1,1,0,0,0],[0,0,0,0,1,1]]
+        let jac = [
+            [1.0, 1.0, 1.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 0.0, 1.0, 1.0],
+        ];
+        let s_star = (48.0 * kappa * kappa * (1.0 + lt).powi(2) * be * (al + be)).sqrt()
+            / ((al + 2.0 * be) * h);
+        let w_star = s_star.sqrt();
+        // P from the amplitude condition
+        let p_star = 2.0
+            * (-(h * h / 6.0) * (al + 2.0 * be) * s_star * 2.0 - al * (lt + lc) - 2.0 * be * lc)
+            / (al + 2.0 * be);
+        let a_star = (p_star / s_star).sqrt();
+        let (mut a, mut w) = (1.1 * a_star, 0.9 * w_star);
+        for _ in 0..60 {
+            let ev = e.evaluate(&state(a, w), WfTerms::ALL, HessianMode::Exact);
+            let hd = dense_hessian(6, &ev.hessian);
+            let g: [f64; 2] =
+                std::array::from_fn(|r| (0..6).map(|k| jac[r][k] * ev.gradient[k]).sum());
+            let hm: [[f64; 2]; 2] = std::array::from_fn(|r| {
+                std::array::from_fn(|c| {
+                    (0..6)
+                        .map(|i| {
+                            (0..6)
+                                .map(|j| jac[r][i] * hd[i][j] * jac[c][j])
+                                .sum::<f64>()
+                        })
+                        .sum()
+                })
+            });
+            let det = hm[0][0] * hm[1][1] - hm[0][1] * hm[1][0];
+            let da = (hm[1][1] * g[0] - hm[0][1] * g[1]) / det;
+            let dw = (-hm[1][0] * g[0] + hm[0][0] * g[1]) / det;
+            a -= da;
+            w -= dw;
+        }
+        assert!(
+            (w.abs() - w_star).abs() <= 1e-6 * w_star,
+            "|ω| {w} vs {w_star}"
+        );
+        assert!((a - a_star).abs() <= 1e-6 * a_star, "a {a} vs {a_star}");
+    }
+}

@@ -45,7 +45,9 @@
 //!   transport between neighbouring faces is the base embedding).
 
 pub mod base;
+pub mod curvature;
 mod dense;
+pub mod energy;
 pub mod material;
 pub mod scene;
 pub mod wfree;
