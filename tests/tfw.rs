@@ -965,3 +965,60 @@ mod wrinkle_energy {
         assert!((a - a_star).abs() <= 1e-6 * a_star, "a {a} vs {a_star}");
     }
 }
+
+mod wrinkle_sqp {
+    use super::*;
+    use pleat::tfw::{solve, SqpOptions, TfwParams, TfwStatus};
+
+    fn params(max_iterations: usize) -> TfwParams {
+        TfwParams {
+            sqp: SqpOptions {
+                max_iterations,
+                ..SqpOptions::default()
+            },
+            ..TfwParams::default()
+        }
+    }
+
+    #[test]
+    fn sqp_keeps_curl_free_nonnegative_amplitude_and_lowers_the_energy() {
+        let scene = Scene::stretched_sheet(21, 9, 0.1);
+        let r = solve(&scene, &params(40), &mut no_progress()).unwrap();
+        let sqp = r.sqp.as_ref().expect("the sheet has compressed faces");
+        eprintln!(
+            "sheet 21x9: status {:?} / {:?}, {} it, E0 {:.6e} → {:.6e}, r0 {:.3e}, seconds {:?}, qp {:.3}s",
+            r.status,
+            sqp.status,
+            sqp.history.len(),
+            sqp.initial_energy,
+            r.energy,
+            sqp.initial_stationarity,
+            r.seconds,
+            sqp.qp_seconds
+        );
+        for (k, it) in sqp.history.iter().enumerate() {
+            eprintln!(
+                "  {k:3} E {:.9e} r {:.3e} |dx| {:.3e} t {} qp_it {} curl {:.1e} {:.3}s",
+                it.energy,
+                it.stationarity,
+                it.step_norm,
+                it.step_length,
+                it.qp_iterations,
+                it.curl_residual,
+                it.seconds
+            );
+        }
+        assert!(r.init_curl_residual <= 1e-10, "{}", r.init_curl_residual);
+        assert!(!sqp.history.is_empty());
+        let mut prev = sqp.initial_energy;
+        for it in &sqp.history {
+            assert!(it.curl_residual <= 1e-10, "curl {}", it.curl_residual);
+            assert!(it.energy <= prev, "E rose: {prev} → {}", it.energy);
+            prev = it.energy;
+        }
+        assert!(r.cwf.amplitude().iter().all(|&a| a >= 0.0));
+        assert!(r.cwf.amplitude().iter().any(|&a| a > 0.0));
+        assert!(r.energy < sqp.initial_energy);
+        assert_ne!(r.status, TfwStatus::OutOfScope);
+    }
+}

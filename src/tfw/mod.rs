@@ -49,7 +49,9 @@ pub mod curvature;
 mod dense;
 pub mod energy;
 pub mod material;
+pub mod pipeline;
 pub mod scene;
+pub mod sqp;
 pub mod wfree;
 
 pub use base::{
@@ -57,4 +59,6 @@ pub use base::{
     StrainSummary, TermEnergies, Terms,
 };
 pub use material::{Branch, Lame};
+pub use pipeline::{solve, TfwParams, TfwResult, TfwSeconds, TfwStatus};
 pub use scene::{Dirichlet, Material, Model, Motion, Panel, Rotation, Scene};
+pub use sqp::{SqpIteration, SqpOptions, SqpResult, SqpStatus};
