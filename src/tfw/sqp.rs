@@ -21,9 +21,10 @@
 //! `ω ← ω − Cᵀ(CCᵀ)⁻¹Cω` (one sparse Cholesky of `CCᵀ`, factored once). The curl residual after
 //! every step is therefore at rounding level (tested ≤ 1e-10).
 //!
-//! **Scaling:** the QP is solved in variables `y = D⁻¹δ` with `D = diag(H)^{-1/2}` of the first
-//! iteration (fixed afterwards), so amplitudes (≈1e-4 m) and one-form values (≈1 rad) are
-//! comparable. **Termination** (A.6.3): relative stationarity `r ≤ stationarity_tolerance · r₀`,
+//! **Scaling:** the QP is solved in variables `y = D⁻¹δ` with `D = (E₀/diag H)^{1/2}` of the
+//! first iteration (fixed afterwards) and its objective divided by `E₀`, so amplitudes (≈1e-4 m)
+//! and one-form values (≈1 rad) are comparable and the QP data do not depend on Young's
+//! modulus. **Termination** (A.6.3): relative stationarity `r ≤ stationarity_tolerance · r₀`,
 //! relative energy change `|ΔE| ≤ energy_tolerance · |E|`, scaled step `‖D⁻¹Δx‖∞ ≤
 //! step_tolerance`, or the iteration limit. Departure: the text's thresholds are absolute SI
 //! values (1e-6, 1e-10, 1e-10), which depend on the units and on Young's modulus (the spec's
@@ -335,6 +336,9 @@ impl Projector {
 struct QpShape {
     /// `D` per free unknown.
     scale: Vec<f64>,
+    /// The QP objective is divided by this (`E₀`), so the QP data do not depend on the units
+    /// of energy (Young's modulus).
+    energy_scale: f64,
 }
 
 /// Upper-triangular CSC of a symmetric matrix given as lower triplets over `n` unknowns.
@@ -422,11 +426,17 @@ pub fn run_sqp(
         } else {
             pos.iter().sum::<f64>() / pos.len() as f64
         };
+        let energy_scale = if initial_energy > 0.0 && initial_energy.is_finite() {
+            initial_energy
+        } else {
+            1.0
+        };
         QpShape {
             scale: diag
                 .iter()
-                .map(|&d| 1.0 / d.max(1e-8 * mean).sqrt())
+                .map(|&d| (energy_scale / d.max(1e-8 * mean)).sqrt())
                 .collect(),
+            energy_scale,
         }
     };
     let mut shift = options.initial_shift;
@@ -535,10 +545,14 @@ fn solve_qp(
         let (sr, sc) = (p.slot[r], p.slot[c]);
         if sr != usize::MAX && sc != usize::MAX {
             let (a, b) = (sr.max(sc), sr.min(sc));
-            lower.push((a, b, v * d[a] * d[b]));
+            lower.push((a, b, v * d[a] * d[b] / shape.energy_scale));
         }
     }
-    let q: Vec<f64> = g_free.iter().zip(d).map(|(g, s)| g * s).collect();
+    let q: Vec<f64> = g_free
+        .iter()
+        .zip(d)
+        .map(|(g, s)| g * s / shape.energy_scale)
+        .collect();
     // constraints: curl rows (zero cone), then −y_a ≤ a_k / D (nonnegative cone)
     let ncurl = p.curl.len();
     let na = p.n_free_a;
@@ -586,6 +600,7 @@ fn solve_qp(
         if let Some((y, z, iters)) = ok {
             let delta: Vec<f64> = y.iter().zip(d).map(|(v, s)| v * s).collect();
             if delta.iter().all(|v| v.is_finite()) {
+                let z = z.iter().map(|v| v * shape.energy_scale).collect();
                 return Some((delta, z, iters));
             }
         }
