@@ -1196,3 +1196,125 @@ mod stretched_sheet_check {
         }
     }
 }
+
+mod twisted_cylinder_check {
+    use super::*;
+    use pleat::tfw::{solve, SqpOptions, TfwParams};
+    use pleat::wrinkle::EvalOptions;
+
+    /// Issue 13's twisted cylinder (r 1 m, height 5 m, h 0.1 mm, ν 0.44, Y 10 MPa, 10°, 688
+    /// vertices): expected 46 ± 5 waves around the mid-height ring. Counter: sign changes of
+    /// `Re z` where the evaluated mesh (2 levels) crosses the plane z = 2.5, sorted by angle.
+    /// Report only (ignored, slow): `cargo test --test tfw twisted_cylinder_waves -- --ignored
+    /// --nocapture`.
+    #[test]
+    #[ignore]
+    fn twisted_cylinder_waves() {
+        let scene = Scene::twisted_cylinder(43, 16, 10.0);
+        let params = TfwParams {
+            sqp: SqpOptions {
+                max_iterations: 300,
+                ..SqpOptions::default()
+            },
+            ..TfwParams::default()
+        };
+        let r = solve(&scene, &params, &mut no_progress()).unwrap();
+        let sqp = r.sqp.as_ref().unwrap();
+        let opts = EvalOptions {
+            want_z: true,
+            ..EvalOptions::default()
+        };
+        let (ev, _) = r.cwf.evaluate(2, &opts).unwrap();
+        let z = ev.z.as_ref().unwrap();
+        let x = ev.smooth_positions.as_ref().unwrap();
+        let mut pts: Vec<(f64, f64)> = Vec::new();
+        for t in ev.mesh.triangles() {
+            for k in 0..3 {
+                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                let (ha, hb) = (x[a][2] - 2.5, x[b][2] - 2.5);
+                if (ha < 0.0) != (hb < 0.0) {
+                    let s = ha / (ha - hb);
+                    let px = x[a][0] + s * (x[b][0] - x[a][0]);
+                    let py = x[a][1] + s * (x[b][1] - x[a][1]);
+                    pts.push((py.atan2(px), z[a].re + s * (z[b].re - z[a].re)));
+                }
+            }
+        }
+        pts.sort_by(|p, q| p.0.total_cmp(&q.0));
+        let peak = pts.iter().fold(0.0f64, |m, p| m.max(p.1.abs()));
+        let signs: Vec<bool> = pts
+            .iter()
+            .filter(|p| p.1.abs() >= 0.01 * peak)
+            .map(|p| p.1 > 0.0)
+            .collect();
+        let mut crossings = signs.windows(2).filter(|w| w[0] != w[1]).count();
+        if signs.len() > 1 && signs[0] != signs[signs.len() - 1] {
+            crossings += 1; // closing the ring
+        }
+        let max_a = r.cwf.amplitude().iter().fold(0.0f64, |m, &a| m.max(a));
+        eprintln!(
+            "cylinder 688 v: {:?} / {:?} in {} it, base {:.2}s, sqp {:.2}s (qp {:.2}s); \
+             waves around the mid ring {}, max a {:.3} mm, {} of {} faces in W, \
+             |κ| mean {:.3}",
+            r.status,
+            sqp.status,
+            sqp.history.len(),
+            r.seconds.base,
+            r.seconds.sqp,
+            sqp.qp_seconds,
+            crossings as f64 / 2.0,
+            max_a * 1e3,
+            r.w_faces.iter().filter(|&&w| w).count(),
+            r.w_faces.len(),
+            r.curvature.iter().map(|k| k.abs()).sum::<f64>() / r.curvature.len() as f64
+        );
+    }
+}
+
+mod curvature_check {
+    use super::*;
+    use pleat::mesh::TriMesh;
+    use pleat::tfw::curvature::tension_curvature;
+    use pleat::tfw::wfree::{face_strains, FaceStrain};
+
+    /// On the untwisted cylinder (r = 1), the normal curvature along the circumferential
+    /// direction is 1/r and along the axis 0 (Euler's formula in between).
+    #[test]
+    fn curvature_of_a_cylinder_by_direction() {
+        let model = Scene::twisted_cylinder(43, 16, 0.0).assemble().unwrap();
+        let base = TriMesh::new(model.positions.clone(), model.triangles.clone()).unwrap();
+        let strains = face_strains(&model.rest_forms, &base);
+        // rest frame: u around (arc length), v along the axis; direction (cos θ, sin θ) in the
+        // rest plane → barycentric coordinates through the rest corners
+        for theta_deg in [0.0f64, 45.0, 90.0] {
+            let th = theta_deg.to_radians();
+            let s: Vec<FaceStrain> = model
+                .rest_corners
+                .iter()
+                .zip(&strains)
+                .map(|(c, st)| {
+                    let e1 = [c[1][0] - c[0][0], c[1][1] - c[0][1]];
+                    let e2 = [c[2][0] - c[0][0], c[2][1] - c[0][1]];
+                    let d = [th.cos(), th.sin()];
+                    let det = e1[0] * e2[1] - e1[1] * e2[0];
+                    let t = [
+                        (d[0] * e2[1] - d[1] * e2[0]) / det,
+                        (e1[0] * d[1] - e1[1] * d[0]) / det,
+                    ];
+                    FaceStrain {
+                        tension_dir: t,
+                        ..*st
+                    }
+                })
+                .collect();
+            let k = tension_curvature(&base, &s);
+            let mean = k.iter().map(|x| x.abs()).sum::<f64>() / k.len() as f64;
+            let want = th.cos().powi(2);
+            eprintln!("θ {theta_deg}: mean |κ| {mean} (want {want})");
+            assert!(
+                (mean - want).abs() < 0.05,
+                "θ {theta_deg}: {mean} vs {want}"
+            );
+        }
+    }
+}
