@@ -31,6 +31,10 @@ mod bake_cmd;
 #[path = "pleat/batch.rs"]
 mod batch;
 
+#[cfg(feature = "tfw")]
+#[path = "pleat/tfw.rs"]
+mod tfw_cmd;
+
 #[derive(Parser)]
 #[command(
     name = "pleat",
@@ -105,6 +109,9 @@ enum Command {
     /// Complex wrinkle fields: build (.cwf files) and evaluate wrinkled meshes.
     #[command(subcommand)]
     Wrinkle(WrinkleCommand),
+    /// Wrinkles from physics (tension-field statics): a scene file in, the wrinkled mesh out.
+    #[cfg(feature = "tfw")]
+    Tfw(tfw_cmd::TfwArgs),
     /// Benchmarks that write CSV tables and SVG plots.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -377,6 +384,8 @@ fn main() -> ExitCode {
             bake: b,
         } => batch::dispatch(&inputs, &batch_args, &b, true),
         Command::Wrinkle(cmd) => wrinkle_cmd::run(cmd),
+        #[cfg(feature = "tfw")]
+        Command::Tfw(args) => tfw_cmd::run(&args),
         Command::Bench(cmd) => bench(cmd),
     }
 }
@@ -391,7 +400,7 @@ fn bench(cmd: BenchCommand) -> ExitCode {
 }
 
 /// Exit code for a failed operation.
-#[cfg(feature = "lod")]
+#[cfg(any(feature = "lod", feature = "tfw"))]
 const EXIT_FAILED: u8 = 1;
 
 /// Placeholders of the output path replaced by the screen size: `{n}` (the and the
@@ -401,7 +410,7 @@ const SIZE_PLACEHOLDERS: [&str; 2] = ["{n}", "{np}"];
 
 /// The exit code of a failed bake: `EXIT_INPUT` when the caller's arguments or input are
 /// at fault (`InvalidArgument`), `EXIT_FAILED` otherwise.
-#[cfg(feature = "lod")]
+#[cfg(any(feature = "lod", feature = "tfw"))]
 fn failure_code(e: &pleat::Error) -> u8 {
     match e {
         pleat::Error::InvalidArgument(_) => EXIT_INPUT,
@@ -541,7 +550,7 @@ fn parse_clearance(s: &str) -> Result<pleat::lowpoly::Clearance, String> {
 }
 
 /// An indicatif bar on a terminal (stderr), nothing otherwise.
-#[cfg(feature = "lod")]
+#[cfg(any(feature = "lod", feature = "tfw"))]
 fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
     use std::io::IsTerminal;
     if quiet || !std::io::stderr().is_terminal() {

@@ -1186,6 +1186,7 @@ pub(super) mod imp {
             want_z: f & (PLEAT_WRINKLE_FIELD_Z | PLEAT_WRINKLE_FIELD_SMOOTH_POSITIONS) != 0,
             want_omega: f & PLEAT_WRINKLE_FIELD_OMEGA != 0,
             max_output_faces: usize::try_from(p.max_output_triangles).unwrap_or(usize::MAX),
+            in_plane_v2: false,
         })
     }
 

@@ -19,10 +19,17 @@
 //!   combing, vertex amplitudes, Helmholtz projection to a one-form on pleat's edges that is
 //!   curl-free on every non-W face).
 //!
-//! **Not implemented yet** (spec steps 3–8): irregular Delaunay meshing of panels (spade),
-//! obstacles, the wrinkle energy
-//! E^wf and its SQP (clarabel), curvature by quadric fitting, the `Cwf` output with the `v2`
-//! evaluation term, the C API, the CLI and benchmarks.
+//! - [`curvature`]: the normal curvature `κ_f` along each face's tension direction (eq. 2.22).
+//! - [`energy`]: the wrinkle energy `E^wf` (2.20–2.27, 3-point rule of A.7) on vertex
+//!   amplitudes and the edge one-form, with its exact gradient and sparse Hessian.
+//! - [`sqp`]: the wrinkle SQP of A.6.3 (clarabel QP per iteration, `a ≥ 0`, `curl ω = 0` off W,
+//!   convexified Hessian, Armijo line search, termination tests, per-iteration history).
+//! - [`pipeline`]: [`solve`] — scene → base → W, init → SQP → [`crate::wrinkle::Cwf`] (Knöppel
+//!   phase), with a report; the wrinkled mesh comes from [`crate::wrinkle::Cwf::evaluate`]
+//!   with [`crate::wrinkle::EvalOptions::in_plane_v2`] (the v2 term of eq. 2.19).
+//!
+//! **Not implemented yet**: irregular Delaunay meshing of panels (spade), obstacles, curvature
+//! by quadric fitting, period snapping on non-contractible loops, the C API and benchmarks.
 //!
 //! **Departures from the spec, and why:**
 //! - Built-in scenes use structured grids with alternating diagonals and jittered interior
@@ -43,11 +50,21 @@
 //!   an absolute 1e-8, so it does not depend on units.
 //! - Sign combing compares the faces' wave vectors embedded in 3D on the base surface (the
 //!   transport between neighbouring faces is the base embedding).
+//! - `κ_f` from vertex normals instead of quadric fitting ([`curvature`]).
+//! - SQP: the per-face PSD projection is applied to each face's whole 5×5 block (all terms
+//!   together: closer to the true Hessian than projecting stretching and bending separately);
+//!   no switch to the true Hessian near the optimum; candidates are made exactly feasible
+//!   after the QP (curl ≤ rounding); the QP is nondimensionalized and the stop tests are
+//!   relative, so Young's modulus does not change the iterates ([`sqp`]).
 
 pub mod base;
+pub mod curvature;
 mod dense;
+pub mod energy;
 pub mod material;
+pub mod pipeline;
 pub mod scene;
+pub mod sqp;
 pub mod wfree;
 
 pub use base::{
@@ -55,4 +72,6 @@ pub use base::{
     StrainSummary, TermEnergies, Terms,
 };
 pub use material::{Branch, Lame};
+pub use pipeline::{solve, TfwParams, TfwResult, TfwSeconds, TfwStatus};
 pub use scene::{Dirichlet, Material, Model, Motion, Panel, Rotation, Scene};
+pub use sqp::{SqpIteration, SqpOptions, SqpResult, SqpStatus};

@@ -55,6 +55,11 @@ pub struct EvalOptions {
     /// Refuse ([`crate::Error::LimitExceeded`]) when the output would have more triangles;
     /// default 64 Mi.
     pub max_output_faces: usize,
+    /// Add the in-plane second-order term of eq. 2.19 (TFW, S:2327):
+    /// `Δx += s² (Re z · Im z / 4) ∇φ` (= `a²/8 sin 2φ ∇φ`), `∇φ` per vertex the mean of the
+    /// corner phase gradients of the finest level's one-form, `s` the displacement scale.
+    /// Default false (outputs unchanged).
+    pub in_plane_v2: bool,
 }
 
 impl Default for EvalOptions {
@@ -68,6 +73,7 @@ impl Default for EvalOptions {
             want_z: false,
             want_omega: false,
             max_output_faces: 1 << 26,
+            in_plane_v2: false,
         }
     }
 }
@@ -138,7 +144,7 @@ impl Cwf {
         let mut faces = self.topo.faces.clone();
         for l in 0..levels {
             let last = l + 1 == levels;
-            let keep_topology = !last || opts.want_omega;
+            let keep_topology = !last || opts.want_omega || opts.in_plane_v2;
             let t0 = std::time::Instant::now();
             let (next, next_faces) = refine_level(
                 &level,
@@ -290,6 +296,11 @@ fn finish(level: Level<'_>, faces: Vec<[u32; 3]>, opts: &EvalOptions) -> Evaluat
         .zip(&normals)
         .map(|((&p, z), &n)| (Vec3::from(p) + Vec3::from(n) * (s * z.re)).to_array())
         .collect();
+    let displaced = if opts.in_plane_v2 && level.omega.len() == level.topo.n_edges() {
+        add_in_plane_v2(&level, &faces, displaced, s)
+    } else {
+        displaced
+    };
     let phase = opts
         .want_phase
         .then(|| level.z.par_iter().map(|z| z.arg()).collect());
@@ -303,6 +314,31 @@ fn finish(level: Level<'_>, faces: Vec<[u32; 3]>, opts: &EvalOptions) -> Evaluat
         z: opts.want_z.then_some(level.z),
         omega: has_omega.then_some(level.omega),
     }
+}
+
+/// Adds the in-plane term of [`EvalOptions::in_plane_v2`] to `displaced`.
+fn add_in_plane_v2(
+    level: &Level<'_>,
+    faces: &[[u32; 3]],
+    mut displaced: Vec<[f64; 3]>,
+    s: f64,
+) -> Vec<[f64; 3]> {
+    let fields = face_gradients(&level.topo, &level.x, &level.omega);
+    let mut sum = vec![Vec3::ZERO; level.x.len()];
+    let mut count = vec![0u32; level.x.len()];
+    for (t, f) in faces.iter().zip(&fields) {
+        for (&v, g) in t.iter().zip(f.corner_gradients()) {
+            sum[v as usize] += g;
+            count[v as usize] += 1;
+        }
+    }
+    for (((d, g), &c), z) in displaced.iter_mut().zip(&sum).zip(&count).zip(&level.z) {
+        if c > 0 {
+            let shift = *g * (s * s * z.re * z.im / (4.0 * f64::from(c)));
+            *d = (Vec3::from(*d) + shift).to_array();
+        }
+    }
+    displaced
 }
 
 /// Unit area-weighted vertex normals (sum of `(x1 − x0) × (x2 − x0)` over incident triangles);

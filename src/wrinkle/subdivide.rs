@@ -468,6 +468,13 @@ pub(crate) struct FaceField {
     g: [Vec3; 3],
 }
 
+impl FaceField {
+    /// The corner tangent vectors `g[c]` (the gradient of the phase at corner `c`).
+    pub(crate) fn corner_gradients(&self) -> [Vec3; 3] {
+        self.g
+    }
+}
+
 /// Solves `g·e1 = r1, g·e2 = r2` for `g = x e1 + y e2` (eq. B.52); `None` when the Gram
 /// matrix is numerically singular.
 fn corner_gradient(e1: Vec3, e2: Vec3, r1: f64, r2: f64) -> Option<Vec3> {

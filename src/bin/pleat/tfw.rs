@@ -1,0 +1,133 @@
+//! `pleat tfw SCENE.json -o OUT.obj [--cwf OUT.cwf] [--base BASE.obj] [--levels 3]`: wrinkles
+//! from physics (feature `tfw`): base surface, wrinkle SQP, and the wrinkled mesh through the
+//! existing evaluation with the in-plane v2 term. A thin layer over `pleat::tfw::solve`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use pleat::mesh::io::write_mesh;
+use pleat::tfw::{solve, Scene, TfwParams, TfwResult};
+use pleat::wrinkle::{write_cwf, EvalOptions};
+
+use super::{failure_code, progress_bar, show_progress, EXIT_FAILED, EXIT_INPUT};
+
+/// Arguments of `pleat tfw`.
+#[derive(clap::Args)]
+pub struct TfwArgs {
+    /// The scene file (JSON; see the README "Tension-field wrinkles" section).
+    pub scene: PathBuf,
+    /// The wrinkled mesh (obj, ply, off, stl, glb, gltf).
+    #[arg(short = 'o', long = "output")]
+    pub out: PathBuf,
+    /// Also write the complex wrinkle field on the base mesh (.cwf).
+    #[arg(long)]
+    pub cwf: Option<PathBuf>,
+    /// Also write the base surface (the tension-field relaxed membrane).
+    #[arg(long)]
+    pub base: Option<PathBuf>,
+    /// Loop subdivision levels of the evaluation.
+    #[arg(long, default_value_t = 3)]
+    pub levels: usize,
+    /// Leave out the in-plane v2 term of eq. 2.19.
+    #[arg(long)]
+    pub no_v2: bool,
+    /// SQP iteration limit.
+    #[arg(long, default_value_t = 1000)]
+    pub max_iterations: usize,
+    /// No progress bar.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+}
+
+/// Runs `pleat tfw`.
+pub fn run(args: &TfwArgs) -> ExitCode {
+    let scene = match Scene::from_json_file(&args.scene) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("pleat tfw: {}: {e}", args.scene.display());
+            return ExitCode::from(EXIT_INPUT);
+        }
+    };
+    if args.levels > 8 {
+        eprintln!("pleat tfw: --levels must be at most 8, got {}", args.levels);
+        return ExitCode::from(EXIT_INPUT);
+    }
+    let mut params = TfwParams::default();
+    params.sqp.max_iterations = args.max_iterations;
+    let bar = progress_bar(args.quiet);
+    let result = solve(&scene, &params, &mut |p| show_progress(&bar, p));
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let r = match result {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("pleat tfw: {e}");
+            return ExitCode::from(failure_code(&e));
+        }
+    };
+    print_summary(&r);
+    match write_outputs(args, &r) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("pleat tfw: {e}");
+            ExitCode::from(EXIT_FAILED)
+        }
+    }
+}
+
+fn write_outputs(args: &TfwArgs, r: &TfwResult) -> pleat::Result<()> {
+    if let Some(p) = &args.base {
+        write_mesh(p, &r.base.mesh)?;
+    }
+    if let Some(p) = &args.cwf {
+        write_cwf(p, &r.cwf)?;
+    }
+    let opts = EvalOptions {
+        in_plane_v2: !args.no_v2,
+        ..EvalOptions::default()
+    };
+    let (ev, _) = r.cwf.evaluate(args.levels, &opts)?;
+    write_mesh(&args.out, &ev.mesh)
+}
+
+fn print_summary(r: &TfwResult) {
+    println!("status        {:?}: {}", r.status, r.status.describe());
+    println!(
+        "base          {:?} in {} Newton iterations, {:.3} s",
+        r.base.status,
+        r.base.history.len(),
+        r.seconds.base
+    );
+    for w in &r.base.warnings {
+        println!("  warning     {w}");
+    }
+    let nw = r.w_faces.iter().filter(|&&w| w).count();
+    println!("W faces       {nw} of {}", r.w_faces.len());
+    if let Some(s) = &r.sqp {
+        let last_r = s
+            .history
+            .last()
+            .map_or(s.initial_stationarity, |i| i.stationarity);
+        println!(
+            "SQP           {:?} in {} iterations, {:.3} s ({:.3} s in QPs)",
+            s.status,
+            s.history.len(),
+            r.seconds.sqp,
+            s.qp_seconds
+        );
+        println!(
+            "energy        {:.6e} J → {:.6e} J; stationarity {:.3e} → {:.3e}",
+            s.initial_energy, r.energy, s.initial_stationarity, last_r
+        );
+    }
+    let max_a = r.cwf.amplitude().iter().fold(0.0f64, |m, &a| m.max(a));
+    println!(
+        "peak a        {max_a:.6e} m; curl residual {:.1e}",
+        r.curl_residual
+    );
+    println!(
+        "seconds       init {:.3}, phase {:.3}",
+        r.seconds.init, r.seconds.phase
+    );
+}
