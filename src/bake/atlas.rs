@@ -274,7 +274,7 @@ fn pack(atlas: &ffi::Handle, side: u32, padding: u32, texels_per_unit: f32) -> R
         attempts: 4096,
         texels_per_unit,
         resolution: side,
-        max_chart_size: side,
+        max_chart_size: max_chart_size(side, padding),
         block_align: false,
         conservative: padding > 0,
         padding,
@@ -291,6 +291,21 @@ fn pack(atlas: &ffi::Handle, side: u32, padding: u32, texels_per_unit: f32) -> R
     let out = unsafe { copy_output(raw, side) }?;
     out.map(Packed::One)
         .ok_or_else(|| Error::Internal("xatlas returned no atlas".into()))
+}
+
+/// The `maxChartSize` that keeps every chart inside a `side`² atlas. xatlas (this version)
+/// scales a chart whose extent exceeds `maxChartSize` down to just below it, rounds its extent
+/// `e` up to whole texels `w = ⌈e⌉ ≤ maxChartSize`, reserves a bit image of `w + 1 + padding`
+/// texels for it (conservative rasterisation: half a texel each side plus the gutter) and
+/// places it at `x ≤ side − (w + 1 + padding)` with UVs `x + t + 0.5`, `t ≤ e < w`. When the
+/// bit image is wider than the atlas no place exists, and xatlas puts the chart at the origin
+/// of an atlas anyway: its UVs reach `w + 0.5 > side` (the "half a texel outside" the check
+/// in [`check_atlas`] rejected, on a long chart of a COLOR_0-only teapot). With
+/// `maxChartSize = side − padding − 1` the bit image fits (`w + 1 + padding ≤ side`) and every
+/// UV is below `side − padding − 0.5`. A chart that large is baked at a lower density than the
+/// others rather than failing the bake.
+fn max_chart_size(side: u32, padding: u32) -> u32 {
+    side.saturating_sub(padding + 1).max(1)
 }
 
 /// Summed utilisation of all atlases of a packing over that of the first; infinite when
@@ -631,6 +646,39 @@ mod tests {
         assert!(pack_density(area, 2 * n, side, p) < d);
         assert!(pack_density(area, n, side, 2 * p) < d);
         assert!(pack_density(area, 1_000_000, 64, 8) > 0.0);
+    }
+
+    /// A planar strip 40 times longer than wide is one chart whose extent at the planned
+    /// density is several atlas sides: xatlas shrinks it to `maxChartSize`, and with the bound
+    /// of [`max_chart_size`] every UV lands inside the atlas (before: up to `side + 0.5`,
+    /// an `Internal` error).
+    #[test]
+    fn a_chart_longer_than_the_atlas_stays_inside_it() {
+        let (n, len) = (4u32, 40.0);
+        let mut p = Vec::new();
+        for i in 0..=10 * n {
+            for j in 0..=n {
+                let x = len * f64::from(i) / f64::from(10 * n);
+                p.push([x, f64::from(j) / f64::from(n), 0.0]);
+            }
+        }
+        let mut t = Vec::new();
+        let id = |i: u32, j: u32| i * (n + 1) + j;
+        for i in 0..10 * n {
+            for j in 0..n {
+                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let strip = TriMesh::new(p, t).unwrap();
+        for (side, padding) in [(64u32, 4u32), (128, 12), (32, 0)] {
+            let a = build_atlas(&strip, side, padding).unwrap();
+            let hi = a.uv.iter().flatten().fold(0.0f32, |m, &c| m.max(c));
+            assert!(hi <= (side - padding) as f32 - 0.5, "{side}/{padding}: UV {hi}");
+            assert_eq!(a.overlapping_texels, 0);
+        }
+        assert_eq!(max_chart_size(64, 4), 59);
+        assert_eq!(max_chart_size(4, 8), 1);
     }
 
     /// A retry plans the spilled charts into `RETRY_FILL` of one atlas, lowers the density by
