@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use pleat::bake::appearance::{linear_to_srgb, srgb_to_linear, Wrap};
 use pleat::bake::{
     bake_chain, chain_glb, read_appearance, read_appearance_bytes, Appearance, BakeParams,
-    BakedLevel, InputIndex,
+    BakedLevel, InputIndex, VertexColors,
 };
 use pleat::geom::Vec3;
 use pleat::lowpoly::LodParams;
@@ -497,17 +497,52 @@ fn untextured_input_gives_vertex_colours() {
             .map(|c| [c[0], c[1], c[2], 1.0])
             .collect(),
     );
-    let levels = bake_chain(
-        &app,
-        &[25.0],
-        &LodParams::default(),
-        &BakeParams::default(),
-        &mut |_| true,
-    )
-    .unwrap()
-    .levels;
-    let b = &levels[0].baked;
+    let with = |vertex_colors: VertexColors| {
+        let params = BakeParams {
+            vertex_colors,
+            ..BakeParams::default()
+        };
+        let chain = bake_chain(&app, &[25.0], &LodParams::default(), &params, &mut |_| true);
+        chain.unwrap().levels.remove(0).baked
+    };
+    // Forced texture: no COLOR_0 on the output (glTF would multiply it in), a base-colour
+    // texture that follows the field far better than 25-pixel vertex colours can.
+    let tex = with(VertexColors::Texture);
+    assert!(tex.colors.is_none() && tex.uvs.is_some() && tex.material.base_color.is_some());
+    assert!(
+        tex.report.appearance_error_mean < 5.0,
+        "{}",
+        tex.report.appearance_error_mean
+    );
+    let out = chain_glb(&[&tex]).unwrap();
+    let (doc, _, _) = gltf::import_slice(&out).unwrap();
+    let prim = doc.meshes().next().unwrap().primitives().next().unwrap();
+    assert!(prim.get(&gltf::Semantic::Colors(0)).is_none());
+    // Auto: the fit's surface error against what 25 pixels allow decides, and both are
+    // reported; here the field's 2–3 periods are far finer than the LOD's vertices.
+    let auto = with(VertexColors::Auto);
+    let (fit, allowed) = (
+        auto.report.vertex_fit_error.unwrap(),
+        auto.report.vertex_fit_allowed_error.unwrap(),
+    );
+    eprintln!("auto at n_p 25: vertex fit error {fit:.2} allowed {allowed:.2} /255");
+    assert_eq!(auto.uvs.is_some(), fit > allowed);
+    assert!(fit > allowed, "fit {fit} allowed {allowed}");
+    assert_eq!(auto.material.base_color, tex.material.base_color);
+    // A constant COLOR_0 is represented exactly by vertex colours: Auto keeps them.
+    let mut flat = app.clone();
+    flat.colors = Some(vec![[0.2, 0.5, 0.7, 1.0]; app.mesh.vertex_count()]);
+    let params = BakeParams::default();
+    let chain = bake_chain(&flat, &[25.0], &LodParams::default(), &params, &mut |_| {
+        true
+    });
+    let kept = chain.unwrap().levels.remove(0).baked;
+    assert!(kept.colors.is_some() && kept.uvs.is_none());
+    assert!(kept.report.vertex_fit_error.unwrap() <= kept.report.vertex_fit_allowed_error.unwrap());
+
+    let b = &with(VertexColors::Vertex);
     assert!(b.colors.is_some() && b.uvs.is_none());
+    assert_eq!(b.report.vertex_fit_error, None);
     // The error is measured over the LOD surface (not only at its vertices, where the old
     // point samples were exact by construction): a 25-pixel LOD cannot carry this 2–3 period
     // field in vertex colours. Measured: 31.47 with point samples at the vertices, 30.85 with

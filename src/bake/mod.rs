@@ -31,9 +31,9 @@ pub use appearance::{
     ImageBuffer, MaterialSample, UvBuffer,
 };
 pub use atlas::{build_atlas, Atlas, AtlasParams};
-pub use bake::{bake_level, bake_level_with_progress, BakeParams};
+pub use bake::{bake_level, bake_level_with_progress, BakeParams, VertexColors};
 pub use level::{BakeReport, BakedLevel, BakedMaterial, Image8};
-pub use output::{chain_glb, screen_coverage};
+pub use output::{chain_glb, chain_glb_with_progress, screen_coverage};
 pub use provenance::{provenance, InputIndex, Provenance, ProvenanceParams};
 
 use crate::lowpoly::LodParams;
