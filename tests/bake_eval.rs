@@ -200,7 +200,10 @@ fn shared_vertex_colour_teapot_meets_the_appearance_target() {
     assert!(!app.has_textures() && app.colors.is_some());
     let level = bake_one(&app, 200.0, &eval_params());
     let r = &level.report;
-    let (fit, allowed) = (r.vertex_fit_error.unwrap(), r.vertex_fit_allowed_error.unwrap());
+    let (fit, allowed) = (
+        r.vertex_fit_error.unwrap(),
+        r.vertex_fit_allowed_error.unwrap(),
+    );
     eprintln!("teapot: vertex fit error {fit:.2} /255, allowed {allowed:.2}");
     assert!(fit > allowed);
     assert!(level.uvs.is_some() && level.colors.is_none());
@@ -618,6 +621,58 @@ fn bake_speed() {
             r.sample_seconds,
             r.dilate_seconds,
             r.measure_seconds
+        );
+    }
+}
+
+/// Issue 11 speed target 2: the whole `--bake` chain {50, 100, 200} (geometry, bake, PNG
+/// encoding) against the geometry-only chain, measured in one process on the same assets
+/// (`PLEAT_ASSETS=a.glb,b.glb`, default duck, spot, torus). The geometry seconds are
+/// `lowpoly::generate_chain`'s inside `bake_chain` — exactly the geometry-only chain. Prints
+/// one row per asset: geometry s, bake s (per stage summed over levels), png s, ratio.
+#[test]
+#[ignore = "measures the chain speed ratio; run with --release"]
+fn chain_speed() {
+    let Some(dir) = assets() else { return };
+    let names: Vec<String> = std::env::var("PLEAT_ASSETS").map_or_else(
+        |_| {
+            [
+                "khronos_duck.glb",
+                "gen_spot_two_materials.glb",
+                "gen_torus_normalmap.glb",
+            ]
+            .map(String::from)
+            .to_vec()
+        },
+        |s| s.split(',').map(String::from).collect(),
+    );
+    println!(
+        "| asset | geometry s | bake s | atlas s | sample s | dilate s | measure s | png s | \
+         ratio |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for name in names {
+        let app = read_appearance(&dir.join(&name)).unwrap();
+        let chain = bake_chain(
+            &app,
+            &[50.0, 100.0, 200.0],
+            &LodParams::default(),
+            &BakeParams::default(),
+            &mut |_| true,
+        )
+        .unwrap();
+        let refs: Vec<&BakedLevel> = chain.levels.iter().map(|l| &l.baked).collect();
+        let (_, png) = pleat::bake::chain_glb_with_progress(&refs, &mut |_| true).unwrap();
+        let sum = |f: fn(&BakeReport) -> f64| refs.iter().map(|l| f(&l.report)).sum::<f64>();
+        let g = chain.geometry_seconds;
+        println!(
+            "| {name} | {g:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {png:.2} | {:.2} |",
+            chain.bake_seconds,
+            sum(|r| r.atlas_seconds),
+            sum(|r| r.sample_seconds),
+            sum(|r| r.dilate_seconds),
+            sum(|r| r.measure_seconds),
+            (g + chain.bake_seconds + png) / g
         );
     }
 }
