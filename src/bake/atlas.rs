@@ -124,6 +124,21 @@ pub struct Atlas {
 /// Errors: `InvalidArgument` for a zero side; `Internal` when xatlas drops a face or produces
 /// a non-finite UV.
 pub fn build_atlas(mesh: &TriMesh, side: u32, padding: u32) -> Result<Atlas> {
+    build_atlas_growing(mesh, side, padding, None)
+}
+
+/// [`build_atlas`] that may grow the side so the gutters do not eat the texel density: with
+/// `grow = Some((ρ, max_side))` (ρ the density rule's texels per unit length), once the
+/// charts are known the side doubles, up to `max_side`, while the density planned for them
+/// with their gutters ([`pack_density`]) is below `ρ / 2`. Small atlases need it: at 64² the
+/// 15-texel gutters of a handful of charts alone exceed the atlas. The returned
+/// [`Atlas::size`] is the side used.
+pub fn build_atlas_growing(
+    mesh: &TriMesh,
+    side: u32,
+    padding: u32,
+    grow: Option<(f64, u32)>,
+) -> Result<Atlas> {
     if side == 0 {
         return Err(Error::InvalidArgument("atlas size must be > 0".into()));
     }
@@ -139,7 +154,8 @@ pub fn build_atlas(mesh: &TriMesh, side: u32, padding: u32) -> Result<Atlas> {
     // (smaller charts), keeping the one with the fewest overlaps.
     let mut best: Option<Atlas> = None;
     for threshold in [2.0f32, 1.0, 0.5, 0.25] {
-        let Some(mut a) = charts_packed(&positions, &indices, area, side, padding, threshold)?
+        let Some(mut a) =
+            charts_packed(&positions, &indices, area, side, padding, threshold, grow)?
         else {
             continue;
         };
@@ -207,6 +223,20 @@ fn pack_density(area: f64, charts: u32, side: u32, padding: u32) -> f64 {
     x / area.max(f64::MIN_POSITIVE).sqrt()
 }
 
+/// The side [`build_atlas_growing`] packs `charts` charts of total area `area` into: `side`
+/// doubled while [`pack_density`] is below half the rule's density and the side is below the
+/// cap.
+fn grown_side(area: f64, charts: u32, side: u32, padding: u32, grow: Option<(f64, u32)>) -> u32 {
+    let Some((rho, max_side)) = grow else {
+        return side;
+    };
+    let mut side = side;
+    while side < max_side && pack_density(area, charts, side, padding) < 0.5 * rho {
+        side = side.saturating_mul(2).min(max_side);
+    }
+    side
+}
+
 /// The charts of one xatlas chart computation at `max_threshold`, packed into one `side`²
 /// atlas: first at [`pack_density`], then at densities lowered by [`RETRY_SCALE`]; `None`
 /// when no density tried fits.
@@ -217,10 +247,12 @@ fn charts_packed(
     side: u32,
     padding: u32,
     max_threshold: f32,
+    grow: Option<(f64, u32)>,
 ) -> Result<Option<Atlas>> {
     let atlas = parameterised_charts(positions, indices, max_threshold)?;
     // SAFETY: `atlas` is live; ParameterizeCharts has set its chart count.
     let charts = unsafe { (*atlas.0).chart_count };
+    let side = grown_side(area, charts, side, padding, grow);
     let mut density = pack_density(area, charts, side, padding);
     for _ in 0..12 {
         match pack(&atlas, side, padding, density as f32)? {
@@ -712,6 +744,14 @@ mod tests {
             assert_eq!(a.overlapping_texels, 0);
         }
         assert_eq!(max_chart_size(64, 4), 59);
+        // Growth: 7 charts with 15-texel gutters cannot keep half of ρ in 64²; they can in a
+        // larger side, never beyond the cap, and never without `grow`.
+        let (area, rho) = (1.0, 55.0);
+        let g = grown_side(area, 7, 64, 15, Some((rho, 4096)));
+        assert!(g > 64 && pack_density(area, 7, g, 15) >= 0.5 * rho);
+        assert!(pack_density(area, 7, g / 2, 15) < 0.5 * rho);
+        assert_eq!(grown_side(area, 7, 64, 15, Some((rho, 64))), 64);
+        assert_eq!(grown_side(area, 7, 64, 15, None), 64);
         assert_eq!(max_chart_size(4, 8), 1);
     }
 

@@ -31,7 +31,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::appearance::{linear_to_srgb, Appearance, MaterialSample};
-use super::atlas::{build_atlas, Atlas, AtlasParams};
+use super::atlas::{build_atlas_growing, Atlas, AtlasParams};
 use super::level::{BakeReport, BakedLevel, BakedMaterial, Image8};
 use super::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 use crate::geom::{normalized, Vec3};
@@ -642,7 +642,14 @@ fn bake_textured(
     steps.check("bake: atlas", 0.0)?;
     let t = Instant::now();
     let side = params.atlas.side(lod, screen_size, diag);
-    let atlas = build_atlas(lod, side, params.atlas.padding)?;
+    // The rule's side may grow so the gutters keep half the rule's density (a caller's size
+    // is kept as given).
+    let grow = params.atlas.size.is_none().then(|| {
+        let rho = params.atlas.texels_per_pixel * screen_size / diag;
+        (rho, params.atlas.max_size.max(side))
+    });
+    let atlas = build_atlas_growing(lod, side, params.atlas.padding, grow)?;
+    let side = atlas.size;
     report.atlas_seconds = t.elapsed().as_secs_f64();
     report.texture_size = side;
     report.charts = atlas.chart_count;

@@ -30,7 +30,7 @@ pub use appearance::{
     read_appearance, read_appearance_bytes, Appearance, AppearanceBuffers, BufferMaterial,
     ImageBuffer, MaterialSample, UvBuffer,
 };
-pub use atlas::{build_atlas, Atlas, AtlasParams};
+pub use atlas::{build_atlas, build_atlas_growing, Atlas, AtlasParams};
 pub use bake::{bake_level, bake_level_with_progress, BakeParams, VertexColors};
 pub use level::{BakeReport, BakedLevel, BakedMaterial, Image8};
 pub use output::{chain_glb, chain_glb_with_progress, screen_coverage};
