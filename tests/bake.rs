@@ -714,14 +714,18 @@ fn shared_torus_bakes_with_normal_map() {
 fn shared_smooth_fields_match_the_bake_within_the_screen_size_bound() {
     let Some(dir) = assets() else { return };
     let n_p = 200.0;
-    for name in [
+    let mut names = vec![
         "gen_torus_normalmap.glb",
         "gen_spot_two_materials.glb",
         "gen_teapot_vertexcolor.glb",
         "gen_elephant_sin.glb",
         "gen_fandisk_sin_xform.glb",
-        "gen_tree_soup_sin.glb",
-    ] {
+    ];
+    // The 22k-face soup's LOD takes over 20 minutes on a loaded 2-core machine: opt in.
+    if std::env::var_os("PLEAT_BAKE_SLOW").is_some() {
+        names.push("gen_tree_soup_sin.glb");
+    }
+    for name in names {
         let app = read_appearance(&dir.join(name)).unwrap();
         let spec = sidecar(&dir, name);
         let level = bake_chain(
