@@ -46,6 +46,17 @@
 // Baked image: tangent-space normal map in the MikkTSpace frame of the bake's tangents.
 #define PLEAT_BAKE_IMAGE_NORMAL 4
 
+// `PleatBakeParams::vertex_colors`: a vertex-coloured input (colours, no image) gets vertex
+// colours when they are good enough for the screen size, else a base-colour texture (the rule
+// of `pleat::bake::VertexColors::Auto`). The default.
+#define PLEAT_VERTEX_COLORS_AUTO 0
+
+// `PleatBakeParams::vertex_colors`: always vertex colours.
+#define PLEAT_VERTEX_COLORS_VERTEX 1
+
+// `PleatBakeParams::vertex_colors`: always a base-colour texture.
+#define PLEAT_VERTEX_COLORS_TEXTURE 2
+
 // `PleatBakeStats::flags` bit: the bake is textured (UVs, tangents and images); unset, the
 // input had no texture and the bake holds vertex colours instead.
 #define PLEAT_BAKE_TEXTURED 1
@@ -368,7 +379,8 @@ typedef struct PleatBakeParams {
   uint32_t texture_size;
   // Screen size n_p the LOD was made for (default 200). Finite and > 0.
   double screen_size;
-  // Gutter between charts in texels (default 4), at most 64.
+  // Gutter between charts in texels (default 15: `4 · 2^m − 1` for the deepest mip `m = 2`
+  // a ×2 chain reads at 2 texels per pixel), at most 64.
   uint32_t padding;
   // Worker threads for this call: 0 (default) = the pool of `pleat_set_thread_count`.
   // At most 256. The output bytes do not depend on it.
@@ -381,6 +393,12 @@ typedef struct PleatBakeParams {
   uint32_t normal_map;
   // Texels compared with the input for the appearance error (default 20000; 0 skips it).
   uint32_t error_samples;
+  // How an input with vertex colours and no image is baked: `PLEAT_VERTEX_COLORS_AUTO`
+  // (default), `PLEAT_VERTEX_COLORS_VERTEX` or `PLEAT_VERTEX_COLORS_TEXTURE`. Never both in
+  // one result (glTF multiplies vertex colours into the base colour). Appended in v2.
+  uint32_t vertex_colors;
+  // Reserved, 0.
+  uint32_t reserved;
 } PleatBakeParams;
 
 // Progress information passed to a [`PleatProgressFn`].

@@ -11,9 +11,22 @@
 //! switch allows before the next finer level takes over): `ρ = k · n_p / l` texels per unit
 //! length; the atlas side is the next power of two of `√(A ρ² / 0.75)` (`A` the LOD's area,
 //! 75 % packing efficiency), clamped to `[min_size, max_size]` (default 32 … 4096). A
-//! caller-given size overrides the rule. The gutter is 2 texels per mip level the rule implies
-//! needs (default 4), enough that the box filter of the first two mip levels reads only the
-//! chart's own (dilated) texels.
+//! caller-given size overrides the rule.
+//!
+//! **Gutter rule.** At its own `n_p` a level is read at mip `log2 k` (1 for `k = 2`); it stays
+//! on screen down to `n_p / 2`, where the next level of a ×2 chain takes over, so the deepest
+//! mip it needs is `m = ⌈log2 k⌉ + 1` ([`deepest_mip`], 2 by default). Bilinear filtering at
+//! mip `m` reads the two mip texels around a point, i.e. level-0 texels up to `1.5 · 2^m` away
+//! from it; the dilation gives every gutter texel to the nearest chart, so the texels a chart's
+//! edge reads stay its own when charts are at least `3 · 2^m` texels apart. xatlas (this
+//! version) reserves a chart's gutter on its right and top side only (it rasterises the chart
+//! `padding` texels in from its bit image's corner but places the UVs at the corner), so two
+//! charts can come within about `padding` texels of each other at some points, and texel
+//! centres round the ownership border by up to one more texel: the rule adds one mip texel,
+//! `padding = 4 · 2^m − 1` ([`gutter_for_mip`], 15 by default). Measured with
+//! `tests/bake_eval.rs` (bilinear reads at mip 2 of every triangle's corners, edge midpoints
+//! and centroid): padding 11 (`3 · 2^m − 1`) left 5 of 630 samples of a sphere reading a
+//! neighbour chart, 15 none on the sphere and the four shared assets checked.
 
 use crate::mesh::TriMesh;
 use crate::{Error, Result};
@@ -29,8 +42,26 @@ pub struct AtlasParams {
     pub min_size: u32,
     /// Largest side the rule may choose (power of two). Default 4096.
     pub max_size: u32,
-    /// Gutter between charts, in texels. Default 4.
+    /// Gutter between charts, in texels. Default [`gutter_for_mip`]`(`[`deepest_mip`]`(2))`
+    /// = 15, the [gutter rule](self) for the default `texels_per_pixel`.
     pub padding: u32,
+}
+
+/// The deepest mip level a level made with `texels_per_pixel = k` texels per pixel is read
+/// at in a ×2 chain: `⌈log2 k⌉ + 1` (see the [gutter rule](self)); 1 for `k ≤ 1`.
+pub fn deepest_mip(texels_per_pixel: f64) -> u32 {
+    let m = texels_per_pixel.log2().ceil();
+    if m.is_finite() && m > 0.0 {
+        m.min(16.0) as u32 + 1
+    } else {
+        1
+    }
+}
+
+/// xatlas padding that keeps bilinear reads at mip `m` inside their chart's own texels:
+/// `4 · 2^m − 1` (the [gutter rule](self)).
+pub fn gutter_for_mip(m: u32) -> u32 {
+    4 * (1u32 << m.min(16)) - 1
 }
 
 impl Default for AtlasParams {
@@ -40,7 +71,7 @@ impl Default for AtlasParams {
             texels_per_pixel: 2.0,
             min_size: 32,
             max_size: 4096,
-            padding: 4,
+            padding: gutter_for_mip(deepest_mip(2.0)),
         }
     }
 }
@@ -93,6 +124,21 @@ pub struct Atlas {
 /// Errors: `InvalidArgument` for a zero side; `Internal` when xatlas drops a face or produces
 /// a non-finite UV.
 pub fn build_atlas(mesh: &TriMesh, side: u32, padding: u32) -> Result<Atlas> {
+    build_atlas_growing(mesh, side, padding, None)
+}
+
+/// [`build_atlas`] that may grow the side so the gutters do not eat the texel density: with
+/// `grow = Some((ρ, max_side))` (ρ the density rule's texels per unit length), once the
+/// charts are known the side doubles, up to `max_side`, while the density planned for them
+/// with their gutters ([`pack_density`]) is below `ρ / 2`. Small atlases need it: at 64² the
+/// 15-texel gutters of a handful of charts alone exceed the atlas. The returned
+/// [`Atlas::size`] is the side used.
+pub fn build_atlas_growing(
+    mesh: &TriMesh,
+    side: u32,
+    padding: u32,
+    grow: Option<(f64, u32)>,
+) -> Result<Atlas> {
     if side == 0 {
         return Err(Error::InvalidArgument("atlas size must be > 0".into()));
     }
@@ -108,7 +154,8 @@ pub fn build_atlas(mesh: &TriMesh, side: u32, padding: u32) -> Result<Atlas> {
     // (smaller charts), keeping the one with the fewest overlaps.
     let mut best: Option<Atlas> = None;
     for threshold in [2.0f32, 1.0, 0.5, 0.25] {
-        let Some(mut a) = charts_packed(&positions, &indices, area, side, padding, threshold)?
+        let Some(mut a) =
+            charts_packed(&positions, &indices, area, side, padding, threshold, grow)?
         else {
             continue;
         };
@@ -176,6 +223,20 @@ fn pack_density(area: f64, charts: u32, side: u32, padding: u32) -> f64 {
     x / area.max(f64::MIN_POSITIVE).sqrt()
 }
 
+/// The side [`build_atlas_growing`] packs `charts` charts of total area `area` into: `side`
+/// doubled while [`pack_density`] is below half the rule's density and the side is below the
+/// cap.
+fn grown_side(area: f64, charts: u32, side: u32, padding: u32, grow: Option<(f64, u32)>) -> u32 {
+    let Some((rho, max_side)) = grow else {
+        return side;
+    };
+    let mut side = side;
+    while side < max_side && pack_density(area, charts, side, padding) < 0.5 * rho {
+        side = side.saturating_mul(2).min(max_side);
+    }
+    side
+}
+
 /// The charts of one xatlas chart computation at `max_threshold`, packed into one `side`²
 /// atlas: first at [`pack_density`], then at densities lowered by [`RETRY_SCALE`]; `None`
 /// when no density tried fits.
@@ -186,10 +247,12 @@ fn charts_packed(
     side: u32,
     padding: u32,
     max_threshold: f32,
+    grow: Option<(f64, u32)>,
 ) -> Result<Option<Atlas>> {
     let atlas = parameterised_charts(positions, indices, max_threshold)?;
     // SAFETY: `atlas` is live; ParameterizeCharts has set its chart count.
     let charts = unsafe { (*atlas.0).chart_count };
+    let side = grown_side(area, charts, side, padding, grow);
     let mut density = pack_density(area, charts, side, padding);
     for _ in 0..12 {
         match pack(&atlas, side, padding, density as f32)? {
@@ -274,7 +337,7 @@ fn pack(atlas: &ffi::Handle, side: u32, padding: u32, texels_per_unit: f32) -> R
         attempts: 4096,
         texels_per_unit,
         resolution: side,
-        max_chart_size: side,
+        max_chart_size: max_chart_size(side, padding),
         block_align: false,
         conservative: padding > 0,
         padding,
@@ -291,6 +354,21 @@ fn pack(atlas: &ffi::Handle, side: u32, padding: u32, texels_per_unit: f32) -> R
     let out = unsafe { copy_output(raw, side) }?;
     out.map(Packed::One)
         .ok_or_else(|| Error::Internal("xatlas returned no atlas".into()))
+}
+
+/// The `maxChartSize` that keeps every chart inside a `side`² atlas. xatlas (this version)
+/// scales a chart whose extent exceeds `maxChartSize` down to just below it, rounds its extent
+/// `e` up to whole texels `w = ⌈e⌉ ≤ maxChartSize`, reserves a bit image of `w + 1 + padding`
+/// texels for it (conservative rasterisation: half a texel each side plus the gutter) and
+/// places it at `x ≤ side − (w + 1 + padding)` with UVs `x + t + 0.5`, `t ≤ e < w`. When the
+/// bit image is wider than the atlas no place exists, and xatlas puts the chart at the origin
+/// of an atlas anyway: its UVs reach `w + 0.5 > side` (the "half a texel outside" the check
+/// in [`check_atlas`] rejected, on a long chart of a COLOR_0-only teapot). With
+/// `maxChartSize = side − padding − 1` the bit image fits (`w + 1 + padding ≤ side`) and every
+/// UV is below `side − padding − 0.5`. A chart that large is baked at a lower density than the
+/// others rather than failing the bake.
+fn max_chart_size(side: u32, padding: u32) -> u32 {
+    side.saturating_sub(padding + 1).max(1)
 }
 
 /// Summed utilisation of all atlases of a packing over that of the first; infinite when
@@ -631,6 +709,62 @@ mod tests {
         assert!(pack_density(area, 2 * n, side, p) < d);
         assert!(pack_density(area, n, side, 2 * p) < d);
         assert!(pack_density(area, 1_000_000, 64, 8) > 0.0);
+    }
+
+    /// A planar strip 40 times longer than wide is one chart whose extent at the planned
+    /// density is several atlas sides: xatlas shrinks it to `maxChartSize`, and with the bound
+    /// of [`max_chart_size`] every UV lands inside the atlas (before: up to `side + 0.5`,
+    /// an `Internal` error).
+    #[test]
+    fn a_chart_longer_than_the_atlas_stays_inside_it() {
+        let (n, len) = (4u32, 40.0);
+        let mut p = Vec::new();
+        for i in 0..=10 * n {
+            for j in 0..=n {
+                let x = len * f64::from(i) / f64::from(10 * n);
+                p.push([x, f64::from(j) / f64::from(n), 0.0]);
+            }
+        }
+        let mut t = Vec::new();
+        let id = |i: u32, j: u32| i * (n + 1) + j;
+        for i in 0..10 * n {
+            for j in 0..n {
+                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let strip = TriMesh::new(p, t).unwrap();
+        for (side, padding) in [(64u32, 4u32), (128, 12), (32, 0)] {
+            let a = build_atlas(&strip, side, padding).unwrap();
+            let hi = a.uv.iter().flatten().fold(0.0f32, |m, &c| m.max(c));
+            assert!(
+                hi <= (side - padding) as f32 - 0.5,
+                "{side}/{padding}: UV {hi}"
+            );
+            assert_eq!(a.overlapping_texels, 0);
+        }
+        assert_eq!(max_chart_size(64, 4), 59);
+        // Growth: 7 charts with 15-texel gutters cannot keep half of ρ in 64²; they can in a
+        // larger side, never beyond the cap, and never without `grow`.
+        let (area, rho) = (1.0, 55.0);
+        let g = grown_side(area, 7, 64, 15, Some((rho, 4096)));
+        assert!(g > 64 && pack_density(area, 7, g, 15) >= 0.5 * rho);
+        assert!(pack_density(area, 7, g / 2, 15) < 0.5 * rho);
+        assert_eq!(grown_side(area, 7, 64, 15, Some((rho, 64))), 64);
+        assert_eq!(grown_side(area, 7, 64, 15, None), 64);
+        assert_eq!(max_chart_size(4, 8), 1);
+    }
+
+    /// The gutter rule: mip 2 for the default 2 texels per pixel, 15 texels of padding.
+    #[test]
+    fn the_default_gutter_follows_the_mip_rule() {
+        assert_eq!(deepest_mip(2.0), 2);
+        assert_eq!(deepest_mip(1.0), 1);
+        assert_eq!(deepest_mip(4.0), 3);
+        assert_eq!(deepest_mip(f64::NAN), 1);
+        assert_eq!(gutter_for_mip(1), 7);
+        assert_eq!(gutter_for_mip(2), 15);
+        assert_eq!(AtlasParams::default().padding, 15);
     }
 
     /// A retry plans the spilled charts into `RETRY_FILL` of one atlas, lowers the density by

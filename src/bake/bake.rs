@@ -21,15 +21,17 @@
 //!    texel a breadth-first search from all covered texels reaches it from (4-neighbours, fixed
 //!    order), so mip levels average a chart only with copies of its own border.
 //!
-//! Without any texture in the input, the LOD gets vertex colours instead (the sampled base
-//! colour, factor × COLOR_0, at each LOD vertex's provenance) and no atlas.
+//! Without any texture in the input, the LOD gets vertex colours instead (the L² fit of the
+//! base colour, factor × COLOR_0, over the LOD surface) and no atlas — except that a
+//! `COLOR_0`-only input follows [`BakeParams::vertex_colors`]: under [`VertexColors::Auto`] it
+//! gets a base-colour texture when the vertex fit's error exceeds what the screen size allows.
 
 use std::time::Instant;
 
 use rayon::prelude::*;
 
 use super::appearance::{linear_to_srgb, Appearance, MaterialSample};
-use super::atlas::{build_atlas, Atlas, AtlasParams};
+use super::atlas::{build_atlas_growing, Atlas, AtlasParams};
 use super::level::{BakeReport, BakedLevel, BakedMaterial, Image8};
 use super::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 use crate::geom::{normalized, Vec3};
@@ -84,7 +86,35 @@ pub struct BakeParams {
     /// with [`super::render::evaluate`] and fill the report's `appearance_psnr_db`,
     /// `appearance_psnr_reference_db` and `normal_map_gain_db`. Default false.
     pub evaluate: bool,
+    /// How an input whose only colour source is `COLOR_0` (no texture) is baked. Default
+    /// [`VertexColors::Auto`].
+    pub vertex_colors: VertexColors,
 }
+
+/// How a `COLOR_0`-only input (vertex colours, no texture in any material) is transferred.
+/// The output never carries both: glTF multiplies `COLOR_0` into the base colour, so a level
+/// is either vertex-coloured (no base-colour texture) or textured (no `COLOR_0`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum VertexColors {
+    /// Vertex colours when they are good enough for the screen size, else a texture. The rule:
+    /// a pixel at `n_p` covers `h = l / n_p` of the surface and shows its colour averaged over
+    /// that footprint, so an error of the colour change across half a pixel, `|∇c| · h/2`
+    /// (`c` the input's sRGB base colour in 1/255, its gradient over the input triangle at the
+    /// closest input point, max over R, G, B), plus one 8-bit step, is not visible at that
+    /// size. The vertex fit ([`bake_level`]'s L² fit) is kept when its mean error over the
+    /// surface samples is at most the mean allowed error over the same samples; otherwise the
+    /// level gets a texture at the atlas rule's density. Both numbers are reported
+    /// (`BakeReport::vertex_fit_error`, `vertex_fit_allowed_error`).
+    #[default]
+    Auto,
+    /// Always vertex colours (the L² fit), as before this option existed.
+    Vertex,
+    /// Always a base-colour texture (the textured path samples `factor × COLOR_0`).
+    Texture,
+}
+
+/// Surface samples the [`VertexColors::Auto`] decision compares at most.
+const AUTO_SAMPLES: usize = 20_000;
 
 impl Default for BakeParams {
     fn default() -> Self {
@@ -94,6 +124,7 @@ impl Default for BakeParams {
             normal_map: true,
             error_samples: 20_000,
             evaluate: false,
+            vertex_colors: VertexColors::Auto,
         }
     }
 }
@@ -144,19 +175,32 @@ pub fn bake_level_with_progress(
         envelope: params.envelope_d * diag / screen_size,
     };
     let mut steps = Steps::new(progress, 0.0, 1.0);
-    let mut level = if app.has_textures() {
-        bake_textured(
-            app,
-            index,
-            lod,
-            screen_size,
-            diag,
-            &prov,
-            params,
-            &mut steps,
-        )?
-    } else {
-        bake_vertex_colors(app, index, lod, screen_size, &prov, params, &mut steps)?
+    let textured = |steps: &mut Steps<'_, '_>| {
+        bake_textured(app, index, lod, screen_size, diag, &prov, params, steps)
+    };
+    let color0_only = !app.has_textures() && app.colors.is_some();
+    let mut level = match params.vertex_colors {
+        _ if app.has_textures() => textured(&mut steps)?,
+        VertexColors::Texture if color0_only => textured(&mut steps)?,
+        VertexColors::Auto if color0_only => {
+            let vertex =
+                bake_vertex_colors(app, index, lod, screen_size, &prov, params, &mut steps)?;
+            let (fit, allowed) = (
+                vertex.report.vertex_fit_error,
+                vertex.report.vertex_fit_allowed_error,
+            );
+            let mut level = if fit.zip(allowed).is_some_and(|(f, a)| f > a) {
+                let mut t = textured(&mut steps)?;
+                t.report.sample_seconds += vertex.report.sample_seconds;
+                t
+            } else {
+                vertex
+            };
+            level.report.vertex_fit_error = fit;
+            level.report.vertex_fit_allowed_error = allowed;
+            level
+        }
+        _ => bake_vertex_colors(app, index, lod, screen_size, &prov, params, &mut steps)?,
     };
     level.report.total_seconds = start.elapsed().as_secs_f64();
     if params.evaluate {
@@ -214,6 +258,12 @@ fn bake_vertex_colors(
         fallback_fraction: fit.fallback_fraction,
         ..BakeReport::default()
     };
+    if params.vertex_colors == VertexColors::Auto && app.colors.is_some() {
+        let h = app.mesh.bbox_diagonal() / screen_size;
+        let (e, a) = auto_verdict(app, index, lod, &fit.samples, &colors, h);
+        report.vertex_fit_error = Some(e);
+        report.vertex_fit_allowed_error = Some(a);
+    }
     if params.error_samples > 0 {
         steps.check("bake: measure", 0.9)?;
         let t = Instant::now();
@@ -256,6 +306,77 @@ fn bake_vertex_colors(
         material,
         report,
     })
+}
+
+/// The [`VertexColors::Auto`] comparison over up to [`AUTO_SAMPLES`] of the fit's surface
+/// samples: (mean fit error, mean allowed error), both in 1/255 sRGB; `h` is one pixel's
+/// footprint `l / n_p` on the surface.
+fn auto_verdict(
+    app: &Appearance,
+    index: &InputIndex<'_>,
+    lod: &TriMesh,
+    samples: &[(usize, [f64; 3])],
+    colors: &[[f32; 4]],
+    h: f64,
+) -> (f64, f64) {
+    let stride = samples.len().div_ceil(AUTO_SAMPLES).max(1);
+    let pairs: Vec<(f64, f64)> = samples
+        .iter()
+        .step_by(stride)
+        .collect::<Vec<_>>()
+        .par_iter()
+        .map(|&&(t, b)| {
+            let tri = lod.triangles()[t];
+            let at = |k: usize| Vec3::from(lod.positions()[tri[k] as usize]);
+            let p = at(0) * b[0] + at(1) * b[1] + at(2) * b[2];
+            let baked: [f64; 4] = std::array::from_fn(|j| {
+                (0..3)
+                    .map(|k| b[k] * f64::from(colors[tri[k] as usize][j]))
+                    .sum()
+            });
+            let allowed = index.closest(p).map_or(1.0, |q| {
+                1.0 + 0.5 * h * srgb_gradient(app, q.triangle as usize)
+            });
+            (color_error(app, index, p, baked), allowed)
+        })
+        .collect();
+    let n = pairs.len().max(1) as f64;
+    (
+        pairs.iter().map(|p| p.0).sum::<f64>() / n,
+        pairs.iter().map(|p| p.1).sum::<f64>() / n,
+    )
+}
+
+/// `|∇c|` over input triangle `t`, max over R, G, B, in 1/255 sRGB per unit length: `c` the
+/// sRGB-encoded base colour at the triangle's corners, interpolated linearly. For a linear
+/// function with corner values `f_k` over corners `p_k`, `∇f = a e₁ + b e₂` with `e₁ = p₁ − p₀`,
+/// `e₂ = p₂ − p₀` and `(a, b)` solving the Gram system `[e₁·e₁ e₁·e₂; e₁·e₂ e₂·e₂] (a, b) =
+/// (f₁ − f₀, f₂ − f₀)`. 0 on a degenerate triangle.
+fn srgb_gradient(app: &Appearance, t: usize) -> f64 {
+    let tri = app.mesh.triangles()[t];
+    let p = tri.map(|v| Vec3::from(app.mesh.positions()[v as usize]));
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let (g11, g12, g22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let det = g11 * g22 - g12 * g12;
+    if det.is_nan() || det <= 1e-300 {
+        return 0.0;
+    }
+    let corner = |k: usize| {
+        let mut b = [0.0; 3];
+        b[k] = 1.0;
+        app.sample(t, b)
+            .base_color
+            .map(|x| 255.0 * linear_to_srgb(x))
+    };
+    let c = [corner(0), corner(1), corner(2)];
+    (0..3)
+        .map(|ch| {
+            let (d1, d2) = (c[1][ch] - c[0][ch], c[2][ch] - c[0][ch]);
+            let a = (g22 * d1 - g12 * d2) / det;
+            let b = (g11 * d2 - g12 * d1) / det;
+            (e1 * a + e2 * b).length()
+        })
+        .fold(0.0, f64::max)
 }
 
 /// Vertex colours fitted to the input's base colour, with the share of quadrature samples whose
@@ -521,7 +642,14 @@ fn bake_textured(
     steps.check("bake: atlas", 0.0)?;
     let t = Instant::now();
     let side = params.atlas.side(lod, screen_size, diag);
-    let atlas = build_atlas(lod, side, params.atlas.padding)?;
+    // The rule's side may grow so the gutters keep half the rule's density (a caller's size
+    // is kept as given).
+    let grow = params.atlas.size.is_none().then(|| {
+        let rho = params.atlas.texels_per_pixel * screen_size / diag;
+        (rho, params.atlas.max_size.max(side))
+    });
+    let atlas = build_atlas_growing(lod, side, params.atlas.padding, grow)?;
+    let side = atlas.size;
     report.atlas_seconds = t.elapsed().as_secs_f64();
     report.texture_size = side;
     report.charts = atlas.chart_count;

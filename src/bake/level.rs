@@ -54,6 +54,15 @@ pub struct BakeReport {
     pub normal_map_gain_db: Option<f64>,
     /// Seconds spent on the evaluation renders (not in `total_seconds`).
     pub evaluate_seconds: f64,
+    /// For a `COLOR_0`-only input under [`VertexColors::Auto`](super::bake::VertexColors): the
+    /// vertex-colour fit's mean surface error (1/255 sRGB, as `appearance_error_mean`) that
+    /// [`BakeParams::vertex_colors`](super::bake::BakeParams::vertex_colors) compared with
+    /// `vertex_fit_allowed_error`; `None` when no decision was made.
+    pub vertex_fit_error: Option<f64>,
+    /// The error the screen size allows at the same samples (see
+    /// [`VertexColors::Auto`](super::bake::VertexColors::Auto)); a texture is baked when
+    /// `vertex_fit_error` exceeds it.
+    pub vertex_fit_allowed_error: Option<f64>,
 }
 
 /// An 8-bit RGBA image, row-major, row 0 at the top (glTF's v = 0).

@@ -32,11 +32,11 @@ pub use appearance::{
     read_appearance_bytes, read_gltf_appearance, Appearance, AppearanceBuffers, BufferMaterial,
     ImageBuffer, MaterialSample, UvBuffer,
 };
-pub use atlas::{build_atlas, Atlas, AtlasParams};
-pub use bake::{bake_level, bake_level_with_progress, BakeParams};
+pub use atlas::{build_atlas, build_atlas_growing, Atlas, AtlasParams};
+pub use bake::{bake_level, bake_level_with_progress, BakeParams, VertexColors};
 pub use level::{BakeReport, BakedLevel, BakedMaterial, Image8};
 pub use obj::read_obj_appearance;
-pub use output::{chain_glb, screen_coverage};
+pub use output::{chain_glb, chain_glb_with_progress, screen_coverage};
 pub use provenance::{provenance, InputIndex, Provenance, ProvenanceParams};
 
 use crate::lowpoly::LodParams;

@@ -112,6 +112,29 @@ pub fn png_bytes(img: &Image8) -> Result<Vec<u8>> {
 /// Errors: `InvalidArgument` for no level or a coordinate beyond `f32`; `Internal` when PNG
 /// encoding fails.
 pub fn chain_glb(levels: &[&BakedLevel]) -> Result<Vec<u8>> {
+    chain_glb_with_progress(levels, &mut |_| true).map(|(bytes, _)| bytes)
+}
+
+/// The images of a material in the order the writer embeds them.
+fn material_images(m: &super::level::BakedMaterial) -> [&Option<Image8>; 5] {
+    [
+        &m.base_color,
+        &m.metallic_roughness,
+        &m.normal,
+        &m.occlusion,
+        &m.emissive,
+    ]
+}
+
+/// [`chain_glb`] with the PNG encoding as a progress stage (`write: png`, before and after;
+/// `false` cancels with `Error::Cancelled`) and its wall seconds returned with the bytes.
+/// Every image is encoded in parallel (rayon) before the file is assembled; the bytes are
+/// [`chain_glb`]'s.
+pub fn chain_glb_with_progress(
+    levels: &[&BakedLevel],
+    progress: &mut crate::report::ProgressFn<'_>,
+) -> Result<(Vec<u8>, f64)> {
+    use rayon::prelude::*;
     if levels.is_empty() {
         return Err(Error::InvalidArgument("no LOD level to write".into()));
     }
@@ -122,6 +145,30 @@ pub fn chain_glb(levels: &[&BakedLevel]) -> Result<Vec<u8>> {
             .total_cmp(&levels[a].screen_size)
             .then(a.cmp(&b))
     });
+    let stage = |progress: &mut crate::report::ProgressFn<'_>, fraction| {
+        if progress(crate::report::Progress {
+            stage: "write: png",
+            fraction,
+        }) {
+            Ok(())
+        } else {
+            Err(Error::Cancelled)
+        }
+    };
+    stage(progress, 0.0)?;
+    let t = std::time::Instant::now();
+    let all: Vec<&Image8> = order
+        .iter()
+        .flat_map(|&li| material_images(&levels[li].material))
+        .flatten()
+        .collect();
+    let encoded = all
+        .par_iter()
+        .map(|img| png_bytes(img))
+        .collect::<Result<Vec<_>>>()?;
+    let png_seconds = t.elapsed().as_secs_f64();
+    stage(progress, 1.0)?;
+    let mut encoded = encoded.into_iter();
     let mut bin = Bin {
         data: Vec::new(),
         views: Vec::new(),
@@ -163,8 +210,12 @@ pub fn chain_glb(levels: &[&BakedLevel]) -> Result<Vec<u8>> {
         meshes.push(json!({"name": format!("LOD{rank}"), "primitives": [{
             "attributes": attributes, "indices": indices, "mode": 4, "material": rank}]}));
         let mut tex = |img: &Option<Image8>, bin: &mut Bin| -> Result<Option<usize>> {
-            let Some(img) = img else { return Ok(None) };
-            let png = png_bytes(img)?;
+            if img.is_none() {
+                return Ok(None);
+            }
+            let png = encoded
+                .next()
+                .ok_or_else(|| Error::Internal("PNG missing for an image".into()))?;
             let view = bin.view(&png, None);
             images.push(json!({"bufferView": view, "mimeType": "image/png"}));
             textures.push(json!({"sampler": 0, "source": images.len() - 1}));
@@ -254,5 +305,5 @@ pub fn chain_glb(levels: &[&BakedLevel]) -> Result<Vec<u8>> {
     out.extend_from_slice(&(bin.data.len() as u32).to_le_bytes());
     out.extend_from_slice(b"BIN\0");
     out.extend_from_slice(&bin.data);
-    Ok(out)
+    Ok((out, png_seconds))
 }

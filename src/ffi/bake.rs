@@ -42,6 +42,15 @@ pub const PLEAT_BAKE_IMAGE_EMISSIVE: u32 = 3;
 /// Baked image: tangent-space normal map in the MikkTSpace frame of the bake's tangents.
 pub const PLEAT_BAKE_IMAGE_NORMAL: u32 = 4;
 
+/// `PleatBakeParams::vertex_colors`: a vertex-coloured input (colours, no image) gets vertex
+/// colours when they are good enough for the screen size, else a base-colour texture (the rule
+/// of `pleat::bake::VertexColors::Auto`). The default.
+pub const PLEAT_VERTEX_COLORS_AUTO: u32 = 0;
+/// `PleatBakeParams::vertex_colors`: always vertex colours.
+pub const PLEAT_VERTEX_COLORS_VERTEX: u32 = 1;
+/// `PleatBakeParams::vertex_colors`: always a base-colour texture.
+pub const PLEAT_VERTEX_COLORS_TEXTURE: u32 = 2;
+
 /// `PleatBakeStats::flags` bit: the bake is textured (UVs, tangents and images); unset, the
 /// input had no texture and the bake holds vertex colours instead.
 pub const PLEAT_BAKE_TEXTURED: u32 = 1;
@@ -156,7 +165,8 @@ pub struct PleatBakeParams {
     pub texture_size: u32,
     /// Screen size n_p the LOD was made for (default 200). Finite and > 0.
     pub screen_size: f64,
-    /// Gutter between charts in texels (default 4), at most 64.
+    /// Gutter between charts in texels (default 15: `4 · 2^m − 1` for the deepest mip `m = 2`
+    /// a ×2 chain reads at 2 texels per pixel), at most 64.
     pub padding: u32,
     /// Worker threads for this call: 0 (default) = the pool of `pleat_set_thread_count`.
     /// At most 256. The output bytes do not depend on it.
@@ -169,6 +179,12 @@ pub struct PleatBakeParams {
     pub normal_map: u32,
     /// Texels compared with the input for the appearance error (default 20000; 0 skips it).
     pub error_samples: u32,
+    /// How an input with vertex colours and no image is baked: `PLEAT_VERTEX_COLORS_AUTO`
+    /// (default), `PLEAT_VERTEX_COLORS_VERTEX` or `PLEAT_VERTEX_COLORS_TEXTURE`. Never both in
+    /// one result (glTF multiplies vertex colours into the base colour). Appended in v2.
+    pub vertex_colors: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
 }
 
 /// Statistics of a bake. Set `struct_size` to `sizeof(PleatBakeStats)`; pleat fills that many
@@ -286,12 +302,15 @@ pub extern "C" fn pleat_bake_params_default() -> PleatBakeParams {
         struct_size: full_size::<PleatBakeParams>(),
         texture_size: 0,
         screen_size: 200.0,
-        padding: 4,
+        // `bake::atlas::gutter_for_mip(deepest_mip(2.0))` (the defaults test checks it).
+        padding: 15,
         threads: 0,
         texels_per_pixel: 2.0,
         envelope_d: 3.0,
         normal_map: 1,
         error_samples: 20_000,
+        vertex_colors: PLEAT_VERTEX_COLORS_AUTO,
+        reserved: 0,
     }
 }
 
@@ -319,7 +338,7 @@ pub(super) mod imp {
     use crate::bake::appearance::{Wrap, MAX_TEXTURE_TEXELS};
     use crate::bake::{
         AppearanceBuffers, AtlasParams, BakeParams, BakedLevel, BufferMaterial, ImageBuffer,
-        InputIndex, Provenance, ProvenanceParams, UvBuffer,
+        InputIndex, Provenance, ProvenanceParams, UvBuffer, VertexColors,
     };
     use crate::ffi::boundary::{arg_slice, bool_field, check_f64, check_range, finite_slice};
     use crate::mesh::TriMesh;
@@ -470,6 +489,17 @@ pub(super) mod imp {
             "finite and > 0",
         )?;
         let normal_map = bool_field(p.normal_map, "params->normal_map")?;
+        let vertex_colors = match p.vertex_colors {
+            PLEAT_VERTEX_COLORS_AUTO => VertexColors::Auto,
+            PLEAT_VERTEX_COLORS_VERTEX => VertexColors::Vertex,
+            PLEAT_VERTEX_COLORS_TEXTURE => VertexColors::Texture,
+            v => {
+                return Err(Error::InvalidArgument(format!(
+                    "params->vertex_colors must be PLEAT_VERTEX_COLORS_AUTO (0), _VERTEX (1) or \
+                     _TEXTURE (2), got {v}"
+                )))
+            }
+        };
         let params = BakeParams {
             atlas: AtlasParams {
                 size: (p.texture_size != 0).then_some(p.texture_size),
@@ -481,6 +511,7 @@ pub(super) mod imp {
             normal_map,
             error_samples: p.error_samples as usize,
             evaluate: false,
+            vertex_colors,
         };
         Ok((params, p.screen_size))
     }

@@ -108,6 +108,26 @@ fn read_versioned_honours_struct_size() {
     );
 }
 
+/// A v1 `PleatBakeParams` (48 bytes, before `vertex_colors`) reads the appended fields'
+/// defaults; an unknown `vertex_colors` is a readable error.
+#[cfg(feature = "bake")]
+#[test]
+fn bake_params_v1_size_and_vertex_colors_are_checked() {
+    use super::boundary::read_versioned;
+    let mut c = pleat_bake_params_default();
+    c.vertex_colors = PLEAT_VERTEX_COLORS_TEXTURE;
+    c.struct_size = 48;
+    // SAFETY: `c` is a full, live struct; pleat reads its first 48 bytes.
+    let v1 = unsafe { read_versioned(&c, "params") }.unwrap();
+    assert_eq!(v1.vertex_colors, PLEAT_VERTEX_COLORS_AUTO);
+    c.struct_size = std::mem::size_of::<PleatBakeParams>() as u32;
+    let (rust, _) = bake::imp::bake_params(&c).unwrap();
+    assert_eq!(rust.vertex_colors, crate::bake::VertexColors::Texture);
+    c.vertex_colors = 3;
+    let e = bake::imp::bake_params(&c).unwrap_err().to_string();
+    assert!(e.contains("params->vertex_colors"), "{e}");
+}
+
 #[cfg(feature = "bake")]
 #[test]
 fn bake_params_default_is_rust_default() {

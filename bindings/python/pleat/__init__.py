@@ -997,7 +997,7 @@ _BakeMaterial = _struct("PleatBakeMaterial", _u32s("struct_size", "uv_layout")
 _BakeParams = _struct("PleatBakeParams", _u32s("struct_size", "texture_size")
                       + _f64s("screen_size") + _u32s("padding", "threads")
                       + _f64s("texels_per_pixel", "envelope_d")
-                      + _u32s("normal_map", "error_samples"))
+                      + _u32s("normal_map", "error_samples", "vertex_colors", "reserved"))
 _BakeStats = _struct("PleatBakeStats", _u32s("struct_size", "flags", "texture_size", "charts")
                      + _u64s("texels_covered", "overlapping_texels", "vertex_count",
                              "triangle_count")
@@ -1222,13 +1222,16 @@ def _fill_material(m, keep, base_color=None, base_color_factor=(1.0, 1.0, 1.0, 1
     m.wrap = _WRAP[wrap]
 
 
+_VERTEX_COLORS = {"auto": 0, "vertex": 1, "texture": 2}
+
+
 def bake(lod, input, uvs=None, base_color=None, *, uv_layout="vertex", normals=None,
          colors=None, base_color_factor=(1.0, 1.0, 1.0, 1.0), metallic_factor=1.0,
          roughness_factor=1.0, metallic_roughness=None, normal=None, normal_scale=1.0,
          occlusion=None, occlusion_strength=1.0, emissive=None, emissive_factor=(0.0, 0.0, 0.0),
-         wrap="repeat", screen_size=200.0, texture_size=0, padding=4, threads=0,
+         wrap="repeat", screen_size=200.0, texture_size=0, padding=None, threads=0,
          texels_per_pixel=2.0, envelope_d=3.0, normal_map=True, error_samples=20000,
-         progress=None, materials=None, triangle_material=None):
+         vertex_colors="auto", progress=None, materials=None, triangle_material=None):
     """Bakes ``input``'s appearance onto ``lod`` (a Mesh made from it at ``screen_size``):
     returns a Bake.
 
@@ -1238,7 +1241,10 @@ def bake(lod, input, uvs=None, base_color=None, *, uv_layout="vertex", normals=N
       sRGB-encoded, ``metallic_roughness`` (G roughness, B metallic), ``occlusion`` (R) and
       ``normal`` (tangent space) linear, as in glTF.
     - ``normals`` (n, 3), ``colors`` (n, 4 linear RGBA): optional per input vertex.
-    - ``texture_size``: 0 for the screen-size rule; ``threads``: 0 for the global setting.
+    - ``texture_size``: 0 for the screen-size rule; ``threads``: 0 for the global setting;
+      ``padding``: None for the library's gutter rule.
+    - ``vertex_colors``: "auto", "vertex" or "texture" — how ``colors`` without any image
+      are baked (auto: vertex colours when the screen size allows, else a texture).
     - ``progress(stage, fraction)``: return True to cancel (raises PleatError CANCELLED).
     - Several materials (``pleat_bake_lod_multi``): ``materials`` a list of dicts with the
       per-material keywords above (``base_color``, ``base_color_factor``, ..., ``wrap``) and
@@ -1262,8 +1268,13 @@ def bake(lod, input, uvs=None, base_color=None, *, uv_layout="vertex", normals=N
             keep.append(a)
             setattr(m, field, _ptr(a, _c.c_float))
     p = _lib.pleat_bake_params_default()
-    p.screen_size, p.texture_size, p.padding = float(screen_size), int(texture_size), \
-        int(padding)
+    p.screen_size, p.texture_size = float(screen_size), int(texture_size)
+    if padding is not None:
+        p.padding = int(padding)
+    if vertex_colors not in _VERTEX_COLORS:
+        raise PleatError(1, f"vertex_colors must be one of {sorted(_VERTEX_COLORS)}, "
+                            f"got {vertex_colors!r}")
+    p.vertex_colors = _VERTEX_COLORS[vertex_colors]
     p.threads, p.texels_per_pixel, p.envelope_d = int(threads), float(texels_per_pixel), \
         float(envelope_d)
     p.normal_map, p.error_samples = int(bool(normal_map)), int(error_samples)

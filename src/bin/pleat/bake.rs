@@ -5,7 +5,10 @@
 use std::path::Path;
 use std::process::ExitCode;
 
-use pleat::bake::{bake_chain, chain_glb, read_appearance, AtlasParams, BakeParams, BakedLevel};
+use pleat::bake::{
+    bake_chain, chain_glb_with_progress, read_appearance, AtlasParams, BakeParams, BakedLevel,
+    VertexColors,
+};
 
 use super::{failure_code, progress_bar, show_progress, BakeArgs, EXIT_FAILED, EXIT_INPUT};
 
@@ -21,6 +24,32 @@ pub struct TextureArgs {
     /// level's n_p, next power of two, 32..4096].
     #[arg(long, requires = "bake")]
     pub texture_size: Option<u32>,
+    /// How an input whose only colour is COLOR_0 (no texture) is baked: `auto` keeps vertex
+    /// colours when they are within the error the screen size allows, else bakes a texture;
+    /// `vertex` or `texture` force one.
+    #[arg(long, requires = "bake", value_enum, default_value_t = VertexColorsArg::Auto)]
+    pub vertex_colors: VertexColorsArg,
+}
+
+/// `--vertex-colors`: [`VertexColors`] on the command line.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VertexColorsArg {
+    /// Vertex colours when good enough for the screen size, else a texture.
+    Auto,
+    /// Always vertex colours.
+    Vertex,
+    /// Always a base-colour texture.
+    Texture,
+}
+
+impl From<VertexColorsArg> for VertexColors {
+    fn from(a: VertexColorsArg) -> Self {
+        match a {
+            VertexColorsArg::Auto => VertexColors::Auto,
+            VertexColorsArg::Vertex => VertexColors::Vertex,
+            VertexColorsArg::Texture => VertexColors::Texture,
+        }
+    }
 }
 
 /// Runs the textured bake; `cmd` names the subcommand in messages.
@@ -56,28 +85,33 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
             size: args.textures.texture_size,
             ..AtlasParams::default()
         },
+        vertex_colors: args.textures.vertex_colors.into(),
         ..BakeParams::default()
     };
     let bar = progress_bar(args.quiet);
     let mut prog = |p: pleat::Progress<'_>| show_progress(&bar, p);
     let result = bake_chain(&app, &args.screen_size, &lod_params, &params, &mut prog);
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
     let chain = match result {
         Ok(l) => l,
         Err(e) => {
+            if let Some(b) = &bar {
+                b.finish_and_clear();
+            }
             eprintln!("pleat {cmd}: {e}");
             return ExitCode::from(failure_code(&e));
         }
     };
     let levels = &chain.levels;
     let refs: Vec<&BakedLevel> = levels.iter().map(|l| &l.baked).collect();
-    let bytes = match chain_glb(&refs) {
+    let written = chain_glb_with_progress(&refs, &mut prog);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let (bytes, png_seconds) = match written {
         Ok(b) => b,
         Err(e) => {
             eprintln!("pleat {cmd}: {e}");
-            return ExitCode::from(EXIT_FAILED);
+            return ExitCode::from(failure_code(&e));
         }
     };
     if let Err(e) = std::fs::write(output, bytes) {
@@ -99,6 +133,17 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
                 r.appearance_error_p95,
                 r.total_seconds
             );
+            if let (Some(fit), Some(allowed)) = (r.vertex_fit_error, r.vertex_fit_allowed_error) {
+                println!(
+                    "  vertex colours: fit error {fit:.2} /255, the screen size allows \
+                     {allowed:.2}: {}",
+                    if r.texture_size > 0 {
+                        "baked a texture"
+                    } else {
+                        "kept vertex colours"
+                    }
+                );
+            }
             if r.overlapping_texels > 0 {
                 println!(
                     "  warning: {} texels where atlas charts overlap (xatlas left a folded chart)",
@@ -107,7 +152,7 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
             }
         }
         println!(
-            "geometry {:.2} s, bake {:.2} s; wrote {}",
+            "geometry {:.2} s, bake {:.2} s, png {png_seconds:.2} s; wrote {}",
             chain.geometry_seconds,
             chain.bake_seconds,
             output.display()
