@@ -561,7 +561,7 @@ fn texel_lut(srgb: bool) -> Vec<f32> {
 impl Appearance {
     /// The appearance of a mesh given as raw arrays (see [`AppearanceBuffers`]): one material,
     /// one UV set (per vertex or per corner), optional normals and vertex colours. The result
-    /// samples exactly like a glTF asset with the same data read by [`read_appearance`]; with
+    /// samples exactly like a glTF asset with the same data read by [`read_gltf_appearance`]; with
     /// per-corner UVs its mesh is the input unwelded (triangle `t` keeps its index, so
     /// provenance triangle indices refer to the caller's triangles either way).
     ///
@@ -746,28 +746,10 @@ fn buffer_material(
     })
 }
 
-/// Reads a file's appearance, by extension (case-insensitive): `.obj` through
-/// [`read_obj_appearance`](super::obj::read_obj_appearance) (OBJ + MTL), `.ply`, `.off` and
-/// `.stl` are refused (`InvalidArgument`: they carry no material), anything else is read as
-/// glTF/GLB (external buffers and images relative to its folder; see the
-/// [module docs](self)).
-pub fn read_appearance(path: &Path) -> Result<Appearance> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    match ext.as_str() {
-        "obj" => return super::obj::read_obj_appearance(path),
-        "ply" | "off" | "stl" => {
-            return Err(Error::InvalidArgument(format!(
-                "'{}': a .{ext} file has no materials to bake; textured bakes read glTF \
-                 (.glb, .gltf) or OBJ + MTL (.obj)",
-                path.display()
-            )))
-        }
-        _ => {}
-    }
+/// Reads a `.glb`/`.gltf` file's appearance (external buffers and images relative to its
+/// folder). See the [module docs](self); [`super::read_appearance`] picks the reader by
+/// extension.
+pub fn read_gltf_appearance(path: &Path) -> Result<Appearance> {
     let name = path.display().to_string();
     let data = std::fs::read(path).map_err(|e| crate::mesh::io::io_error(&name, &e))?;
     let base = path.parent().unwrap_or(Path::new("."));

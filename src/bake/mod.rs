@@ -29,7 +29,7 @@ pub mod provenance;
 pub mod render;
 
 pub use appearance::{
-    read_appearance, read_appearance_bytes, Appearance, AppearanceBuffers, BufferMaterial,
+    read_appearance_bytes, read_gltf_appearance, Appearance, AppearanceBuffers, BufferMaterial,
     ImageBuffer, MaterialSample, UvBuffer,
 };
 pub use atlas::{build_atlas, Atlas, AtlasParams};
@@ -41,7 +41,29 @@ pub use provenance::{provenance, InputIndex, Provenance, ProvenanceParams};
 
 use crate::lowpoly::LodParams;
 use crate::report::{Progress, ProgressFn};
+use crate::Error;
 use crate::Result;
+
+/// Reads a file's appearance, by extension (case-insensitive): `.obj` through
+/// [`read_obj_appearance`] (OBJ + MTL); `.ply`, `.off` and `.stl` are refused
+/// (`InvalidArgument`: they carry no material); anything else is read as glTF/GLB by
+/// [`read_gltf_appearance`].
+pub fn read_appearance(path: &std::path::Path) -> Result<Appearance> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match ext.as_str() {
+        "obj" => read_obj_appearance(path),
+        "ply" | "off" | "stl" => Err(Error::InvalidArgument(format!(
+            "'{}': a .{ext} file has no materials to bake; textured bakes read glTF (.glb, \
+             .gltf) or OBJ + MTL (.obj)",
+            path.display()
+        ))),
+        _ => read_gltf_appearance(path),
+    }
+}
 
 /// Share of [`bake_chain`]'s progress range given to the geometry (the bake gets the rest).
 pub const GEOMETRY_SHARE: f64 = 0.7;
