@@ -746,8 +746,9 @@ fn buffer_material(
     })
 }
 
-/// Reads a glTF/GLB file's appearance (external buffers and images relative to its folder; see
-/// the [module docs](self)). [`super::read_appearance`] dispatches here by extension.
+/// Reads a `.glb`/`.gltf` file's appearance (external buffers and images relative to its
+/// folder). See the [module docs](self); [`super::read_appearance`] picks the reader by
+/// extension.
 pub fn read_gltf_appearance(path: &Path) -> Result<Appearance> {
     let name = path.display().to_string();
     let data = std::fs::read(path).map_err(|e| crate::mesh::io::io_error(&name, &e))?;

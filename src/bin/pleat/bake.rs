@@ -1,6 +1,6 @@
-//! `pleat lod IN.glb --screen-size 50,100,200 --bake [--texture-size N] -o OUT.glb`: the LOD
-//! chain with the input's materials baked onto every level, written as one `.glb` linked with
-//! `MSFT_lod` (feature `bake`).
+//! `pleat lod IN.glb|IN.obj --screen-size 50,100,200 --bake [--texture-size N] -o OUT.glb`: the
+//! LOD chain with the input's materials (glTF, or OBJ + MTL) baked onto every level, written as
+//! one `.glb` linked with `MSFT_lod` (feature `bake`).
 
 use std::path::Path;
 use std::process::ExitCode;
@@ -16,8 +16,8 @@ use super::{failure_code, progress_bar, show_progress, BakeArgs, EXIT_FAILED, EX
 #[derive(clap::Args)]
 pub struct TextureArgs {
     /// Bake the input's materials (glTF: base colour, metallic-roughness, occlusion, emissive,
-    /// normal map; vertex colours when untextured) onto every level and write ONE .glb holding
-    /// the chain (MSFT_lod); the output needs no {np} placeholder.
+    /// normal map; OBJ + MTL: Kd, map_Kd; vertex colours when untextured) onto every level and
+    /// write ONE .glb holding the chain (MSFT_lod); the output needs no {np} placeholder.
     #[arg(long)]
     pub bake: bool,
     /// Side of the baked square textures in texels [default: 2 texels per screen pixel at the
