@@ -32,22 +32,22 @@ pub use appearance::{
     read_appearance_bytes, read_gltf_appearance, Appearance, AppearanceBuffers, BufferMaterial,
     ImageBuffer, MaterialSample, UvBuffer,
 };
-pub use atlas::{build_atlas, Atlas, AtlasParams};
-pub use bake::{bake_level, bake_level_with_progress, BakeParams};
+pub use atlas::{build_atlas, build_atlas_growing, Atlas, AtlasParams};
+pub use bake::{bake_level, bake_level_with_progress, BakeParams, VertexColors};
 pub use level::{BakeReport, BakedLevel, BakedMaterial, Image8};
 pub use obj::read_obj_appearance;
-pub use output::{chain_glb, screen_coverage};
+pub use output::{chain_glb, chain_glb_with_progress, screen_coverage};
 pub use provenance::{provenance, InputIndex, Provenance, ProvenanceParams};
 
 use crate::lowpoly::LodParams;
 use crate::report::{Progress, ProgressFn};
-use crate::Error;
 use crate::Result;
 
 /// Reads a file's appearance, by extension (case-insensitive): `.obj` through
-/// [`read_obj_appearance`] (OBJ + MTL); `.ply`, `.off` and `.stl` are refused
-/// (`InvalidArgument`: they carry no material); anything else is read as glTF/GLB by
-/// [`read_gltf_appearance`].
+/// [`obj::read_obj_appearance`] (OBJ + MTL), `.ply`, `.off` and `.stl` are refused
+/// (`InvalidArgument`: they carry no material), anything else is read as glTF/GLB by
+/// [`read_gltf_appearance`]. (Here, not in `appearance`, so that `obj` → `appearance` is the
+/// only edge between the two readers.)
 pub fn read_appearance(path: &std::path::Path) -> Result<Appearance> {
     let ext = path
         .extension()
@@ -55,10 +55,10 @@ pub fn read_appearance(path: &std::path::Path) -> Result<Appearance> {
         .unwrap_or("")
         .to_ascii_lowercase();
     match ext.as_str() {
-        "obj" => read_obj_appearance(path),
-        "ply" | "off" | "stl" => Err(Error::InvalidArgument(format!(
-            "'{}': a .{ext} file has no materials to bake; textured bakes read glTF (.glb, \
-             .gltf) or OBJ + MTL (.obj)",
+        "obj" => obj::read_obj_appearance(path),
+        "ply" | "off" | "stl" => Err(crate::Error::InvalidArgument(format!(
+            "'{}': a .{ext} file has no materials to bake; textured bakes read glTF \
+             (.glb, .gltf) or OBJ + MTL (.obj)",
             path.display()
         ))),
         _ => read_gltf_appearance(path),
@@ -89,7 +89,9 @@ pub struct BakedChain {
 }
 
 /// LODs of `app.mesh` at every screen size (`lowpoly::generate_chain`), each baked with
-/// [`bake_level`]. Levels are returned in the order of `screen_sizes`. `progress` sees the
+/// [`bake_level`]. Levels are returned in the order of `screen_sizes`. With one screen size and
+/// `lod_params.target_faces` set, the level is `lowpoly::generate` with that face target (a
+/// chain ignores face targets). `progress` sees the
 /// geometry stages in the first [`GEOMETRY_SHARE`] of the range, then each level's bake stages
 /// ([`bake_level_with_progress`]) in an equal share of the rest; returning `false` cancels
 /// with `Error::Cancelled` (within a texel chunk during the bake).
@@ -108,7 +110,19 @@ pub fn bake_chain(
                 fraction: GEOMETRY_SHARE * p.fraction,
             })
         };
-        crate::lowpoly::generate_chain(&app.mesh, screen_sizes, lod_params, &mut geometry)?
+        match (screen_sizes, lod_params.target_faces) {
+            // One level with a face target: the chain ignores targets (they are per level).
+            ([n_p], Some(_)) => {
+                let p = LodParams {
+                    screen_size: *n_p,
+                    ..lod_params.clone()
+                };
+                vec![crate::lowpoly::generate(&app.mesh, &p, &mut geometry)?]
+            }
+            _ => {
+                crate::lowpoly::generate_chain(&app.mesh, screen_sizes, lod_params, &mut geometry)?
+            }
+        }
     };
     let geometry_seconds = t.elapsed().as_secs_f64();
     let t = std::time::Instant::now();
