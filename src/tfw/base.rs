@@ -33,6 +33,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+use super::dense::{cross, dot, scale, sub};
 use crate::mesh::TriMesh;
 use crate::report::{Progress, ProgressFn};
 use crate::solve::{assemble, CholeskyAnalysis, Entry, Parallelism, ShiftSchedule};
@@ -835,26 +836,6 @@ fn normal_matrix(n: usize, rows: &[Vec<(u32, f64)>], areas: &[f64]) -> Vec<(u32,
 fn vec3(x: &[f64], v: u32) -> [f64; 3] {
     let i = 3 * v as usize;
     [x[i], x[i + 1], x[i + 2]]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// `skew(v) w = v × w`.

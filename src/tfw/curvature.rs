@@ -8,6 +8,7 @@
 //! sphere whose vertex normals are exact, needs no neighbourhood search, and its sign is
 //! irrelevant (κ enters squared). Quadric fitting remains the spec's default and is not written.
 
+use super::dense::{cross, dot, sub};
 use crate::mesh::TriMesh;
 use crate::tfw::wfree::FaceStrain;
 
@@ -63,20 +64,4 @@ pub fn tension_curvature(mesh: &TriMesh, strains: &[FaceStrain]) -> Vec<f64> {
             }
         })
         .collect()
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }

@@ -17,6 +17,7 @@
 //!
 //! Unknowns are numbered `[a_0 … a_{n−1}, ω_0 … ω_{m−1}]` (vertices, then edges).
 
+use super::dense::{dot, sub};
 use crate::mesh::TriMesh;
 use crate::tfw::dense::project_psd;
 use crate::tfw::material::{Form, Lame};
@@ -385,12 +386,4 @@ fn sv_norm2_sym(lame: &Lame, inv: Form, s: &[Jet; 3]) -> Jet {
     tr.mul(&tr)
         .scale(0.5 * lame.alpha)
         .add(&tr_m2.scale(lame.beta))
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }

@@ -22,6 +22,7 @@
 //!   Lagrangian) on one sparse Cholesky of `Q + μCᵀC` reaches the constraint to rounding in a
 //!   few solves instead. Edges of W faces only are 0.
 
+use super::dense::{dot, sub};
 use crate::mesh::TriMesh;
 use crate::solve::{assemble, CholeskyAnalysis, Entry, Parallelism};
 use crate::tfw::material::{principal_strains, Form};
@@ -493,12 +494,4 @@ pub fn helmholtz_projection(
         curl_residual: residual,
         solves,
     })
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
