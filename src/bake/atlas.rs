@@ -113,6 +113,9 @@ pub struct Atlas {
     /// Texel centres covered by two triangles that share no vertex (an overlap or fold in the
     /// parameterisation); 0 for a valid atlas. See [`overlapping_texels`].
     pub overlapping_texels: u64,
+    /// Gutter in texels between charts actually used: the requested padding, or less when
+    /// the charts could not be packed with it (see [`build_atlas_growing`]).
+    pub padding: u32,
 }
 
 /// Builds the atlas of `mesh` with side `side` (see [`AtlasParams::side`]) and `padding` texels
@@ -130,9 +133,12 @@ pub fn build_atlas(mesh: &TriMesh, side: u32, padding: u32) -> Result<Atlas> {
 /// [`build_atlas`] that may grow the side so the gutters do not eat the texel density: with
 /// `grow = Some((ρ, max_side))` (ρ the density rule's texels per unit length), once the
 /// charts are known the side doubles, up to `max_side`, while the density planned for them
-/// with their gutters ([`pack_density`]) is below `ρ / 2`. Small atlases need it: at 64² the
-/// 15-texel gutters of a handful of charts alone exceed the atlas. The returned
-/// [`Atlas::size`] is the side used.
+/// with their gutters ([`pack_density`]) is below `ρ / 2` or the gutters alone do not fit
+/// ([`gutters_fit`]). Small atlases need it: at 64² the 15-texel gutters of a handful of charts
+/// alone exceed the atlas, and a soup's LOD with thousands of charts needs it at any side
+/// the rule picks. The returned [`Atlas::size`] is the side used. When the charts still do
+/// not fit (no growth allowed, or the cap reached), the padding is halved until they do
+/// ([`Atlas::padding`] is the one used) instead of failing.
 pub fn build_atlas_growing(
     mesh: &TriMesh,
     side: u32,
@@ -149,17 +155,47 @@ pub fn build_atlas_growing(
         .collect();
     let indices: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
     let area = mesh.surface_area().max(f64::MIN_POSITIVE);
+    // Gutters are what a huge chart count cannot afford (a soup's LOD can have thousands of
+    // charts): when no packing fits at the requested padding, halve it rather than fail, and
+    // say so in `Atlas::padding` (the bake reports it; seams then hold to a shallower mip).
+    let mut pad = padding;
+    loop {
+        if let Some(a) = best_of_thresholds(&positions, &indices, area, side, pad, grow)? {
+            return Ok(a);
+        }
+        if pad == 0 {
+            break;
+        }
+        pad /= 2;
+    }
+    Err(Error::Internal(format!(
+        "xatlas could not pack the charts of {} triangles into one {side}² atlas, even without \
+         gutters",
+        mesh.triangle_count()
+    )))
+}
+
+/// The packed atlas with the fewest overlapping texels over xatlas chart thresholds (stopping
+/// at the first without overlaps); `None` when no threshold's charts fit one atlas.
+fn best_of_thresholds(
+    positions: &[f32],
+    indices: &[u32],
+    area: f64,
+    side: u32,
+    padding: u32,
+    grow: Option<(f64, u32)>,
+) -> Result<Option<Atlas>> {
     // xatlas (this version) can leave a chart whose LSCM boundary self-intersects; such
     // atlases are detected by rasterisation and recomputed with a lower chart-growth threshold
     // (smaller charts), keeping the one with the fewest overlaps.
     let mut best: Option<Atlas> = None;
     for threshold in [2.0f32, 1.0, 0.5, 0.25] {
-        let Some(mut a) =
-            charts_packed(&positions, &indices, area, side, padding, threshold, grow)?
+        let Some(mut a) = charts_packed(positions, indices, area, side, padding, threshold, grow)?
         else {
             continue;
         };
         a.overlapping_texels = overlapping_texels(&a);
+        a.padding = padding;
         let done = a.overlapping_texels == 0;
         if best
             .as_ref()
@@ -171,12 +207,7 @@ pub fn build_atlas_growing(
             break;
         }
     }
-    best.ok_or_else(|| {
-        Error::Internal(format!(
-            "xatlas could not pack the charts of {} triangles into one {side}² atlas",
-            mesh.triangle_count()
-        ))
-    })
+    Ok(best)
 }
 
 /// Fraction of the atlas the charts and their gutters are planned to cover (xatlas's packer
@@ -223,6 +254,22 @@ fn pack_density(area: f64, charts: u32, side: u32, padding: u32) -> f64 {
     x / area.max(f64::MIN_POSITIVE).sqrt()
 }
 
+/// Whether the gutters of `charts` charts alone (`4 g² charts` texels, `g = padding + 1`, see
+/// [`pack_density`]) leave room in the planned [`PACK_FILL`] of a `side`² atlas. When they do
+/// not, [`pack_density`]'s fallback density says nothing about fitting, so the side must grow.
+fn gutters_fit(charts: u32, side: u32, padding: u32) -> bool {
+    let g = f64::from(padding) + 1.0;
+    4.0 * g * g * f64::from(charts.max(1)) < PACK_FILL * f64::from(side) * f64::from(side)
+}
+
+/// False when `charts` charts certainly cannot share one `side`² atlas with `padding`-texel
+/// gutters: xatlas reserves at least `(1 + 1 + padding)²` texels per chart (one texel of
+/// extent, one of conservative rasterisation, the gutter), so the packing attempts are skipped.
+fn could_fit(charts: u32, side: u32, padding: u32) -> bool {
+    let per_chart = (u64::from(padding) + 2).pow(2);
+    u64::from(charts) * per_chart <= u64::from(side) * u64::from(side)
+}
+
 /// The side [`build_atlas_growing`] packs `charts` charts of total area `area` into: `side`
 /// doubled while [`pack_density`] is below half the rule's density and the side is below the
 /// cap.
@@ -231,7 +278,10 @@ fn grown_side(area: f64, charts: u32, side: u32, padding: u32, grow: Option<(f64
         return side;
     };
     let mut side = side;
-    while side < max_side && pack_density(area, charts, side, padding) < 0.5 * rho {
+    while side < max_side
+        && (!gutters_fit(charts, side, padding)
+            || pack_density(area, charts, side, padding) < 0.5 * rho)
+    {
         side = side.saturating_mul(2).min(max_side);
     }
     side
@@ -253,6 +303,9 @@ fn charts_packed(
     // SAFETY: `atlas` is live; ParameterizeCharts has set its chart count.
     let charts = unsafe { (*atlas.0).chart_count };
     let side = grown_side(area, charts, side, padding, grow);
+    if !could_fit(charts, side, padding) {
+        return Ok(None);
+    }
     let mut density = pack_density(area, charts, side, padding);
     for _ in 0..12 {
         match pack(&atlas, side, padding, density as f32)? {
@@ -457,6 +510,7 @@ unsafe fn copy_output(a: &ffi::RawAtlas, side: u32) -> Result<Option<Atlas>> {
         triangles: idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
         chart_count: a.chart_count,
         overlapping_texels: 0,
+        padding: 0,
     }))
 }
 
@@ -753,6 +807,50 @@ mod tests {
         assert_eq!(grown_side(area, 7, 64, 15, Some((rho, 64))), 64);
         assert_eq!(grown_side(area, 7, 64, 15, None), 64);
         assert_eq!(max_chart_size(4, 8), 1);
+    }
+
+    /// `n` disjoint unit squares (two triangles each) in a row: `n` charts.
+    fn squares(n: u32) -> TriMesh {
+        let mut p = Vec::new();
+        let mut t = Vec::new();
+        for i in 0..n {
+            let x = 2.0 * f64::from(i);
+            let b = 4 * i;
+            p.extend([
+                [x, 0.0, 0.0],
+                [x + 1.0, 0.0, 0.0],
+                [x + 1.0, 1.0, 0.0],
+                [x, 1.0, 0.0],
+            ]);
+            t.extend([[b, b + 1, b + 2], [b, b + 2, b + 3]]);
+        }
+        TriMesh::new(p, t).unwrap()
+    }
+
+    /// A soup's LOD can have thousands of charts whose 15-texel gutters alone exceed the atlas
+    /// the texel rule picks (the 6036-face LOD of `gen_tree_soup_sin` at n_p = 200 failed with
+    /// "xatlas could not pack the charts … into one 512² atlas"): the side grows until the
+    /// gutters fit, and without growth the padding shrinks instead of failing.
+    #[test]
+    fn thousands_of_charts_grow_the_side_or_shrink_the_gutter() {
+        assert!(!gutters_fit(150, 64, 15));
+        assert!(gutters_fit(150, 512, 15));
+        let g = grown_side(150.0, 150, 64, 15, Some((1.0, 4096)));
+        assert!(g >= 512 && gutters_fit(150, g, 15), "grew to {g}");
+        assert!(!could_fit(150, 64, 15) && could_fit(150, 64, 3));
+        let mesh = squares(150);
+        let grown = build_atlas_growing(&mesh, 64, 15, Some((1.0, 4096))).unwrap();
+        assert_eq!(grown.padding, 15);
+        assert!(grown.size >= 512);
+        assert_eq!(grown.overlapping_texels, 0);
+        let fixed = build_atlas(&mesh, 64, 15).unwrap();
+        assert_eq!(fixed.size, 64);
+        assert!(fixed.padding < 15, "padding {}", fixed.padding);
+        assert_eq!(fixed.overlapping_texels, 0);
+        let hi = fixed.uv.iter().flatten().fold(0.0f32, |m, &c| m.max(c));
+        assert!(hi <= 64.0, "UV {hi}");
+        // A few charts keep the requested gutter.
+        assert_eq!(build_atlas(&squares(3), 128, 15).unwrap().padding, 15);
     }
 
     /// The gutter rule: mip 2 for the default 2 texels per pixel, 15 texels of padding.

@@ -654,6 +654,7 @@ fn bake_textured(
     report.texture_size = side;
     report.charts = atlas.chart_count;
     report.overlapping_texels = atlas.overlapping_texels;
+    report.atlas_padding = atlas.padding;
 
     let lod_normals = vertex_normals(lod);
     let positions: Vec<[f64; 3]> = atlas

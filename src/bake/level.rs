@@ -31,6 +31,9 @@ pub struct BakeReport {
     /// Texel centres where two non-adjacent atlas triangles overlap (0 for a valid atlas;
     /// xatlas occasionally leaves a folded chart, see `atlas::overlapping_texels`).
     pub overlapping_texels: u64,
+    /// Gutter between charts in texels, as used: the requested padding unless the charts did
+    /// not fit with it (thousands of charts), then less, and seams hold to a shallower mip.
+    pub atlas_padding: u32,
     /// Fraction of samples whose provenance came from the closest-point fallback, in [0, 1].
     pub fallback_fraction: f64,
     /// Mean appearance error: |baked base colour − input base colour at the closest input

@@ -144,6 +144,14 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
                     }
                 );
             }
+            let requested_padding = params.atlas.padding;
+            if r.texture_size > 0 && r.atlas_padding < requested_padding {
+                println!(
+                    "  warning: {} charts needed a {}-texel gutter instead of {requested_padding} \
+                     (seams hold to a shallower mip level)",
+                    r.charts, r.atlas_padding
+                );
+            }
             if r.overlapping_texels > 0 {
                 println!(
                     "  warning: {} texels where atlas charts overlap (xatlas left a folded chart)",
