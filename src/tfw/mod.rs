@@ -59,6 +59,7 @@
 
 pub mod base;
 pub mod curvature;
+pub mod delaunay;
 mod dense;
 pub mod energy;
 pub mod material;
