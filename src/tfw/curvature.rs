@@ -1,12 +1,19 @@
 //! Normal curvature of the base surface along each face's tension (crest) direction, the `κ_f`
-//! of eq. 2.22.
+//! of eq. 2.22, by two estimators ([`CurvatureMethod`]):
 //!
-//! Departure from the spec (quadric fitting on a 5-ring, Panozzo 2010, S:2276): per face the
-//! second fundamental form is estimated from area-weighted vertex normals,
-//! `II ≈ −½(dn dxᵀ + dx dnᵀ)` in the face's barycentric frame (`dn(e_i) = n_i − n_0`), and
-//! `κ_f = tᵀ II t / tᵀ I t` with `t` the tension direction. It is exact on a sampled cylinder or
-//! sphere whose vertex normals are exact, needs no neighbourhood search, and its sign is
-//! irrelevant (κ enters squared). Quadric fitting remains the spec's default and is not written.
+//! - **Quadric fitting** (the spec's default, S:2276; R: `igl::principal_curvature`, 5 rings):
+//!   per vertex a graph `z = c0 x² + c1 xy + c2 y² + c3 x + c4 y` fitted by least squares to its
+//!   5-ring in the frame of its normal ([`quadric_fit`]); per face the fitted normal curvature
+//!   along `dr_b t` at its three corners, averaged ([`tension_curvature_quadric`]).
+//! - **Vertex normals** ([`tension_curvature`]): per face the second fundamental form from
+//!   area-weighted vertex normals, `II ≈ −½(dn dxᵀ + dx dnᵀ)` in the face's barycentric frame
+//!   (`dn(e_i) = n_i − n_0`), and `κ_f = tᵀ II t / tᵀ I t`. Exact on a sampled cylinder or
+//!   sphere whose vertex normals are exact; local (no neighbourhood search).
+//!
+//! Sign irrelevant (κ enters squared). Note (measured on the twisted cylinder, README): on a
+//! converged tension-field base without pressure, `κ_f ≈ 0` wherever there is tension, by the
+//! membrane's normal equilibrium `σ : II = p` with the uniaxial stress `σ = T t tᵀ` (`T κ_t =
+//! p = 0`); both estimators find |κ| ≈ 0.02–0.03 m⁻¹ there, so W_s² is weak on such bases.
 
 use super::dense::{cross, dot, sub};
 use crate::mesh::TriMesh;

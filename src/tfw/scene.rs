@@ -541,6 +541,63 @@ impl Scene {
     }
 }
 
+impl Scene {
+    /// The sheared rectangle of S:730 (Wong & Pellegrino 2006, "Wrinkled membranes Part I:
+    /// experiments", J. Mech. Mater. Struct. 1(1)): a 380 × 128 mm Kapton HN foil, 25 µm
+    /// thick, E 3.53 GPa, ν 0.3 (the dimensions and material the spec takes from that paper;
+    /// the dissertation gives none of them), on an irregular Delaunay mesh of about
+    /// `target_vertices` vertices. The bottom edge is clamped; the top edge is clamped and
+    /// moved by `shear_mm` (mm) along the long side (x) and by `stretch_mm` (mm) away from
+    /// the bottom edge (a small pre-tension; 0 = pure shear). The sides are free.
+    pub fn sheared_rectangle(
+        target_vertices: usize,
+        shear_mm: f64,
+        stretch_mm: f64,
+        seed: u64,
+    ) -> Result<Scene> {
+        let (w, h) = (0.38, 0.128);
+        let panel = Panel::from_polygon(&PolygonPanel {
+            outer: vec![[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]],
+            holes: vec![],
+            target_vertices,
+            seed,
+        })?;
+        let bottom = panel.vertices_in_rest_box([0.0, 0.0], [w, 0.0]);
+        let top = panel.vertices_in_rest_box([0.0, h], [w, h]);
+        Ok(Scene {
+            name: format!(
+                "sheared rectangle (Wong-Pellegrino), {target_vertices} v (seed {seed}), \
+                 shear {shear_mm} mm, stretch {stretch_mm} mm"
+            ),
+            material: Material {
+                young: 3.53e9,
+                poisson: 0.3,
+                thickness: 25e-6,
+                density: 0.0,
+            },
+            panels: vec![panel],
+            gravity: [0.0; 3],
+            pressure: 0.0,
+            dirichlet: vec![
+                Dirichlet {
+                    panel: 0,
+                    vertices: bottom,
+                    motion: Motion::default(),
+                },
+                Dirichlet {
+                    panel: 0,
+                    vertices: top,
+                    motion: Motion {
+                        translation: [shear_mm / 1000.0, stretch_mm / 1000.0, 0.0],
+                        rotation: None,
+                    },
+                },
+            ],
+            seam_tolerance: 1e-9,
+        })
+    }
+}
+
 /// The cylinder scene around a rolled panel of the `2πr × hgt` pattern: bottom ring (rest
 /// v = 0) clamped, top ring (v = hgt) rotated about the z axis, height fixed.
 fn twisted_cylinder_scene(
