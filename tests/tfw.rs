@@ -1507,14 +1507,18 @@ mod curvature_check {
                 })
                 .collect();
             let want = th.cos().powi(2);
-            for (name, k) in [
-                ("normals", tension_curvature(&base, &s)),
-                ("quadric", tension_curvature_quadric(&base, &s, 5)),
+            // the 5-ring fit (the spec's and R's default) spans ±42° of this 43-around
+            // cylinder, where a circle is no parabola: it overestimates 1/r by ~12%
+            // (z = 1 − √(1 − x²) ≈ x²/2 + x⁴/8); the 2-ring fit by ~2%
+            for (name, k, tol) in [
+                ("normals", tension_curvature(&base, &s), 0.05),
+                ("quadric 2", tension_curvature_quadric(&base, &s, 2), 0.05),
+                ("quadric 5", tension_curvature_quadric(&base, &s, 5), 0.15),
             ] {
                 let mean = k.iter().map(|x| x.abs()).sum::<f64>() / k.len() as f64;
                 eprintln!("{name}, θ {theta_deg}: mean |κ| {mean} (want {want})");
                 assert!(
-                    (mean - want).abs() < 0.05,
+                    (mean - want).abs() < tol * want.max(0.05) + 0.01,
                     "{name}, θ {theta_deg}: {mean} vs {want}"
                 );
             }
