@@ -1574,13 +1574,17 @@ mod sheared_rectangle_check {
         let (ev, _) = r.cwf.evaluate(3, &opts).unwrap();
         let (wrinkles, peak) = mid_line_wrinkles(&ev.mesh, 0.064);
         eprintln!(
-            "{}: {:?} / {:?} in {} it, base {:.2}s, sqp {:.2}s; wrinkles on the mid line \
-             {wrinkles}, peak |z| {:.3} mm, {} of {} faces in W",
+            "{}: {:?} / {:?} in {} it, base {:.2}s ({:?}, {} Newton it, relative gradient \
+             {:.1e}), sqp {:.2}s; wrinkles on the mid line {wrinkles}, peak |z| {:.3} mm, \
+             {} of {} faces in W",
             scene.name,
             r.status,
             sqp.status,
             sqp.history.len(),
             r.seconds.base,
+            r.base.status,
+            r.base.history.len(),
+            r.base.relative_gradient,
             r.seconds.sqp,
             peak * 1e3,
             r.w_faces.iter().filter(|&&w| w).count(),
