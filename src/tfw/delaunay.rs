@@ -70,7 +70,11 @@ pub fn mesh_polygon(panel: &PolygonPanel) -> Result<PanelMesh> {
     if area <= 0.0 {
         return Err(bad("holes cover the outer polygon"));
     }
-    let (d, points, ring_counts) = sample_to_target(&rings, area, panel)?;
+    let Sampling {
+        spacing: d,
+        points,
+        ring_counts,
+    } = sample_to_target(&rings, area, panel)?;
     let triangles = constrained_delaunay(&rings, &points, &ring_counts)?;
     let boundary_count = ring_counts.iter().sum();
     Ok(PanelMesh {
@@ -285,12 +289,15 @@ fn sample(rings: &[&[[f64; 2]]], d: f64, target: usize, seed: u64) -> (Vec<[f64;
     (pts, ring_counts)
 }
 
+/// The samples at one spacing: boundary samples first (ring by ring), then the interior.
+struct Sampling {
+    spacing: f64,
+    points: Vec<[f64; 2]>,
+    ring_counts: Vec<usize>,
+}
+
 /// Bisection on `log d` for the vertex count closest to the target (step 3).
-fn sample_to_target(
-    rings: &[&[[f64; 2]]],
-    area: f64,
-    panel: &PolygonPanel,
-) -> Result<(f64, Vec<[f64; 2]>, Vec<usize>)> {
+fn sample_to_target(rings: &[&[[f64; 2]]], area: f64, panel: &PolygonPanel) -> Result<Sampling> {
     let target = panel.target_vertices;
     let d0 = (area / target as f64).sqrt();
     let perimeter: f64 = rings
@@ -305,13 +312,20 @@ fn sample_to_target(
         })
         .sum();
     let (mut lo, mut hi) = ((0.2 * d0).ln(), (5.0 * d0).max(perimeter).ln());
-    let mut best: Option<(usize, f64, Vec<[f64; 2]>, Vec<usize>)> = None;
+    let mut best: Option<(usize, Sampling)> = None;
     for _ in 0..40 {
         let d = (0.5 * (lo + hi)).exp();
         let (pts, counts) = sample(rings, d, target, panel.seed);
         let err = pts.len().abs_diff(target);
         if best.as_ref().is_none_or(|b| err < b.0) {
-            best = Some((err, d, pts.clone(), counts));
+            best = Some((
+                err,
+                Sampling {
+                    spacing: d,
+                    points: pts.clone(),
+                    ring_counts: counts,
+                },
+            ));
         }
         if pts.len() > target {
             lo = d.ln();
@@ -322,8 +336,7 @@ fn sample_to_target(
             break;
         }
     }
-    let (_, d, pts, counts) = best.ok_or_else(|| bad("sampling failed"))?;
-    Ok((d, pts, counts))
+    best.map(|b| b.1).ok_or_else(|| bad("sampling failed"))
 }
 
 /// The constraint edges `(min, max)` of the boundary rings, sorted.
