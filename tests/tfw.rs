@@ -1113,6 +1113,94 @@ mod wrinkle_sqp {
         let got = Scene::from_json_file(&path).unwrap();
         assert_eq!(got.to_json_string(), want);
     }
+
+    /// The shipped cylinder scene (a polygon panel meshed at load time, Dirichlet rings by
+    /// `rest_box`) is the built-in Delaunay cylinder.
+    #[test]
+    fn shipped_twisted_cylinder_scene_matches_the_builtin() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples/tfw/twisted_cylinder.json");
+        let mut got = Scene::from_json_file(&path).unwrap();
+        let want = Scene::twisted_cylinder_delaunay(720, 10.0, 1).unwrap();
+        got.name = want.name.clone();
+        assert_eq!(got, want);
+        let model = got.assemble().unwrap();
+        let n = model.positions.len();
+        assert!((650..=760).contains(&n), "{n} vertices after sewing");
+        // both rings clamped, the seam sewn: a closed tube has as many boundary vertices as
+        // clamped ones
+        assert_eq!(model.clamps.len(), 2 * want.dirichlet[0].vertices.len() - 2);
+        // the parsed-and-written scene reads back to the same model
+        let again = Scene::from_json_str(&got.to_json_string()).unwrap();
+        assert_eq!(again.assemble().unwrap().triangles, model.triangles);
+    }
+
+    /// The shipped sheared rectangle is the built-in one (3 mm shear, no pre-stretch).
+    #[test]
+    fn shipped_sheared_rectangle_scene_matches_the_builtin() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples/tfw/sheared_rectangle.json");
+        let mut got = Scene::from_json_file(&path).unwrap();
+        let want = Scene::sheared_rectangle(1000, 3.0, 0.0, 1).unwrap();
+        got.name = want.name.clone();
+        assert_eq!(got, want);
+        let n = got.panels[0].rest.len();
+        assert!((900..=1100).contains(&n), "{n} vertices");
+    }
+
+    /// Polygon panels: errors name the field.
+    #[test]
+    fn polygon_panel_errors_name_the_field() {
+        let base = |panel: &str, dir: &str| {
+            format!(
+                r#"{{"material": {{"young": 1e6, "poisson": 0.3, "thickness": 1e-4}},
+                    "panels": [{panel}], "dirichlet": [{dir}]}}"#
+            )
+        };
+        let ok = r#"{"polygon": [[0,0],[1,0],[1,1],[0,1]], "target_vertices": 50}"#;
+        let s =
+            Scene::from_json_str(&base(ok, r#"{"panel": 0, "rest_box": [[0,0],[1,0]]}"#)).unwrap();
+        assert!((45..=55).contains(&s.panels[0].rest.len()));
+        assert!(s.dirichlet[0].vertices.len() >= 2);
+        for (panel, dir, want) in [
+            (
+                r#"{"polygon": [[0,0],[1,0],[1,1]], "target_vertices": 50, "rest": []}"#,
+                "",
+                "panels[0].rest",
+            ),
+            (
+                r#"{"polygon": [[0,0],[1,0],[1,1]]}"#,
+                "",
+                "panels[0].target_vertices",
+            ),
+            (
+                r#"{"polygon": [[0,0],[1,0]], "target_vertices": 50}"#,
+                "",
+                "panels[0]: polygon panel: polygon",
+            ),
+            (
+                r#"{"rest": [[0,0],[1,0],[0,1]], "triangles": [[0,1,2]], "seed": 3}"#,
+                "",
+                "panels[0].seed",
+            ),
+            (
+                ok,
+                r#"{"panel": 0, "rest_box": [[5,5],[6,6]]}"#,
+                "dirichlet[0].rest_box",
+            ),
+            (ok, r#"{"panel": 0}"#, "dirichlet[0].vertices"),
+            (
+                r#"{"polygon": [[0,0],[1,0],[1,1]], "target_vertices": 50, "roll_radius": -1}"#,
+                "",
+                "panels[0].roll_radius",
+            ),
+        ] {
+            let e = Scene::from_json_str(&base(panel, dir))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(want), "{e} should name {want}");
+        }
+    }
 }
 
 mod stretched_sheet_check {
@@ -1212,32 +1300,66 @@ mod stretched_sheet_check {
 
 mod twisted_cylinder_check {
     use super::*;
-    use pleat::tfw::{solve, SqpOptions, TfwParams};
+    use pleat::tfw::{solve, TfwParams};
     use pleat::wrinkle::EvalOptions;
 
-    /// Issue 13's twisted cylinder (r 1 m, height 5 m, h 0.1 mm, ν 0.44, Y 10 MPa, 10°, 688
-    /// vertices): expected 46 ± 5 waves around the mid-height ring. Counter: sign changes of
-    /// `Re z` where the evaluated mesh (2 levels) crosses the plane z = 2.5, sorted by angle.
-    /// Report only (ignored, slow): `cargo test --test tfw twisted_cylinder_waves -- --ignored
-    /// --nocapture`.
-    #[test]
-    #[ignore]
-    fn twisted_cylinder_waves() {
-        let scene = Scene::twisted_cylinder(43, 16, 10.0);
-        let params = TfwParams {
-            sqp: SqpOptions {
-                max_iterations: 300,
-                ..SqpOptions::default()
-            },
-            ..TfwParams::default()
-        };
-        let r = solve(&scene, &params, &mut no_progress()).unwrap();
-        let sqp = r.sqp.as_ref().unwrap();
+    /// Base-surface measurements on the mid-height ring (|z − 2.5| ≤ 0.25 m): mean radius,
+    /// mean angle between the tension direction and the axis (degrees), mean |κ| along it,
+    /// mean λ_t and λ_c.
+    pub struct MidRing {
+        pub radius: f64,
+        pub tension_angle_deg: f64,
+        pub kappa: f64,
+        pub lambda_t: f64,
+        pub lambda_c: f64,
+    }
+
+    pub fn mid_ring(r: &pleat::tfw::TfwResult, model: &Model) -> MidRing {
+        use pleat::tfw::wfree::face_strains;
+        let mesh = &r.base.mesh;
+        let p = mesh.positions();
+        let near = |z: f64| (z - 2.5).abs() <= 0.25;
+        let ring_v: Vec<f64> = p
+            .iter()
+            .filter(|q| near(q[2]))
+            .map(|q| q[0].hypot(q[1]))
+            .collect();
+        let strains = face_strains(&model.rest_forms, mesh);
+        let (mut n, mut ang, mut kap, mut lt, mut lc) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for (f, t) in mesh.triangles().iter().enumerate() {
+            let c = t.map(|v| p[v as usize]);
+            if !near((c[0][2] + c[1][2] + c[2][2]) / 3.0) {
+                continue;
+            }
+            let w = strains[f].tension_dir;
+            let d: Vec<f64> = (0..3)
+                .map(|k| (c[1][k] - c[0][k]) * w[0] + (c[2][k] - c[0][k]) * w[1])
+                .collect();
+            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            ang += (d[2].abs() / len).acos().to_degrees();
+            kap += r.curvature[f].abs();
+            lt += strains[f].lambda_t;
+            lc += strains[f].lambda_c;
+            n += 1.0;
+        }
+        MidRing {
+            radius: ring_v.iter().sum::<f64>() / ring_v.len() as f64,
+            tension_angle_deg: ang / n,
+            kappa: kap / n,
+            lambda_t: lt / n,
+            lambda_c: lc / n,
+        }
+    }
+
+    /// Waves around the mid-height ring: sign changes of `Re z` where the evaluated mesh
+    /// (2 Loop levels) crosses the plane z = 2.5, sorted by angle, values below 1% of the
+    /// peak ignored; waves = crossings / 2.
+    pub fn mid_ring_waves(cwf: &pleat::wrinkle::Cwf) -> f64 {
         let opts = EvalOptions {
             want_z: true,
             ..EvalOptions::default()
         };
-        let (ev, _) = r.cwf.evaluate(2, &opts).unwrap();
+        let (ev, _) = cwf.evaluate(2, &opts).unwrap();
         let z = ev.z.as_ref().unwrap();
         let x = ev.smooth_positions.as_ref().unwrap();
         let mut pts: Vec<(f64, f64)> = Vec::new();
@@ -1264,30 +1386,94 @@ mod twisted_cylinder_check {
         if signs.len() > 1 && signs[0] != signs[signs.len() - 1] {
             crossings += 1; // closing the ring
         }
+        crossings as f64 / 2.0
+    }
+
+    /// Solves `scene` and prints the base measurements and the wave count; returns the count.
+    pub fn report(scene: &Scene, params: &TfwParams) -> f64 {
+        let model = scene.assemble().unwrap();
+        let r = solve(scene, params, &mut no_progress()).unwrap();
+        let sqp = r.sqp.as_ref().unwrap();
+        let ring = mid_ring(&r, &model);
+        let waves = mid_ring_waves(&r.cwf);
+        for (k, it) in sqp.history.iter().enumerate() {
+            if k % 50 == 0 || k + 1 == sqp.history.len() {
+                eprintln!(
+                    "  it {k}: E {:.6e}, r/r0 {:.2e}, step {:.2e}, t {:.2}, {:.1}s",
+                    it.energy,
+                    it.stationarity / sqp.initial_stationarity,
+                    it.step_norm,
+                    it.step_length,
+                    it.seconds
+                );
+            }
+        }
         let max_a = r.cwf.amplitude().iter().fold(0.0f64, |m, &a| m.max(a));
         eprintln!(
-            "cylinder 688 v: {:?} / {:?} in {} it, base {:.2}s, sqp {:.2}s (qp {:.2}s); \
-             waves around the mid ring {}, max a {:.3} mm, {} of {} faces in W, \
-             |κ| mean {:.3}",
+            "{} ({} v): {:?} / {:?} in {} it, base {:.2}s ({:?}), sqp {:.2}s (qp {:.2}s); \
+             mid ring: radius {:.4} m, tension {:.1}° from the axis, |κ| {:.4} 1/m, \
+             λ_t {:.4}, λ_c {:.4}; waves around the mid ring {waves}, max a {:.3} mm, \
+             {} of {} faces in W",
+            scene.name,
+            model.positions.len(),
             r.status,
             sqp.status,
             sqp.history.len(),
             r.seconds.base,
+            r.base.status,
             r.seconds.sqp,
             sqp.qp_seconds,
-            crossings as f64 / 2.0,
+            ring.radius,
+            ring.tension_angle_deg,
+            ring.kappa,
+            ring.lambda_t,
+            ring.lambda_c,
             max_a * 1e3,
             r.w_faces.iter().filter(|&&w| w).count(),
-            r.w_faces.len(),
-            r.curvature.iter().map(|k| k.abs()).sum::<f64>() / r.curvature.len() as f64
+            r.w_faces.len()
         );
+        waves
+    }
+
+    /// Measurements (report only): `PLEAT_CYL_TARGET` (default 720) vertices, curvature
+    /// method `PLEAT_CYL_KAPPA` (`normals` or `quadric`), `PLEAT_CYL_ITERS` SQP iterations.
+    #[test]
+    #[ignore]
+    fn twisted_cylinder_measure() {
+        use pleat::tfw::curvature::CurvatureMethod;
+        let env = |k: &str, d: &str| std::env::var(k).unwrap_or_else(|_| d.to_string());
+        let target: usize = env("PLEAT_CYL_TARGET", "720").parse().unwrap();
+        let iters: usize = env("PLEAT_CYL_ITERS", "1000").parse().unwrap();
+        let mut params = TfwParams::default();
+        params.sqp.max_iterations = iters;
+        params.curvature = match env("PLEAT_CYL_KAPPA", "quadric").as_str() {
+            "normals" => CurvatureMethod::VertexNormals,
+            _ => CurvatureMethod::QuadricFit,
+        };
+        let scene = Scene::twisted_cylinder_delaunay(target, 10.0, 1).unwrap();
+        report(&scene, &params);
+    }
+
+    /// Issue 13's twisted cylinder (r 1 m, height 5 m, h 0.1 mm, ν 0.44, Y 10 MPa, 10°) on
+    /// irregular Delaunay meshes of ~700 and ~1300 vertices: expected 46 ± 5 waves around the
+    /// mid-height ring ([`mid_ring_waves`]). Slow (ignored): `cargo test --release --test tfw
+    /// twisted_cylinder_waves -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn twisted_cylinder_waves() {
+        let params = TfwParams::default();
+        for target in [720, 1330] {
+            let scene = Scene::twisted_cylinder_delaunay(target, 10.0, 1).unwrap();
+            let waves = report(&scene, &params);
+            assert!((41.0..=51.0).contains(&waves), "{waves} waves");
+        }
     }
 }
 
 mod curvature_check {
     use super::*;
     use pleat::mesh::TriMesh;
-    use pleat::tfw::curvature::tension_curvature;
+    use pleat::tfw::curvature::{tension_curvature, tension_curvature_quadric};
     use pleat::tfw::wfree::{face_strains, FaceStrain};
 
     /// On the untwisted cylinder (r = 1), the normal curvature along the circumferential
@@ -1320,14 +1506,90 @@ mod curvature_check {
                     }
                 })
                 .collect();
-            let k = tension_curvature(&base, &s);
-            let mean = k.iter().map(|x| x.abs()).sum::<f64>() / k.len() as f64;
             let want = th.cos().powi(2);
-            eprintln!("θ {theta_deg}: mean |κ| {mean} (want {want})");
-            assert!(
-                (mean - want).abs() < 0.05,
-                "θ {theta_deg}: {mean} vs {want}"
-            );
+            // the 5-ring fit (the spec's and R's default) spans ±42° of this 43-around
+            // cylinder, where a circle is no parabola: it overestimates 1/r by ~12%
+            // (z = 1 − √(1 − x²) ≈ x²/2 + x⁴/8); the 2-ring fit by ~2%
+            for (name, k, tol) in [
+                ("normals", tension_curvature(&base, &s), 0.05),
+                ("quadric 2", tension_curvature_quadric(&base, &s, 2), 0.05),
+                ("quadric 5", tension_curvature_quadric(&base, &s, 5), 0.15),
+            ] {
+                let mean = k.iter().map(|x| x.abs()).sum::<f64>() / k.len() as f64;
+                eprintln!("{name}, θ {theta_deg}: mean |κ| {mean} (want {want})");
+                assert!(
+                    (mean - want).abs() < tol * want.max(0.05) + 0.01,
+                    "{name}, θ {theta_deg}: {mean} vs {want}"
+                );
+            }
         }
+    }
+}
+
+mod sheared_rectangle_check {
+    use super::*;
+    use pleat::tfw::{solve, TfwParams};
+    use pleat::wrinkle::EvalOptions;
+
+    /// Wrinkles across the horizontal mid-line (y = 64 mm) of the evaluated mesh (3 Loop
+    /// levels, v2 on): sign changes of z (the base stays in z = 0) sorted by x, values below
+    /// 1% of the peak ignored; wrinkles = crossings / 2.
+    fn mid_line_wrinkles(mesh: &pleat::mesh::TriMesh, y0: f64) -> (f64, f64) {
+        let p = mesh.positions();
+        let mut pts = Vec::new();
+        for t in mesh.triangles() {
+            for k in 0..3 {
+                let (a, b) = (p[t[k] as usize], p[t[(k + 1) % 3] as usize]);
+                if (a[1] < y0) != (b[1] < y0) {
+                    let s = (y0 - a[1]) / (b[1] - a[1]);
+                    pts.push((a[0] + s * (b[0] - a[0]), a[2] + s * (b[2] - a[2])));
+                }
+            }
+        }
+        pts.sort_by(|p, q| p.0.total_cmp(&q.0));
+        let peak = pts.iter().fold(0.0f64, |m, p| m.max(p.1.abs()));
+        let signs: Vec<bool> = pts
+            .iter()
+            .filter(|p| p.1.abs() >= 0.01 * peak)
+            .map(|p| p.1 > 0.0)
+            .collect();
+        let crossings = signs.windows(2).filter(|w| w[0] != w[1]).count();
+        (crossings as f64 / 2.0, peak)
+    }
+
+    /// The Wong–Pellegrino sheared rectangle ([`Scene::sheared_rectangle`]: 380 × 128 mm,
+    /// 25 µm Kapton, 3 mm shear, ~1k vertices): issue 13 expects 25 ± 6 wrinkles (experiment
+    /// 19, the dissertation 25). Slow (ignored): `cargo test --release --test tfw
+    /// sheared_rectangle_wrinkles -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn sheared_rectangle_wrinkles() {
+        let scene = Scene::sheared_rectangle(1000, 3.0, 0.0, 1).unwrap();
+        let r = solve(&scene, &TfwParams::default(), &mut no_progress()).unwrap();
+        let sqp = r.sqp.as_ref().unwrap();
+        let opts = EvalOptions {
+            in_plane_v2: true,
+            ..EvalOptions::default()
+        };
+        let (ev, _) = r.cwf.evaluate(3, &opts).unwrap();
+        let (wrinkles, peak) = mid_line_wrinkles(&ev.mesh, 0.064);
+        eprintln!(
+            "{}: {:?} / {:?} in {} it, base {:.2}s ({:?}, {} Newton it, relative gradient \
+             {:.1e}), sqp {:.2}s; wrinkles on the mid line {wrinkles}, peak |z| {:.3} mm, \
+             {} of {} faces in W",
+            scene.name,
+            r.status,
+            sqp.status,
+            sqp.history.len(),
+            r.seconds.base,
+            r.base.status,
+            r.base.history.len(),
+            r.base.relative_gradient,
+            r.seconds.sqp,
+            peak * 1e3,
+            r.w_faces.iter().filter(|&&w| w).count(),
+            r.w_faces.len()
+        );
+        assert!((19.0..=31.0).contains(&wrinkles), "{wrinkles} wrinkles");
     }
 }

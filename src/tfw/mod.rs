@@ -19,7 +19,12 @@
 //!   combing, vertex amplitudes, Helmholtz projection to a one-form on pleat's edges that is
 //!   curl-free on every non-W face).
 //!
-//! - [`curvature`]: the normal curvature `κ_f` along each face's tension direction (eq. 2.22).
+//! - [`curvature`]: the normal curvature `κ_f` along each face's tension direction (eq. 2.22),
+//!   by quadric fitting on 5 rings (default) or from vertex normals.
+//! - [`delaunay`]: irregular Delaunay meshing of a polygon panel (holes allowed) to a target
+//!   vertex count (A.6.1): boundary samples (equal samples on equal edges, so seams match),
+//!   Poisson-disk interior, spade's constrained Delaunay triangulation. Scene files ask for
+//!   it with a `polygon` panel and `target_vertices` ([`scene`]).
 //! - [`energy`]: the wrinkle energy `E^wf` (2.20–2.27, 3-point rule of A.7) on vertex
 //!   amplitudes and the edge one-form, with its exact gradient and sparse Hessian.
 //! - [`sqp`]: the wrinkle SQP of A.6.3 (clarabel QP per iteration, `a ≥ 0`, `curl ω = 0` off W,
@@ -28,13 +33,13 @@
 //!   phase), with a report; the wrinkled mesh comes from [`crate::wrinkle::Cwf::evaluate`]
 //!   with [`crate::wrinkle::EvalOptions::in_plane_v2`] (the v2 term of eq. 2.19).
 //!
-//! **Not implemented yet**: irregular Delaunay meshing of panels (spade), obstacles, curvature
-//! by quadric fitting, period snapping on non-contractible loops, the C API and benchmarks.
+//! **Not implemented yet**: obstacles, period snapping on non-contractible loops.
 //!
 //! **Departures from the spec, and why:**
-//! - Built-in scenes use structured grids with alternating diagonals and jittered interior
-//!   vertices (±20% of the spacing) instead of Delaunay meshes (not written yet); the jitter
-//!   breaks the grid's direction bias that S:698 warns about, but is not a substitute.
+//! - The built-in stretched sheet and [`Scene::twisted_cylinder`] use structured grids with
+//!   alternating diagonals and jittered interior vertices (±20% of the spacing);
+//!   [`Scene::twisted_cylinder_delaunay`] and `polygon` panels in scene files are irregular
+//!   Delaunay meshes ([`delaunay`]), as the spec asks.
 //! - Hessian regularization: instead of `reg·I` doubled from 1e-8, the crate's
 //!   `factor_with_growing_shift` adds `σI` with σ from `1e-10·mean|H_ii|` (or a tenth of the
 //!   last σ needed) growing ×10: relative to the Hessian's scale, so the same for SI and
@@ -50,7 +55,6 @@
 //!   an absolute 1e-8, so it does not depend on units.
 //! - Sign combing compares the faces' wave vectors embedded in 3D on the base surface (the
 //!   transport between neighbouring faces is the base embedding).
-//! - `κ_f` from vertex normals instead of quadric fitting ([`curvature`]).
 //! - SQP: the per-face PSD projection is applied to each face's whole 5×5 block (all terms
 //!   together: closer to the true Hessian than projecting stretching and bending separately);
 //!   no switch to the true Hessian near the optimum; candidates are made exactly feasible
@@ -59,6 +63,7 @@
 
 pub mod base;
 pub mod curvature;
+pub mod delaunay;
 mod dense;
 pub mod energy;
 pub mod material;

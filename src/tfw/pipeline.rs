@@ -6,7 +6,7 @@
 use crate::mesh::TriMesh;
 use crate::report::{Progress, ProgressFn};
 use crate::tfw::base::{solve_base, BaseOptions, BaseResult, BaseStatus};
-use crate::tfw::curvature::tension_curvature;
+use crate::tfw::curvature::{tension_curvature_by, CurvatureMethod};
 use crate::tfw::energy::{WfTerms, WrinkleEnergy};
 use crate::tfw::scene::Scene;
 use crate::tfw::sqp::{run_sqp, SqpOptions, SqpProblem, SqpResult, SqpStatus};
@@ -28,6 +28,8 @@ pub struct TfwParams {
     pub initial_amplitude: Option<f64>,
     /// The wrinkle SQP.
     pub sqp: SqpOptions,
+    /// How the curvature `κ_f` along the tension direction (eq. 2.22) is estimated.
+    pub curvature: CurvatureMethod,
     /// The phase solve of the output `Cwf`.
     pub knoppel: KnoppelOptions,
     /// Rest-area fraction of slack faces above which the scene is out of scope (S:588;
@@ -42,6 +44,7 @@ impl Default for TfwParams {
             w_rule: WRule::Text,
             initial_amplitude: None,
             sqp: SqpOptions::default(),
+            curvature: CurvatureMethod::default(),
             knoppel: KnoppelOptions::default(),
             out_of_scope_slack_fraction: 0.5,
         }
@@ -144,7 +147,7 @@ pub fn solve(
     let strains = face_strains(&model.rest_forms, &mesh);
     let lc: Vec<f64> = strains.iter().map(|s| s.lambda_c).collect();
     let w_faces = wrinkle_free_faces(&model.triangles, &lc, params.w_rule);
-    let curvature = tension_curvature(&mesh, &strains);
+    let curvature = tension_curvature_by(&mesh, &strains, params.curvature);
     let mut clamped = vec![false; nv];
     for &(v, _) in &model.clamps {
         clamped[v as usize] = true;

@@ -24,9 +24,20 @@
 //! `material.density` (default 0) are optional. Unknown keys are errors. Panels are sewn by
 //! merging vertices whose initial 3D positions lie within `seam_tolerance` (default 1e-6 m) of
 //! each other, in or across panels (R: `Stitch.cpp` merges within 1e-5).
+//!
+//! **Panels meshed from an outline** (irregular Delaunay, [`crate::tfw::delaunay`]): instead of
+//! `rest`/`triangles`/`positions`, a panel may give `"polygon": [[u, v], …]` (outer ring),
+//! optional `"holes": [[[u, v], …], …]`, `"target_vertices": 700`, optional `"seed"` (default 0)
+//! and optional `"roll_radius": r` (initial positions rolled onto the cylinder of radius `r`
+//! about z, `(r cos(u/r), r sin(u/r), v)`; default `(u, v, 0)`). Its vertex numbers are then
+//! not known in advance, so a Dirichlet condition may name vertices by
+//! `"rest_box": [[umin, vmin], [umax, vmax]]` (the panel's vertices whose rest position lies
+//! in the box, inclusive) instead of, or in addition to, `vertices`. Example:
+//! `examples/tfw/twisted_cylinder.json`. [`Scene::to_json_string`] writes the meshed panel.
 
 use serde_json::{Map, Value};
 
+use crate::tfw::delaunay::{mesh_polygon, PolygonPanel};
 use crate::tfw::material::{Form, Lame};
 use crate::{Error, Result};
 
@@ -80,6 +91,43 @@ pub struct Motion {
     pub translation: [f64; 3],
     /// Optional rotation.
     pub rotation: Option<Rotation>,
+}
+
+impl Panel {
+    /// The panel meshed irregularly from an outline ([`crate::tfw::delaunay::mesh_polygon`]);
+    /// initial positions `(u, v, 0)`. Errors as `mesh_polygon`.
+    pub fn from_polygon(polygon: &PolygonPanel) -> Result<Panel> {
+        let m = mesh_polygon(polygon)?;
+        Ok(Panel {
+            rest: m.rest,
+            triangles: m.triangles,
+            positions: None,
+        })
+    }
+
+    /// The panel's vertices whose rest position lies in the box `[lo, hi]` (inclusive, with a
+    /// tolerance of 1e-9 of the box's size plus 1e-12 m): how a scene file names the clamped
+    /// vertices of a panel it asks to be meshed.
+    pub fn vertices_in_rest_box(&self, lo: [f64; 2], hi: [f64; 2]) -> Vec<u32> {
+        let tol = 1e-9 * (hi[0] - lo[0]).abs().max((hi[1] - lo[1]).abs()) + 1e-12;
+        (0..self.rest.len() as u32)
+            .filter(|&i| {
+                let p = self.rest[i as usize];
+                (0..2).all(|k| p[k] >= lo[k] - tol && p[k] <= hi[k] + tol)
+            })
+            .collect()
+    }
+}
+
+/// Rolls rest coordinates `(u, v)` onto the cylinder of radius `r` about the z axis:
+/// `(r cos(u/r), r sin(u/r), v)` (arc length along u, height v).
+pub fn roll_onto_cylinder(rest: &[[f64; 2]], r: f64) -> Vec<[f64; 3]> {
+    rest.iter()
+        .map(|p| {
+            let (s, c) = (p[0] / r).sin_cos();
+            [r * c, r * s, p[1]]
+        })
+        .collect()
 }
 
 impl Motion {
@@ -458,50 +506,141 @@ impl Scene {
         let (r, hgt) = (1.0, 5.0);
         let nx = n_around + 1;
         let (rest, triangles) = grid(nx, n_height, 2.0 * std::f64::consts::PI * r, hgt, true);
-        let positions = rest
-            .iter()
-            .map(|p| {
-                let (s, c) = (p[0] / r).sin_cos();
-                [r * c, r * s, p[1]]
-            })
-            .collect();
-        let ring = |row: usize| (0..nx).map(|i| (row * nx + i) as u32).collect::<Vec<_>>();
-        Scene {
-            name: format!("twisted cylinder {n_around}x{n_height}, {twist_degrees} deg"),
+        let panel = Panel {
+            positions: Some(roll_onto_cylinder(&rest, r)),
+            rest,
+            triangles,
+        };
+        let name = format!("twisted cylinder {n_around}x{n_height}, {twist_degrees} deg");
+        twisted_cylinder_scene(name, panel, r, hgt, twist_degrees)
+    }
+
+    /// The twisted cylinder of [`twisted_cylinder`](Self::twisted_cylinder) on an irregular
+    /// Delaunay mesh of the pattern with about `target_vertices` vertices before sewing
+    /// ([`crate::tfw::delaunay`]; the seam's two sides get the same samples, so the sewn mesh
+    /// has `target_vertices − (samples on the seam)` vertices), as the dissertation's
+    /// experiments use (irregular meshes, S:698). `seed` selects the sampling.
+    pub fn twisted_cylinder_delaunay(
+        target_vertices: usize,
+        twist_degrees: f64,
+        seed: u64,
+    ) -> Result<Scene> {
+        let (r, hgt) = (1.0, 5.0);
+        let w = 2.0 * std::f64::consts::PI * r;
+        let mut panel = Panel::from_polygon(&PolygonPanel {
+            outer: vec![[0.0, 0.0], [w, 0.0], [w, hgt], [0.0, hgt]],
+            holes: vec![],
+            target_vertices,
+            seed,
+        })?;
+        panel.positions = Some(roll_onto_cylinder(&panel.rest, r));
+        let name = format!(
+            "twisted cylinder, Delaunay {target_vertices} v (seed {seed}), {twist_degrees} deg"
+        );
+        Ok(twisted_cylinder_scene(name, panel, r, hgt, twist_degrees))
+    }
+}
+
+impl Scene {
+    /// The sheared rectangle of S:730 (Wong & Pellegrino 2006, "Wrinkled membranes Part I:
+    /// experiments", J. Mech. Mater. Struct. 1(1)): a 380 × 128 mm Kapton HN foil, 25 µm
+    /// thick, E 3.53 GPa, ν 0.3 (the dimensions and material the spec takes from that paper;
+    /// the dissertation gives none of them), on an irregular Delaunay mesh of about
+    /// `target_vertices` vertices. The bottom edge is clamped; the top edge is clamped and
+    /// moved by `shear_mm` (mm) along the long side (x) and by `stretch_mm` (mm) away from
+    /// the bottom edge (a small pre-tension; 0 = pure shear). The sides are free.
+    pub fn sheared_rectangle(
+        target_vertices: usize,
+        shear_mm: f64,
+        stretch_mm: f64,
+        seed: u64,
+    ) -> Result<Scene> {
+        let (w, h) = (0.38, 0.128);
+        let panel = Panel::from_polygon(&PolygonPanel {
+            outer: vec![[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]],
+            holes: vec![],
+            target_vertices,
+            seed,
+        })?;
+        let bottom = panel.vertices_in_rest_box([0.0, 0.0], [w, 0.0]);
+        let top = panel.vertices_in_rest_box([0.0, h], [w, h]);
+        Ok(Scene {
+            name: format!(
+                "sheared rectangle (Wong-Pellegrino), {target_vertices} v (seed {seed}), \
+                 shear {shear_mm} mm, stretch {stretch_mm} mm"
+            ),
             material: Material {
-                young: 1e7,
-                poisson: 0.44,
-                thickness: 1e-4,
+                young: 3.53e9,
+                poisson: 0.3,
+                thickness: 25e-6,
                 density: 0.0,
             },
-            panels: vec![Panel {
-                rest,
-                triangles,
-                positions: Some(positions),
-            }],
+            panels: vec![panel],
             gravity: [0.0; 3],
             pressure: 0.0,
             dirichlet: vec![
                 Dirichlet {
                     panel: 0,
-                    vertices: ring(0),
+                    vertices: bottom,
                     motion: Motion::default(),
                 },
                 Dirichlet {
                     panel: 0,
-                    vertices: ring(n_height - 1),
+                    vertices: top,
                     motion: Motion {
-                        translation: [0.0; 3],
-                        rotation: Some(Rotation {
-                            axis: [0.0, 0.0, 1.0],
-                            origin: [0.0; 3],
-                            degrees: twist_degrees,
-                        }),
+                        translation: [shear_mm / 1000.0, stretch_mm / 1000.0, 0.0],
+                        rotation: None,
                     },
                 },
             ],
-            seam_tolerance: 1e-6,
-        }
+            seam_tolerance: 1e-9,
+        })
+    }
+}
+
+/// The cylinder scene around a rolled panel of the `2πr × hgt` pattern: bottom ring (rest
+/// v = 0) clamped, top ring (v = hgt) rotated about the z axis, height fixed.
+fn twisted_cylinder_scene(
+    name: String,
+    panel: Panel,
+    r: f64,
+    hgt: f64,
+    twist_degrees: f64,
+) -> Scene {
+    let w = 2.0 * std::f64::consts::PI * r;
+    let bottom = panel.vertices_in_rest_box([0.0, 0.0], [w, 0.0]);
+    let top = panel.vertices_in_rest_box([0.0, hgt], [w, hgt]);
+    Scene {
+        name,
+        material: Material {
+            young: 1e7,
+            poisson: 0.44,
+            thickness: 1e-4,
+            density: 0.0,
+        },
+        panels: vec![panel],
+        gravity: [0.0; 3],
+        pressure: 0.0,
+        dirichlet: vec![
+            Dirichlet {
+                panel: 0,
+                vertices: bottom,
+                motion: Motion::default(),
+            },
+            Dirichlet {
+                panel: 0,
+                vertices: top,
+                motion: Motion {
+                    translation: [0.0; 3],
+                    rotation: Some(Rotation {
+                        axis: [0.0, 0.0, 1.0],
+                        origin: [0.0; 3],
+                        degrees: twist_degrees,
+                    }),
+                },
+            },
+        ],
+        seam_tolerance: 1e-6,
     }
 }
 
@@ -588,7 +727,7 @@ fn grid(nx: usize, ny: usize, lx: f64, ly: f64, jitter: bool) -> (Vec<[f64; 2]>,
 }
 
 /// A deterministic value in [−1, 1) from an integer (splitmix64).
-fn hash_unit(k: u64) -> f64 {
+pub(crate) fn hash_unit(k: u64) -> f64 {
     let mut z = k.wrapping_add(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
@@ -691,6 +830,60 @@ fn index(v: &Value, path: &str) -> Result<u64> {
         .ok_or_else(|| bad(path, "expected a non-negative integer"))
 }
 
+/// A panel given by its outline (`polygon`, optional `holes`, `target_vertices`, optional
+/// `seed` and `roll_radius`), meshed here by [`mesh_polygon`].
+fn parse_polygon_panel(po: &Map<String, Value>, path: &str) -> Result<Panel> {
+    for key in ["rest", "triangles", "positions"] {
+        if po.contains_key(key) {
+            return Err(bad(
+                &join(path, key),
+                "not allowed with \"polygon\" (the panel is meshed from its outline)",
+            ));
+        }
+    }
+    let ring = |v: &Value, rp: &str| -> Result<Vec<[f64; 2]>> {
+        array(v, rp)?
+            .iter()
+            .enumerate()
+            .map(|(i, x)| fixed::<2>(x, &format!("{rp}[{i}]")))
+            .collect()
+    };
+    let outer = ring(&po["polygon"], &join(path, "polygon"))?;
+    let mut holes = Vec::new();
+    if let Some(h) = po.get("holes") {
+        let hp = join(path, "holes");
+        for (k, x) in array(h, &hp)?.iter().enumerate() {
+            holes.push(ring(x, &format!("{hp}[{k}]"))?);
+        }
+    }
+    let tp = join(path, "target_vertices");
+    let target_vertices = usize::try_from(index(required(po, path, "target_vertices")?, &tp)?)
+        .map_err(|_| bad(&tp, "too large"))?;
+    let seed = match po.get("seed") {
+        None => 0,
+        Some(x) => index(x, &join(path, "seed"))?,
+    };
+    let polygon = PolygonPanel {
+        outer,
+        holes,
+        target_vertices,
+        seed,
+    };
+    let mut panel = Panel::from_polygon(&polygon).map_err(|e| match e {
+        Error::InvalidArgument(m) => bad(path, m),
+        other => other,
+    })?;
+    if let Some(r) = po.get("roll_radius") {
+        let rp = join(path, "roll_radius");
+        let r = number(r, &rp)?;
+        if r <= 0.0 {
+            return Err(bad(&rp, "must be > 0"));
+        }
+        panel.positions = Some(roll_onto_cylinder(&panel.rest, r));
+    }
+    Ok(panel)
+}
+
 fn parse_scene(v: &Value) -> Result<Scene> {
     let top = object(
         v,
@@ -736,7 +929,29 @@ fn parse_scene(v: &Value) -> Result<Scene> {
     let mut panels = Vec::with_capacity(pv.len());
     for (p, v) in pv.iter().enumerate() {
         let path = format!("panels[{p}]");
-        let po = object(v, &path, &["rest", "triangles", "positions"])?;
+        let po = object(
+            v,
+            &path,
+            &[
+                "rest",
+                "triangles",
+                "positions",
+                "polygon",
+                "holes",
+                "target_vertices",
+                "seed",
+                "roll_radius",
+            ],
+        )?;
+        if po.contains_key("polygon") {
+            panels.push(parse_polygon_panel(po, &path)?);
+            continue;
+        }
+        for key in ["holes", "target_vertices", "seed", "roll_radius"] {
+            if po.contains_key(key) {
+                return Err(bad(&join(&path, key), "only allowed with \"polygon\""));
+            }
+        }
         let rest = array(required(po, &path, "rest")?, &format!("{path}.rest"))?
             .iter()
             .enumerate()
@@ -782,16 +997,51 @@ fn parse_scene(v: &Value) -> Result<Scene> {
     if let Some(dv) = top.get("dirichlet") {
         for (k, d) in array(dv, "dirichlet")?.iter().enumerate() {
             let path = format!("dirichlet[{k}]");
-            let o = object(d, &path, &["panel", "vertices", "translation", "rotation"])?;
+            let o = object(
+                d,
+                &path,
+                &["panel", "vertices", "rest_box", "translation", "rotation"],
+            )?;
             let panel = index(required(o, &path, "panel")?, &format!("{path}.panel"))? as usize;
-            let vertices = array(required(o, &path, "vertices")?, &format!("{path}.vertices"))?
-                .iter()
-                .enumerate()
-                .map(|(i, x)| {
-                    let vp = format!("{path}.vertices[{i}]");
-                    u32::try_from(index(x, &vp)?).map_err(|_| bad(&vp, "index exceeds u32"))
-                })
-                .collect::<Result<Vec<_>>>()?;
+            if !o.contains_key("vertices") && !o.contains_key("rest_box") {
+                return Err(bad(
+                    &format!("{path}.vertices"),
+                    "missing (required unless rest_box is given)",
+                ));
+            }
+            let mut vertices = match o.get("vertices") {
+                None => Vec::new(),
+                Some(vv) => array(vv, &format!("{path}.vertices"))?
+                    .iter()
+                    .enumerate()
+                    .map(|(i, x)| {
+                        let vp = format!("{path}.vertices[{i}]");
+                        u32::try_from(index(x, &vp)?).map_err(|_| bad(&vp, "index exceeds u32"))
+                    })
+                    .collect::<Result<Vec<_>>>()?,
+            };
+            if let Some(b) = o.get("rest_box") {
+                let bp = format!("{path}.rest_box");
+                let corners = array(b, &bp)?;
+                if corners.len() != 2 {
+                    return Err(bad(&bp, "expected [[umin, vmin], [umax, vmax]]"));
+                }
+                let lo = fixed::<2>(&corners[0], &format!("{bp}[0]"))?;
+                let hi = fixed::<2>(&corners[1], &format!("{bp}[1]"))?;
+                let Some(p) = panels.get(panel) else {
+                    return Err(bad(
+                        &format!("{path}.panel"),
+                        format!("{panel} is not a panel index (< {})", panels.len()),
+                    ));
+                };
+                let found = p.vertices_in_rest_box(lo, hi);
+                if found.is_empty() {
+                    return Err(bad(&bp, "no vertex of the panel lies in the box"));
+                }
+                vertices.extend(found);
+                vertices.sort_unstable();
+                vertices.dedup();
+            }
             let translation = match o.get("translation") {
                 None => [0.0; 3],
                 Some(t) => fixed::<3>(t, &format!("{path}.translation"))?,
