@@ -539,6 +539,84 @@ fn edited_keyframe_animates_and_evaluates() {
     }
 }
 
+/// Largest `|z̃(t) − z̃⁰|`, `|a(t) − a⁰|` and `|ω(t) − ω⁰|` over the animation's frames, on the
+/// vertices `far` and on the edges between two of them.
+fn fixed_drift(anim: &pleat::wrinkle::CwfAnimation, k0: &Cwf, far: &[usize]) -> [f64; 3] {
+    let mut is_far = vec![false; k0.base().vertex_count()];
+    far.iter().for_each(|&v| is_far[v] = true);
+    let mut d = [0.0f64; 3];
+    for i in 0..anim.frame_count() {
+        let f = anim.frame(i).unwrap();
+        for &v in far {
+            d[0] = d[0].max((f.zeta()[v] - k0.zeta()[v]).abs());
+            d[1] = d[1].max((f.amplitude()[v] - k0.amplitude()[v]).abs());
+        }
+        for (e, &[a, b]) in k0.edges().iter().enumerate() {
+            if is_far[a as usize] && is_far[b as usize] {
+                d[2] = d[2].max((f.omega()[e] - k0.omega()[e]).abs());
+            }
+        }
+    }
+    d
+}
+
+/// C10 locality: interpolating a plane wave towards a local edit of it leaves the fixed region
+/// alone. With `InterpOptions::locality` (default) the vertices whose star the edit did not touch
+/// are held, so on every frame `z̃` there equals `z̃⁰` up to the linear sub-step blend's round-off
+/// (`(1−s)z + s z`: a few ulp, bounded by 1e-15), `a` likewise, and `ω` on edges between them to
+/// the explicit path's round-off (1e-12 of |ω|). Without it (the literal eq. 3.12) the far
+/// phases drift (measured here, and asserted to be visible so the test cannot pass vacuously).
+#[test]
+fn local_edit_animation_keeps_the_fixed_region_still() {
+    let m = irregular_grid(16, 0.2, 11);
+    let k0 = plane_wave(m.clone(), [12.0, 0.0, 0.0], 0.01);
+    let mut r = RegionEdit::new(disk_region(&m, [0.5, 0.5], 2));
+    r.rotate = FRAC_PI_2;
+    r.interface_rings = 2;
+    let (k1, rep) = edit(&k0, &[r], &EditOptions::default()).unwrap();
+    let far = far_fixed_vertices(&k0, &rep.face_class, 2);
+    assert!(far.len() > 50, "only {} far fixed vertices", far.len());
+    let pinned = pleat::wrinkle::unchanged_vertices(&k0, &k1);
+    assert!(
+        far.iter().all(|&v| pinned[v]),
+        "a far fixed vertex is not pinned"
+    );
+    let mut drift_off = 0.0;
+    for locality in [true, false] {
+        let iopts = InterpOptions {
+            guide_frames: 10,
+            substeps: 3,
+            locality,
+            ..InterpOptions::default()
+        };
+        let (anim, irep) = interpolate(&k0, &k1, &iopts).unwrap();
+        let d = fixed_drift(&anim, &k0, &far);
+        eprintln!(
+            "locality {locality}: {} pinned, stop {:?}, max drift |Δz̃| {:.2e}, |Δa| {:.2e}, |Δω| {:.2e}",
+            irep.pinned_vertices, irep.stop, d[0], d[1], d[2]
+        );
+        let last = anim.frame(anim.frame_count() - 1).unwrap();
+        assert_eq!(
+            last.zeta(),
+            k1.zeta(),
+            "the animation ends on the edited keyframe"
+        );
+        if locality {
+            assert_eq!(irep.pinned_vertices, pinned.iter().filter(|&&p| p).count());
+            assert!(d[0] <= 1e-15, "fixed phase drifts by {:e}", d[0]);
+            assert!(d[1] <= 1e-15 * 0.01, "fixed amplitude drifts by {:e}", d[1]);
+            assert!(d[2] <= 1e-12 * 12.0, "fixed ω drifts by {:e}", d[2]);
+        } else {
+            assert_eq!(irep.pinned_vertices, 0);
+            drift_off = d[0];
+        }
+    }
+    assert!(
+        drift_off > 1e-6,
+        "without locality the far phase should move ({drift_off:e})"
+    );
+}
+
 // ---------------------------------------------------------------------------------------------
 // corpus meshes (skipped without ../shared/meshes)
 
@@ -947,7 +1025,26 @@ fn corpus_interfaces_are_smooth_and_singularities_pair() {
             .collect();
         let (k0, k1, rep) = run_corpus_edit(&mesh, k, &wide, &opts);
         check_interface(&format!("{name}, 5 interface rings"), &k0, &k1, &rep);
+        eprintln!(
+            "  interface rings used {:?} ({} edits)",
+            rep.interface_rings, rep.attempts
+        );
         if !file.contains("torus") {
+            assert!(rep.compat_rms <= 0.3, "{name}: {}", rep.compat_rms);
+        }
+        if !reference {
+            // the adaptive width (EditOptions::compat_target = 0.3, from 5 rings) widens the
+            // torus's band until its curl floor lets the phase meet the target
+            let adaptive = EditOptions {
+                compat_target: 0.3,
+                ..opts
+            };
+            let (k0, k1, rep) = run_corpus_edit(&mesh, k, &wide, &adaptive);
+            eprintln!(
+                "  adaptive: interface rings used {:?} ({} edits)",
+                rep.interface_rings, rep.attempts
+            );
+            check_interface(&format!("{name}, adaptive width"), &k0, &k1, &rep);
             assert!(rep.compat_rms <= 0.3, "{name}: {}", rep.compat_rms);
         }
     }
@@ -1405,6 +1502,127 @@ fn readme_frames() {
         let path = root.join(format!("docs/{name}.png"));
         std::fs::write(&path, &png).unwrap();
         eprintln!("  {}: {w}×{sd}, {} bytes", path.display(), png.len());
+    }
+}
+
+/// Per frame step `i → i+1` of an animation: the RMS change of the coarse displacement field
+/// `Re(a z̃)` over the vertices, divided by the largest keyframe amplitude.
+fn frame_steps(anim: &pleat::wrinkle::CwfAnimation, amp: f64) -> Vec<f64> {
+    let re = |i: usize| -> Vec<f64> {
+        let f = anim.frame(i).unwrap();
+        f.zeta()
+            .iter()
+            .zip(f.amplitude())
+            .map(|(z, a)| a * z.re)
+            .collect()
+    };
+    let mut prev = re(0);
+    (1..anim.frame_count())
+        .map(|i| {
+            let cur = re(i);
+            let d = cur
+                .iter()
+                .zip(&prev)
+                .map(|(a, b)| (a - b).powi(2))
+                .sum::<f64>()
+                / cur.len() as f64;
+            prev = cur;
+            d.sqrt() / amp
+        })
+        .collect()
+}
+
+/// The two-region spot edit of the README (head 90°, body ×2.5 coupled; |k| = 12, 4 rings, 4
+/// interface rings) animated with `guide` guide frames: per-step changes and the keyframes.
+fn two_region_animation(
+    guide: usize,
+    locality: bool,
+) -> Option<(Vec<f64>, pleat::wrinkle::InterpReport)> {
+    let mesh = corpus_mesh("coarse_spot_1k.obj")?;
+    let amp = 0.02;
+    let k0 = exact_plane_wave(mesh.clone(), [12.0, 0.0, 0.0], amp);
+    let mut edits = vec![];
+    for (v, rot, sigma) in [(500u32, FRAC_PI_2, 1.0), (100, 0.0, 2.5)] {
+        let mut r = RegionEdit::new(grow_faces(&mesh, &[], &[v], 4, Adjacency::Vertex).unwrap());
+        r.interface_rings = 4;
+        r.rotate = rot;
+        r.frequency_scale = sigma;
+        edits.push(if sigma != 1.0 { r.coupled() } else { r });
+    }
+    let (k1, _) = edit(&k0, &edits, &EditOptions::default()).unwrap();
+    let iopts = InterpOptions {
+        guide_frames: guide,
+        substeps: 1,
+        locality,
+        ..InterpOptions::default()
+    };
+    let (anim, irep) = interpolate(&k0, &k1, &iopts).unwrap();
+    Some((frame_steps(&anim, amp), irep))
+}
+
+/// The two-region animation has no temporal pop (issue 14 leftover). Without locality the
+/// far fixed region's phase drifted and snapped back at t ≈ 0.56–0.6: one step of 0.21–0.23
+/// (RMS of `Δ Re(a z̃)` over the amplitude) at both 20 and 40 guide frames — a jump, since it
+/// does not shrink with the step. With [`InterpOptions::locality`] the largest step halves when
+/// the guide frames double (0.202 → 0.080, measured; a continuous motion moving at finite speed
+/// halves, a jump stays), and at 40 guide frames it is 5.5× the median step (10.2× without).
+/// Bounds: doubling the frames must cut the largest step to ≤ 0.6× and the peak must stay
+/// ≤ 8× the median.
+#[test]
+fn two_region_animation_has_no_temporal_pop() {
+    let Some((s20, _)) = two_region_animation(20, true) else {
+        return;
+    };
+    let (s40, _) = two_region_animation(40, true).unwrap();
+    let max = |s: &[f64]| s.iter().cloned().fold(0.0, f64::max);
+    let mut sorted = s40.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    eprintln!(
+        "largest step: {:.3} (20 frames), {:.3} (40 frames); median (40) {median:.4}",
+        max(&s20),
+        max(&s40)
+    );
+    assert!(
+        max(&s40) <= 0.6 * max(&s20),
+        "largest step does not shrink with the frame step: {} vs {}",
+        max(&s40),
+        max(&s20)
+    );
+    assert!(
+        max(&s40) <= 8.0 * median,
+        "peak {} vs median {median}",
+        max(&s40)
+    );
+}
+
+/// Diagnostic (ignored): the per-step change of the two-region animation, with and without
+/// locality, at 20 and 40 guide frames.
+#[test]
+#[ignore]
+fn two_region_pop_diagnostic() {
+    for guide in [20, 40] {
+        for locality in [true, false] {
+            let Some((steps, rep)) = two_region_animation(guide, locality) else {
+                return;
+            };
+            let mut sorted = steps.clone();
+            sorted.sort_by(f64::total_cmp);
+            let med = sorted[sorted.len() / 2];
+            let (imax, max) =
+                steps
+                    .iter()
+                    .enumerate()
+                    .fold((0, 0.0), |b, (i, &s)| if s > b.1 { (i, s) } else { b });
+            eprintln!(
+                "guide {guide} locality {locality}: {:?} {} it, median {med:.4}, max {max:.4} at t = {:.3}, ratio {:.1}\n  {}",
+                rep.stop,
+                rep.iterations,
+                (imax + 1) as f64 / guide as f64,
+                max / med,
+                steps.iter().map(|s| format!("{s:.3}")).collect::<Vec<_>>().join(" ")
+            );
+        }
     }
 }
 

@@ -392,6 +392,8 @@ pub(super) mod imp {
             gradient_tolerance: p.gradient_tolerance,
             max_iterations: p.max_iterations as usize,
             hessian,
+            // C10 locality is on for C callers (no field in the params struct)
+            ..InterpOptions::default()
         })
     }
 

@@ -139,6 +139,12 @@ pub struct InterpOptions {
     pub max_iterations: usize,
     /// Solver / Hessian model. Default [`HessianModel::TrustRegion`].
     pub hessian: HessianModel,
+    /// Locality (spec check C10): hold `z̃(t) = z̃⁰` at every vertex whose *star* is the same in
+    /// both keyframes (amplitude and `z̃` at the vertex, `ω` on every incident edge, bit for
+    /// bit — what [`edit`](super::edit()) guarantees on its fixed region), so a local edit
+    /// animates locally. Default `true`; `false` solves for every vertex (eq. 3.12 as printed).
+    /// See [`unchanged_vertices`].
+    pub locality: bool,
 }
 
 impl Default for InterpOptions {
@@ -150,6 +156,7 @@ impl Default for InterpOptions {
             gradient_tolerance: 1e-6,
             max_iterations: 200,
             hessian: HessianModel::TrustRegion,
+            locality: true,
         }
     }
 }
@@ -222,8 +229,10 @@ pub struct InterpReport {
     pub factorizations: usize,
     /// Conjugate-gradient iterations ([`HessianModel::TrustRegion`]; 0 for the direct models).
     pub cg_iterations: usize,
-    /// Unknown reals (`2 V (N' − 1)`).
+    /// Unknown reals (`2 V (N' − 1)`, pinned vertices included: they are held, not removed).
     pub unknowns: usize,
+    /// Vertices held at their keyframe phase by [`InterpOptions::locality`] (0 when off).
+    pub pinned_vertices: usize,
     /// Wall seconds per stage (`setup`, then `assemble` and `solve` when there was a solve).
     pub stages: StageTimes<InterpStage>,
 }
@@ -257,6 +266,7 @@ impl InterpReport {
         e.count_entry("factorizations", self.factorizations as u64);
         e.count_entry("cg iterations", self.cg_iterations as u64);
         e.count_entry("unknowns", self.unknowns as u64);
+        e.count_entry("pinned vertices", self.pinned_vertices as u64);
         e
     }
 }
@@ -415,6 +425,40 @@ fn identical(a: &Cwf, b: &Cwf) -> bool {
             .all(|(x, y)| x.re.to_bits() == y.re.to_bits() && x.im.to_bits() == y.im.to_bits())
 }
 
+/// Per vertex: `true` when the keyframes agree on its whole star, bit for bit — amplitude and
+/// `z̃` at the vertex and `ω` on every incident edge. These are the vertices
+/// [`InterpOptions::locality`] holds at `z̃⁰`: an [`edit`](super::edit()) copies its fixed
+/// region, so they are the fixed vertices not touching an interface edge. A vertex in no edge
+/// is never pinned. Keyframes that share no star (a global edit, unrelated keyframes) pin
+/// nothing, and the interpolation is eq. 3.12 unchanged.
+///
+/// Why pin rather than weight: the reference code multiplies the kinetic weight of a vertex at
+/// distance `d` from the edit by `min(exp((d/σ)²), 1e10)` (spec C10), which freezes far vertices
+/// only in the limit and makes the time coupling of the spacetime Hessian — and so the block
+/// Gauss–Seidel preconditioner — badly conditioned; holding them is that limit taken exactly.
+/// The minimizer stays the one of eq. 3.12 restricted to paths that leave unchanged stars alone.
+pub fn unchanged_vertices(a: &Cwf, b: &Cwf) -> Vec<bool> {
+    let same = |x: f64, y: f64| x.to_bits() == y.to_bits();
+    let n = a.base().vertex_count().min(b.base().vertex_count());
+    let mut keep: Vec<bool> = (0..n)
+        .map(|j| {
+            let (za, zb) = (a.zeta()[j], b.zeta()[j]);
+            same(a.amplitude()[j], b.amplitude()[j]) && same(za.re, zb.re) && same(za.im, zb.im)
+        })
+        .collect();
+    let mut has_edge = vec![false; n];
+    for (e, &[k, l]) in a.edges().iter().enumerate() {
+        let (k, l) = (k as usize, l as usize);
+        has_edge[k] = true;
+        has_edge[l] = true;
+        if !same(a.omega()[e], b.omega()[e]) {
+            keep[k] = false;
+            keep[l] = false;
+        }
+    }
+    keep.iter().zip(&has_edge).map(|(&k, &h)| k && h).collect()
+}
+
 /// Keyframe-derived data shared by the solve and the output.
 struct Setup {
     /// Path of the compatible parts.
@@ -474,6 +518,7 @@ fn trivial_report(setup: &Setup, stop: StopReason, start: Instant) -> InterpRepo
         factorizations: 0,
         cg_iterations: 0,
         unknowns: 0,
+        pinned_vertices: 0,
         stages: StageTimes::default(),
     }
 }
@@ -514,6 +559,10 @@ struct Problem {
     w_smooth: Vec<f64>,
     /// Keyframe phases (frames 0 and N').
     z_ends: [Vec<Complex>; 2],
+    /// Per vertex: held at `z̃⁰` on every frame ([`InterpOptions::locality`]). A pinned vertex
+    /// keeps its unknowns, but its gradient is zeroed and its rows and columns of `K` keep only
+    /// the diagonal, so every step leaves it where it is.
+    pinned: Vec<bool>,
     /// Unnormalization: `A_tot g_ref`, and `c`.
     scale: f64,
     c: f64,
@@ -575,6 +624,11 @@ impl Problem {
                 .map(|(&aj, &gj)| 0.5 * aj * gj / (dt * area * g_ref))
                 .collect(),
             z_ends: [a.zeta().to_vec(), b.zeta().to_vec()],
+            pinned: if opts.locality {
+                unchanged_vertices(a, b)
+            } else {
+                vec![false; a.base().vertex_count()]
+            },
             scale: area * g_ref,
             c: cs * g_ref,
             g_ave: setup.g_ave,
@@ -654,7 +708,42 @@ impl Problem {
                 g[j] += (z[j] - zp[j] + z[j] - zn[j]).scale(2.0 * ws);
             }
         }
+        if want_grad {
+            self.mask(&mut g);
+        }
         (p, g)
+    }
+
+    /// Zeroes the entries of pinned vertices in one frame's vector.
+    fn mask(&self, g: &mut [Complex]) {
+        for (gj, &p) in g.iter_mut().zip(&self.pinned) {
+            if p {
+                *gj = Complex::ZERO;
+            }
+        }
+    }
+
+    /// Every frame's pinned vertices set to the keyframe phase `z̃⁰` (the start of a solve).
+    fn start_vector(&self) -> Vec<Complex> {
+        let mut x = vec![Complex::ZERO; self.n_unknown()];
+        for frame in x.chunks_exact_mut(self.n_v) {
+            for (j, z) in frame.iter_mut().enumerate() {
+                if self.pinned[j] {
+                    *z = self.z_ends[0][j];
+                }
+            }
+        }
+        x
+    }
+
+    /// `E_unit`'s Hessian block of unknown `u` at `z` (zero for a pinned vertex).
+    fn unit_block_at(&self, u: usize, z: Complex, model: HessianModel) -> [f64; 3] {
+        let j = u % self.n_v;
+        if self.pinned[j] {
+            [0.0; 3]
+        } else {
+            unit_block(z, self.w_unit[j], model)
+        }
     }
 
     /// The guide-frame phases and the report of a finished solve; `counts` are the iterations,
@@ -683,6 +772,7 @@ impl Problem {
             factorizations: counts[1],
             cg_iterations: counts[2],
             unknowns: 2 * self.n_unknown(),
+            pinned_vertices: self.pinned.iter().filter(|&&p| p).count(),
             stages: StageTimes::default(),
         };
         (frames, report)
@@ -705,12 +795,13 @@ impl Problem {
             return self.solve_trust_region(opts, start, progress);
         }
         let mut hess = Hessian::new(self)?;
-        let mut x = vec![Complex::ZERO; self.n_unknown()];
-        // initial guess: the quadratic part's minimizer (a projected Newton step from 0)
+        let mut x = self.start_vector();
+        // initial guess: the quadratic part's minimizer (a projected Newton step from 0, pinned
+        // vertices held; the step is zero on them)
         let (_, g0) = self.evaluate(&x, true);
         let mut mu = 1e-10;
         let d = hess.newton_direction(self, &x, &g0, &mut mu, HessianModel::Projected)?;
-        x = d;
+        x.iter_mut().zip(&d).for_each(|(xi, di)| *xi += *di);
         normalize_unknowns(&mut x);
         let mut log = IterationLog::new(start);
         let mut iterations = 0;
@@ -780,7 +871,12 @@ impl Problem {
 impl Problem {
     /// The frame blocks of `K` and the time coupling, for the preconditioner.
     fn frame_blocks(&self) -> Result<FrameBlocks> {
-        let coupling = self.w_smooth.iter().map(|w| 2.0 * w).collect();
+        let coupling = self
+            .w_smooth
+            .iter()
+            .zip(&self.pinned)
+            .map(|(w, &p)| if p { 0.0 } else { 2.0 * w })
+            .collect();
         FrameBlocks::new(self.n_v, self.n_frames - 1, coupling, |n| {
             let mut t = Vec::new();
             push_frame_triplets(self, n, 0, false, &mut t);
@@ -792,7 +888,7 @@ impl Problem {
     fn hess_vec(&self, k: &FrameBlocks, x: &[Complex], v: &[f64], y: &mut [f64]) {
         k.k_matvec(v, y);
         for (u, z) in x.iter().enumerate() {
-            let b = unit_block(*z, self.w_unit[u % self.n_v], HessianModel::Exact);
+            let b = self.unit_block_at(u, *z, HessianModel::Exact);
             let (v0, v1) = (v[2 * u], v[2 * u + 1]);
             y[2 * u] += b[0] * v0 + b[1] * v1;
             y[2 * u + 1] += b[1] * v0 + b[2] * v1;
@@ -812,10 +908,9 @@ impl Problem {
         const REFACTOR_EVERY: usize = 5;
         let blocks = self.frame_blocks()?;
         let (mut factorizations, mut cg_iterations) = (0usize, 0usize);
-        let nu = self.n_unknown();
         // initial guess: the minimizer of the quadratic part K alone (E_unit's projected
         // Hessian vanishes at z = 0), normalized per vertex
-        let mut x = vec![Complex::ZERO; nu];
+        let mut x = self.start_vector();
         {
             let (_, g0) = self.evaluate(&x, true);
             let g = to_real(&g0);
@@ -825,7 +920,9 @@ impl Problem {
             let tol = 1e-6 * dot_n(&g, &g).sqrt();
             let st = steihaug(&g, &kv, &|r| pre.apply(r), f64::INFINITY, tol, MAX_CG);
             cg_iterations += st.iterations;
-            x = to_complex(&st.step);
+            x.iter_mut()
+                .zip(to_complex(&st.step))
+                .for_each(|(xi, di)| *xi += di);
             normalize_unknowns(&mut x);
         }
         let mut log = IterationLog::new(start);
@@ -847,7 +944,7 @@ impl Problem {
             if pre.is_none() || since_factor >= REFACTOR_EVERY || last_cg > 20 {
                 pre = Some(blocks.factor(|n, j| {
                     let u = (n - 1) * self.n_v + j;
-                    unit_block(x[u], self.w_unit[j], HessianModel::Projected)
+                    self.unit_block_at(u, x[u], HessianModel::Projected)
                 })?);
                 factorizations += self.n_frames - 1;
                 since_factor = 0;
@@ -1047,8 +1144,7 @@ impl Hessian {
         let mut h = self.k.clone();
         let vals = h.val_mut();
         for (u, s) in self.diag_slots.iter().enumerate() {
-            let w = p.w_unit[u % p.n_v];
-            let b = unit_block(x[u], w, model);
+            let b = p.unit_block_at(u, x[u], model);
             vals[s[0]] += b[0] + mu * self.diag_mean;
             vals[s[1]] += b[1];
             vals[s[2]] += b[2] + mu * self.diag_mean;
@@ -1122,7 +1218,11 @@ fn push_frame_triplets(
         t.push(Entry::new(2 * u + 1, 2 * u + 1, d));
         if time_coupling && n + 1 < p.n_frames {
             let v = u + p.n_v;
-            let o = -2.0 * p.w_smooth[j];
+            let o = if p.pinned[j] {
+                0.0
+            } else {
+                -2.0 * p.w_smooth[j]
+            };
             t.push(Entry::new(2 * v, 2 * u, o));
             t.push(Entry::new(2 * v + 1, 2 * u + 1, o));
         }
@@ -1134,10 +1234,16 @@ fn push_frame_triplets(
             t.push(Entry::new(2 * uu, 2 * uu, w2));
             t.push(Entry::new(2 * uu + 1, 2 * uu + 1, w2));
         }
-        // block (l, k) = −2w [t], [t] = [[c, −s], [s, c]]; l > k so it is lower
+        // block (l, k) = −2w [t], [t] = [[c, −s], [s, c]]; l > k so it is lower. Dropped (kept
+        // as explicit zeros, one pattern for every frame) when an end is pinned.
         let r = p.rot[n][e];
+        let wo = if p.pinned[k as usize] || p.pinned[l as usize] {
+            0.0
+        } else {
+            w2
+        };
         for (a, q, v) in [(0, 0, r.re), (0, 1, -r.im), (1, 0, r.im), (1, 1, r.re)] {
-            t.push(Entry::new(2 * ul + a, 2 * uk + q, -w2 * v));
+            t.push(Entry::new(2 * ul + a, 2 * uk + q, -wo * v));
         }
     }
 }

@@ -64,8 +64,8 @@ pub use design::{design, DesignOptions, DesignReport, WrinkleSource};
 pub use edit::{edit, EditOptions, EditReport, PhaseCoupling, RegionEdit};
 pub use evaluate::{EvalOptions, Evaluated};
 pub use interpolate::{
-    explicit_omega, interpolate, interpolate_with_progress, linear_interpolation, HessianModel,
-    InterpOptions, InterpReport, IterationRecord, StopReason,
+    explicit_omega, interpolate, interpolate_with_progress, linear_interpolation,
+    unchanged_vertices, HessianModel, InterpOptions, InterpReport, IterationRecord, StopReason,
 };
 pub use io::{
     connectivity_hash, cwf_to_string, parse_cwf, read_cwf, write_cwf, CWF_FORMAT_VERSION,

@@ -215,6 +215,10 @@ pub fn run_edit(
         rep.vertex_counts,
         rep.edge_counts
     );
+    eprintln!(
+        "  interface rings used {:?} ({} edit(s); widened while compat RMS > {} rad)",
+        rep.interface_rings, rep.attempts, opts.compat_target
+    );
     eprintln!("  labels + ω¹   {:.4} s", rep.seconds[0]);
     eprintln!(
         "  ω (3.26)     {:.4} s  residual {:.2e}",
