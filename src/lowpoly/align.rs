@@ -81,7 +81,7 @@ pub(crate) fn aligned_position(
 }
 
 /// Solves the 3×3 system `h x = r` by Cramer's rule; `None` when singular or non-finite.
-fn solve3(h: [[f64; 3]; 3], r: Vec3) -> Option<Vec3> {
+pub(crate) fn solve3(h: [[f64; 3]; 3], r: Vec3) -> Option<Vec3> {
     let det3 = |m: [[f64; 3]; 3]| {
         let [r0, r1, r2] = m.map(Vec3::from);
         r0.dot(r1.cross(r2))
