@@ -106,7 +106,7 @@ pub const CAP_HALVINGS: u32 = 4;
 
 /// Shortens `d` (halving) until `p + d` is within `max(cap, dist(p))` of the input; `None`
 /// when [`CAP_HALVINGS`] halvings do not suffice.
-fn capped_step(g: &Guard<'_>, p: Vec3, mut d: Vec3, cap: f64) -> Option<Vec3> {
+pub(crate) fn capped_step(g: &Guard<'_>, p: Vec3, mut d: Vec3, cap: f64) -> Option<Vec3> {
     let input = g.input();
     // The allowance grows to the current distance only when the cap alone refuses a step.
     let mut allowed = None;

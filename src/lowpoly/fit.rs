@@ -16,13 +16,16 @@
 //!    vertex in place along the directions no plane constrains (flat areas: tangentially;
 //!    creases: along the crease), so the fit only removes the offset and re-sharpens creases
 //!    and corners where two or three input planes meet. The step is capped at
-//!    [`MAX_STEP`]·`d` and applied through the guard with the halving line search of Alg. 4.
+//!    [`MAX_STEP`]·`d`, halved while it would end farther from the input than
+//!    `max(`[`DRIFT_CAP`]`·d, current distance)`, and applied through the guard with the
+//!    halving line search of Alg. 4.
 //! 2. **Flips** — an edge is flipped when the two triangles after the flip deviate less from
 //!    the input's normals than the two before, by a factor [`FLIP_GAIN`]. The deviation of a
 //!    triangle `T` is `area(T) · mean_s (1 − |n_T · n_in(s)|)` over 4 samples `s` (centroid and
 //!    the points `(4, 1, 1)/6`), `n_in(s)` the unit normal of the input triangle closest to `s`
-//!    (a sample without input triangle within the radius counts 1). The flip goes through the
-//!    guard ([`Guard::try_flip`]).
+//!    (a sample without input triangle within the radius counts 1), and when the new edge's
+//!    midpoint is within `max(`[`DRIFT_CAP`]`·d, the old edge midpoint's distance)` of the
+//!    input. The flip goes through the guard ([`Guard::try_flip`]).
 //!
 //! [`FIT_SWEEPS`] sweeps of {placement, flips}, then one last placement. Every operation passes
 //! the guard, so the mesh stays watertight, manifold, self-intersection-free and of the same
@@ -35,6 +38,7 @@
 
 use rayon::prelude::*;
 
+use super::align::capped_step;
 use super::flow::{local_update, record, MoveReport};
 use super::guard::{Guard, InputModel};
 use crate::geom::{normalized, tri_normal, Vec3};
@@ -49,6 +53,12 @@ pub const SAMPLE_RADIUS: f64 = 4.0;
 
 /// Longest placement step, in `d`.
 pub const MAX_STEP: f64 = 3.0;
+
+/// No placement step ends farther from the input than `max(DRIFT_CAP · d, where it
+/// started)` (halved until it does, as the alignment's drift cap, `align::capped_step`): where
+/// the planes of a thin spike or a sheet's rim meet far beyond the input, the QEM optimum
+/// extrapolates, and the Hausdorff distance would grow there.
+pub const DRIFT_CAP: f64 = 1.0;
 
 /// Tikhonov weight `μ / tr A` of the placement (keeps unconstrained directions in place).
 pub const REGULARIZATION: f64 = 1e-2;
@@ -105,10 +115,12 @@ struct InputPlanes<'a> {
     input: &'a InputModel,
     planes: Vec<Option<(Vec3, Vec3)>>,
     radius: f64,
+    /// [`DRIFT_CAP`]` · d`.
+    drift_cap: f64,
 }
 
 impl<'a> InputPlanes<'a> {
-    fn new(input: &'a InputModel, radius: f64) -> Self {
+    fn new(input: &'a InputModel, radius: f64, drift_cap: f64) -> Self {
         let planes = (0..input.tris.len() as u32)
             .into_par_iter()
             .map(|t| {
@@ -120,6 +132,7 @@ impl<'a> InputPlanes<'a> {
             input,
             planes,
             radius,
+            drift_cap,
         }
     }
 
@@ -145,7 +158,7 @@ pub(crate) fn fit_to_input(
     d: f64,
     keep_going: &mut dyn FnMut(f64) -> bool,
 ) -> Result<FitReport> {
-    let planes = InputPlanes::new(g.input(), SAMPLE_RADIUS * d);
+    let planes = InputPlanes::new(g.input(), SAMPLE_RADIUS * d, DRIFT_CAP * d);
     let mut rep = FitReport::default();
     let steps = 2 * FIT_SWEEPS + 1;
     for step in 0..steps {
@@ -237,11 +250,12 @@ fn place_vertices(g: &mut Guard<'_>, planes: &InputPlanes<'_>, max_step: f64) ->
         if len > max_step {
             step *= max_step / len;
         }
-        let moved = if len > 0.0 {
-            local_update(g, v, step)
+        let capped = if len > 0.0 {
+            capped_step(g, p, step, planes.drift_cap)
         } else {
-            0.0
+            None
         };
+        let moved = capped.map_or(0.0, |step| local_update(g, v, step));
         record(&mut rep, moved);
     }
     rep
@@ -326,7 +340,16 @@ fn plan_flip(g: &Guard<'_>, e: EdgeId, planes: &InputPlanes<'_>) -> Option<FlipP
         return None;
     }
     let after = deviation([c, d, b], planes) + deviation([d, c, a], planes);
-    (after < FLIP_GAIN * before).then_some(FlipPlan { edge: e, quad })
+    if after >= FLIP_GAIN * before {
+        return None;
+    }
+    // The drift cap of the placement, at the new edge's midpoint.
+    let input = g.input();
+    let new_mid = input.distance(((c + d) * 0.5).to_array());
+    let allowed = planes
+        .drift_cap
+        .max(input.distance(((a + b) * 0.5).to_array()));
+    (new_mid <= allowed).then_some(FlipPlan { edge: e, quad })
 }
 
 #[cfg(test)]

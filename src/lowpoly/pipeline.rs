@@ -463,6 +463,7 @@ fn bake_level(
         let t0 = Instant::now();
         let pre_sides = verify::hausdorff_sides(&pre, input);
         ls.fit_s += t0.elapsed().as_secs_f64();
+        ls.fit_sides = Some([sides.input_to_output / l, sides.output_to_input / l]);
         if hausdorff_of(&sides) > hausdorff_of(&pre_sides) + FIT_HAUSDORFF_SLACK * l {
             // The fit's safety revert: the loop's output (guarded like the fit's) instead.
             let t0 = Instant::now();
@@ -618,6 +619,8 @@ struct LoopStats {
     fit_s: f64,
     fit: FitReport,
     fit_reverted: bool,
+    /// The fitted LOD's one-sided distances over `l` (in→out, out→in), kept or not.
+    fit_sides: Option<[f64; 2]>,
     /// The loop's output before the fit, kept for the safety revert.
     prefit: Option<TriMesh>,
 }
@@ -643,6 +646,7 @@ impl LoopStats {
         s.fit_flips = self.fit.flips;
         s.fit_motion = self.fit.motion;
         s.fit_reverted = self.fit_reverted;
+        s.fit_sides_rel = self.fit_sides;
     }
 }
 

@@ -193,6 +193,9 @@ pub struct LodReport {
     pub fit_motion: f64,
     /// The fit was reverted because the Hausdorff distance grew (the output is the loop's).
     pub fit_reverted: bool,
+    /// The fitted LOD's one-sided Hausdorff distances over `l`, `[in→out, out→in]`, whether
+    /// it was kept or reverted (`None` without a fit).
+    pub fit_sides_rel: Option<[f64; 2]>,
     /// Reruns with exact checks only (0 or 1; §4.3.3: the normal-cone shortcut let an
     /// intersection through).
     pub reruns_exact: u64,
@@ -271,6 +274,10 @@ impl LodReport {
         e.count_entry("fit_flips", self.fit_flips);
         e.metric_entry("fit_motion", self.fit_motion);
         e.count_entry("fit_reverted", self.fit_reverted as u64);
+        if let Some([i, o]) = self.fit_sides_rel {
+            e.metric_entry("fit_in_to_out_rel", i);
+            e.metric_entry("fit_out_to_in_rel", o);
+        }
         e.count_entry("reruns_exact", self.reruns_exact);
         self.verified.write_entries(&mut e);
         if let Some(f) = &self.floor {
