@@ -140,6 +140,10 @@
 // instead of a fraction of the offset distance d.
 #define PLEAT_LOD_CLEARANCE_ABSOLUTE 4
 
+// `PleatLodParams::flags` bit: skip the final input-plane fit of LODs (QEM vertex placement
+// on the input's planes and normal-improving flips after the loop; ignored for cages).
+#define PLEAT_LOD_NO_FIT 8
+
 // `pleat_mesh_check` flag: skip the self-intersection test (the most expensive part);
 // `self_intersections_checked` is then 0.
 #define PLEAT_CHECK_SKIP_SELF_INTERSECTIONS 1

@@ -166,6 +166,10 @@ struct BakeArgs {
     /// Skip the feature-alignment step.
     #[arg(long)]
     no_align: bool,
+    /// Skip the final fit of LODs to the input's planes (keeps the loop's output, which sits
+    /// about d outside the input with rounded creases; ignored for cages).
+    #[arg(long)]
+    no_fit: bool,
     /// Cages: the distance kept from the input, a fraction of d with a `d` suffix (`0.1d`,
     /// the default) or a length in model units (`0.002`); below d. `0d` only forbids contact.
     #[arg(long, value_parser = parse_clearance)]
@@ -499,6 +503,7 @@ fn lod_params(args: &BakeArgs, sizes: &[f64], faces: Option<usize>) -> LodParams
         target_faces: faces,
         max_rounds: args.rounds,
         align: !args.no_align,
+        fit_to_input: !args.no_fit,
         clearance: args.clearance.unwrap_or_default(),
         ..LodParams::default()
     }

@@ -28,6 +28,10 @@ pub const PLEAT_LOD_MEASURE_FLOOR: u32 = 2;
 /// instead of a fraction of the offset distance d.
 pub const PLEAT_LOD_CLEARANCE_ABSOLUTE: u32 = 4;
 
+/// `PleatLodParams::flags` bit: skip the final input-plane fit of LODs (QEM vertex placement
+/// on the input's planes and normal-improving flips after the loop; ignored for cages).
+pub const PLEAT_LOD_NO_FIT: u32 = 8;
+
 /// Parameters of `pleat_lod_generate`, `pleat_lod_generate_chain` and `pleat_cage_generate`.
 /// Get the defaults from `pleat_lod_params_default()` and change what you need; the defaults
 /// are the dissertation's (n_p = 200, N = 50, r = 1/8, ε = 1e-4, θ0 = 120°, l0 = 4).
@@ -172,7 +176,8 @@ impl From<&crate::lowpoly::LodParams> for PleatLodParams {
                 | flag(
                     matches!(p.clearance, Clearance::Absolute(_)),
                     PLEAT_LOD_CLEARANCE_ABSOLUTE,
-                ),
+                )
+                | flag(!p.fit_to_input, PLEAT_LOD_NO_FIT),
             memory_budget_bytes: p.memory_budget_bytes,
             clearance: match p.clearance {
                 Clearance::FractionOfD(c) | Clearance::Absolute(c) => c,
@@ -217,7 +222,10 @@ pub(super) mod imp {
         };
         check_flags(
             p.flags,
-            PLEAT_LOD_NO_ALIGN | PLEAT_LOD_MEASURE_FLOOR | PLEAT_LOD_CLEARANCE_ABSOLUTE,
+            PLEAT_LOD_NO_ALIGN
+                | PLEAT_LOD_MEASURE_FLOOR
+                | PLEAT_LOD_CLEARANCE_ABSOLUTE
+                | PLEAT_LOD_NO_FIT,
             "params->flags",
         )?;
         Ok(LodParams {
@@ -231,6 +239,7 @@ pub(super) mod imp {
             memory_budget_bytes: p.memory_budget_bytes,
             align: p.flags & PLEAT_LOD_NO_ALIGN == 0,
             measure_floor: p.flags & PLEAT_LOD_MEASURE_FLOOR != 0,
+            fit_to_input: p.flags & PLEAT_LOD_NO_FIT == 0,
             clearance: if p.flags & PLEAT_LOD_CLEARANCE_ABSOLUTE != 0 {
                 Clearance::Absolute(p.clearance)
             } else {

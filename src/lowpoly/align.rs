@@ -81,7 +81,7 @@ pub(crate) fn aligned_position(
 }
 
 /// Solves the 3×3 system `h x = r` by Cramer's rule; `None` when singular or non-finite.
-fn solve3(h: [[f64; 3]; 3], r: Vec3) -> Option<Vec3> {
+pub(crate) fn solve3(h: [[f64; 3]; 3], r: Vec3) -> Option<Vec3> {
     let det3 = |m: [[f64; 3]; 3]| {
         let [r0, r1, r2] = m.map(Vec3::from);
         r0.dot(r1.cross(r2))
@@ -106,7 +106,7 @@ pub const CAP_HALVINGS: u32 = 4;
 
 /// Shortens `d` (halving) until `p + d` is within `max(cap, dist(p))` of the input; `None`
 /// when [`CAP_HALVINGS`] halvings do not suffice.
-fn capped_step(g: &Guard<'_>, p: Vec3, mut d: Vec3, cap: f64) -> Option<Vec3> {
+pub(crate) fn capped_step(g: &Guard<'_>, p: Vec3, mut d: Vec3, cap: f64) -> Option<Vec3> {
     let input = g.input();
     // The allowance grows to the current distance only when the cap alone refuses a step.
     let mut allowed = None;

@@ -2,8 +2,9 @@
 //! §4.3.2 "checks", §4.3.3 self-intersection acceleration, §4.5.2 cages).
 //!
 //! [`Guard`] owns the working [`HalfEdgeMesh`] together with a BVH over its faces. Every
-//! collapse (simplification, Alg. 5), vertex move (flow, Alg. 3–4; alignment, Alg. 6) goes
-//! through [`Guard::try_collapse`] or [`Guard::try_move`]: the operation is applied, the
+//! collapse (simplification, Alg. 5), vertex move (flow, Alg. 3–4; alignment, Alg. 6; the final
+//! input-plane fit, `fit.rs`) and edge flip (the fit's flips) goes through
+//! [`Guard::try_collapse`], [`Guard::try_move`] or [`Guard::try_flip`]: the operation is applied, the
 //! modified faces `M_e` are checked, and the operation is undone when a check fails. After every
 //! accepted operation the mesh therefore still is:
 //!
@@ -137,9 +138,8 @@ impl InputModel {
 /// Why the guard refused an operation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Reject {
-    /// The half-edge preconditions refuse the collapse (topology would change). Collapses
-    /// outside tests check them before the guard (see `simplify`).
-    #[cfg_attr(not(test), allow(dead_code))]
+    /// The half-edge preconditions refuse the collapse or flip (topology would change).
+    /// Collapses outside tests check them before the guard (see `simplify`).
     Topology,
     /// A modified face would be degenerate.
     Degenerate,
@@ -373,12 +373,64 @@ impl<'a> Guard<'a> {
         }
     }
 
+    /// Flips the edge of half-edge `h` (the fit's flips, `fit.rs`) if the result passes every
+    /// check; the mesh is unchanged on `Err` (the flip is undone exactly).
+    pub fn try_flip(&mut self, h: HalfedgeId) -> Result<(), Reject> {
+        if self.mesh.can_flip(h).is_err() {
+            self.stats.checks += 1;
+            self.stats.rejected_topology += 1;
+            return Err(Reject::Topology);
+        }
+        let mut s = std::mem::take(&mut self.scratch);
+        s.old_patch.clear();
+        if self.cage {
+            let m = &self.mesh;
+            s.old_patch.extend(
+                [m.face(h), m.face(h.twin())]
+                    .into_iter()
+                    .flatten()
+                    .map(|f| m.face_positions(f)),
+            );
+        }
+        let rec = self.mesh.flip_edge(h).expect("a flip that passed can_flip");
+        self.fill_patch(rec.faces.into_iter(), &mut s);
+        let mut st = GuardCounts::default();
+        let r = self.check(&mut s, &mut st);
+        self.stats.add(&st);
+        match r {
+            Ok(()) => {
+                for f in rec.faces {
+                    self.tris[f] = raw_corners(&self.mesh, f);
+                }
+                self.bvh.update(
+                    self.mesh.positions(),
+                    self.tris.as_slice(),
+                    FaceId::raw_slice(&rec.faces),
+                );
+                self.note_edits(2);
+            }
+            Err(_) => {
+                self.mesh
+                    .undo(rec.undo)
+                    .expect("undoing the flip just made");
+            }
+        }
+        self.scratch = s;
+        r
+    }
+
     /// Neighbourhood of a vertex that was just moved (the mesh holds the new position).
     fn fill_move(&self, v: VertexId, s: &mut GuardScratch) {
+        self.fill_patch(self.mesh.vertex_faces(v), s);
+    }
+
+    /// Neighbourhood of an operation that just changed the faces `changed` (`M_e`; the mesh
+    /// holds the new state).
+    fn fill_patch(&self, changed: impl Iterator<Item = FaceId>, s: &mut GuardScratch) {
         let m = &self.mesh;
         s.m_1.clear();
         s.verts.clear();
-        for f in m.vertex_faces(v) {
+        for f in changed {
             let fv = m.face_vertices(f);
             s.m_1.push(NFace {
                 id: f,

@@ -4,7 +4,8 @@
 //! triangle soup (§4.3.1): narrow-band unsigned distance (`distance`), Marching Cubes 33
 //! topology (`mc33`), feature vertices (`features`), interior removal (`interior`).
 //!
-//! Stage 2, the mesh-optimization loop (§4.3.2–4.3.3, Alg. 3–7): [`generate`] bakes one LOD,
+//! Stage 2, the mesh-optimization loop (§4.3.2–4.3.3, Alg. 3–7), then for LODs a final fit to
+//! the input's planes (`fit`, issue 12): [`generate`] bakes one LOD,
 //! [`generate_chain`] several. Every local operation of the loop — edge collapses
 //! (`simplify`, Alg. 5), the flow (Alg. 3–4) and the feature alignment (Alg. 6, eq. 4.5) —
 //! goes through one guard (`guard.rs`) that keeps the mesh watertight, manifold, of the same
@@ -22,6 +23,7 @@ pub(crate) mod distance;
 mod extract;
 pub(crate) mod features;
 mod filter;
+mod fit;
 mod flips;
 mod flow;
 pub(crate) mod guard;
@@ -35,7 +37,9 @@ mod simplify;
 
 pub use guard::CONE_HALF_ANGLE;
 pub use offset::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};
-pub use pipeline::{generate, generate_chain, Clearance, LodParams, DEFAULT_CLEARANCE_FRACTION};
+pub use pipeline::{
+    generate, generate_chain, Clearance, LodParams, DEFAULT_CLEARANCE_FRACTION, FIT_HAUSDORFF_SLACK,
+};
 #[cfg(feature = "cage")]
 pub(crate) use pipeline::{run, run_chain, Mode};
 pub use report::{

@@ -9,6 +9,7 @@
 use std::time::Instant;
 
 use super::align::{align_sweep, reference_normals};
+use super::fit::{fit_to_input, FitReport};
 use super::flow::flow_sweep;
 use super::guard::{Guard, InputModel};
 use super::measure::{self, Surface};
@@ -103,7 +104,17 @@ pub struct LodParams {
     /// Cages only: the distance the cage keeps from the input (see [`Clearance`]; default a
     /// tenth of `d`). `FractionOfD(0.0)` keeps only "no contact", as before issue 12.
     pub clearance: Clearance,
+    /// LODs only (ignored for cages): after the loop, fit the LOD to the input's planes
+    /// (guarded QEM vertex placement and normal-improving flips, `fit.rs`), which removes the
+    /// offset and re-sharpens rounded creases; reverted when the two-sided Hausdorff distance
+    /// would grow by more than [`FIT_HAUSDORFF_SLACK`]` · l`. Default true.
+    pub fit_to_input: bool,
 }
+
+/// The largest growth of the two-sided Hausdorff distance (over `l`) the input-plane fit may
+/// cause; beyond it the fit is reverted ([`LodReport::fit_reverted`]). A quarter of issue 12's
+/// 0.001 l budget for the excess over the floor.
+pub const FIT_HAUSDORFF_SLACK: f64 = 2.5e-4;
 
 impl Default for LodParams {
     fn default() -> Self {
@@ -119,6 +130,7 @@ impl Default for LodParams {
             align: true,
             measure_floor: false,
             clearance: Clearance::default(),
+            fit_to_input: true,
         }
     }
 }
@@ -425,6 +437,7 @@ fn bake_level(
             Mode::Cage => params.clearance.resolve(d),
             Mode::Lod => 0.0,
         },
+        fit: mode == Mode::Lod && params.fit_to_input,
     };
     let (mut mesh, mut ls) = optimize(&start, model, &cfg, false, rep)?;
     rep.window(w0 + 0.9 * ws, 0.1 * ws);
@@ -441,7 +454,26 @@ fn bake_level(
         ls = ls2;
         v = verify_level(&mesh, level);
     }
-    let verify_s = t0.elapsed().as_secs_f64();
+    let mut verify_s = t0.elapsed().as_secs_f64();
+    rep.check("measure", 0.5)?;
+    let t0 = Instant::now();
+    let mut sides = verify::hausdorff_sides(&mesh, input);
+    let measure_s = t0.elapsed().as_secs_f64();
+    if let Some(pre) = ls.prefit.take() {
+        let t0 = Instant::now();
+        let pre_sides = verify::hausdorff_sides(&pre, input);
+        ls.fit_s += t0.elapsed().as_secs_f64();
+        ls.fit_sides = Some([sides.input_to_output / l, sides.output_to_input / l]);
+        if hausdorff_of(&sides) > hausdorff_of(&pre_sides) + FIT_HAUSDORFF_SLACK * l {
+            // The fit's safety revert: the loop's output (guarded like the fit's) instead.
+            let t0 = Instant::now();
+            mesh = pre;
+            sides = pre_sides;
+            ls.fit_reverted = true;
+            v = verify_level(&mesh, level);
+            verify_s += t0.elapsed().as_secs_f64();
+        }
+    }
     ls.write(&mut stats);
     stats.stages.push(LodStage::Verify, verify_s);
     stats.reruns_exact = reruns;
@@ -459,13 +491,8 @@ fn bake_level(
             "the output failed independent verification ({v:?}); please report the input"
         )));
     }
-    rep.check("measure", 0.5)?;
-    let t0 = Instant::now();
-    let sides = verify::hausdorff_sides(&mesh, input);
-    let h = sides.input_to_output.max(sides.output_to_input);
-    stats
-        .stages
-        .push(LodStage::Measure, t0.elapsed().as_secs_f64());
+    let h = hausdorff_of(&sides);
+    stats.stages.push(LodStage::Measure, measure_s);
     if params.measure_floor && finer.is_none() {
         let (t0, c0) = (Instant::now(), crate::report::process_cpu_seconds());
         let floor = verify::input_to_surface(&start, input);
@@ -499,6 +526,11 @@ fn bake_level(
     stats.vertices = mesh.vertex_count() as u64;
     rep.check("done", 1.0)?;
     Ok((mesh, stats))
+}
+
+/// The two-sided distance of measured `sides`.
+fn hausdorff_of(sides: &verify::HausdorffSides) -> f64 {
+    sides.input_to_output.max(sides.output_to_input)
 }
 
 /// `(components, Euler characteristic)` of a mesh (no self-intersection pass).
@@ -561,6 +593,8 @@ struct LoopConfig {
     mode: Mode,
     /// Cage mode: the clearance the guard keeps (model units); 0 for LODs.
     clearance: f64,
+    /// Run the input-plane fit after the loop (LODs with `fit_to_input`).
+    fit: bool,
 }
 
 /// Totals of one run of the loop.
@@ -581,6 +615,14 @@ struct LoopStats {
     align_motion: f64,
     target_met: bool,
     relaxations: u64,
+    /// Seconds of the input-plane fit (with the measurement of its safety revert).
+    fit_s: f64,
+    fit: FitReport,
+    fit_reverted: bool,
+    /// The fitted LOD's one-sided distances over `l` (in→out, out→in), kept or not.
+    fit_sides: Option<[f64; 2]>,
+    /// The loop's output before the fit, kept for the safety revert.
+    prefit: Option<TriMesh>,
 }
 
 impl LoopStats {
@@ -589,6 +631,7 @@ impl LoopStats {
         s.stages.push(LodStage::Flow, self.flow_s);
         s.stages.push(LodStage::Align, self.align_s);
         s.stages.push(LodStage::Convergence, self.converge_s);
+        s.stages.push(LodStage::Fit, self.fit_s);
         s.simplify_first_pass_seconds = self.simplify_first_s;
         s.rounds = self.rounds;
         s.faces_per_round = self.faces_per_round.clone();
@@ -599,6 +642,11 @@ impl LoopStats {
         s.converged = self.converged;
         s.flow_motion = self.flow_motion;
         s.align_motion = self.align_motion;
+        s.fit_moves = self.fit.moves;
+        s.fit_flips = self.fit.flips;
+        s.fit_motion = self.fit.motion;
+        s.fit_reverted = self.fit_reverted;
+        s.fit_sides_rel = self.fit_sides;
     }
 }
 
@@ -685,6 +733,14 @@ fn optimize(
         if converged {
             break;
         }
+    }
+    if cfg.fit {
+        rep.check("fit", 1.0)?;
+        let t0 = Instant::now();
+        ls.prefit = Some(g.mesh().to_trimesh());
+        let mut kg = |_: f64| rep.report("fit", 1.0);
+        ls.fit = fit_to_input(&mut g, cfg.d, &mut kg)?;
+        ls.fit_s += t0.elapsed().as_secs_f64();
     }
     ls.guard = g.stats;
     Ok((g.mesh().to_trimesh(), ls))

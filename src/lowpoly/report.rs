@@ -28,6 +28,8 @@ pub enum LodStage {
     Floor,
     /// Cages: exact measurement of the clearance (`clearance`).
     Clearance,
+    /// LODs: the final input-plane fit and its safety check (`fit`).
+    Fit,
 }
 
 impl Stage for LodStage {
@@ -42,6 +44,7 @@ impl Stage for LodStage {
             LodStage::Measure => "measure",
             LodStage::Floor => "floor",
             LodStage::Clearance => "clearance",
+            LodStage::Fit => "fit",
         })
     }
 }
@@ -153,7 +156,7 @@ pub struct ClearanceMeasure {
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LodReport {
     /// Wall seconds per stage, in execution order (`offset`, `simplify`, `flow`, `align`,
-    /// `convergence`, `verify`, `measure`, then `floor` when measured).
+    /// `convergence`, `fit`, `verify`, `measure`, then `floor` when measured).
     pub stages: StageTimes<LodStage>,
     /// Offset distance `d = l / n_p` (model units).
     pub d: f64,
@@ -182,6 +185,17 @@ pub struct LodReport {
     pub flow_motion: f64,
     /// Total vertex motion of the alignment steps (model units, summed).
     pub align_motion: f64,
+    /// Vertex moves of the input-plane fit (`LodParams::fit_to_input`).
+    pub fit_moves: u64,
+    /// Edge flips of the input-plane fit.
+    pub fit_flips: u64,
+    /// Total vertex motion of the fit (model units).
+    pub fit_motion: f64,
+    /// The fit was reverted because the Hausdorff distance grew (the output is the loop's).
+    pub fit_reverted: bool,
+    /// The fitted LOD's one-sided Hausdorff distances over `l`, `[in→out, out→in]`, whether
+    /// it was kept or reverted (`None` without a fit).
+    pub fit_sides_rel: Option<[f64; 2]>,
     /// Reruns with exact checks only (0 or 1; §4.3.3: the normal-cone shortcut let an
     /// intersection through).
     pub reruns_exact: u64,
@@ -256,6 +270,14 @@ impl LodReport {
         e.count_entry("converged", self.converged as u64);
         e.metric_entry("flow_motion", self.flow_motion);
         e.metric_entry("align_motion", self.align_motion);
+        e.count_entry("fit_moves", self.fit_moves);
+        e.count_entry("fit_flips", self.fit_flips);
+        e.metric_entry("fit_motion", self.fit_motion);
+        e.count_entry("fit_reverted", self.fit_reverted as u64);
+        if let Some([i, o]) = self.fit_sides_rel {
+            e.metric_entry("fit_in_to_out_rel", i);
+            e.metric_entry("fit_out_to_in_rel", o);
+        }
         e.count_entry("reruns_exact", self.reruns_exact);
         self.verified.write_entries(&mut e);
         if let Some(f) = &self.floor {

@@ -291,7 +291,7 @@ for _fn, _cls in [("pleat_lod_params_default", _LodParams),
                           f"in the library, {_c.sizeof(_cls)} in this module")
 
 # PLEAT_LOD_* flags, PLEAT_CHECK_* flags, PLEAT_WRINKLE_FIELD_* bits and doubles per element.
-_LOD_NO_ALIGN, _LOD_MEASURE_FLOOR = 1, 2
+_LOD_NO_ALIGN, _LOD_MEASURE_FLOOR, _LOD_NO_FIT = 1, 2, 8
 _CHECK_SKIP_SELF_INTERSECTIONS, _CHECK_WELD = 1, 2
 _FIELDS = {"amplitude": (1, 1), "phase": (2, 1), "normals": (4, 3), "z": (8, 2),
            "smooth_positions": (16, 3), "omega": (32, 1)}
@@ -458,18 +458,19 @@ _REPORT_FLAGS = ("is_closed", "is_edge_manifold", "is_manifold", "is_watertight"
                  "consistently_oriented", "self_intersections_checked", "self_intersection_free")
 
 
-def _lod_params(screen_size, align=True, measure_floor=False, **kw):
+def _lod_params(screen_size, align=True, measure_floor=False, fit=True, **kw):
     """PleatLodParams from the defaults and keyword overrides (names of the C fields)."""
     p = _lib.pleat_lod_params_default()
     unknown = set(kw) - set(_LOD_KEYS)
     if unknown:
         raise TypeError(f"unknown LOD parameter(s) {sorted(unknown)}; known: "
-                        f"{sorted(_LOD_KEYS + ('align', 'measure_floor'))}")
+                        f"{sorted(_LOD_KEYS + ('align', 'measure_floor', 'fit'))}")
     if screen_size is not None:
         p.screen_size = float(screen_size)
     for k, v in kw.items():
         setattr(p, k, float(v) if k in ("flow_ratio", "epsilon", "theta0_deg") else int(v))
-    p.flags = (0 if align else _LOD_NO_ALIGN) | (_LOD_MEASURE_FLOOR if measure_floor else 0)
+    p.flags = ((0 if align else _LOD_NO_ALIGN) | (_LOD_MEASURE_FLOOR if measure_floor else 0)
+               | (0 if fit else _LOD_NO_FIT))
     return p
 
 
@@ -590,7 +591,8 @@ class Mesh(_Handle):
         this one, with ``stats`` (PleatLodStats as a dict). ``params``: ``target_faces``,
         ``max_rounds``, ``flow_ratio``, ``epsilon``, ``theta0_deg``, ``l0``,
         ``memory_budget_bytes`` (C field names and defaults), ``align=False`` to skip the
-        feature alignment, ``measure_floor=True`` for ``hausdorff_floor_relative``.
+        feature alignment, ``measure_floor=True`` for ``hausdorff_floor_relative``,
+        ``fit=False`` to skip the final fit to this mesh's planes (PLEAT_LOD_NO_FIT).
         ``progress(stage, fraction)`` is called on this thread; return True to cancel
         (PleatError CANCELLED); an exception it raises comes out of this call."""
         return self._bake(_lib.pleat_lod_generate, screen_size, progress, params)
