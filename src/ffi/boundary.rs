@@ -334,3 +334,252 @@ impl<T: Versioned> VersionedOut<T> {
         unsafe { self.write_at(0, v) }
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Tests (run under Miri by `.ci/miri.sh`: no FFI calls, no threads, no file system)
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ffi::common::c_str_arg;
+
+    /// A versioned struct as the C side sees it: version 1 is 16 bytes (`struct_size`, `a`,
+    /// `b`), version 2 appends `c`.
+    #[repr(C)]
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    struct Params {
+        struct_size: u32,
+        a: u32,
+        b: f64,
+        c: f64,
+    }
+
+    fn params_default() -> Params {
+        Params {
+            struct_size: full_size::<Params>(),
+            a: 7,
+            b: 0.5,
+            c: -1.0,
+        }
+    }
+
+    versioned!(Params, 16, params_default);
+
+    /// The first published version of `Params` (what an older caller compiled against).
+    #[repr(C)]
+    #[derive(Clone, Copy)]
+    struct ParamsV1 {
+        struct_size: u32,
+        a: u32,
+        b: f64,
+    }
+
+    fn message(e: Error) -> String {
+        e.to_string()
+    }
+
+    #[test]
+    fn arg_ref_borrows_or_names_the_null_parameter() {
+        let x = 5u64;
+        assert_eq!(unsafe { arg_ref(&x, "x") }.copied().unwrap(), 5);
+        let e = unsafe { arg_ref::<u64>(std::ptr::null(), "mesh") }.unwrap_err();
+        assert!(message(e).contains("`mesh` is NULL"));
+        assert!(non_null(&x as *const u64, "x").is_ok());
+        assert!(non_null(std::ptr::null::<u8>(), "out").is_err());
+    }
+
+    #[test]
+    fn arg_slice_reads_exactly_the_given_values() {
+        let v = [1.0f64, 2.0, 3.0];
+        let s = unsafe { arg_slice(v.as_ptr(), 3, "positions") }.unwrap();
+        assert_eq!(s, &v[..]);
+        let empty = unsafe { arg_slice(v.as_ptr(), 0, "positions") }.unwrap();
+        assert!(empty.is_empty());
+        // a sub-range through an offset pointer stays inside the allocation
+        let tail = unsafe { arg_slice(v.as_ptr().add(1), 2, "positions") }.unwrap();
+        assert_eq!(tail, &[2.0, 3.0]);
+        let e = unsafe { arg_slice::<f64>(std::ptr::null(), 0, "indices") }.unwrap_err();
+        assert!(message(e).contains("`indices` is NULL"));
+    }
+
+    #[test]
+    fn arg_slice_refuses_counts_beyond_the_address_space_without_reading() {
+        let v = [0u32; 2];
+        for len in [usize::MAX, usize::MAX / 4 + 1, isize::MAX as usize / 2] {
+            let e = unsafe { arg_slice(v.as_ptr(), len, "indices") }.unwrap_err();
+            assert!(message(e).contains("cannot hold"), "{len}");
+        }
+    }
+
+    #[test]
+    fn out_writes_once_and_arrays_by_offset() {
+        let mut slot = 0u32;
+        unsafe { arg_out(&mut slot, "out") }.unwrap().put(42);
+        assert_eq!(slot, 42);
+        let e = unsafe { arg_out::<u32>(std::ptr::null_mut(), "out_count") }.err();
+        assert!(message(e.unwrap()).contains("`out_count` is NULL"));
+        let mut arr = [0u16; 4];
+        let out = unsafe { arg_out(arr.as_mut_ptr(), "out_values") }.unwrap();
+        for i in 0..4 {
+            unsafe { out.add(i) }.put(10 + i as u16);
+        }
+        assert_eq!(arr, [10, 11, 12, 13]);
+    }
+
+    #[test]
+    fn boxed_handles_round_trip_through_destroy() {
+        let mut h: *mut Vec<u8> = std::ptr::null_mut();
+        unsafe { arg_out(&mut h, "out_handle") }
+            .unwrap()
+            .put_boxed(vec![1, 2, 3]);
+        assert_eq!(unsafe { &*h }, &vec![1, 2, 3]);
+        unsafe { destroy(h) };
+        unsafe { destroy::<Vec<u8>>(std::ptr::null_mut()) };
+    }
+
+    #[test]
+    fn destroy_contains_a_panicking_destructor() {
+        struct Bomb;
+        impl Drop for Bomb {
+            fn drop(&mut self) {
+                panic!("drop");
+            }
+        }
+        let mut h: *mut Bomb = std::ptr::null_mut();
+        unsafe { arg_out(&mut h, "h") }.unwrap().put_boxed(Bomb);
+        let hook = std::panic::take_hook();
+        std::panic::set_hook(Box::new(|_| {}));
+        unsafe { destroy(h) };
+        std::panic::set_hook(hook);
+    }
+
+    #[test]
+    fn c_str_arg_reads_to_the_nul_and_checks_utf8() {
+        let s = b"mesh.obj\0";
+        let r = unsafe { c_str_arg(s.as_ptr().cast(), "path") }.unwrap();
+        assert_eq!(r, "mesh.obj");
+        let empty = b"\0";
+        assert_eq!(
+            unsafe { c_str_arg(empty.as_ptr().cast(), "path") }.unwrap(),
+            ""
+        );
+        let bad = b"\xff\xfe\0";
+        let e = unsafe { c_str_arg(bad.as_ptr().cast(), "path") }.unwrap_err();
+        assert!(message(e).contains("not valid UTF-8"));
+        let e = unsafe { c_str_arg(std::ptr::null(), "path") }.unwrap_err();
+        assert!(message(e).contains("`path` is NULL"));
+    }
+
+    #[test]
+    fn numbers_are_checked_with_the_parameter_named() {
+        assert!(finite_slice(&[0.0, 1.0], "p").is_ok());
+        let e = finite_slice(&[0.0, f64::NAN], "positions").unwrap_err();
+        assert!(message(e).contains("positions[1] is NaN"));
+        assert!(check_f64(1.0, true, "d", "> 0").is_ok());
+        assert!(message(check_f64(-1.0, false, "d", "> 0").unwrap_err()).contains("d is -1"));
+        assert!(check_range(3, 1, 3, "n").is_ok());
+        assert!(message(check_range(4, 1, 3, "n").unwrap_err()).contains("allowed 1 to 3"));
+        assert!(check_flags(0b101, 0b111, "flags").is_ok());
+        assert!(message(check_flags(0b1000, 0b111, "flags").unwrap_err()).contains("0x8"));
+        assert!(bool_field(1, "x").unwrap());
+        assert!(!bool_field(0, "x").unwrap());
+        assert!(bool_field(2, "x").is_err());
+    }
+
+    #[test]
+    fn read_versioned_takes_null_as_defaults() {
+        let p = unsafe { read_versioned::<Params>(std::ptr::null(), "params") }.unwrap();
+        assert_eq!(p, params_default());
+    }
+
+    #[test]
+    fn read_versioned_reads_only_an_older_callers_bytes() {
+        // an older caller's struct is 16 bytes: reading must not touch bytes beyond it
+        let old = ParamsV1 {
+            struct_size: std::mem::size_of::<ParamsV1>() as u32,
+            a: 3,
+            b: 2.5,
+        };
+        let p = unsafe { read_versioned(&old as *const ParamsV1 as *const Params, "params") };
+        let p = p.unwrap();
+        assert_eq!((p.a, p.b, p.c), (3, 2.5, -1.0));
+        assert_eq!(p.struct_size, full_size::<Params>());
+        // a newer caller's larger struct: only our size is read
+        #[repr(C)]
+        struct ParamsV3 {
+            v2: Params,
+            d: u64,
+        }
+        let mut newer = ParamsV3 {
+            v2: Params {
+                a: 9,
+                b: 1.0,
+                c: 2.0,
+                ..params_default()
+            },
+            d: 1,
+        };
+        newer.v2.struct_size = std::mem::size_of::<ParamsV3>() as u32;
+        let p = unsafe { read_versioned(&newer as *const ParamsV3 as *const Params, "params") };
+        let p = p.unwrap();
+        assert_eq!((p.a, p.b, p.c), (9, 1.0, 2.0));
+        assert_eq!(newer.d, 1);
+    }
+
+    #[test]
+    fn read_versioned_refuses_a_short_struct_size() {
+        let mut short = params_default();
+        short.struct_size = 8;
+        let e = unsafe { read_versioned(&short, "params") }.unwrap_err();
+        let m = message(e);
+        assert!(m.contains("params->struct_size is 8"), "{m}");
+        assert!(m.contains("params_default()"), "{m}");
+    }
+
+    #[test]
+    fn versioned_out_fills_only_the_callers_bytes() {
+        // an older caller's output array of two 16-byte elements, followed by a guard value
+        #[repr(C)]
+        struct OldOut {
+            items: [ParamsV1; 2],
+            guard: u64,
+        }
+        let zero = ParamsV1 {
+            struct_size: 16,
+            a: 0,
+            b: 0.0,
+        };
+        let mut out = OldOut {
+            items: [zero; 2],
+            guard: 0xdead_beef,
+        };
+        let p = &mut out as *mut OldOut as *mut Params;
+        let vo = unsafe { versioned_out(p, "out_stats") }.unwrap().unwrap();
+        for i in 0..2 {
+            let v = Params {
+                a: i as u32 + 1,
+                b: 4.0,
+                ..params_default()
+            };
+            unsafe { vo.write_at(i, v) };
+        }
+        assert_eq!((out.items[0].a, out.items[1].a), (1, 2));
+        assert_eq!(out.items[1].b, 4.0);
+        assert_eq!(out.items[0].struct_size, 16);
+        assert_eq!(out.guard, 0xdead_beef);
+        // a current caller gets the whole struct
+        let mut full = params_default();
+        full.c = 0.0;
+        let vo = unsafe { required_versioned_out(&mut full, "out") }.unwrap();
+        vo.write(params_default());
+        assert_eq!(full, params_default());
+        // NULL: optional, or named when required
+        assert!(
+            unsafe { versioned_out::<Params>(std::ptr::null_mut(), "o") }
+                .unwrap()
+                .is_none()
+        );
+        let e = unsafe { required_versioned_out::<Params>(std::ptr::null_mut(), "out_report") };
+        assert!(message(e.err().unwrap()).contains("`out_report` is NULL"));
+    }
+}

@@ -215,7 +215,7 @@ pub fn offset_surface_with_progress(
     if params.verify {
         step(progress, "verify", 0.95)?;
         let t = Instant::now();
-        verify(&out, &input, r, &mut stats);
+        verify(&out, &input, r, &mut stats, progress)?;
         stats
             .stages
             .push(OffsetStage::Verify, t.elapsed().as_secs_f64());
@@ -451,23 +451,42 @@ fn visible_patches(set: &PatchSet, stats: &mut OffsetReport) -> Vec<bool> {
 
 /// Independent checks of the output ([`MeshReport`], code independent of this stage):
 /// watertight, manifold, consistently oriented, self-intersection-free; plus the exact
-/// distance of every vertex to the input (`|f(v) − d| ≤ h`).
-fn verify(out: &TriMesh, input: &InputDistance, r: Resolved, stats: &mut OffsetReport) {
+/// distance of every vertex to the input (`|f(v) − d| ≤ h`), in chunks with a progress call
+/// (and cancellation point) after each.
+fn verify(
+    out: &TriMesh,
+    input: &InputDistance,
+    r: Resolved,
+    stats: &mut OffsetReport,
+    progress: &mut ProgressFn<'_>,
+) -> Result<()> {
     let report = MeshReport::compute_with(out, &ReportOptions::default());
     let v = &mut stats.verified;
     v.watertight = Some(report.is_watertight);
     v.manifold = Some(report.is_manifold);
     v.consistently_oriented = Some(report.consistently_oriented);
     v.self_intersection_free = Some(report.self_intersection_free == Some(true));
+    step(progress, "verify", 0.96)?;
     let cap = r.d + 4.0 * r.h;
-    let max_dev = out
-        .positions()
-        .par_iter()
-        .map(|&x| deviation(input, x.into(), r.d, cap))
-        .reduce(|| 0.0, f64::max);
+    let positions = out.positions();
+    let mut max_dev: f64 = 0.0;
+    // chunked so that a cancel is seen between chunks (issue 15); a maximum, so the same bytes
+    for (i, chunk) in positions.chunks(DEVIATION_CHUNK).enumerate() {
+        let m = chunk
+            .par_iter()
+            .map(|&x| deviation(input, x.into(), r.d, cap))
+            .reduce(|| 0.0, f64::max);
+        max_dev = max_dev.max(m);
+        let done = (i * DEVIATION_CHUNK + chunk.len()) as f64 / positions.len() as f64;
+        step(progress, "verify", 0.96 + 0.04 * done)?;
+    }
     v.vertices_within_h_of_offset = Some(max_dev <= r.h);
     stats.verification = Some(OffsetVerification {
         output_components: report.n_components as u64,
         max_deviation_over_d: max_dev / r.d,
     });
+    Ok(())
 }
+
+/// Output vertices whose deviation [`verify`] measures between two progress calls.
+const DEVIATION_CHUNK: usize = 8192;

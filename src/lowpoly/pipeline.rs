@@ -137,8 +137,13 @@ impl Default for LodParams {
 
 /// Approximate bytes per working-mesh face (half-edge records, BVH node, caches).
 const BYTES_PER_WORK_FACE: f64 = 400.0;
-/// Approximate bytes per input face (copy, BVH, flags).
-const BYTES_PER_INPUT_FACE: f64 = 200.0;
+/// Approximate bytes per input face (copy, BVH, flags, reader buffers). Measured 2026-11-27 as
+/// the peak RSS of `pleat lod --screen-size 8` (an offset surface of a few hundred faces) less
+/// the 8 MB of a tiny input, per input face: 700 B (cad_thingi10k_908460, 36k faces), 680 B
+/// (dirty_ogre, 124k), 670 B (large_armadillo_loopA, 600k), 670 B (large_cycloidal_mid16,
+/// 694k). With the work term, dirty_ogre at n_p 200 peaks at 205 MB against an estimate of
+/// 211 MB (149 MB with the former 200 B).
+const BYTES_PER_INPUT_FACE: f64 = 700.0;
 
 impl LodParams {
     /// Checks every parameter (and the memory estimate for `input`) before any work.
@@ -457,11 +462,18 @@ fn bake_level(
     let mut verify_s = t0.elapsed().as_secs_f64();
     rep.check("measure", 0.5)?;
     let t0 = Instant::now();
-    let mut sides = verify::hausdorff_sides(&mesh, input);
+    // chunked so that a cancel is seen within tens of milliseconds (issue 15)
+    let mut sides = verify::hausdorff_sides_with_progress(&mesh, input, &mut |f| {
+        rep.report("measure", 0.5 + 0.25 * f)
+    })
+    .ok_or(Error::Cancelled)?;
     let measure_s = t0.elapsed().as_secs_f64();
     if let Some(pre) = ls.prefit.take() {
         let t0 = Instant::now();
-        let pre_sides = verify::hausdorff_sides(&pre, input);
+        let pre_sides = verify::hausdorff_sides_with_progress(&pre, input, &mut |f| {
+            rep.report("fit", 0.75 + 0.25 * f)
+        })
+        .ok_or(Error::Cancelled)?;
         ls.fit_s += t0.elapsed().as_secs_f64();
         ls.fit_sides = Some([sides.input_to_output / l, sides.output_to_input / l]);
         if hausdorff_of(&sides) > hausdorff_of(&pre_sides) + FIT_HAUSDORFF_SLACK * l {
@@ -507,7 +519,9 @@ fn bake_level(
     }
     if let Some(c) = &level.cage_input {
         let t0 = Instant::now();
-        let min = c.min_distance(&mesh);
+        let min = c
+            .min_distance_with_progress(&mesh, &mut |f| rep.report("clearance", 0.75 + 0.25 * f))
+            .ok_or(Error::Cancelled)?;
         stats
             .stages
             .push(LodStage::Clearance, t0.elapsed().as_secs_f64());

@@ -107,22 +107,55 @@ impl<'a> CageInput<'a> {
     /// else the minimum of its 6 corner–triangle and 9 edge–edge distances, the closed-form
     /// distance of two disjoint triangles. This is the `min_clearance` of a cage's report.
     pub fn min_distance(&self, cage: &TriMesh) -> f64 {
+        self.min_distance_with_progress(cage, &mut |_| true)
+            .expect("never cancelled")
+    }
+
+    /// [`CageInput::min_distance`] with a progress callback, called on the calling thread
+    /// between chunks of [`super::hausdorff::FACES_PER_CHUNK`] cage vertices or triangles with
+    /// the fraction done; `None` as soon as it returns `false`. The result is the same bytes
+    /// (a minimum, which the chunking does not change).
+    pub fn min_distance_with_progress(
+        &self,
+        cage: &TriMesh,
+        keep_going: &mut dyn FnMut(f64) -> bool,
+    ) -> Option<f64> {
         let pos = cage.positions();
-        let upper = referenced_points(pos, cage.triangles())
-            .par_iter()
-            .map(|&p| {
-                self.bvh
-                    .closest_point(self.positions, self.tris, p, f64::INFINITY)
-                    .map_or(f64::INFINITY, |c| c.distance)
-            })
-            .reduce(|| f64::INFINITY, f64::min);
-        if !upper.is_finite() {
-            return upper;
+        let points = referenced_points(pos, cage.triangles());
+        let tris = cage.triangles();
+        let chunk = super::hausdorff::FACES_PER_CHUNK;
+        let total = (points.len() + tris.len()).max(1) as f64;
+        let mut upper = f64::INFINITY;
+        for (i, ps) in points.chunks(chunk).enumerate() {
+            let u = ps
+                .par_iter()
+                .map(|&p| {
+                    self.bvh
+                        .closest_point(self.positions, self.tris, p, f64::INFINITY)
+                        .map_or(f64::INFINITY, |c| c.distance)
+                })
+                .reduce(|| f64::INFINITY, f64::min);
+            upper = upper.min(u);
+            if !keep_going(((i * chunk + ps.len()) as f64 / total).min(1.0)) {
+                return None;
+            }
         }
-        cage.triangles()
-            .par_iter()
-            .map(|t| self.triangle_gap(&t.map(|v| pos[v as usize]), upper))
-            .reduce(|| upper, f64::min)
+        if !upper.is_finite() {
+            return Some(upper);
+        }
+        let mut best = upper;
+        for (i, ts) in tris.chunks(chunk).enumerate() {
+            let b = ts
+                .par_iter()
+                .map(|t| self.triangle_gap(&t.map(|v| pos[v as usize]), upper))
+                .reduce(|| upper, f64::min);
+            best = best.min(b);
+            let done = points.len() + i * chunk + ts.len();
+            if !keep_going((done as f64 / total).min(1.0)) {
+                return None;
+            }
+        }
+        Some(best)
     }
 
     /// Smallest distance from the cage triangle `tri` to the input, or `upper` if that is

@@ -50,18 +50,44 @@ pub struct HausdorffSides {
 /// Both one-sided sampled distances between `output` and `input`, with the sampling of
 /// [`hausdorff_to_input`].
 pub fn hausdorff_sides(output: &TriMesh, input: &TriMesh) -> HausdorffSides {
-    HausdorffSides {
-        input_to_output: one_sided(input, &Surface::new(output), input),
-        output_to_input: one_sided(output, &Surface::new(input), input),
-    }
+    hausdorff_sides_with_progress(output, input, &mut |_| true).expect("never cancelled")
 }
+
+/// [`hausdorff_sides`] with a progress callback, called on the calling thread between chunks
+/// of samples (about [`FACES_PER_CHUNK`] faces, tens of milliseconds of work) with the
+/// fraction done; `None` as soon as it returns `false`. The result is the same bytes as
+/// [`hausdorff_sides`]'s: each side is a maximum, which the chunking does not change.
+pub fn hausdorff_sides_with_progress(
+    output: &TriMesh,
+    input: &TriMesh,
+    keep_going: &mut dyn FnMut(f64) -> bool,
+) -> Option<HausdorffSides> {
+    let input_to_output = one_sided_with(input, &Surface::new(output), input, &mut |f| {
+        keep_going(0.5 * f)
+    })?;
+    if !keep_going(0.5) {
+        return None;
+    }
+    let output_to_input = one_sided_with(output, &Surface::new(input), input, &mut |f| {
+        keep_going(0.5 + 0.5 * f)
+    })?;
+    Some(HausdorffSides {
+        input_to_output,
+        output_to_input,
+    })
+}
+
+/// Faces sampled between two progress calls of [`hausdorff_sides_with_progress`]. A face has
+/// at most 561 samples (`MAX_SUBDIVISIONS` = 32), typically a few; the vertices go in chunks
+/// of `16 ×` this.
+pub const FACES_PER_CHUNK: usize = 2048;
 
 /// One-sided sampled distance (model units) from `input` to `surface` (sampling of
 /// [`hausdorff_to_input`]). Applied to the offset surface it gives the *floor* of the
 /// input-to-output error: input the offset already hides (buried components, cavities and
 /// crevices narrower than `2d`) stays hidden through the LOD loop, which keeps its topology.
 pub fn input_to_surface(surface: &TriMesh, input: &TriMesh) -> f64 {
-    one_sided(input, &Surface::new(surface), input)
+    one_sided_with(input, &Surface::new(surface), input, &mut |_| true).expect("never cancelled")
 }
 
 /// A triangle set with its BVH.
@@ -91,8 +117,14 @@ impl<'a> Surface<'a> {
 }
 
 /// Max over the samples of `from` (see the module docs) of the distance to `to`, at the
-/// spacing set by `input`'s diagonal.
-fn one_sided(from: &TriMesh, to: &Surface<'_>, input: &TriMesh) -> f64 {
+/// spacing set by `input`'s diagonal; `keep_going(fraction)` between chunks, `None` when it
+/// returns `false`.
+fn one_sided_with(
+    from: &TriMesh,
+    to: &Surface<'_>,
+    input: &TriMesh,
+    keep_going: &mut dyn FnMut(f64) -> bool,
+) -> Option<f64> {
     let spacing = input.bbox_diagonal() / SAMPLES_PER_DIAGONAL;
     let from_pos = from.positions();
     let from_tris = from.triangles();
@@ -102,28 +134,49 @@ fn one_sided(from: &TriMesh, to: &Surface<'_>, input: &TriMesh) -> f64 {
             used[v as usize] = true;
         }
     }
-    let vmax = (0..from_pos.len())
-        .into_par_iter()
-        .filter(|&v| used[v])
-        .map(|v| to.distance(Vec3::from(from_pos[v])))
-        .reduce(|| 0.0, f64::max);
-    let fmax = from_tris
-        .par_iter()
-        .map(|t| {
-            let corners = t.map(|v| from_pos[v as usize]);
-            if is_collinear(corners[0], corners[1], corners[2]) {
-                // Zero area: nothing of it is visible, and area-weighted sampling (Metro,
-                // the CGAL `compare` tool) never lands on it; its corners are sampled above.
-                return 0.0;
-            }
-            let tri = corners.map(Vec3::from);
-            let k = resolution(&tri, spacing, MAX_SUBDIVISIONS);
-            let mut m: f64 = 0.0;
-            for_each_interior_sample(&tri, k, |p| m = m.max(to.distance(p)));
-            m
-        })
-        .reduce(|| 0.0, f64::max);
-    vmax.max(fmax)
+    let total = (from_pos.len() + 16 * from_tris.len()).max(1) as f64;
+    let mut done = 0usize;
+    let mut m: f64 = 0.0;
+    let vertices: Vec<usize> = (0..from_pos.len()).filter(|&v| used[v]).collect();
+    for chunk in vertices.chunks(16 * FACES_PER_CHUNK) {
+        let vmax = chunk
+            .par_iter()
+            .map(|&v| to.distance(Vec3::from(from_pos[v])))
+            .reduce(|| 0.0, f64::max);
+        m = m.max(vmax);
+        done += chunk.len();
+        if !keep_going(done as f64 / total) {
+            return None;
+        }
+    }
+    done = from_pos.len();
+    for chunk in from_tris.chunks(FACES_PER_CHUNK) {
+        let fmax = chunk
+            .par_iter()
+            .map(|t| face_max(t, from_pos, to, spacing))
+            .reduce(|| 0.0, f64::max);
+        m = m.max(fmax);
+        done += 16 * chunk.len();
+        if !keep_going(done as f64 / total) {
+            return None;
+        }
+    }
+    Some(m)
+}
+
+/// Max distance to `to` over the interior samples of face `t` of `from_pos`.
+fn face_max(t: &[u32; 3], from_pos: &[[f64; 3]], to: &Surface<'_>, spacing: f64) -> f64 {
+    let corners = t.map(|v| from_pos[v as usize]);
+    if is_collinear(corners[0], corners[1], corners[2]) {
+        // Zero area: nothing of it is visible, and area-weighted sampling (Metro,
+        // the CGAL `compare` tool) never lands on it; its corners are sampled above.
+        return 0.0;
+    }
+    let tri = corners.map(Vec3::from);
+    let k = resolution(&tri, spacing, MAX_SUBDIVISIONS);
+    let mut m: f64 = 0.0;
+    for_each_interior_sample(&tri, k, |p| m = m.max(to.distance(p)));
+    m
 }
 
 /// Calls `f` at the barycentric grid points of `t` with `k` subdivisions per edge, corners
@@ -176,6 +229,25 @@ mod tests {
         assert_eq!(s.input_to_output, 0.25);
         assert_eq!(s.output_to_input, 0.25);
         assert_eq!(hausdorff_to_input(&square(0.0), &square(0.0)), 0.0);
+    }
+
+    #[test]
+    fn progress_sees_every_chunk_and_can_cancel() {
+        let (a, b) = (square(0.25), square(0.0));
+        let mut calls = Vec::new();
+        let s = hausdorff_sides_with_progress(&a, &b, &mut |f| {
+            calls.push(f);
+            true
+        });
+        assert_eq!(s, Some(hausdorff_sides(&a, &b)));
+        assert!(calls.windows(2).all(|w| w[0] <= w[1]), "{calls:?}");
+        assert_eq!(calls.last(), Some(&1.0));
+        let mut n = 0;
+        let cancelled = hausdorff_sides_with_progress(&a, &b, &mut |_| {
+            n += 1;
+            n < 2
+        });
+        assert_eq!((cancelled, n), (None, 2));
     }
 
     #[test]

@@ -120,7 +120,8 @@ impl Cwf {
         self.evaluate_with_progress(levels, opts, &mut |_| true)
     }
 
-    /// [`Cwf::evaluate`] with a progress callback, called on the calling thread after each
+    /// [`Cwf::evaluate`] with a progress callback, called on the calling thread between the
+    /// parts of each level (positions, amplitude, cotangent vectors, `z`, topology), after each
     /// level and before the displacement with the stage name and the fraction done (by output
     /// size: level `k` of `n` costs about `4^k`). Returning `false` stops the evaluation
     /// promptly with [`crate::Error::Cancelled`].
@@ -146,13 +147,27 @@ impl Cwf {
             let last = l + 1 == levels;
             let keep_topology = !last || opts.want_omega || opts.in_plane_v2;
             let t0 = std::time::Instant::now();
+            let stage = format!("level {}", l + 1);
+            let (f0, f1) = (work_done(l, levels), work_done(l + 1, levels));
+            let mut part = 0.0;
+            // a progress call (and cancellation point) between the parts of a level (issue 15),
+            // at increasing fractions below the level's own report
+            let mut keep_going = || {
+                part += 1.0;
+                progress(Progress {
+                    stage: &stage,
+                    fraction: f0 + (f1 - f0) * part / (LEVEL_PARTS + 1.0),
+                })
+            };
             let (next, next_faces) = refine_level(
                 &level,
                 keep_topology,
                 opts.subdivision.boundary,
                 &mut stats.stages,
                 l + 1,
-            );
+                &mut keep_going,
+            )
+            .ok_or(crate::Error::Cancelled)?;
             stats.levels.push(LevelReport {
                 seconds: t0.elapsed().as_secs_f64(),
                 vertices: next.x.len() as u64,
@@ -160,7 +175,6 @@ impl Cwf {
             });
             level = next;
             faces = next_faces;
-            let stage = format!("level {}", l + 1);
             if !progress(Progress {
                 stage: &stage,
                 fraction: work_done(l + 1, levels),
@@ -218,21 +232,28 @@ fn work_done(k: usize, n: usize) -> f64 {
     (1..=k).map(cost).sum::<f64>() / total
 }
 
+/// Progress calls inside a level of [`Cwf::evaluate_with_progress`]: after the positions, the
+/// amplitude, the cotangent vectors, `z` and (except on the last level) the topology.
+const LEVEL_PARTS: f64 = 5.0;
+
 /// One Loop step of every field, timing its parts as [`EvalStage::Level`] in `stats`. Without
 /// `keep_topology` only the fine triangles are built (the last level needs no adjacency and no
-/// one-form).
+/// one-form). `keep_going` is called between the parts (the cancellation points inside a
+/// level); `None` as soon as it returns `false`.
 fn refine_level<'a>(
     c: &Level<'_>,
     keep_topology: bool,
     boundary: BoundaryRule,
     stats: &mut StageTimes<EvalStage>,
     k: usize,
-) -> (Level<'a>, Vec<[u32; 3]>) {
+    keep_going: &mut dyn FnMut() -> bool,
+) -> Option<(Level<'a>, Vec<[u32; 3]>)> {
     let topo = c.topo.as_ref();
     let name = |part: LevelPart| EvalStage::Level(k, part);
     let x = stats.time(name(LevelPart::Positions), || {
         apply_s0(topo, &c.rules, &c.x)
     });
+    keep_going().then_some(())?;
     let amplitude = stats.time(name(LevelPart::Amplitude), || {
         if c.amplitude.is_empty() {
             Vec::new()
@@ -240,9 +261,11 @@ fn refine_level<'a>(
             apply_s0(topo, &c.rules, &c.amplitude)
         }
     });
+    keep_going().then_some(())?;
     let faces = stats.time(name(LevelPart::CotangentVectors), || {
         face_gradients(topo, &c.x, &c.omega)
     });
+    keep_going().then_some(())?;
     let ctx = ZContext {
         topo,
         rules: &c.rules,
@@ -252,6 +275,7 @@ fn refine_level<'a>(
         faces,
     };
     let z = stats.time(name(LevelPart::Z), || apply_z(&ctx, &x));
+    keep_going().then_some(())?;
     if !keep_topology {
         let faces = stats.time(name(LevelPart::Triangles), || topo.refine_faces());
         let next = Level {
@@ -262,9 +286,10 @@ fn refine_level<'a>(
             z,
             amplitude,
         };
-        return (next, faces);
+        return Some((next, faces));
     }
     let fine = stats.time(name(LevelPart::Topology), || topo.refine());
+    keep_going().then_some(())?;
     let omega = stats.time(name(LevelPart::OneForm), || {
         apply_s1(topo, &fine, &c.rules, &c.omega)
     });
@@ -278,7 +303,7 @@ fn refine_level<'a>(
         z,
         amplitude,
     };
-    (next, faces)
+    Some((next, faces))
 }
 
 fn empty_topology() -> Topology {

@@ -1,0 +1,179 @@
+/* Resource exhaustion from C (issue 15): a soup of 10^6 tiny components and a soup of 10^6
+ * coincident vertices each get a clear answer (a report, a LOD or PLEAT_STATUS_LIMIT_EXCEEDED)
+ * within the memory budget, and a LOD bake cancelled from the progress callback returns
+ * PLEAT_STATUS_CANCELLED promptly (the latency is printed, not asserted).
+ * Runs natively (10^6-element inputs take minutes under valgrind's memcheck); .ci/asan.sh runs
+ * it under ASan + UBSan. */
+#define _POSIX_C_SOURCE 199309L
+#include <time.h>
+#include "test_util.h"
+
+static double now_s(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* n^3 disjoint right triangles with legs 1e-3 on an n x n x n lattice of the unit cube. */
+static PleatMesh *tiny_components(uint32_t n) {
+    size_t faces = (size_t)n * n * n, v = 0, t = 0;
+    double *p = malloc(faces * 9 * sizeof *p);
+    uint32_t *idx = malloc(faces * 3 * sizeof *idx);
+    PleatMesh *m = NULL;
+    uint32_t i, j, k;
+    CHECK(p != NULL && idx != NULL);
+    if (p == NULL || idx == NULL) {
+        free(p);
+        free(idx);
+        return NULL;
+    }
+    for (i = 0; i < n; i++)
+        for (j = 0; j < n; j++)
+            for (k = 0; k < n; k++) {
+                double o[3];
+                int c, corner;
+                o[0] = (double)i / n;
+                o[1] = (double)j / n;
+                o[2] = (double)k / n;
+                for (corner = 0; corner < 3; corner++) {
+                    for (c = 0; c < 3; c++)
+                        p[3 * (v + corner) + c] = o[c] + (corner == c + 1 ? 1e-3 : 0.0);
+                    idx[t++] = (uint32_t)(v + corner);
+                }
+                v += 3;
+            }
+    CHECK_STATUS(pleat_mesh_create_f64(p, v, 0, idx, t, &m), PLEAT_STATUS_OK);
+    free(p);
+    free(idx);
+    return m;
+}
+
+/* A unit tetrahedron whose 4 corners are each stored `copies` times and whose 4 faces are
+ * repeated `copies` times, each copy on its own vertices. */
+static PleatMesh *coincident_tetrahedron(uint32_t copies) {
+    static const double C[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const uint32_t F[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    size_t nv = (size_t)copies * 4;
+    double *p = malloc(nv * 3 * sizeof *p);
+    uint32_t *idx = malloc(nv * 3 * sizeof *idx);
+    PleatMesh *m = NULL;
+    uint32_t c;
+    int i;
+    CHECK(p != NULL && idx != NULL);
+    if (p == NULL || idx == NULL) {
+        free(p);
+        free(idx);
+        return NULL;
+    }
+    for (c = 0; c < copies; c++) {
+        memcpy(p + 12 * (size_t)c, C, sizeof C);
+        for (i = 0; i < 12; i++) idx[12 * (size_t)c + i] = 4 * c + F[i];
+    }
+    CHECK_STATUS(pleat_mesh_create_f64(p, nv, 0, idx, nv * 3, &m), PLEAT_STATUS_OK);
+    free(p);
+    free(idx);
+    return m;
+}
+
+/* Reports (`flags`: PLEAT_CHECK_SKIP_SELF_INTERSECTIONS for stacked copies of a face, whose
+ * intersecting pairs are quadratic in number; README "Security and robustness"), then a LOD at
+ * n_p 16 under a 1 GiB budget (a LOD or LIMIT_EXCEEDED), then a 1 MiB budget (LIMIT_EXCEEDED
+ * before any work). */
+static void answer(const char *name, PleatMesh *m, uint32_t flags, uint64_t components,
+                   uint64_t welded_comps) {
+    PleatMeshReport r;
+    PleatLodParams lp = pleat_lod_params_default();
+    PleatMesh *lod = NULL;
+    PleatStatus st;
+    double t = now_s();
+    if (m == NULL) return;
+    memset(&r, 0, sizeof r);
+    r.struct_size = sizeof r;
+    CHECK_STATUS(pleat_mesh_check(m, flags, &r), PLEAT_STATUS_OK);
+    printf("%s: report %.2f s: V=%llu F=%llu components=%llu duplicate_faces=%llu\n", name,
+           now_s() - t, (unsigned long long)r.vertex_count, (unsigned long long)r.triangle_count,
+           (unsigned long long)r.component_count, (unsigned long long)r.duplicate_face_count);
+    CHECK(r.component_count == components);
+    t = now_s();
+    CHECK_STATUS(pleat_mesh_check(m, flags | PLEAT_CHECK_WELD, &r), PLEAT_STATUS_OK);
+    printf("%s: welded report %.2f s: components=%llu\n", name, now_s() - t,
+           (unsigned long long)r.component_count);
+    CHECK(r.component_count == welded_comps);
+    lp.screen_size = 16;
+    lp.memory_budget_bytes = 1u << 30;
+    t = now_s();
+    st = pleat_lod_generate(m, &lp, NULL, NULL, &lod, NULL);
+    printf("%s: LOD at n_p 16, 1 GiB: status %d in %.2f s (%s)\n", name, (int)st, now_s() - t,
+           st == PLEAT_STATUS_OK ? "ok" : pleat_last_error());
+    CHECK(st == PLEAT_STATUS_OK || st == PLEAT_STATUS_LIMIT_EXCEEDED);
+    if (st == PLEAT_STATUS_OK) {
+        CHECK_STATUS(pleat_mesh_check(lod, 0, &r), PLEAT_STATUS_OK);
+        CHECK(r.is_watertight == 1 && r.self_intersection_free == 1);
+    }
+    pleat_mesh_destroy(lod);
+    lod = NULL;
+    lp.memory_budget_bytes = 1u << 20;
+    CHECK_STATUS(pleat_lod_generate(m, &lp, NULL, NULL, &lod, NULL),
+                 PLEAT_STATUS_LIMIT_EXCEEDED);
+    CHECK(lod == NULL);
+}
+
+/* Cancels at the first progress call `after` seconds past `start`; records when. */
+typedef struct {
+    double start, after, requested;
+    int calls;
+} CancelAt;
+
+static int cancel_after(void *user_data, const PleatProgress *info) {
+    CancelAt *c = user_data;
+    double t = now_s();
+    (void)info;
+    c->calls++;
+    if (t - c->start < c->after) return 0;
+    if (c->requested == 0) c->requested = c->start + c->after;
+    return 1;
+}
+
+/* A LOD bake of `m` cancelled at several times; prints the worst request-to-return latency. */
+static void cancellation_latency(PleatMesh *m) {
+    static const double AFTER[] = {0.05, 0.3, 0.8, 1.5};
+    PleatLodParams lp = pleat_lod_params_default();
+    double worst = 0;
+    size_t i;
+    if (m == NULL) return;
+    lp.screen_size = 16;
+    for (i = 0; i < sizeof AFTER / sizeof AFTER[0]; i++) {
+        CancelAt c = {0, 0, 0, 0};
+        PleatMesh *lod = NULL;
+        PleatStatus st;
+        double end;
+        c.after = AFTER[i];
+        c.start = now_s();
+        st = pleat_lod_generate(m, &lp, cancel_after, &c, &lod, NULL);
+        end = now_s();
+        if (st == PLEAT_STATUS_OK) {
+            printf("  cancel after %.2f s: finished first (%.2f s)\n", AFTER[i], end - c.start);
+            pleat_mesh_destroy(lod);
+            continue;
+        }
+        CHECK_STATUS(st, PLEAT_STATUS_CANCELLED);
+        CHECK(lod == NULL);
+        printf("  cancel after %.2f s: returned %.3f s after the request (%d calls)\n", AFTER[i],
+               end - (c.start + c.after), c.calls);
+        if (end - (c.start + c.after) > worst) worst = end - (c.start + c.after);
+    }
+    printf("LOD cancellation from C: worst request-to-return %.3f s\n", worst);
+}
+
+int main(void) {
+    PleatMesh *comps;
+    setvbuf(stdout, NULL, _IONBF, 0);
+    comps = tiny_components(100);
+    PleatMesh *coinc = coincident_tetrahedron(250000);
+    answer("10^6 tiny components", comps, 0, 1000000, 1000000);
+    answer("10^6 coincident vertices", coinc, PLEAT_CHECK_SKIP_SELF_INTERSECTIONS, 250000, 1);
+    cancellation_latency(comps);
+    pleat_mesh_destroy(comps);
+    pleat_mesh_destroy(coinc);
+    return finish("exhaustion");
+}
