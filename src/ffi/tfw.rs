@@ -960,3 +960,87 @@ pub(super) mod imp {
         Ok(())
     }
 }
+
+#[cfg(all(test, feature = "tfw"))]
+mod tests {
+    use super::*;
+    use crate::ffi::{
+        pleat_cwf_copy_amplitude, pleat_cwf_destroy, pleat_mesh_copy_positions_f64,
+        pleat_mesh_destroy, pleat_set_thread_count,
+    };
+    use std::ffi::CString;
+    use std::ptr::null_mut;
+
+    /// Base positions, amplitudes and the history of a small sheet solved through the C API
+    /// on `threads` worker threads.
+    fn solve_small(threads: u32) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let json =
+            CString::new(crate::tfw::Scene::stretched_sheet(9, 4, 0.05).to_json_string()).unwrap();
+        let mut params = pleat_tfw_params_default();
+        params.sqp_max_iterations = 10;
+        // SAFETY: valid pointers throughout; every handle is destroyed once.
+        unsafe {
+            assert_eq!(pleat_set_thread_count(threads), PleatStatus::Ok);
+            let mut scene = null_mut();
+            assert_eq!(
+                pleat_tfw_scene_from_json(json.as_ptr(), &mut scene),
+                PleatStatus::Ok
+            );
+            let mut result = null_mut();
+            let st = pleat_tfw_solve(scene, &params, None, null_mut(), &mut result);
+            assert_eq!(st, PleatStatus::Ok);
+            let mut stats = PleatTfwStats {
+                struct_size: full_size::<PleatTfwStats>(),
+                ..Default::default()
+            };
+            assert_eq!(
+                pleat_tfw_result_get_stats(result, &mut stats),
+                PleatStatus::Ok
+            );
+            let (nv, n) = (stats.vertex_count as usize, stats.sqp_iterations as usize);
+            assert_eq!(pleat_tfw_result_history_count(result), n);
+            let mut history = vec![0.0; 4 * n];
+            let st = pleat_tfw_result_copy_history(result, history.as_mut_ptr(), n);
+            assert_eq!(st, PleatStatus::Ok);
+            let (mut mesh, mut cwf) = (null_mut(), null_mut());
+            assert_eq!(
+                pleat_tfw_result_base_mesh(result, &mut mesh),
+                PleatStatus::Ok
+            );
+            assert_eq!(pleat_tfw_result_cwf(result, &mut cwf), PleatStatus::Ok);
+            let mut pos = vec![0.0; 3 * nv];
+            let st = pleat_mesh_copy_positions_f64(mesh, pos.as_mut_ptr(), nv, 0);
+            assert_eq!(st, PleatStatus::Ok);
+            let mut amp = vec![0.0; nv];
+            assert_eq!(
+                pleat_cwf_copy_amplitude(cwf, amp.as_mut_ptr(), nv),
+                PleatStatus::Ok
+            );
+            assert!(amp.iter().fold(0.0f64, |m, &a| m.max(a)) == stats.peak_amplitude);
+            pleat_mesh_destroy(mesh);
+            pleat_cwf_destroy(cwf);
+            pleat_tfw_result_destroy(result);
+            pleat_tfw_scene_destroy(scene);
+            assert_eq!(pleat_set_thread_count(0), PleatStatus::Ok);
+            (pos, amp, history)
+        }
+    }
+
+    /// Same scene and parameters ⇒ the same bytes on 1 and 2 threads (the history's wall
+    /// times aside).
+    #[test]
+    fn c_api_solve_is_thread_count_independent() {
+        let (p1, a1, h1) = solve_small(1);
+        let (p2, a2, h2) = solve_small(2);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&p1), bits(&p2));
+        assert_eq!(bits(&a1), bits(&a2));
+        let numbers = |h: &[f64]| {
+            h.chunks_exact(4)
+                .flat_map(|r| [r[0].to_bits(), r[1].to_bits(), r[2].to_bits()])
+                .collect::<Vec<_>>()
+        };
+        assert!(!h1.is_empty());
+        assert_eq!(numbers(&h1), numbers(&h2));
+    }
+}

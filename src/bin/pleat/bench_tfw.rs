@@ -185,24 +185,41 @@ fn csv_field(s: &str) -> String {
     }
 }
 
-/// Per SQP iteration: `(wall seconds since the solve started, E, r, r/r₀, step)`; the
-/// iteration 0 row is the SQP's starting point.
-fn iteration_rows(r: &TfwResult) -> Vec<(f64, f64, f64, f64, f64)> {
+/// One SQP iteration of a scene, as written to the CSV and plotted.
+struct IterRow {
+    /// Wall seconds since the solve started (base included).
+    seconds: f64,
+    /// `E^wf` (J).
+    energy: f64,
+    /// Stationarity residual `r`.
+    residual: f64,
+    /// `r / r₀`.
+    relative: f64,
+    /// `‖Δx‖∞` of the accepted step.
+    step: f64,
+}
+
+/// Per SQP iteration, the row of [`IterRow`]; row 0 is the SQP's starting point.
+fn iteration_rows(r: &TfwResult) -> Vec<IterRow> {
     let Some(s) = &r.sqp else {
         return Vec::new();
     };
     let t0 = r.seconds.base + r.seconds.init;
     let r0 = s.initial_stationarity;
     let rel = |x: f64| if r0 > 0.0 { x / r0 } else { 0.0 };
-    let mut rows = vec![(t0, s.initial_energy, r0, rel(r0), 0.0)];
-    rows.extend(s.history.iter().map(|it| {
-        (
-            t0 + it.seconds,
-            it.energy,
-            it.stationarity,
-            rel(it.stationarity),
-            it.step_norm,
-        )
+    let mut rows = vec![IterRow {
+        seconds: t0,
+        energy: s.initial_energy,
+        residual: r0,
+        relative: rel(r0),
+        step: 0.0,
+    }];
+    rows.extend(s.history.iter().map(|it| IterRow {
+        seconds: t0 + it.seconds,
+        energy: it.energy,
+        residual: it.stationarity,
+        relative: rel(it.stationarity),
+        step: it.step_norm,
     }));
     rows
 }
@@ -211,11 +228,16 @@ fn iterations_csv(outcomes: &[Outcome]) -> String {
     let mut s = String::from("scene,iteration,seconds,energy,residual,relative_residual,step\n");
     for o in outcomes {
         let Ok(r) = &o.result else { continue };
-        for (i, (t, e, res, rel, step)) in iteration_rows(r).into_iter().enumerate() {
+        for (i, row) in iteration_rows(r).into_iter().enumerate() {
             let _ = writeln!(
                 s,
-                "{},{i},{t:.6},{e:e},{res:e},{rel:e},{step:e}",
-                csv_field(&o.name)
+                "{},{i},{:.6},{:e},{:e},{:e},{:e}",
+                csv_field(&o.name),
+                row.seconds,
+                row.energy,
+                row.residual,
+                row.relative,
+                row.step
             );
         }
     }
@@ -233,7 +255,7 @@ fn scenes_csv(outcomes: &[Outcome]) -> String {
             Ok(r) => {
                 let m = &r.base.mesh;
                 let iters = r.sqp.as_ref().map_or(0, |q| q.history.len());
-                let rel = iteration_rows(r).last().map_or(0.0, |row| row.3);
+                let rel = iteration_rows(r).last().map_or(0.0, |row| row.relative);
                 let peak = r.cwf.amplitude().iter().fold(0.0f64, |a, &b| a.max(b));
                 let _ = writeln!(
                     s,
@@ -259,16 +281,16 @@ fn scenes_csv(outcomes: &[Outcome]) -> String {
 
 /// Two plots stacked in one SVG: `r/r₀` and `E/E₀` against seconds, log y.
 fn svg(outcomes: &[Outcome]) -> String {
-    let series = |col: fn(&(f64, f64, f64, f64, f64), f64) -> f64| -> Vec<Series> {
+    let series = |col: fn(&IterRow, f64) -> f64| -> Vec<Series> {
         outcomes
             .iter()
             .filter_map(|o| o.result.as_ref().ok().map(|r| (o, r)))
             .map(|(o, r)| {
                 let rows = iteration_rows(r);
-                let e0 = rows.first().map_or(1.0, |row| row.1);
+                let e0 = rows.first().map_or(1.0, |row| row.energy);
                 Series {
                     label: o.name.clone(),
-                    points: rows.iter().map(|row| (row.0, col(row, e0))).collect(),
+                    points: rows.iter().map(|row| (row.seconds, col(row, e0))).collect(),
                 }
             })
             .collect()
@@ -277,14 +299,14 @@ fn svg(outcomes: &[Outcome]) -> String {
         "TFW SQP: relative stationarity residual",
         "wall seconds (base included)",
         "r / r0",
-        &series(|row, _| row.3),
+        &series(|row, _| row.relative),
         true,
     );
     let energy = svg_plot(
         "TFW SQP: wrinkle energy",
         "wall seconds (base included)",
         "E / E0",
-        &series(|row, e0| if e0 != 0.0 { row.1 / e0 } else { 0.0 }),
+        &series(|row, e0| if e0 != 0.0 { row.energy / e0 } else { 0.0 }),
         true,
     );
     let inner = |svg: &str, y: u32| svg.replacen("<svg ", &format!("<svg y=\"{y}\" "), 1);
@@ -303,7 +325,7 @@ fn print_summary(outcomes: &[Outcome]) {
     for o in outcomes {
         match &o.result {
             Ok(r) => {
-                let rel = iteration_rows(r).last().map_or(0.0, |row| row.3);
+                let rel = iteration_rows(r).last().map_or(0.0, |row| row.relative);
                 let peak = r.cwf.amplitude().iter().fold(0.0f64, |a, &b| a.max(b));
                 println!(
                     "{:<16} {:>6} {:>8.3} {:>8.3} {:>6} {:>10.4} {:>10.2e}  {:?}",
