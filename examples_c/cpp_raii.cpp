@@ -215,6 +215,58 @@ static void lods() {
     }
 }
 
+// pleat::TfwScene / TfwResult: a 7 x 4 stretched sheet from arrays, solved briefly.
+static void tension_field() {
+    if (!pleat::has_feature("tfw")) {
+        try {
+            pleat::TfwScene::from_json("{}");
+            EXPECT(false);
+        } catch (const pleat::Error &err) {
+            EXPECT(err.status() == PLEAT_STATUS_UNSUPPORTED);
+        }
+        return;
+    }
+    const int nx = 7, ny = 4;
+    std::vector<double> rest, pos;
+    std::vector<uint32_t> tris, clamped;
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++) {
+            double u = 0.25 * i / (nx - 1), v = 0.1 * j / (ny - 1);
+            rest.insert(rest.end(), {u, v});
+            pos.insert(pos.end(), {(u - 0.125) * 1.05, v - 0.05, 0.0});
+        }
+    for (int j = 0; j + 1 < ny; j++)
+        for (int i = 0; i + 1 < nx; i++) {
+            uint32_t a = uint32_t(j * nx + i), b = a + 1, c = a + nx + 1, d = a + nx;
+            tris.insert(tris.end(), {a, b, c, a, c, d});
+        }
+    for (int j = 0; j < ny; j++) clamped.insert(clamped.end(), {uint32_t(j * nx), uint32_t(j * nx + nx - 1)});
+    pleat::TfwScene scene = pleat::TfwScene::from_arrays(rest, tris, pos, clamped);
+    PleatTfwParams params = pleat::tfw_params();
+    params.sqp_max_iterations = 5;
+    pleat::TfwResult result = scene.solve(params);
+    PleatTfwStats st = result.stats();
+    const size_t nv = size_t(nx * ny);
+    EXPECT(st.vertex_count == nv && st.sqp_iterations <= 5);
+    EXPECT(result.history().size() == PLEAT_TFW_HISTORY_COLUMNS * st.sqp_iterations);
+    EXPECT(result.base_mesh().vertex_count() == nv);
+    EXPECT(result.cwf().vertex_count() == nv);
+    EXPECT(result.evaluate(1).triangle_count() == 4 * st.triangle_count);
+    try {
+        scene.solve(params, [](const char *, double) { return false; });
+        EXPECT(false);
+    } catch (const pleat::Error &err) {
+        EXPECT(err.status() == PLEAT_STATUS_CANCELLED);
+    }
+    try {
+        pleat::TfwScene::from_json("{\"material\": {\"yung\": 1}}");
+        EXPECT(false);
+    } catch (const pleat::Error &err) {
+        EXPECT(err.status() == PLEAT_STATUS_INVALID_ARGUMENT);
+        std::printf("  ok: unknown scene key -> %s\n", err.what());
+    }
+}
+
 int main() {
     EXPECT(pleat::abi_version() == PLEAT_ABI_VERSION && !pleat::version().empty());
     const double p[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
@@ -242,6 +294,7 @@ int main() {
     EXPECT(moved.report().is_watertight && moved.report().total_genus == 0);
     wrinkles(moved);
     lods();
+    tension_field();
     std::printf("cpp_raii: %d passed, %d failed\n", checks - failures, failures);
     return failures == 0 ? 0 : 1;
 }

@@ -151,6 +151,30 @@
 // `pleat_mesh_check` flag: analyse topology after merging exactly coincident vertices.
 #define PLEAT_CHECK_WELD 2
 
+// `PleatTfwStats::status`: the base solve and the SQP both met a convergence test.
+#define PLEAT_TFW_STATUS_CONVERGED 0
+
+// `PleatTfwStats::status`: a result was produced, but the base solve or the SQP stopped
+// before converging (see `base_status`, `sqp_status`).
+#define PLEAT_TFW_STATUS_NOT_CONVERGED 1
+
+// `PleatTfwStats::status`: no compression anywhere: amplitude ≡ 0, returned at once.
+#define PLEAT_TFW_STATUS_NO_COMPRESSION 2
+
+// `PleatTfwStats::status`: compressed in every direction over most of the surface: out of
+// the model's scope; the best-effort base surface with amplitude ≡ 0.
+#define PLEAT_TFW_STATUS_OUT_OF_SCOPE 3
+
+// `PleatTfwParams::w_rule`: the dissertation's rule for the wrinkle-free faces (default).
+#define PLEAT_TFW_W_RULE_TEXT 0
+
+// `PleatTfwParams::w_rule`: the reference code's rule (`λ_c ≥ 0`, then vertex fill).
+#define PLEAT_TFW_W_RULE_REFERENCE 1
+
+// Doubles per iteration written by `pleat_tfw_result_copy_history`: energy (J), stationarity
+// residual (absolute), step `‖Δx‖∞`, wall seconds since the SQP started.
+#define PLEAT_TFW_HISTORY_COLUMNS 4
+
 // Per-vertex field of an evaluation: the Loop-subdivided amplitude `a` (1 double per vertex).
 #define PLEAT_WRINKLE_FIELD_AMPLITUDE 1
 
@@ -284,6 +308,15 @@ typedef struct PleatMesh PleatMesh;
 // Statistics of one long operation (opaque). Returned through the optional `PleatStats **`
 // output of long operations; destroyed with `pleat_stats_destroy`. Immutable.
 typedef struct PleatStats PleatStats;
+
+// The result of `pleat_tfw_solve` (opaque): base surface, wrinkle field, stats and history.
+// Destroyed by `pleat_tfw_result_destroy`. Immutable.
+typedef struct PleatTfwResult PleatTfwResult;
+
+// A validated TFW scene (opaque): panels, material, loads, Dirichlet conditions. Created by
+// `pleat_tfw_scene_read_file`, `pleat_tfw_scene_from_json` or `pleat_tfw_scene_from_arrays`;
+// destroyed by `pleat_tfw_scene_destroy`. Immutable: may be solved from several threads.
+typedef struct PleatTfwScene PleatTfwScene;
 
 // Optional per-vertex (and per-edge) fields of one evaluation (opaque), requested with
 // `PLEAT_WRINKLE_FIELD_*` bits in `PleatWrinkleEvalParams::flags` and returned by
@@ -806,6 +839,70 @@ typedef struct PleatMeshReport {
   double bbox_max[3];
 } PleatMeshReport;
 
+// Parameters of `pleat_tfw_solve`. Get the defaults from `pleat_tfw_params_default()`;
+// `struct_size` must stay `sizeof(PleatTfwParams)` (an older, shorter struct is accepted:
+// missing fields take their defaults).
+typedef struct PleatTfwParams {
+  // `sizeof(PleatTfwParams)`; at least 8.
+  uint32_t struct_size;
+  // SQP iteration limit, 1 to 1,000,000; default 1000 (A.6.3).
+  uint32_t sqp_max_iterations;
+  // Newton iterations of the base solve per load step, 1 to 1,000,000; default 200.
+  uint32_t base_max_iterations;
+  // Load steps of the Dirichlet motions, 1 to 10,000; default 1.
+  uint32_t base_load_steps;
+  // `PLEAT_TFW_W_RULE_TEXT` (default) or `PLEAT_TFW_W_RULE_REFERENCE`.
+  uint32_t w_rule;
+  // Reserved, set to 0.
+  uint32_t reserved;
+  // Base solve: stop when the relative gradient is at most this; finite, > 0; default 1e-8.
+  double base_gradient_tolerance;
+  // Base solve: stop when a step changes E by at most this times |E|; finite, ≥ 0;
+  // default 1e-14.
+  double base_energy_tolerance;
+  // Multiplier of the bending coefficient `α h³/24`; finite, ≥ 0; default 1.
+  double bending_scale;
+  // Initial peak amplitude `k` of A.6.2 (m); 0 = automatic (`min(0.01 m, 0.1 · bbox
+  // diagonal)`, the default); else finite, > 0.
+  double initial_amplitude;
+  // SQP: stop when `r ≤ tol · r₀`; finite, ≥ 0; default 1e-6.
+  double sqp_stationarity_tolerance;
+  // SQP: stop when a step changes E by at most this times |E|; finite, ≥ 0; default 1e-10.
+  double sqp_energy_tolerance;
+  // SQP: stop when the scaled step is at most this; finite, ≥ 0; default 1e-10.
+  double sqp_step_tolerance;
+  // SQP Armijo constant, in (0, 1); default 0.2.
+  double sqp_armijo;
+  // SQP initial relative Hessian shift; finite, > 0; default 1e-6.
+  double sqp_initial_shift;
+  // SQP wall-time budget in seconds; 0 = unlimited (default); else finite, > 0.
+  double sqp_time_limit_seconds;
+  // Rest-area fraction of slack faces above which the scene is out of scope, in [0, 1];
+  // default 0.5.
+  double out_of_scope_slack_fraction;
+} PleatTfwParams;
+
+// Material and loads of `pleat_tfw_scene_from_arrays` (SI units). Get the defaults from
+// `pleat_tfw_material_default()`; versioned like `PleatTfwParams`.
+typedef struct PleatTfwMaterial {
+  // `sizeof(PleatTfwMaterial)`; at least 16.
+  uint32_t struct_size;
+  // Reserved, set to 0.
+  uint32_t reserved;
+  // Young's modulus (Pa), > 0; default 1e6.
+  double young;
+  // Poisson's ratio, in (−1, 1); default 0.5.
+  double poisson;
+  // Thickness (m), > 0; default 1e-4.
+  double thickness;
+  // Density (kg/m³), ≥ 0; default 0.
+  double density;
+  // Gravity acceleration (m/s²); default 0.
+  double gravity[3];
+  // Internal pressure (Pa); default 0.
+  double pressure;
+} PleatTfwMaterial;
+
 // Parameters of `pleat_cwf_evaluate`. Get the defaults from
 // `pleat_wrinkle_eval_params_default()` and change what you need; `struct_size` must stay
 // `sizeof(PleatWrinkleEvalParams)` (an older, shorter struct is accepted: missing fields take
@@ -833,6 +930,56 @@ typedef struct PleatWrinkleEvalParams {
   // also limited to the u32 index range.
   uint64_t max_output_triangles;
 } PleatWrinkleEvalParams;
+
+// What `pleat_tfw_solve` did (`pleat_tfw_result_get_stats`). Set `struct_size =
+// sizeof(PleatTfwStats)` before the call; pleat fills at most that many bytes.
+typedef struct PleatTfwStats {
+  // In: `sizeof(PleatTfwStats)` as the caller knows it (≥ 8). Out: bytes filled.
+  uint32_t struct_size;
+  // `PLEAT_TFW_STATUS_*`.
+  uint32_t status;
+  // Why the base solve stopped: 0 converged, 1 energy stalled (at its rounding floor),
+  // 2 iteration limit, 3 line search failed, 4 factorization failed.
+  uint32_t base_status;
+  // Why the SQP stopped: 0 stationary, 1 energy converged, 2 step converged, 3 iteration
+  // limit, 4 time limit, 5 line search failed, 6 QP failed, 7 no free unknowns, 8 did not
+  // run (no compression or out of scope).
+  uint32_t sqp_status;
+  // Newton iterations of the base solve (all load steps).
+  uint32_t base_iterations;
+  // SQP iterations (the length of the history).
+  uint32_t sqp_iterations;
+  // Vertices of the base mesh.
+  uint64_t vertex_count;
+  // Triangles of the base mesh.
+  uint64_t triangle_count;
+  // Wrinkle-free faces (W).
+  uint64_t wrinkle_free_face_count;
+  // `E^wf` at the result (J).
+  double energy;
+  // `E^wf` at the start of the SQP (J); equals `energy` when the SQP did not run.
+  double initial_energy;
+  // Stationarity residual at the end of the SQP (absolute); 0 when it did not run.
+  double residual;
+  // Stationarity residual at the start of the SQP; 0 when it did not run.
+  double initial_residual;
+  // `max |curl ω|` over the faces outside W at the result.
+  double curl_residual;
+  // Largest vertex amplitude (m).
+  double peak_amplitude;
+  // `‖g‖∞ / ‖g₀‖∞` of the base solve at the result.
+  double base_relative_gradient;
+  // Wall seconds of the base solve.
+  double seconds_base;
+  // Wall seconds of strains, W, curvature, initialization and Helmholtz projection.
+  double seconds_init;
+  // Wall seconds of the SQP.
+  double seconds_sqp;
+  // Wall seconds of the SQP spent in the QP solver.
+  double seconds_qp;
+  // Wall seconds of the Knöppel phase.
+  double seconds_phase;
+} PleatTfwStats;
 
 // Outcome of the Knöppel phase solve of a `PleatCwf` (`pleat_cwf_get_knoppel_report`).
 typedef struct PleatKnoppelReport {
@@ -1595,6 +1742,170 @@ PleatStatus pleat_stats_to_json(const struct PleatStats *stats,
 // # Safety
 // `stats` is NULL or a live handle not yet destroyed.
 void pleat_stats_destroy(struct PleatStats *stats);
+
+// The default solve parameters (those of the Rust `TfwParams::default()`), with
+// `struct_size` set. Available in every build.
+struct PleatTfwParams pleat_tfw_params_default(void);
+
+// The default material: Young 1 MPa, Poisson 0.5, thickness 0.1 mm, density 0, no gravity,
+// no pressure (the stretched sheet's), with `struct_size` set. Available in every build.
+struct PleatTfwMaterial pleat_tfw_material_default(void);
+
+// Reads and validates a scene file (JSON; format in README "Tension-field wrinkles").
+//
+// - `path`: NUL-terminated UTF-8 path; non-NULL.
+// - `out`: receives the new scene (destroy with `pleat_tfw_scene_destroy`); non-NULL.
+//
+// Returns `PLEAT_STATUS_IO` when the file cannot be read, `PLEAT_STATUS_INVALID_ARGUMENT`
+// for malformed JSON or an invalid scene (the message names the field, e.g.
+// `scene: material.thickness: must be > 0`), `PLEAT_STATUS_UNSUPPORTED` without `tfw`.
+//
+// # Safety
+// `path` is NULL or NUL-terminated; `out` is NULL or writable.
+PleatStatus pleat_tfw_scene_read_file(const char *path, struct PleatTfwScene **out);
+
+// Parses and validates a scene from JSON text (as `pleat_tfw_scene_read_file`).
+//
+// - `json`: NUL-terminated UTF-8 text; non-NULL.
+// - `out`: receives the new scene; non-NULL.
+//
+// # Safety
+// `json` is NULL or NUL-terminated; `out` is NULL or writable.
+PleatStatus pleat_tfw_scene_from_json(const char *json, struct PleatTfwScene **out);
+
+// Builds a scene of one flat panel from arrays.
+//
+// - `rest`: `2 * vertex_count` doubles, the rest (pattern) coordinates `u, v` of each vertex
+//   (m); finite; non-NULL.
+// - `vertex_count`: ≥ 3.
+// - `triangles`: `3 * triangle_count` vertex indices, each < `vertex_count`; every triangle
+//   must have a positive rest area; non-NULL.
+// - `triangle_count`: ≥ 1.
+// - `positions`: NULL (the initial 3D position of vertex i is `(u_i, v_i, 0)`) or
+//   `3 * vertex_count` finite doubles.
+// - `material`: NULL = `pleat_tfw_material_default()`, else a `PleatTfwMaterial` with
+//   `struct_size` set.
+// - `clamped`: `clamped_count` vertex indices held by a Dirichlet condition (their target is
+//   the initial position plus `translation`); NULL only when `clamped_count` is 0.
+// - `translation`: NULL (no motion) or 3 finite doubles (m).
+// - `out`: receives the new scene; non-NULL.
+//
+// Returns `PLEAT_STATUS_INVALID_ARGUMENT` naming the bad argument or scene field.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes described above.
+PleatStatus pleat_tfw_scene_from_arrays(const double *rest,
+                                        size_t vertex_count,
+                                        const uint32_t *triangles,
+                                        size_t triangle_count,
+                                        const double *positions,
+                                        const struct PleatTfwMaterial *material,
+                                        const uint32_t *clamped,
+                                        size_t clamped_count,
+                                        const double *translation,
+                                        struct PleatTfwScene **out);
+
+// Destroys a scene. NULL is accepted and ignored.
+//
+// # Safety
+// `scene` is NULL or a handle from pleat not yet destroyed.
+void pleat_tfw_scene_destroy(struct PleatTfwScene *scene);
+
+// Solves a scene: the tension-field base surface (§2.4.1), the wrinkle-free faces and the
+// initial field (A.6.2), the wrinkle SQP (A.6.3) and the Knöppel phase.
+//
+// - `scene`: non-NULL.
+// - `params`: NULL = `pleat_tfw_params_default()`; see `PleatTfwParams` for the ranges.
+// - `progress`: NULL or a callback, called on the calling thread per Newton and SQP
+//   iteration; returning non-zero cancels (`PLEAT_STATUS_CANCELLED`, no output).
+// - `user_data`: passed to `progress` unchanged; may be NULL.
+// - `out`: receives the result (destroy with `pleat_tfw_result_destroy`); non-NULL.
+//
+// Non-convergence is not an error: it is `PleatTfwStats::status`. Errors:
+// `PLEAT_STATUS_INVALID_ARGUMENT` (parameters), `PLEAT_STATUS_NUMERICAL` (a factorization
+// that cannot be regularized), `PLEAT_STATUS_CANCELLED`, `PLEAT_STATUS_UNSUPPORTED`.
+//
+// # Safety
+// Pointers are NULL or valid as described; `progress` is a valid function or NULL.
+PleatStatus pleat_tfw_solve(const struct PleatTfwScene *scene,
+                            const struct PleatTfwParams *params,
+                            PleatProgressFn progress,
+                            void *user_data,
+                            struct PleatTfwResult **out);
+
+// Destroys a result. NULL is accepted and ignored.
+//
+// # Safety
+// `result` is NULL or a handle from pleat not yet destroyed.
+void pleat_tfw_result_destroy(struct PleatTfwResult *result);
+
+// The base surface as a new mesh handle (destroy with `pleat_mesh_destroy`): copy it out with
+// `pleat_mesh_vertex_count` / `pleat_mesh_copy_positions_f64` / `pleat_mesh_copy_indices`.
+// Sewn panels share vertices; triangles keep the scene's orientation.
+//
+// # Safety
+// `result` is NULL or live; `out` is NULL or writable.
+PleatStatus pleat_tfw_result_base_mesh(const struct PleatTfwResult *result, struct PleatMesh **out);
+
+// The complex wrinkle field on the base mesh as a new `PleatCwf` (destroy with
+// `pleat_cwf_destroy`): amplitude per vertex (m), ω per edge in pleat's edge numbering,
+// phase by Knöppel's method. Evaluate it with `pleat_cwf_evaluate` (without the v2 term) or
+// use `pleat_tfw_result_evaluate`.
+//
+// # Safety
+// `result` is NULL or live; `out` is NULL or writable.
+PleatStatus pleat_tfw_result_cwf(const struct PleatTfwResult *result, struct PleatCwf **out);
+
+// The wrinkled surface: the field evaluated as `pleat_cwf_evaluate` does (`params->levels`
+// Loop refinements, displacement `Re(z) n̂`), plus, when `in_plane_v2` is 1, the in-plane
+// term of eq. 2.19 (`Δx += (Re z · Im z / 4) ∇φ`; `pleat tfw` uses it).
+//
+// - `result`: non-NULL.
+// - `params`: NULL = `pleat_wrinkle_eval_params_default()` (3 levels); `flags` must be 0
+//   here (no per-vertex fields).
+// - `in_plane_v2`: 0 or 1.
+// - `progress`, `user_data`: as `pleat_cwf_evaluate`.
+// - `out_mesh`: receives the wrinkled mesh (destroy with `pleat_mesh_destroy`); non-NULL.
+//
+// # Safety
+// Pointers are NULL or valid as described; `progress` is a valid function or NULL.
+PleatStatus pleat_tfw_result_evaluate(const struct PleatTfwResult *result,
+                                      const struct PleatWrinkleEvalParams *params,
+                                      uint32_t in_plane_v2,
+                                      PleatProgressFn progress,
+                                      void *user_data,
+                                      struct PleatMesh **out_mesh);
+
+// Fills `*out` with the stats of the solve.
+//
+// - `result`: non-NULL.
+// - `out`: non-NULL, `out->struct_size = sizeof(PleatTfwStats)` (≥ 8).
+//
+// # Safety
+// `result` is NULL or live; `out` is NULL or valid for `out->struct_size` bytes.
+PleatStatus pleat_tfw_result_get_stats(const struct PleatTfwResult *result,
+                                       struct PleatTfwStats *out);
+
+// Number of SQP iterations recorded (0 when the SQP did not run, `result` is NULL or the
+// build lacks `tfw`).
+//
+// # Safety
+// `result` is NULL or live.
+size_t pleat_tfw_result_history_count(const struct PleatTfwResult *result);
+
+// Copies the SQP history: `PLEAT_TFW_HISTORY_COLUMNS` (4) doubles per iteration, in order:
+// energy `E^wf` (J), stationarity residual, step `‖Δx‖∞`, wall seconds since the SQP started.
+//
+// - `result`, `dst`: non-NULL.
+// - `iteration_capacity`: iterations `dst` holds (it holds `4 * iteration_capacity`
+//   doubles); ≥ `pleat_tfw_result_history_count(result)`, else `PLEAT_STATUS_LIMIT_EXCEEDED`
+//   and nothing is written.
+//
+// # Safety
+// `result` is NULL or live; `dst` is NULL or valid for `4 * iteration_capacity` doubles.
+PleatStatus pleat_tfw_result_copy_history(const struct PleatTfwResult *result,
+                                          double *dst,
+                                          size_t iteration_capacity);
 
 // The default evaluation parameters (levels 3, no fields, fixed boundary, corner angle π/6,
 // displacement scale 1, at most 2^26 output triangles), with `struct_size` set. Available in

@@ -32,6 +32,9 @@ fn features() -> Vec<&'static str> {
     if cfg!(feature = "bake") {
         f.push("bake");
     }
+    if cfg!(feature = "tfw") {
+        f.push("tfw");
+    }
     f
 }
 

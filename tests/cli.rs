@@ -512,3 +512,80 @@ fn wrinkle_design_then_edit_reports_solves_and_refuses_bad_regions() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `pleat bench tfw` on a small built-in sheet and a scene file: both CSVs and the SVG exist
+/// and parse (one summary row per scene, iteration rows with finite numbers, energies
+/// non-increasing per scene).
+#[cfg(feature = "tfw")]
+#[test]
+fn bench_tfw_writes_csv_and_svg() {
+    let dir = std::env::temp_dir().join(format!("pleat-cli-bench-tfw-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("small.json");
+    std::fs::write(
+        &scene,
+        pleat::tfw::Scene::stretched_sheet(11, 5, 0.05).to_json_string(),
+    )
+    .unwrap();
+    let o = pleat(&[
+        "bench",
+        "tfw",
+        "--builtin",
+        "sheet-small",
+        path_str(&scene),
+        "--max-iterations",
+        "20",
+        "--out-dir",
+        path_str(&dir),
+        "-q",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{out}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let scenes = std::fs::read_to_string(dir.join("tfw_scenes.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = scenes.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3, "{scenes}");
+    assert_eq!(rows[0][0], "scene");
+    assert_eq!(
+        (rows[1][0], rows[2][0], rows[1][1], rows[2][1]),
+        ("sheet-small", "small", "78", "55"),
+        "{scenes}"
+    );
+    for r in &rows[1..] {
+        assert_eq!(r.len(), rows[0].len(), "{scenes}");
+        let peak: f64 = r[9].parse().unwrap();
+        assert!(peak > 0.0 && peak < 5e-3, "{scenes}");
+    }
+    let iters = std::fs::read_to_string(dir.join("tfw_iterations.csv")).unwrap();
+    let mut last: Option<(String, f64)> = None;
+    for l in iters.lines().skip(1) {
+        let f: Vec<&str> = l.split(',').collect();
+        assert_eq!(f.len(), 7, "{l}");
+        let v: Vec<f64> = f[2..].iter().map(|x| x.parse().unwrap()).collect();
+        assert!(v.iter().all(|x| x.is_finite()), "{l}");
+        if let Some((s, e)) = &last {
+            if s == f[0] {
+                assert!(v[1] <= *e, "energy rose: {l}");
+            }
+        }
+        last = Some((f[0].to_string(), v[1]));
+    }
+    assert!(iters.lines().count() > 2, "{iters}");
+    let svg = std::fs::read_to_string(dir.join("tfw_bench.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    assert!(svg.contains("sheet-small") && svg.contains("r / r0"));
+    let o = pleat(&[
+        "bench",
+        "tfw",
+        "--builtin",
+        "nope",
+        "--out-dir",
+        path_str(&dir),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -2,7 +2,8 @@
 //
 // Covers the whole C API: meshes (arrays, files, validity report), LODs, LOD chains, cages,
 // offset surfaces with their stats, wrinkle fields (creation, copy-out, Knoppel report,
-// evaluation with fields) and wrinkle animations (interpolation, frames, history, files).
+// evaluation with fields), wrinkle animations (interpolation, frames, history, files) and
+// tension-field wrinkles (TfwScene, TfwResult).
 // Every failing call throws pleat::Error carrying the PleatStatus and pleat's message.
 // Handles are move-only and released in destructors. Progress callbacks return false to
 // cancel; an exception thrown by one comes out of the call that ran it.
@@ -733,6 +734,140 @@ class Bake {
         return v;
     }
     PleatBake *raw_ = nullptr;
+};
+
+/// Tension-field wrinkle solve parameters (pleat_tfw_params_default()).
+inline PleatTfwParams tfw_params() noexcept { return pleat_tfw_params_default(); }
+
+/// The result of a tension-field wrinkle solve (wraps PleatTfwResult*): base surface, wrinkle
+/// field, stats and the SQP history. Made by TfwScene::solve.
+class TfwResult {
+  public:
+    TfwResult() = default;
+    explicit TfwResult(PleatTfwResult *raw) noexcept : raw_(raw) {}
+    TfwResult(const TfwResult &) = delete;
+    TfwResult &operator=(const TfwResult &) = delete;
+    TfwResult(TfwResult &&o) noexcept : raw_(std::exchange(o.raw_, nullptr)) {}
+    TfwResult &operator=(TfwResult &&o) noexcept {
+        if (this != &o) {
+            pleat_tfw_result_destroy(raw_);
+            raw_ = std::exchange(o.raw_, nullptr);
+        }
+        return *this;
+    }
+    ~TfwResult() { pleat_tfw_result_destroy(raw_); }
+
+    /// Status (PLEAT_TFW_STATUS_*), energies, residuals, iterations, seconds per stage.
+    PleatTfwStats stats() const {
+        PleatTfwStats s{};
+        s.struct_size = sizeof s;
+        check(pleat_tfw_result_get_stats(raw_, &s));
+        return s;
+    }
+    /// The base surface.
+    Mesh base_mesh() const {
+        PleatMesh *m = nullptr;
+        check(pleat_tfw_result_base_mesh(raw_, &m));
+        return Mesh(m);
+    }
+    /// The complex wrinkle field on the base mesh (evaluate it with Cwf::evaluate).
+    Cwf cwf() const {
+        PleatCwf *c = nullptr;
+        check(pleat_tfw_result_cwf(raw_, &c));
+        return Cwf(c);
+    }
+    /// The wrinkled mesh after `levels` Loop refinements, with the in-plane v2 term of
+    /// eq. 2.19 unless `in_plane_v2` is false.
+    Mesh evaluate(uint32_t levels = 3, bool in_plane_v2 = true,
+                  const Progress &keep_going = {}) const {
+        PleatWrinkleEvalParams p = pleat_wrinkle_eval_params_default();
+        p.levels = levels;
+        detail::ProgressRelay relay(keep_going);
+        PleatMesh *m = nullptr;
+        relay.finish(pleat_tfw_result_evaluate(raw_, &p, in_plane_v2 ? 1 : 0, relay.callback(),
+                                               relay.user_data(), &m));
+        return Mesh(m);
+    }
+    /// SQP history: PLEAT_TFW_HISTORY_COLUMNS (4) doubles per iteration (energy, stationarity
+    /// residual, step, wall seconds), flattened.
+    std::vector<double> history() const {
+        size_t n = pleat_tfw_result_history_count(raw_);
+        std::vector<double> v(PLEAT_TFW_HISTORY_COLUMNS * n + 1);
+        check(pleat_tfw_result_copy_history(raw_, v.data(), n));
+        v.resize(PLEAT_TFW_HISTORY_COLUMNS * n);
+        return v;
+    }
+    const PleatTfwResult *get() const noexcept { return raw_; }
+    explicit operator bool() const noexcept { return raw_ != nullptr; }
+
+  private:
+    PleatTfwResult *raw_ = nullptr;
+};
+
+/// A validated tension-field wrinkle scene (wraps PleatTfwScene*): from a JSON file, JSON
+/// text or one panel's arrays.
+class TfwScene {
+  public:
+    TfwScene() = default;
+    explicit TfwScene(PleatTfwScene *raw) noexcept : raw_(raw) {}
+    TfwScene(const TfwScene &) = delete;
+    TfwScene &operator=(const TfwScene &) = delete;
+    TfwScene(TfwScene &&o) noexcept : raw_(std::exchange(o.raw_, nullptr)) {}
+    TfwScene &operator=(TfwScene &&o) noexcept {
+        if (this != &o) {
+            pleat_tfw_scene_destroy(raw_);
+            raw_ = std::exchange(o.raw_, nullptr);
+        }
+        return *this;
+    }
+    ~TfwScene() { pleat_tfw_scene_destroy(raw_); }
+
+    /// Reads a scene file (JSON).
+    static TfwScene read(const std::string &path) {
+        PleatTfwScene *s = nullptr;
+        check(pleat_tfw_scene_read_file(path.c_str(), &s));
+        return TfwScene(s);
+    }
+    /// Parses JSON text.
+    static TfwScene from_json(const std::string &json) {
+        PleatTfwScene *s = nullptr;
+        check(pleat_tfw_scene_from_json(json.c_str(), &s));
+        return TfwScene(s);
+    }
+    /// One flat panel: rest uv (2 per vertex), triangles (3 per triangle), initial positions
+    /// (3 per vertex; empty = rest at z = 0), clamped vertices moved by `translation`.
+    static TfwScene from_arrays(const std::vector<double> &rest,
+                                const std::vector<uint32_t> &triangles,
+                                const std::vector<double> &positions = {},
+                                const std::vector<uint32_t> &clamped = {},
+                                const double translation[3] = nullptr,
+                                const PleatTfwMaterial &material = pleat_tfw_material_default()) {
+        if (rest.size() % 2 != 0 || triangles.size() % 3 != 0 ||
+            (!positions.empty() && positions.size() != rest.size() / 2 * 3))
+            throw Error(PLEAT_STATUS_INVALID_ARGUMENT,
+                        "rest: 2 doubles per vertex, triangles: 3 indices, positions: 3 doubles "
+                        "per vertex (or empty)");
+        PleatTfwScene *s = nullptr;
+        check(pleat_tfw_scene_from_arrays(
+            rest.data(), rest.size() / 2, triangles.data(), triangles.size() / 3,
+            positions.empty() ? nullptr : positions.data(), &material, clamped.data(),
+            clamped.size(), translation, &s));
+        return TfwScene(s);
+    }
+    /// Solves the scene (base surface, wrinkle SQP, phase). `keep_going(stage, fraction)`
+    /// returns false to cancel.
+    TfwResult solve(const PleatTfwParams &params = pleat_tfw_params_default(),
+                    const Progress &keep_going = {}) const {
+        detail::ProgressRelay relay(keep_going);
+        PleatTfwResult *r = nullptr;
+        relay.finish(pleat_tfw_solve(raw_, &params, relay.callback(), relay.user_data(), &r));
+        return TfwResult(r);
+    }
+    const PleatTfwScene *get() const noexcept { return raw_; }
+    explicit operator bool() const noexcept { return raw_ != nullptr; }
+
+  private:
+    PleatTfwScene *raw_ = nullptr;
 };
 
 }  // namespace pleat

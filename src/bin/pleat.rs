@@ -35,6 +35,10 @@ mod batch;
 #[path = "pleat/tfw.rs"]
 mod tfw_cmd;
 
+#[cfg(feature = "tfw")]
+#[path = "pleat/bench_tfw.rs"]
+mod bench_tfw;
+
 #[derive(Parser)]
 #[command(
     name = "pleat",
@@ -124,6 +128,10 @@ enum BenchCommand {
     /// lod_bench.csv and lod_bench.svg (Hausdorff/l against seconds, log-log).
     #[cfg(feature = "lod")]
     Lod(bench_lod::LodBenchArgs),
+    /// Tension-field wrinkles: energy and residual against wall time per scene (built-ins or
+    /// scene files); writes tfw_iterations.csv, tfw_scenes.csv and tfw_bench.svg.
+    #[cfg(feature = "tfw")]
+    Tfw(bench_tfw::TfwBenchArgs),
     /// Wrinkle interpolation: residual vs seconds per keyframe pair (rotation, frequency ×3,
     /// local rotation) and quality vs number of guide frames (ablation B.7.1). Writes
     /// interp_convergence.csv/.svg and interp_guide_frames.csv/.svg into OUT_DIR.
@@ -399,6 +407,8 @@ fn bench(cmd: BenchCommand) -> ExitCode {
     match cmd {
         #[cfg(feature = "lod")]
         BenchCommand::Lod(args) => bench_lod::run(&args),
+        #[cfg(feature = "tfw")]
+        BenchCommand::Tfw(args) => bench_tfw::run(&args),
         cmd @ BenchCommand::Wrinkle { .. } => wrinkle_cmd::bench(cmd),
     }
 }

@@ -179,3 +179,16 @@ fn cwf_design_and_edit_params_default_are_rust_default() {
     let rust = design::imp::edit_options(&c).expect("the C default is valid");
     assert_eq!(rust, crate::wrinkle::EditOptions::default());
 }
+
+#[cfg(feature = "tfw")]
+#[test]
+fn tfw_params_default_is_rust_default() {
+    let c = pleat_tfw_params_default();
+    assert_eq!(
+        c.struct_size as usize,
+        std::mem::size_of::<PleatTfwParams>()
+    );
+    let rust = tfw::imp::params(&c).expect("the C default is valid");
+    assert_eq!(rust, crate::tfw::TfwParams::default());
+    assert_eq!(c, tfw::defaults_without_tfw());
+}

@@ -29,6 +29,7 @@ mod mesh;
 mod offset;
 mod report;
 mod stats;
+mod tfw;
 mod wrinkle;
 
 pub use bake::*;
@@ -41,6 +42,7 @@ pub use mesh::*;
 pub use offset::*;
 pub use report::*;
 pub use stats::*;
+pub use tfw::*;
 pub use wrinkle::*;
 
 #[cfg(test)]

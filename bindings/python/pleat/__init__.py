@@ -1311,3 +1311,184 @@ def bake(lod, input, uvs=None, base_color=None, *, uv_layout="vertex", normals=N
     relay.finish(st)
     del keep
     return Bake(out, _as_dict(stats))
+
+
+# --- tension-field wrinkles (capability "tfw") ----------------------------------------------
+
+_TfwParams = _struct("PleatTfwParams",
+                     _u32s("struct_size", "sqp_max_iterations", "base_max_iterations",
+                           "base_load_steps", "w_rule", "reserved")
+                     + _f64s("base_gradient_tolerance", "base_energy_tolerance", "bending_scale",
+                             "initial_amplitude", "sqp_stationarity_tolerance",
+                             "sqp_energy_tolerance", "sqp_step_tolerance", "sqp_armijo",
+                             "sqp_initial_shift", "sqp_time_limit_seconds",
+                             "out_of_scope_slack_fraction"))
+_TfwMaterial = _struct("PleatTfwMaterial", _u32s("struct_size", "reserved")
+                       + _f64s("young", "poisson", "thickness", "density")
+                       + [("gravity", _c.c_double * 3)] + _f64s("pressure"))
+_TfwStats = _struct("PleatTfwStats",
+                    _u32s("struct_size", "status", "base_status", "sqp_status", "base_iterations",
+                          "sqp_iterations")
+                    + _u64s("vertex_count", "triangle_count", "wrinkle_free_face_count")
+                    + _f64s("energy", "initial_energy", "residual", "initial_residual",
+                            "curl_residual", "peak_amplitude", "base_relative_gradient",
+                            "seconds_base", "seconds_init", "seconds_sqp", "seconds_qp",
+                            "seconds_phase"))
+for _name, _res, _args in [
+    ("pleat_tfw_params_default", _TfwParams, ()),
+    ("pleat_tfw_material_default", _TfwMaterial, ()),
+    ("pleat_tfw_scene_read_file", _st, (_c.c_char_p, _PP)),
+    ("pleat_tfw_scene_from_json", _st, (_c.c_char_p, _PP)),
+    ("pleat_tfw_scene_from_arrays", _st, (_D, _sz, _U, _sz, _D, _c.POINTER(_TfwMaterial), _U,
+                                          _sz, _D, _PP)),
+    ("pleat_tfw_scene_destroy", None, (_P,)),
+    ("pleat_tfw_solve", _st, (_P, _c.POINTER(_TfwParams)) + _PROGRESS_ARGS + (_PP,)),
+    ("pleat_tfw_result_destroy", None, (_P,)),
+    ("pleat_tfw_result_base_mesh", _st, (_P, _PP)),
+    ("pleat_tfw_result_cwf", _st, (_P, _PP)),
+    ("pleat_tfw_result_evaluate", _st, (_P, _c.POINTER(_EvalParams), _u32) + _PROGRESS_ARGS
+     + (_PP,)),
+    ("pleat_tfw_result_get_stats", _st, (_P, _c.POINTER(_TfwStats))),
+    ("pleat_tfw_result_history_count", _sz, (_P,)),
+    ("pleat_tfw_result_copy_history", _st, (_P, _D, _sz)),
+]:
+    _sig(_name, _res, *_args)
+for _fn, _cls in [("pleat_tfw_params_default", _TfwParams),
+                  ("pleat_tfw_material_default", _TfwMaterial)]:
+    if getattr(_lib, _fn)().struct_size != _c.sizeof(_cls):
+        raise ImportError(f"{_path}: {_cls.__name__} is {getattr(_lib, _fn)().struct_size} bytes "
+                          f"in the library, {_c.sizeof(_cls)} in this module")
+
+#: PleatTfwStats.status values.
+TFW_STATUS = {0: "converged", 1: "not_converged", 2: "no_compression", 3: "out_of_scope"}
+_TFW_W_RULE = {"text": 0, "reference": 1}
+_TFW_MATERIAL_KEYS = ("young", "poisson", "thickness", "density", "gravity", "pressure")
+
+
+def _tfw_params(w_rule="text", **kw):
+    p = _lib.pleat_tfw_params_default()
+    if w_rule not in _TFW_W_RULE:
+        raise PleatError(1, f"w_rule {w_rule!r}; known: {sorted(_TFW_W_RULE)}")
+    p.w_rule = _TFW_W_RULE[w_rule]
+    names = {n for n, _ in _TfwParams._fields_} - {"struct_size", "reserved", "w_rule"}
+    for k, v in kw.items():
+        if k not in names:
+            raise PleatError(1, f"unknown TFW parameter {k!r}; known: {sorted(names)}")
+        setattr(p, k, v)
+    return p
+
+
+class TfwScene(_Handle):
+    """A validated tension-field wrinkle scene (panels, material, loads, Dirichlet
+    conditions; README "Tension-field wrinkles"). Needs the ``tfw`` capability (else
+    PleatError UNSUPPORTED). Immutable; ``solve()`` gives a TfwResult."""
+
+    _destroy = "pleat_tfw_scene_destroy"
+
+    @classmethod
+    def read(cls, path):
+        """Reads a scene file (JSON)."""
+        h = _P()
+        _check(_lib.pleat_tfw_scene_read_file(_os.fsencode(path), _c.byref(h)))
+        return cls(h)
+
+    @classmethod
+    def from_json(cls, text):
+        """Parses scene JSON text (errors name the field)."""
+        h = _P()
+        _check(_lib.pleat_tfw_scene_from_json(text.encode("utf-8"), _c.byref(h)))
+        return cls(h)
+
+    @classmethod
+    def from_arrays(cls, rest, triangles, positions=None, clamped=(), translation=None,
+                    **material):
+        """One flat panel: rest uv (n×2), triangles (m×3), initial positions (n×3; None = rest
+        at z = 0), clamped vertex indices moved by ``translation`` (3 values; None = held in
+        place); material keywords: young, poisson, thickness, density, gravity, pressure (SI;
+        defaults Y 1 MPa, nu 0.5, h 0.1 mm)."""
+        uv = _np.ascontiguousarray(rest, dtype=_np.float64).reshape(-1)
+        if uv.size % 2:
+            raise PleatError(1, "rest: 2 values per vertex")
+        n = uv.size // 2
+        tri = _indices(triangles, "triangles")
+        if tri.size % 3:
+            raise PleatError(1, "triangles: 3 indices per triangle")
+        pos = None if positions is None else _doubles(positions, 3 * n, "positions")
+        cl = _indices(clamped, "clamped")
+        tr = None if translation is None else _doubles(translation, 3, "translation")
+        m = _lib.pleat_tfw_material_default()
+        for k, v in material.items():
+            if k not in _TFW_MATERIAL_KEYS:
+                raise PleatError(1, f"unknown material key {k!r}; known: {_TFW_MATERIAL_KEYS}")
+            if k == "gravity":
+                m.gravity[:] = [float(x) for x in v]
+            else:
+                setattr(m, k, float(v))
+        h = _P()
+        _check(_lib.pleat_tfw_scene_from_arrays(
+            _ptr(uv, _c.c_double), n, _ptr(tri, _c.c_uint32), tri.size // 3,
+            None if pos is None else _ptr(pos, _c.c_double), _c.byref(m),
+            _ptr(cl, _c.c_uint32) if cl.size else None, cl.size,
+            None if tr is None else _ptr(tr, _c.c_double), _c.byref(h)))
+        return cls(h)
+
+    def solve(self, progress=None, **params):
+        """Solves the scene (base surface, wrinkle SQP, phase); keywords are PleatTfwParams
+        fields (e.g. ``sqp_max_iterations=50``, ``w_rule="reference"``).
+        ``progress(stage, fraction)`` returning True cancels (PleatError CANCELLED)."""
+        p = _tfw_params(**params)
+        relay, h = _Relay(progress), _P()
+        st = _lib.pleat_tfw_solve(self._h, _c.byref(p), relay.fn, None, _c.byref(h))
+        relay.finish(st)
+        return TfwResult(h)
+
+
+class TfwResult(_Handle):
+    """The result of ``TfwScene.solve``: ``stats`` (dict of PleatTfwStats, status as a name),
+    the base mesh, the wrinkle field (a Cwf), the wrinkled mesh and the SQP history."""
+
+    _destroy = "pleat_tfw_result_destroy"
+
+    def __init__(self, handle):
+        super().__init__(handle)
+        s = _TfwStats()
+        s.struct_size = _c.sizeof(s)
+        _check(_lib.pleat_tfw_result_get_stats(self._h, _c.byref(s)))
+        self.stats = _as_dict(s)
+        self.stats["status"] = TFW_STATUS.get(self.stats["status"], self.stats["status"])
+
+    def base_mesh(self):
+        """The base surface (a Mesh)."""
+        h = _P()
+        _check(_lib.pleat_tfw_result_base_mesh(self._h, _c.byref(h)))
+        return Mesh(h)
+
+    def cwf(self):
+        """The complex wrinkle field on the base mesh (a Cwf)."""
+        h = _P()
+        _check(_lib.pleat_tfw_result_cwf(self._h, _c.byref(h)))
+        return Cwf(h)
+
+    def evaluate(self, levels=3, in_plane_v2=True, progress=None):
+        """The wrinkled Mesh after ``levels`` Loop refinements (with the in-plane v2 term of
+        eq. 2.19 unless ``in_plane_v2`` is False)."""
+        p = _lib.pleat_wrinkle_eval_params_default()
+        p.levels = int(levels)
+        relay, h = _Relay(progress), _P()
+        st = _lib.pleat_tfw_result_evaluate(self._h, _c.byref(p), 1 if in_plane_v2 else 0,
+                                            relay.fn, None, _c.byref(h))
+        relay.finish(st)
+        return Mesh(h)
+
+    def history(self):
+        """SQP history, a (k, 4) array: energy (J), stationarity residual, step, wall
+        seconds since the SQP started."""
+        n = int(_lib.pleat_tfw_result_history_count(self._h))
+        out = _np.empty((max(n, 1), 4), dtype=_np.float64)
+        _check(_lib.pleat_tfw_result_copy_history(self._h, _ptr(out, _c.c_double), n))
+        return out[:n]
+
+    def __repr__(self):
+        s = self.stats
+        return (f"<pleat.TfwResult {s['status']}, {s['vertex_count']} vertices, "
+                f"{s['sqp_iterations']} SQP iterations>")

@@ -1,0 +1,83 @@
+"""Tension-field wrinkles through the Python package: a small stretched sheet from arrays
+(13 × 6 vertices, solved in well under a second), stats, history, base mesh, field,
+wrinkled mesh, cancellation and errors."""
+import numpy as np
+import pytest
+
+import pleat
+from conftest import needs
+
+pytestmark = needs("tfw")
+
+NX, NY = 13, 6
+
+
+def sheet_arrays(stretch=0.05):
+    """The stretched sheet (0.25 × 0.1 m) on an NX × NY grid, both short edges clamped."""
+    j, i = np.mgrid[0:NY, 0:NX]
+    uv = np.stack([0.25 * i.ravel() / (NX - 1), 0.1 * j.ravel() / (NY - 1)], axis=1)
+    pos = np.stack([(uv[:, 0] - 0.125) * (1 + stretch), uv[:, 1] - 0.05, np.zeros(NX * NY)], 1)
+    tris = []
+    for jj in range(NY - 1):
+        for ii in range(NX - 1):
+            a, b, c, d = jj * NX + ii, jj * NX + ii + 1, (jj + 1) * NX + ii + 1, (jj + 1) * NX + ii
+            tris += [[a, b, c], [a, c, d]] if (ii + jj) % 2 == 0 else [[a, b, d], [b, c, d]]
+    clamped = [jj * NX for jj in range(NY)] + [jj * NX + NX - 1 for jj in range(NY)]
+    return uv, np.array(tris, dtype=np.uint32), pos, clamped
+
+
+@pytest.fixture(scope="module")
+def solved():
+    uv, tris, pos, clamped = sheet_arrays()
+    scene = pleat.TfwScene.from_arrays(uv, tris, pos, clamped, young=1e6, poisson=0.5,
+                                       thickness=1e-4)
+    return scene.solve(sqp_max_iterations=40)
+
+
+def test_small_sheet_wrinkles(solved):
+    s = solved.stats
+    assert s["status"] in ("converged", "not_converged")
+    assert s["vertex_count"] == NX * NY and s["triangle_count"] == 2 * (NX - 1) * (NY - 1)
+    assert 0 < s["peak_amplitude"] < 5e-3
+    assert s["energy"] <= s["initial_energy"] and s["curl_residual"] <= 1e-10
+    h = solved.history()
+    assert h.shape == (s["sqp_iterations"], 4)
+    assert np.all(np.diff(h[:, 0]) <= 0) and np.all(np.diff(h[:, 3]) >= 0)
+
+
+def test_result_meshes_and_field(solved):
+    base = solved.base_mesh()
+    assert base.vertex_count == NX * NY
+    cwf = solved.cwf()
+    assert cwf.vertex_count == NX * NY
+    assert cwf.amplitude().max() == solved.stats["peak_amplitude"]
+    w = solved.evaluate(levels=2)
+    assert w.triangle_count == 16 * base.triangle_count
+    z = w.positions()[:, 2]
+    assert z.max() - z.min() > 0
+    assert solved.evaluate(levels=1, in_plane_v2=False).triangle_count == 4 * base.triangle_count
+
+
+def test_cancel_and_errors(tmp_path):
+    uv, tris, pos, clamped = sheet_arrays()
+    scene = pleat.TfwScene.from_arrays(uv, tris, pos, clamped)
+    with pytest.raises(pleat.PleatError) as e:
+        scene.solve(progress=lambda stage, f: True)
+    assert e.value.status == "CANCELLED"
+    with pytest.raises(pleat.PleatError) as e:
+        scene.solve(sqp_armijo=float("nan"))
+    assert "sqp_armijo" in str(e.value)
+    bad = uv.copy()
+    bad[3, 1] = np.nan
+    with pytest.raises(pleat.PleatError) as e:
+        pleat.TfwScene.from_arrays(bad, tris, pos, clamped)
+    assert "rest[7]" in str(e.value)
+    with pytest.raises(pleat.PleatError) as e:
+        pleat.TfwScene.from_arrays(uv, tris, pos, clamped, thickness=-1)
+    assert "thickness" in str(e.value)
+    with pytest.raises(pleat.PleatError) as e:
+        pleat.TfwScene.from_json('{"material": {"yung": 1}}')
+    assert "yung" in str(e.value)
+    with pytest.raises(pleat.PleatError) as e:
+        pleat.TfwScene.read(tmp_path / "missing.json")
+    assert e.value.status == "IO"
