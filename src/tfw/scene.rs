@@ -562,39 +562,23 @@ impl Scene {
             target_vertices,
             seed,
         })?;
-        let bottom = panel.vertices_in_rest_box([0.0, 0.0], [w, 0.0]);
-        let top = panel.vertices_in_rest_box([0.0, h], [w, h]);
-        Ok(Scene {
-            name: format!(
-                "sheared rectangle (Wong-Pellegrino), {target_vertices} v (seed {seed}), \
-                 shear {shear_mm} mm, stretch {stretch_mm} mm"
-            ),
-            material: Material {
-                young: 3.53e9,
-                poisson: 0.3,
-                thickness: 25e-6,
-                density: 0.0,
-            },
-            panels: vec![panel],
-            gravity: [0.0; 3],
-            pressure: 0.0,
-            dirichlet: vec![
-                Dirichlet {
-                    panel: 0,
-                    vertices: bottom,
-                    motion: Motion::default(),
-                },
-                Dirichlet {
-                    panel: 0,
-                    vertices: top,
-                    motion: Motion {
-                        translation: [shear_mm / 1000.0, stretch_mm / 1000.0, 0.0],
-                        rotation: None,
-                    },
-                },
-            ],
-            seam_tolerance: 1e-9,
-        })
+        let name = format!(
+            "sheared rectangle (Wong-Pellegrino), {target_vertices} v (seed {seed}), \
+             shear {shear_mm} mm, stretch {stretch_mm} mm"
+        );
+        let material = Material {
+            young: 3.53e9,
+            poisson: 0.3,
+            thickness: 25e-6,
+            density: 0.0,
+        };
+        let motion = Motion {
+            translation: [shear_mm / 1000.0, stretch_mm / 1000.0, 0.0],
+            rotation: None,
+        };
+        let mut scene = bottom_clamped_top_moved(name, material, panel, [w, h], motion);
+        scene.seam_tolerance = 1e-9;
+        Ok(scene)
     }
 }
 
@@ -608,16 +592,39 @@ fn twisted_cylinder_scene(
     twist_degrees: f64,
 ) -> Scene {
     let w = 2.0 * std::f64::consts::PI * r;
+    let material = Material {
+        young: 1e7,
+        poisson: 0.44,
+        thickness: 1e-4,
+        density: 0.0,
+    };
+    let motion = Motion {
+        translation: [0.0; 3],
+        rotation: Some(Rotation {
+            axis: [0.0, 0.0, 1.0],
+            origin: [0.0; 3],
+            degrees: twist_degrees,
+        }),
+    };
+    bottom_clamped_top_moved(name, material, panel, [w, hgt], motion)
+}
+
+/// A one-panel scene on the `size[0] × size[1]` rest rectangle: the bottom edge (rest v = 0)
+/// clamped, the top edge (v = `size[1]`) clamped and moved by `motion`; no gravity, no
+/// pressure, seam tolerance 1e-6.
+fn bottom_clamped_top_moved(
+    name: String,
+    material: Material,
+    panel: Panel,
+    size: [f64; 2],
+    motion: Motion,
+) -> Scene {
+    let [w, h] = size;
     let bottom = panel.vertices_in_rest_box([0.0, 0.0], [w, 0.0]);
-    let top = panel.vertices_in_rest_box([0.0, hgt], [w, hgt]);
+    let top = panel.vertices_in_rest_box([0.0, h], [w, h]);
     Scene {
         name,
-        material: Material {
-            young: 1e7,
-            poisson: 0.44,
-            thickness: 1e-4,
-            density: 0.0,
-        },
+        material,
         panels: vec![panel],
         gravity: [0.0; 3],
         pressure: 0.0,
@@ -630,14 +637,7 @@ fn twisted_cylinder_scene(
             Dirichlet {
                 panel: 0,
                 vertices: top,
-                motion: Motion {
-                    translation: [0.0; 3],
-                    rotation: Some(Rotation {
-                        axis: [0.0, 0.0, 1.0],
-                        origin: [0.0; 3],
-                        degrees: twist_degrees,
-                    }),
-                },
+                motion,
             },
         ],
         seam_tolerance: 1e-6,
