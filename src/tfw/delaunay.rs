@@ -264,10 +264,8 @@ fn sample(rings: &[&[[f64; 2]]], d: f64, target: usize, seed: u64) -> (Vec<[f64;
     let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
     let candidates = CANDIDATES_PER_VERTEX * target;
     for c in 0..candidates as u64 {
-        let u =
-            0.5 * (1.0 + crate::tfw::scene::hash_unit(seed.wrapping_mul(0x1000_0001) ^ (2 * c)));
-        let v = 0.5
-            * (1.0 + crate::tfw::scene::hash_unit(seed.wrapping_mul(0x1000_0001) ^ (2 * c + 1)));
+        let u = 0.5 * (1.0 + hash_unit(seed.wrapping_mul(0x1000_0001) ^ (2 * c)));
+        let v = 0.5 * (1.0 + hash_unit(seed.wrapping_mul(0x1000_0001) ^ (2 * c + 1)));
         let p = [lo[0] + u * w, lo[1] + v * h];
         if !inside(rings, p) {
             continue;
@@ -464,6 +462,15 @@ fn constrained_delaunay(
         .filter_map(|(t, k)| k.then_some(t))
         .collect();
     Ok(tris)
+}
+
+/// A deterministic value in [−1, 1) from an integer (splitmix64).
+pub(crate) fn hash_unit(k: u64) -> f64 {
+    let mut z = k.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
 }
 
 #[cfg(test)]

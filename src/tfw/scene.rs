@@ -37,7 +37,7 @@
 
 use serde_json::{Map, Value};
 
-use crate::tfw::delaunay::{mesh_polygon, PolygonPanel};
+use crate::tfw::delaunay::{hash_unit, mesh_polygon, PolygonPanel};
 use crate::tfw::material::{Form, Lame};
 use crate::{Error, Result};
 
@@ -724,15 +724,6 @@ fn grid(nx: usize, ny: usize, lx: f64, ly: f64, jitter: bool) -> (Vec<[f64; 2]>,
         }
     }
     (rest, tris)
-}
-
-/// A deterministic value in [−1, 1) from an integer (splitmix64).
-pub(crate) fn hash_unit(k: u64) -> f64 {
-    let mut z = k.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^= z >> 31;
-    (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
 }
 
 /// Per vertex, the smallest index of the vertices within `tol` (Euclidean) of it, merged
