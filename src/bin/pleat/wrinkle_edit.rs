@@ -167,6 +167,40 @@ pub fn run_design(
     Ok(())
 }
 
+/// The `pleat wrinkle edit` flags that tune the solve beyond the regions (each an
+/// [`EditOptions`] field; validated by [`edit`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EditTuning {
+    /// `--compat-target` ([`EditOptions::compat_target`]).
+    pub compat_target: f64,
+    /// `--max-interface-rings` ([`EditOptions::max_interface_rings`]).
+    pub max_interface_rings: usize,
+    /// `--edit-weight` ([`EditOptions::edit_weight`]).
+    pub edit_weight: f64,
+}
+
+impl EditTuning {
+    /// Refuses NaN, negative or out-of-range values with a message naming the flag.
+    fn check(&self) -> Result<(), Fail> {
+        if !(self.compat_target.is_finite() && self.compat_target >= 0.0) {
+            return Err(bad(format!(
+                "--compat-target {}: must be finite and ≥ 0 radians (0: the requested widths)",
+                self.compat_target
+            )));
+        }
+        if self.max_interface_rings == 0 {
+            return Err(bad("--max-interface-rings 0: must be ≥ 1".into()));
+        }
+        if !(self.edit_weight.is_finite() && self.edit_weight >= 1.0) {
+            return Err(bad(format!(
+                "--edit-weight {}: must be finite and ≥ 1",
+                self.edit_weight
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// `pleat wrinkle edit`.
 pub fn run_edit(
     base: &Path,
@@ -174,6 +208,7 @@ pub fn run_edit(
     regions: &[String],
     adjacency: &str,
     reference: bool,
+    tuning: EditTuning,
     labels: Option<&Path>,
     out: &Path,
 ) -> Result<(), Fail> {
@@ -190,6 +225,10 @@ pub fn run_edit(
         _ if reference => opts.adjacency,
         other => return Err(bad(format!("--adjacency {other:?}: vertex or edge"))),
     };
+    tuning.check()?;
+    opts.compat_target = tuning.compat_target;
+    opts.max_interface_rings = tuning.max_interface_rings;
+    opts.edit_weight = tuning.edit_weight;
     let mut edits = Vec::new();
     for s in regions {
         let spec = parse_region(s)?;
@@ -215,10 +254,18 @@ pub fn run_edit(
         rep.vertex_counts,
         rep.edge_counts
     );
-    eprintln!(
-        "  interface rings used {:?} ({} edit(s); widened while compat RMS > {} rad)",
-        rep.interface_rings, rep.attempts, opts.compat_target
-    );
+    if opts.compat_target > 0.0 {
+        eprintln!(
+            "  interface rings used {:?} ({} edit(s); widened while compat RMS > {} rad, up to \
+             {} rings)",
+            rep.interface_rings, rep.attempts, opts.compat_target, opts.max_interface_rings
+        );
+    } else {
+        eprintln!(
+            "  interface rings used {:?} (as requested; --compat-target off)",
+            rep.interface_rings
+        );
+    }
     eprintln!("  labels + ω¹   {:.4} s", rep.seconds[0]);
     eprintln!(
         "  ω (3.26)     {:.4} s  residual {:.2e}",
