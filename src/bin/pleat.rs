@@ -338,14 +338,24 @@ enum WrinkleCommand {
         /// Adaptive interface width: widen every band by one ring while the compatibility RMS
         /// over edit + interface edges exceeds RAD radians (0 = off: the requested widths; 0.3
         /// is issue 14's smoothness target). The widths used are printed.
-        #[arg(long, value_name = "RAD", default_value_t = 0.0)]
+        #[arg(
+            long,
+            value_name = "RAD",
+            default_value_t = 0.0,
+            allow_hyphen_values = true
+        )]
         compat_target: f64,
         /// Widest band the adaptive width (--compat-target) may reach, in rings.
         #[arg(long, value_name = "N", default_value_t = 8)]
         max_interface_rings: usize,
         /// Weight (≥ 1) of the edit edges' compatibility terms in the phase solve (eq. 3.28)
         /// relative to the interface edges'; 1 is the literal eq. 3.28.
-        #[arg(long, value_name = "W", default_value_t = 1.0)]
+        #[arg(
+            long,
+            value_name = "W",
+            default_value_t = 1.0,
+            allow_hyphen_values = true
+        )]
         edit_weight: f64,
         /// Output .cwf file.
         #[arg(short = 'o', long = "output")]
