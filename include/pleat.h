@@ -674,10 +674,10 @@ typedef struct PleatWrinkleInterpParams {
   // Reserved, set to 0.
   uint32_t reserved;
   // 1 (default): vertices whose star (amplitude, z̃ and ω on the incident edges) is the
-  // same bit for bit in both keyframes (the fixed part of an edit) are held at their keyframe phase on every frame, so an edit's animation
-  // moves only where it changed (README, "Wrinkle animation", C10); 0: every vertex is
-  // solved (the dissertation's literal problem). Appended 2026-11-27: an older, shorter
-  // struct gets 1.
+  // same bit for bit in both keyframes (the fixed part of an edit) are held at their
+  // keyframe phase on every frame, so an edit's animation moves only where it changed
+  // (README, "Wrinkle animation", C10); 0: every vertex is solved (the dissertation's
+  // literal problem). Appended 2026-11-27: an older, shorter struct gets 1.
   uint32_t locality;
   // Reserved, set to 0.
   uint32_t reserved2;
