@@ -941,9 +941,9 @@ mod wrinkle_cmd {
                     &base,
                     &cwf,
                     &regions,
-                    &adjacency,
-                    reference,
-                    crate::wrinkle_edit::EditTuning {
+                    &crate::wrinkle_edit::EditTuning {
+                        adjacency,
+                        reference,
                         compat_target,
                         max_interface_rings,
                         edit_weight,

@@ -409,7 +409,6 @@ pub(super) mod imp {
             max_iterations: p.max_iterations as usize,
             hessian,
             locality: bool_field(p.locality, "params->locality")?,
-            ..InterpOptions::default()
         })
     }
 

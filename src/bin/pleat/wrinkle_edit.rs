@@ -167,10 +167,13 @@ pub fn run_design(
     Ok(())
 }
 
-/// The `pleat wrinkle edit` flags that tune the solve beyond the regions (each an
-/// [`EditOptions`] field; validated by [`edit`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The `pleat wrinkle edit` flags that set the solve's options (besides the regions).
+#[derive(Debug, Clone, PartialEq)]
 pub struct EditTuning {
+    /// `--adjacency`: `vertex` or `edge` (ignored with `--reference` unless given).
+    pub adjacency: String,
+    /// `--reference`: start from [`EditOptions::reference`].
+    pub reference: bool,
     /// `--compat-target` ([`EditOptions::compat_target`]).
     pub compat_target: f64,
     /// `--max-interface-rings` ([`EditOptions::max_interface_rings`]).
@@ -206,20 +209,19 @@ pub fn run_edit(
     base: &Path,
     cwf: &Path,
     regions: &[String],
-    adjacency: &str,
-    reference: bool,
-    tuning: EditTuning,
+    tuning: &EditTuning,
     labels: Option<&Path>,
     out: &Path,
 ) -> Result<(), Fail> {
     let mesh = read_mesh(base).map_err(classify)?;
     let k0 = read_cwf(cwf, mesh.clone()).map_err(classify)?;
+    let reference = tuning.reference;
     let mut opts = if reference {
         EditOptions::reference()
     } else {
         EditOptions::default()
     };
-    opts.adjacency = match adjacency {
+    opts.adjacency = match tuning.adjacency.as_str() {
         "vertex" => Adjacency::Vertex,
         "edge" => Adjacency::Edge,
         _ if reference => opts.adjacency,
