@@ -245,6 +245,38 @@ static void adaptive_width(void) {
         CHECK(old_rep.struct_size == offsetof(PleatCwfEditReport, face_counts));
     }
 
+    /* animating the edit: locality (default 1) holds the unchanged vertices, 0 solves all; an
+       older interpolation struct (before `locality`) keeps it on */
+    {
+        PleatWrinkleInterpParams ip = pleat_wrinkle_interp_params_default();
+        PleatWrinkleInterpStats st;
+        PleatCwfAnimation *anim = NULL;
+        uint32_t locality;
+        CHECK(ip.locality == 1);
+        ip.guide_frames = 2, ip.substeps = 1, ip.max_iterations = 5;
+        for (locality = 0; locality < 3; locality++) {
+            memset(&st, 0, sizeof st);
+            st.struct_size = sizeof st;
+            ip.struct_size = sizeof ip;
+            ip.locality = locality == 1;
+            if (locality == 2) { /* the older struct: bytes after it are not read */
+                ip.struct_size = (uint32_t)offsetof(PleatWrinkleInterpParams, locality);
+                ip.locality = 0;
+            }
+            CHECK_STATUS(pleat_cwf_interpolate(a, wide, &ip, NULL, NULL, &anim, &st),
+                         PLEAT_STATUS_OK);
+            CHECK(locality == 0 ? st.pinned_vertices == 0 : st.pinned_vertices > 0);
+            pleat_cwf_animation_destroy(anim);
+            anim = NULL;
+        }
+        ip = pleat_wrinkle_interp_params_default();
+        ip.locality = 2;
+        CHECK_STATUS(pleat_cwf_interpolate(a, wide, &ip, NULL, NULL, &anim, NULL),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        check_names("locality");
+        CHECK(anim == NULL);
+    }
+
     /* NaN / negative compat_target, edit_weight < 1, max_interface_rings 0: refused, named */
     ep = pleat_cwf_edit_params_default();
     ep.compat_target = NAN;

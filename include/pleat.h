@@ -709,6 +709,9 @@ typedef struct PleatWrinkleInterpStats {
   double g_ave;
   // The penalty c used.
   double c;
+  // Vertices held at their keyframe phase by `params->locality` (0 when off). Appended
+  // 2026-11-27: an older, shorter stats struct does not receive it.
+  uint64_t pinned_vertices;
 } PleatWrinkleInterpStats;
 
 // Parameters of `pleat_lod_generate`, `pleat_lod_generate_chain` and `pleat_cage_generate`.

@@ -122,6 +122,9 @@ pub struct PleatWrinkleInterpStats {
     pub g_ave: f64,
     /// The penalty c used.
     pub c: f64,
+    /// Vertices held at their keyframe phase by `params->locality` (0 when off). Appended
+    /// 2026-11-27: an older, shorter stats struct does not receive it.
+    pub pinned_vertices: u64,
 }
 
 /// The default interpolation parameters (50 guide frames, 4 sub-steps, 200 iterations,
@@ -454,6 +457,7 @@ pub(super) mod imp {
                 unit_energy: report.unit_energy,
                 g_ave: report.g_ave,
                 c: report.c,
+                pinned_vertices: report.pinned_vertices as u64,
             };
             let history = report
                 .history

@@ -182,7 +182,8 @@ _InterpParams = _struct("PleatWrinkleInterpParams",
 _InterpStats = _struct("PleatWrinkleInterpStats",
                        _u32s("struct_size", "iterations", "stop_reason", "factorizations")
                        + _f64s("total_seconds", "final_gradient_norm", "smooth_energy",
-                               "compat_energy", "unit_energy", "g_ave", "c"))
+                               "compat_energy", "unit_energy", "g_ave", "c")
+                       + _u64s("pinned_vertices"))
 
 _WrinkleSource = _struct("PleatWrinkleSource", _u32s("vertex", "rings")
                          + [("wave_vector", _c.c_double * 3)] + _f64s("amplitude"))

@@ -85,8 +85,10 @@ def test_interpolate_locality_flag(grid):
     touched = np.zeros(grid.vertex_count, dtype=bool)
     touched[tri[labels != 0].ravel()] = True
     kw = dict(guide_frames=2, substeps=1, max_iterations=20)
-    local = a.interpolate(b, **kw).frame(0.5).zeta()
-    free = a.interpolate(b, locality=False, **kw).frame(0.5).zeta()
+    anim_local, anim_free = a.interpolate(b, **kw), a.interpolate(b, locality=False, **kw)
+    assert anim_local.stats["pinned_vertices"] > 0
+    assert anim_free.stats["pinned_vertices"] == 0
+    local, free = anim_local.frame(0.5).zeta(), anim_free.frame(0.5).zeta()
     far = ~touched
     far[tri[touched[tri].any(axis=1)].ravel()] = False  # also away from the stars
     assert np.array_equal(local[far], a.zeta()[far])
