@@ -120,6 +120,14 @@ static void wrinkles(const pleat::Mesh &base) {
         EXPECT(err.status() == PLEAT_STATUS_INVALID_ARGUMENT);
     }
     try {
+        cwf.edit_report();  // not made by edit: no edit report
+        EXPECT(false);
+    } catch (const pleat::Error &err) {
+        EXPECT(err.status() == PLEAT_STATUS_INVALID_ARGUMENT);
+    }
+    ip.locality = 0;  // every vertex solved
+    EXPECT(cwf.interpolate(key_b, ip).frame_count() == 5);
+    try {
         cwf.knoppel_report();  // zeta was given: no solve, no report
         EXPECT(false);
     } catch (const pleat::Error &err) {

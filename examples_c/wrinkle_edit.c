@@ -1,8 +1,11 @@
 /* Wrinkle design and region edits through the C ABI (issue 14, dissertation ch. 3.6):
    grow a region, rotate the wrinkles in it, check the fixed part is copied bit for bit, an
    identity edit returns the input, design from a source, evaluate the edited keyframe, and
-   misuse answers a status with a message. Without the "wrinkle" capability every call answers
+   misuse answers a status with a message; the adaptive interface width (compat_target) and the
+   edit report; a caller compiled before edit_weight / compat_target / max_interface_rings were
+   appended keeps working. Without the "wrinkle" capability every call answers
    PLEAT_STATUS_UNSUPPORTED (checked). */
+#include <stddef.h>
 #include "wrinkle_util.h"
 
 #define N 21
@@ -156,6 +159,153 @@ static void edits(void) {
     free(a0), free(a1), free(z0), free(z1), free(w0), free(w1);
 }
 
+/* Checks `msg` names `field` (the status message of the last call). */
+static void check_names(const char *field) {
+    CHECK(strstr(pleat_last_error(), field) != NULL);
+}
+
+/* compat_target = 0.3: the interface is widened until the compatibility RMS is under 0.3 rad
+   (or max_interface_rings is reached); the report says which widths and how many edits. */
+static void adaptive_width(void) {
+    const double k[3] = {2 * 2 * M_PI, 0, 0}; /* 2 waves: resolved on the 21^2 grid */
+    PleatMesh *m = make_grid(N);
+    size_t nv = pleat_mesh_vertex_count(m), nt = pleat_mesh_triangle_count(m), ne = 0, i, count = 0;
+    double *zeta = (double *)malloc(2 * nv * sizeof *zeta);
+    double *omega = plane_wave(m, k, &ne, zeta);
+    double *amp = filled(nv, 0.01);
+    uint8_t *flags = (uint8_t *)malloc(nt);
+    uint32_t *faces = (uint32_t *)malloc(nt * sizeof *faces);
+    uint32_t centre = (N / 2) * N + N / 2, rings[2] = {0, 0};
+    PleatCwf *a = NULL, *fixed = NULL, *wide = NULL, *old = NULL, *none = NULL;
+    PleatCwfRegionEdit r;
+    PleatCwfEditParams ep = pleat_cwf_edit_params_default();
+    PleatCwfEditReport narrow_rep, wide_rep, old_rep;
+
+    CHECK(ep.edit_weight == 1.0 && ep.compat_target == 0.0 && ep.max_interface_rings == 8);
+    CHECK_STATUS(pleat_cwf_create(m, omega, ne, amp, zeta, nv, &a), PLEAT_STATUS_OK);
+    CHECK_STATUS(pleat_mesh_grow_faces(m, NULL, 0, &centre, 1, 3, PLEAT_ADJACENCY_VERTEX, flags,
+                                       &count),
+                 PLEAT_STATUS_OK);
+    count = 0;
+    for (i = 0; i < nt; i++)
+        if (flags[i]) faces[count++] = (uint32_t)i;
+    memset(&r, 0, sizeof r);
+    r.struct_size = sizeof r;
+    r.interface_rings = 1;
+    r.faces = faces;
+    r.face_count = count;
+    r.rotate_radians = M_PI / 2;
+    r.frequency_scale = 1.0;
+    r.amplitude_scale = 1.0;
+
+    /* the requested width (compat_target = 0: off) */
+    CHECK_STATUS(pleat_cwf_edit(a, &r, 1, &ep, &fixed, NULL), PLEAT_STATUS_OK);
+    memset(&narrow_rep, 0, sizeof narrow_rep);
+    narrow_rep.struct_size = sizeof narrow_rep;
+    CHECK_STATUS(pleat_cwf_get_edit_report(fixed, &narrow_rep), PLEAT_STATUS_OK);
+    CHECK(narrow_rep.attempts == 1 && narrow_rep.region_count == 1);
+    CHECK(narrow_rep.interface_rings_min == 1 && narrow_rep.interface_rings_max == 1);
+
+    /* adaptive: widened until the RMS is under 0.3 rad */
+    ep.compat_target = 0.3;
+    ep.max_interface_rings = 6;
+    CHECK_STATUS(pleat_cwf_edit(a, &r, 1, &ep, &wide, NULL), PLEAT_STATUS_OK);
+    memset(&wide_rep, 0, sizeof wide_rep);
+    wide_rep.struct_size = sizeof wide_rep;
+    CHECK_STATUS(pleat_cwf_get_edit_report(wide, &wide_rep), PLEAT_STATUS_OK);
+    CHECK_STATUS(pleat_cwf_copy_edit_interface_rings(wide, rings, 2), PLEAT_STATUS_OK);
+    printf("  compat_target 0.3: interface %u -> %u rings in %u edits; RMS %.3f -> %.3f rad "
+           "(edit %.3f, interface %.3f, floor %.3f)\n",
+           r.interface_rings, rings[0], wide_rep.attempts, narrow_rep.compat_rms,
+           wide_rep.compat_rms, wide_rep.compat_rms_edit, wide_rep.compat_rms_interface,
+           wide_rep.compat_floor);
+    CHECK(narrow_rep.compat_rms > 0.3);
+    CHECK(wide_rep.attempts > 1 && rings[0] > r.interface_rings);
+    CHECK(rings[0] == wide_rep.interface_rings_max && wide_rep.region_count == 1);
+    CHECK(wide_rep.compat_rms < narrow_rep.compat_rms);
+    CHECK(wide_rep.compat_rms <= 0.3);
+    CHECK_STATUS(pleat_cwf_copy_edit_interface_rings(wide, rings, 0), PLEAT_STATUS_LIMIT_EXCEEDED);
+    CHECK_STATUS(pleat_cwf_get_edit_report(a, &wide_rep), PLEAT_STATUS_INVALID_ARGUMENT);
+
+    /* a caller compiled before the three fields: whatever follows its struct is ignored */
+    {
+        PleatCwfEditParams older = pleat_cwf_edit_params_default();
+        older.struct_size = (uint32_t)offsetof(PleatCwfEditParams, edit_weight);
+        older.edit_weight = NAN;
+        older.compat_target = -1.0;
+        older.max_interface_rings = 0;
+        CHECK_STATUS(pleat_cwf_edit(a, &r, 1, &older, &old, NULL), PLEAT_STATUS_OK);
+        memset(&old_rep, 0, sizeof old_rep);
+        /* an older report struct: only its prefix is written */
+        old_rep.struct_size = (uint32_t)offsetof(PleatCwfEditReport, face_counts);
+        old_rep.compat_rms = -7.0;
+        CHECK_STATUS(pleat_cwf_get_edit_report(old, &old_rep), PLEAT_STATUS_OK);
+        CHECK(old_rep.attempts == 1 && old_rep.interface_rings_max == 1);
+        CHECK(old_rep.compat_rms == -7.0);
+        CHECK(old_rep.struct_size == offsetof(PleatCwfEditReport, face_counts));
+    }
+
+    /* animating the edit: locality (default 1) holds the unchanged vertices, 0 solves all; an
+       older interpolation struct (before `locality`) keeps it on */
+    {
+        PleatWrinkleInterpParams ip = pleat_wrinkle_interp_params_default();
+        PleatWrinkleInterpStats st;
+        PleatCwfAnimation *anim = NULL;
+        uint32_t locality;
+        CHECK(ip.locality == 1);
+        ip.guide_frames = 2, ip.substeps = 1, ip.max_iterations = 5;
+        for (locality = 0; locality < 3; locality++) {
+            memset(&st, 0, sizeof st);
+            st.struct_size = sizeof st;
+            ip.struct_size = sizeof ip;
+            ip.locality = locality == 1;
+            if (locality == 2) { /* the older struct: bytes after it are not read */
+                ip.struct_size = (uint32_t)offsetof(PleatWrinkleInterpParams, locality);
+                ip.locality = 0;
+            }
+            CHECK_STATUS(pleat_cwf_interpolate(a, wide, &ip, NULL, NULL, &anim, &st),
+                         PLEAT_STATUS_OK);
+            CHECK(locality == 0 ? st.pinned_vertices == 0 : st.pinned_vertices > 0);
+            pleat_cwf_animation_destroy(anim);
+            anim = NULL;
+        }
+        ip = pleat_wrinkle_interp_params_default();
+        ip.locality = 2;
+        CHECK_STATUS(pleat_cwf_interpolate(a, wide, &ip, NULL, NULL, &anim, NULL),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        check_names("locality");
+        CHECK(anim == NULL);
+    }
+
+    /* NaN / negative compat_target, edit_weight < 1, max_interface_rings 0: refused, named */
+    ep = pleat_cwf_edit_params_default();
+    ep.compat_target = NAN;
+    CHECK_STATUS(pleat_cwf_edit(a, &r, 1, &ep, &none, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+    check_names("compat_target");
+    ep.compat_target = -0.3;
+    CHECK_STATUS(pleat_cwf_edit(a, &r, 1, &ep, &none, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+    check_names("compat_target");
+    ep = pleat_cwf_edit_params_default();
+    ep.edit_weight = NAN;
+    CHECK_STATUS(pleat_cwf_edit(a, &r, 1, &ep, &none, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+    check_names("edit_weight");
+    ep.edit_weight = -1.0;
+    CHECK_STATUS(pleat_cwf_edit(a, &r, 1, &ep, &none, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+    check_names("edit_weight");
+    ep = pleat_cwf_edit_params_default();
+    ep.max_interface_rings = 0;
+    CHECK_STATUS(pleat_cwf_edit(a, &r, 1, &ep, &none, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+    check_names("max_interface_rings");
+    CHECK(none == NULL);
+
+    pleat_cwf_destroy(a);
+    pleat_cwf_destroy(fixed);
+    pleat_cwf_destroy(wide);
+    pleat_cwf_destroy(old);
+    pleat_mesh_destroy(m);
+    free(zeta), free(omega), free(amp), free(flags), free(faces);
+}
+
 /* Without the capability the calls answer UNSUPPORTED; the defaults still work. */
 static void unsupported(void) {
     PleatMesh *m = make_grid(5);
@@ -167,6 +317,7 @@ static void unsupported(void) {
     PleatCwfDesignParams dp = pleat_cwf_design_params_default();
     printf("SKIPPED: this pleat was built without \"wrinkle\"; checking UNSUPPORTED\n");
     CHECK(ep.struct_size == sizeof ep && dp.struct_size == sizeof dp);
+    CHECK(ep.compat_target == 0.0 && ep.max_interface_rings == 8 && ep.edit_weight == 1.0);
     CHECK_STATUS(pleat_cwf_design(m, &s, 1, &dp, NULL, &out), PLEAT_STATUS_UNSUPPORTED);
     CHECK_STATUS(pleat_cwf_edit(NULL, NULL, 0, &ep, &out, NULL), PLEAT_STATUS_UNSUPPORTED);
     CHECK_STATUS(pleat_mesh_grow_faces(m, NULL, 0, &v, 1, 2, PLEAT_ADJACENCY_VERTEX, flags, NULL),
@@ -176,9 +327,10 @@ static void unsupported(void) {
 }
 
 int main(void) {
-    if (pleat_has_feature("wrinkle"))
+    if (pleat_has_feature("wrinkle")) {
         edits();
-    else
+        adaptive_width();
+    } else
         unsupported();
     return finish("wrinkle_edit");
 }

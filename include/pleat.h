@@ -535,6 +535,21 @@ typedef struct PleatCwfEditParams {
   double gamma;
   // Inverse-iteration tolerance, finite, > 0; default 1e-12.
   double tolerance;
+  // Weight of the edit edges' compatibility terms in the phase solve (eq. 3.28) relative to
+  // the interface edges', finite, ≥ 1; default 1 (the literal eq. 3.28). Appended
+  // 2026-11-27: an older, shorter struct gets the default.
+  double edit_weight;
+  // Adaptive interface width: target RMS compatibility residual over edit + interface edges,
+  // radians, finite, ≥ 0; 0 (default) = off, the regions' `interface_rings` exactly. While the
+  // residual exceeds it, every band is widened by one ring (up to `max_interface_rings`) and
+  // the edit redone; the edit with the smallest residual is returned
+  // (`pleat_cwf_get_edit_report`, `pleat_cwf_copy_edit_interface_rings`). 0.3 is issue 14's
+  // smoothness target. Appended 2026-11-27.
+  double compat_target;
+  // Widest band the adaptive width may reach, 1 to 1,000,000; default 8. Appended 2026-11-27.
+  uint32_t max_interface_rings;
+  // Reserved, set to 0.
+  uint32_t reserved;
 } PleatCwfEditParams;
 
 // One wrinkle source of `pleat_cwf_design` (a plain array element, no `struct_size`).
@@ -586,6 +601,56 @@ typedef struct PleatCwfRegionEdit {
   double amplitude_scale;
 } PleatCwfRegionEdit;
 
+// What `pleat_cwf_edit` did (`pleat_cwf_get_edit_report`): class sizes, each solve's residual
+// and seconds, the compatibility residual by class and what the adaptive width did.
+typedef struct PleatCwfEditReport {
+  // In: `sizeof(PleatCwfEditReport)` (≥ 8). Out: bytes filled.
+  uint32_t struct_size;
+  // Edits computed: 1 + the widenings tried (`compat_target`).
+  uint32_t attempts;
+  // Regions edited (the length of `pleat_cwf_copy_edit_interface_rings`' output).
+  uint32_t region_count;
+  // Narrowest interface band used, in rings.
+  uint32_t interface_rings_min;
+  // Widest interface band used, in rings (wider than requested when `compat_target` widened
+  // it).
+  uint32_t interface_rings_max;
+  // 1 when no vertex is fixed (a global edit: plain Knöppel phase), else 0.
+  uint32_t global;
+  // 1 when the phase fell back to `s = 1` (harmonic extension), else 0.
+  uint32_t phase_fallback;
+  // Inverse-iteration steps of the phase solve.
+  uint32_t phase_iterations;
+  // Faces `[fixed, edit, interface]`.
+  uint64_t face_counts[3];
+  // Vertices `[fixed, edit, interface-only]`.
+  uint64_t vertex_counts[3];
+  // Edges `[fixed, edit, interface-only]`.
+  uint64_t edge_counts[3];
+  // Interface amplitudes clamped to 0.
+  uint64_t clamped;
+  // Relative residual of eq. 3.26 (0 without interface edges).
+  double omega_residual;
+  // Relative residual of eq. 3.27 (0 without interface vertices).
+  double amplitude_residual;
+  // Smallest eigenvalue of the phase pencil (3.28), or Knöppel's for a global edit.
+  double eigenvalue;
+  // Final inverse-iteration residual of the phase solve.
+  double phase_residual;
+  // RMS of `|wrap(ω¹ − Δarg z̃¹)|` over edit + interface edges, radians (what
+  // `compat_target` bounds).
+  double compat_rms;
+  // The same RMS over the edit edges only.
+  double compat_rms_edit;
+  // The same RMS over the interface-only edges only.
+  double compat_rms_interface;
+  // The smallest RMS any phase without singularities can reach for this ω¹ (how
+  // incompatible the requested field is, not the phase solve).
+  double compat_floor;
+  // Wall seconds: `[labels + ω¹, eq. 3.26, eq. 3.27, eq. 3.28]` of the returned edit.
+  double seconds[4];
+} PleatCwfEditReport;
+
 // Parameters of `pleat_cwf_interpolate`. Get the defaults from
 // `pleat_wrinkle_interp_params_default()`; `struct_size` versioned as
 // `PleatWrinkleEvalParams`.
@@ -608,6 +673,14 @@ typedef struct PleatWrinkleInterpParams {
   uint32_t hessian;
   // Reserved, set to 0.
   uint32_t reserved;
+  // 1 (default): vertices whose star (amplitude, z̃ and ω on the incident edges) is the
+  // same bit for bit in both keyframes (the fixed part of an edit) are held at their
+  // keyframe phase on every frame, so an edit's animation moves only where it changed
+  // (README, "Wrinkle animation", C10); 0: every vertex is solved (the dissertation's
+  // literal problem). Appended 2026-11-27: an older, shorter struct gets 1.
+  uint32_t locality;
+  // Reserved, set to 0.
+  uint32_t reserved2;
 } PleatWrinkleInterpParams;
 
 // What `pleat_cwf_interpolate` did. Set `struct_size = sizeof(PleatWrinkleInterpStats)`
@@ -636,6 +709,9 @@ typedef struct PleatWrinkleInterpStats {
   double g_ave;
   // The penalty c used.
   double c;
+  // Vertices held at their keyframe phase by `params->locality` (0 when off). Appended
+  // 2026-11-27: an older, shorter stats struct does not receive it.
+  uint64_t pinned_vertices;
 } PleatWrinkleInterpStats;
 
 // Parameters of `pleat_lod_generate`, `pleat_lod_generate_chain` and `pleat_cage_generate`.
@@ -1315,6 +1391,9 @@ PleatStatus pleat_cwf_design(const struct PleatMesh *base,
 // - `face_labels_out`: NULL, or `pleat_cwf_triangle_count(cwf)` bytes receiving
 //   `PLEAT_FACE_FIXED` / `_EDIT` / `_INTERFACE` per triangle.
 //
+// The output keeps the edit's report: `pleat_cwf_get_edit_report` and
+// `pleat_cwf_copy_edit_interface_rings` (the widths used, per region).
+//
 // # Safety
 // Pointers are NULL or valid for the sizes described above.
 PleatStatus pleat_cwf_edit(const struct PleatCwf *cwf,
@@ -1323,6 +1402,31 @@ PleatStatus pleat_cwf_edit(const struct PleatCwf *cwf,
                            const struct PleatCwfEditParams *params,
                            struct PleatCwf **out,
                            uint8_t *face_labels_out);
+
+// Fills `*out` with the report of the `pleat_cwf_edit` call that produced `cwf`.
+//
+// - `cwf`: non-NULL; a field not made by `pleat_cwf_edit` has no edit report:
+//   `PLEAT_STATUS_INVALID_ARGUMENT`.
+// - `out`: non-NULL, `out->struct_size = sizeof(PleatCwfEditReport)` (≥ 8; an older, shorter
+//   struct receives its prefix).
+//
+// # Safety
+// `cwf` is NULL or live; `out` is NULL or valid for `out->struct_size` bytes.
+PleatStatus pleat_cwf_get_edit_report(const struct PleatCwf *cwf, struct PleatCwfEditReport *out);
+
+// Copies the interface width used per region (rings, in `regions` order) by the
+// `pleat_cwf_edit` call that produced `cwf`: the requested widths, or wider ones when
+// `compat_target` widened them.
+//
+// - `cwf`: non-NULL, made by `pleat_cwf_edit` (else `PLEAT_STATUS_INVALID_ARGUMENT`).
+// - `dst`: non-NULL; `capacity` ≥ the region count (`PleatCwfEditReport::region_count`), else
+//   `PLEAT_STATUS_LIMIT_EXCEEDED`.
+//
+// # Safety
+// `cwf` is NULL or live; `dst` is NULL or valid for `capacity` values.
+PleatStatus pleat_cwf_copy_edit_interface_rings(const struct PleatCwf *cwf,
+                                                uint32_t *dst,
+                                                size_t capacity);
 
 // A region of `mesh`: the seed triangles and the triangles of the seed vertices (ring 1),
 // grown by `rings − 1` more rings across `adjacency`. Writes 1 (in the region) or 0 per

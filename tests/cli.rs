@@ -589,3 +589,140 @@ fn bench_tfw_writes_csv_and_svg() {
     assert_eq!(o.status.code(), Some(2));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A flat `n × n`-vertex grid on [0,1]² as OBJ in `dir/grid.obj` (vertex `j·n + i` at
+/// `(i, j)/(n − 1)`).
+#[cfg(feature = "wrinkle")]
+fn write_grid(dir: &std::path::Path, n: usize) -> std::path::PathBuf {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    for j in 0..n {
+        for i in 0..n {
+            let d = (n - 1) as f64;
+            let _ = writeln!(s, "v {} {} 0", i as f64 / d, j as f64 / d);
+        }
+    }
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let v = j * n + i + 1;
+            let _ = writeln!(
+                s,
+                "f {} {} {}\nf {} {} {}",
+                v,
+                v + 1,
+                v + n + 1,
+                v,
+                v + n + 1,
+                v + n
+            );
+        }
+    }
+    let path = dir.join("grid.obj");
+    std::fs::write(&path, s).unwrap();
+    path
+}
+
+/// `--compat-target 0.3` widens the interface of a 90° rotation on a flat grid (the printed
+/// report says which width), the other edit flags are accepted, bad values exit 2 naming the
+/// flag, and `wrinkle interp --no-locality` solves every vertex.
+#[cfg(feature = "wrinkle")]
+#[test]
+fn wrinkle_edit_compat_target_widens_and_interp_no_locality() {
+    let dir = scratch_with_octahedron("compat-target");
+    let base = write_grid(&dir, 21);
+    let (k0, k1) = (dir.join("k0.cwf"), dir.join("k1.cwf"));
+    let o = pleat(&[
+        "wrinkle",
+        "plane-wave",
+        path_str(&base),
+        "--k",
+        "12.566370614359172,0,0",
+        "--amplitude",
+        "0.01",
+        "-o",
+        path_str(&k0),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let edit = |extra: &[&str], out: &std::path::Path| {
+        let mut args = vec![
+            "wrinkle",
+            "edit",
+            path_str(&base),
+            "--cwf",
+            path_str(&k0),
+            "--region",
+            "vertex=220,rings=3,interface=1,rotate=90",
+        ];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["-o", path_str(out)]);
+        pleat(&args)
+    };
+    let o = edit(&[], &k1);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("interface rings used [1] (as requested"),
+        "{err}"
+    );
+    let o = edit(
+        &[
+            "--compat-target",
+            "0.3",
+            "--max-interface-rings",
+            "6",
+            "--edit-weight",
+            "1",
+        ],
+        &k1,
+    );
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(o.status.success(), "{err}");
+    let used: usize = err
+        .split("interface rings used [")
+        .nth(1)
+        .and_then(|s| s.split(']').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no widths in {err}"));
+    assert!((2..=6).contains(&used), "{err}");
+    assert!(err.contains("widened while compat RMS > 0.3 rad"), "{err}");
+    for (flag, value) in [
+        ("--compat-target", "-0.3"),
+        ("--compat-target", "NaN"),
+        ("--edit-weight", "0.5"),
+        ("--max-interface-rings", "0"),
+    ] {
+        let bad = dir.join("bad.cwf");
+        let o = edit(&[flag, value], &bad);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{flag} {value}: {err}");
+        assert!(err.contains(flag), "{err}");
+        assert!(!bad.exists());
+    }
+    for (extra, expect) in [
+        (None, "locality held"),
+        (Some("--no-locality"), "locality off"),
+    ] {
+        let anim = dir.join("a.cwfa");
+        let mut args = vec![
+            "wrinkle",
+            "interp",
+            path_str(&k0),
+            path_str(&k1),
+            "--base",
+            path_str(&base),
+            "--frames",
+            "2",
+            "--substeps",
+            "1",
+            "--max-iterations",
+            "5",
+        ];
+        args.extend(extra);
+        args.extend_from_slice(&["-o", path_str(&anim)]);
+        let o = pleat(&args);
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(out.contains(expect), "{out}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

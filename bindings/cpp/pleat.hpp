@@ -484,7 +484,25 @@ class Cwf {
         check(pleat_cwf_get_knoppel_report(raw_, &r));
         return r;
     }
-    /// The animation from this keyframe (t = 0) to `other` (t = 1) on the same base mesh.
+    /// What the `edit` that made this keyframe did (class sizes, residuals, the compatibility
+    /// RMS by class, attempts of the adaptive width `PleatCwfEditParams::compat_target`);
+    /// INVALID_ARGUMENT when this keyframe was not made by `edit`.
+    PleatCwfEditReport edit_report() const {
+        PleatCwfEditReport r{};
+        r.struct_size = sizeof r;
+        check(pleat_cwf_get_edit_report(raw_, &r));
+        return r;
+    }
+    /// The interface width (rings) `edit` used per region, in the order of its `regions`
+    /// (wider than requested when `compat_target` widened them).
+    std::vector<uint32_t> edit_interface_rings() const {
+        std::vector<uint32_t> v(edit_report().region_count + 1);
+        check(pleat_cwf_copy_edit_interface_rings(raw_, v.data(), v.size()));
+        v.pop_back();
+        return v;
+    }
+    /// The animation from this keyframe (t = 0) to `other` (t = 1) on the same base mesh;
+    /// `params.locality` (default 1) holds an edit's unchanged vertices at their keyframe phase.
     Animation interpolate(
         const Cwf &other,
         const PleatWrinkleInterpParams &params = pleat_wrinkle_interp_params_default(),

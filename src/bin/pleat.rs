@@ -266,6 +266,11 @@ enum WrinkleCommand {
         /// Newton iteration cap.
         #[arg(long, default_value_t = 200)]
         max_iterations: usize,
+        /// Solve the phase at every vertex (eq. 3.12 as printed). By default vertices whose star
+        /// is the same in both keyframes (an edit's fixed part) keep their keyframe phase on
+        /// every frame, so a local edit animates locally (spec check C10).
+        #[arg(long)]
+        no_locality: bool,
         /// Output animation (.cwfa).
         #[arg(short = 'o', long = "output")]
         out: PathBuf,
@@ -330,6 +335,28 @@ enum WrinkleCommand {
         /// Also write the face labels (one per line: 0 fixed, 1 edit, 2 interface).
         #[arg(long)]
         labels: Option<PathBuf>,
+        /// Adaptive interface width: widen every band by one ring while the compatibility RMS
+        /// over edit + interface edges exceeds RAD radians (0 = off: the requested widths; 0.3
+        /// is issue 14's smoothness target). The widths used are printed.
+        #[arg(
+            long,
+            value_name = "RAD",
+            default_value_t = 0.0,
+            allow_hyphen_values = true
+        )]
+        compat_target: f64,
+        /// Widest band the adaptive width (--compat-target) may reach, in rings.
+        #[arg(long, value_name = "N", default_value_t = 8)]
+        max_interface_rings: usize,
+        /// Weight (≥ 1) of the edit edges' compatibility terms in the phase solve (eq. 3.28)
+        /// relative to the interface edges'; 1 is the literal eq. 3.28.
+        #[arg(
+            long,
+            value_name = "W",
+            default_value_t = 1.0,
+            allow_hyphen_values = true
+        )]
+        edit_weight: f64,
         /// Output .cwf file.
         #[arg(short = 'o', long = "output")]
         out: PathBuf,
@@ -862,6 +889,7 @@ mod wrinkle_cmd {
                 c_scale,
                 tolerance,
                 max_iterations,
+                no_locality,
                 out,
             } => {
                 let opts = InterpOptions {
@@ -870,7 +898,8 @@ mod wrinkle_cmd {
                     c_scale,
                     gradient_tolerance: tolerance,
                     max_iterations,
-                    ..Default::default()
+                    hessian: Default::default(),
+                    locality: !no_locality,
                 };
                 ("interp", interp(&a, &b, &base, &opts, &out))
             }
@@ -902,6 +931,9 @@ mod wrinkle_cmd {
                 adjacency,
                 reference,
                 labels,
+                compat_target,
+                max_interface_rings,
+                edit_weight,
                 out,
             } => (
                 "edit",
@@ -909,8 +941,13 @@ mod wrinkle_cmd {
                     &base,
                     &cwf,
                     &regions,
-                    &adjacency,
-                    reference,
+                    &crate::wrinkle_edit::EditTuning {
+                        adjacency,
+                        reference,
+                        compat_target,
+                        max_interface_rings,
+                        edit_weight,
+                    },
                     labels.as_deref(),
                     &out,
                 )
@@ -1068,7 +1105,7 @@ mod wrinkle_cmd {
         let secs = report.history.last().map_or(0.0, |h| h.seconds);
         println!(
             "{}: {} guide frames × {} sub-steps = {} frames; {} after {} iterations (gradient \
-             {:.2e}) in {secs:.2} s; E_smooth {:.4e}, E_compat {:.4e}, E_unit {:.4e}",
+             {:.2e}) in {secs:.2} s; E_smooth {:.4e}, E_compat {:.4e}, E_unit {:.4e}; {}",
             out.display(),
             anim.guide_intervals(),
             anim.substeps(),
@@ -1078,7 +1115,12 @@ mod wrinkle_cmd {
             report.final_gradient_norm(),
             report.smooth_energy,
             report.compat_energy,
-            report.unit_energy
+            report.unit_energy,
+            if opts.locality {
+                format!("locality held {} vertices", report.pinned_vertices)
+            } else {
+                "locality off (--no-locality)".to_string()
+            }
         );
         Ok(())
     }

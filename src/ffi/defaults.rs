@@ -192,3 +192,97 @@ fn tfw_params_default_is_rust_default() {
     assert_eq!(rust, crate::tfw::TfwParams::default());
     assert_eq!(c, tfw::defaults_without_tfw());
 }
+
+/// A caller compiled before `edit_weight`, `compat_target` and `max_interface_rings` were
+/// appended (struct_size = offset of `edit_weight`) gets their defaults, whatever the bytes
+/// after its struct; the new fields are validated with messages naming them.
+#[cfg(feature = "wrinkle")]
+#[test]
+fn cwf_edit_params_older_size_and_new_fields() {
+    use super::boundary::read_versioned;
+    let mut p = pleat_cwf_edit_params_default();
+    p.struct_size = std::mem::offset_of!(PleatCwfEditParams, edit_weight) as u32;
+    assert_eq!(p.struct_size, 48, "the published size before 2026-11-27");
+    (p.edit_weight, p.compat_target, p.max_interface_rings) = (f64::NAN, -1.0, 0);
+    let read = unsafe { read_versioned(&p, "params") }.unwrap();
+    let rust = design::imp::edit_options(&read).expect("older struct valid");
+    assert_eq!(rust, crate::wrinkle::EditOptions::default());
+    let full = pleat_cwf_edit_params_default();
+    for (bad, field) in [
+        (
+            PleatCwfEditParams {
+                compat_target: f64::NAN,
+                ..full
+            },
+            "compat_target",
+        ),
+        (
+            PleatCwfEditParams {
+                compat_target: -0.3,
+                ..full
+            },
+            "compat_target",
+        ),
+        (
+            PleatCwfEditParams {
+                edit_weight: f64::NAN,
+                ..full
+            },
+            "edit_weight",
+        ),
+        (
+            PleatCwfEditParams {
+                edit_weight: 0.5,
+                ..full
+            },
+            "edit_weight",
+        ),
+        (
+            PleatCwfEditParams {
+                max_interface_rings: 0,
+                ..full
+            },
+            "max_interface_rings",
+        ),
+    ] {
+        let e = design::imp::edit_options(&bad).unwrap_err().to_string();
+        assert!(e.contains(&format!("params->{field}")), "{e}");
+    }
+    let set = PleatCwfEditParams {
+        compat_target: 0.3,
+        edit_weight: 4.0,
+        max_interface_rings: 6,
+        ..full
+    };
+    let rust = design::imp::edit_options(&set).unwrap();
+    assert_eq!(
+        (
+            rust.compat_target,
+            rust.edit_weight,
+            rust.max_interface_rings
+        ),
+        (0.3, 4.0, 6)
+    );
+}
+
+/// The interpolation params before `locality` was appended keep locality on; 0 turns it off;
+/// other values are refused naming the field.
+#[cfg(feature = "wrinkle")]
+#[test]
+fn wrinkle_interp_params_locality_field() {
+    use super::boundary::read_versioned;
+    let mut p = pleat_wrinkle_interp_params_default();
+    p.struct_size = std::mem::offset_of!(PleatWrinkleInterpParams, locality) as u32;
+    assert_eq!(p.struct_size, 40, "the published size before 2026-11-27");
+    p.locality = 0;
+    let read = unsafe { read_versioned(&p, "params") }.unwrap();
+    assert!(interpolate::imp::options(&read).unwrap().locality);
+    let off = PleatWrinkleInterpParams {
+        locality: 0,
+        ..pleat_wrinkle_interp_params_default()
+    };
+    assert!(!interpolate::imp::options(&off).unwrap().locality);
+    let bad = PleatWrinkleInterpParams { locality: 2, ..off };
+    let e = interpolate::imp::options(&bad).unwrap_err().to_string();
+    assert!(e.contains("params->locality"), "{e}");
+}

@@ -110,6 +110,73 @@ pub struct PleatCwfEditParams {
     pub gamma: f64,
     /// Inverse-iteration tolerance, finite, > 0; default 1e-12.
     pub tolerance: f64,
+    /// Weight of the edit edges' compatibility terms in the phase solve (eq. 3.28) relative to
+    /// the interface edges', finite, ≥ 1; default 1 (the literal eq. 3.28). Appended
+    /// 2026-11-27: an older, shorter struct gets the default.
+    pub edit_weight: f64,
+    /// Adaptive interface width: target RMS compatibility residual over edit + interface edges,
+    /// radians, finite, ≥ 0; 0 (default) = off, the regions' `interface_rings` exactly. While the
+    /// residual exceeds it, every band is widened by one ring (up to `max_interface_rings`) and
+    /// the edit redone; the edit with the smallest residual is returned
+    /// (`pleat_cwf_get_edit_report`, `pleat_cwf_copy_edit_interface_rings`). 0.3 is issue 14's
+    /// smoothness target. Appended 2026-11-27.
+    pub compat_target: f64,
+    /// Widest band the adaptive width may reach, 1 to 1,000,000; default 8. Appended 2026-11-27.
+    pub max_interface_rings: u32,
+    /// Reserved, set to 0.
+    pub reserved: u32,
+}
+
+/// What `pleat_cwf_edit` did (`pleat_cwf_get_edit_report`): class sizes, each solve's residual
+/// and seconds, the compatibility residual by class and what the adaptive width did.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PleatCwfEditReport {
+    /// In: `sizeof(PleatCwfEditReport)` (≥ 8). Out: bytes filled.
+    pub struct_size: u32,
+    /// Edits computed: 1 + the widenings tried (`compat_target`).
+    pub attempts: u32,
+    /// Regions edited (the length of `pleat_cwf_copy_edit_interface_rings`' output).
+    pub region_count: u32,
+    /// Narrowest interface band used, in rings.
+    pub interface_rings_min: u32,
+    /// Widest interface band used, in rings (wider than requested when `compat_target` widened
+    /// it).
+    pub interface_rings_max: u32,
+    /// 1 when no vertex is fixed (a global edit: plain Knöppel phase), else 0.
+    pub global: u32,
+    /// 1 when the phase fell back to `s = 1` (harmonic extension), else 0.
+    pub phase_fallback: u32,
+    /// Inverse-iteration steps of the phase solve.
+    pub phase_iterations: u32,
+    /// Faces `[fixed, edit, interface]`.
+    pub face_counts: [u64; 3],
+    /// Vertices `[fixed, edit, interface-only]`.
+    pub vertex_counts: [u64; 3],
+    /// Edges `[fixed, edit, interface-only]`.
+    pub edge_counts: [u64; 3],
+    /// Interface amplitudes clamped to 0.
+    pub clamped: u64,
+    /// Relative residual of eq. 3.26 (0 without interface edges).
+    pub omega_residual: f64,
+    /// Relative residual of eq. 3.27 (0 without interface vertices).
+    pub amplitude_residual: f64,
+    /// Smallest eigenvalue of the phase pencil (3.28), or Knöppel's for a global edit.
+    pub eigenvalue: f64,
+    /// Final inverse-iteration residual of the phase solve.
+    pub phase_residual: f64,
+    /// RMS of `|wrap(ω¹ − Δarg z̃¹)|` over edit + interface edges, radians (what
+    /// `compat_target` bounds).
+    pub compat_rms: f64,
+    /// The same RMS over the edit edges only.
+    pub compat_rms_edit: f64,
+    /// The same RMS over the interface-only edges only.
+    pub compat_rms_interface: f64,
+    /// The smallest RMS any phase without singularities can reach for this ω¹ (how
+    /// incompatible the requested field is, not the phase solve).
+    pub compat_floor: f64,
+    /// Wall seconds: `[labels + ω¹, eq. 3.26, eq. 3.27, eq. 3.28]` of the returned edit.
+    pub seconds: [f64; 4],
 }
 
 /// The default design parameters (vertex rings, sources pinned, heat time 1, κ = γ = 1, data
@@ -141,11 +208,16 @@ pub extern "C" fn pleat_cwf_edit_params_default() -> PleatCwfEditParams {
         eps_amplitude: 1e-3,
         gamma: 1.0,
         tolerance: 1e-12,
+        edit_weight: 1.0,
+        compat_target: 0.0,
+        max_interface_rings: 8,
+        reserved: 0,
     }
 }
 
 versioned!(PleatCwfDesignParams, 8, pleat_cwf_design_params_default);
 versioned!(PleatCwfEditParams, 8, pleat_cwf_edit_params_default);
+versioned!(PleatCwfEditReport, 8);
 
 /// Designs a keyframe from wrinkle sources (§3.6.1): wave vectors extended from the sources by
 /// the vector heat method, amplitude by eq. 3.25, phase by Knöppel; ω = 0 and a = 0 outside the
@@ -184,6 +256,9 @@ pub unsafe extern "C" fn pleat_cwf_design(
 /// - `face_labels_out`: NULL, or `pleat_cwf_triangle_count(cwf)` bytes receiving
 ///   `PLEAT_FACE_FIXED` / `_EDIT` / `_INTERFACE` per triangle.
 ///
+/// The output keeps the edit's report: `pleat_cwf_get_edit_report` and
+/// `pleat_cwf_copy_edit_interface_rings` (the widths used, per region).
+///
 /// # Safety
 /// Pointers are NULL or valid for the sizes described above.
 #[no_mangle]
@@ -197,6 +272,42 @@ pub unsafe extern "C" fn pleat_cwf_edit(
 ) -> PleatStatus {
     wrinkle_only!([cwf, regions, region_count, params, out, face_labels_out]
     guard(|| imp::edit(cwf, regions, region_count, params, out, face_labels_out)))
+}
+
+/// Fills `*out` with the report of the `pleat_cwf_edit` call that produced `cwf`.
+///
+/// - `cwf`: non-NULL; a field not made by `pleat_cwf_edit` has no edit report:
+///   `PLEAT_STATUS_INVALID_ARGUMENT`.
+/// - `out`: non-NULL, `out->struct_size = sizeof(PleatCwfEditReport)` (≥ 8; an older, shorter
+///   struct receives its prefix).
+///
+/// # Safety
+/// `cwf` is NULL or live; `out` is NULL or valid for `out->struct_size` bytes.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_cwf_get_edit_report(
+    cwf: *const PleatCwf,
+    out: *mut PleatCwfEditReport,
+) -> PleatStatus {
+    wrinkle_only!([cwf, out] guard(|| imp::get_edit_report(cwf, out)))
+}
+
+/// Copies the interface width used per region (rings, in `regions` order) by the
+/// `pleat_cwf_edit` call that produced `cwf`: the requested widths, or wider ones when
+/// `compat_target` widened them.
+///
+/// - `cwf`: non-NULL, made by `pleat_cwf_edit` (else `PLEAT_STATUS_INVALID_ARGUMENT`).
+/// - `dst`: non-NULL; `capacity` ≥ the region count (`PleatCwfEditReport::region_count`), else
+///   `PLEAT_STATUS_LIMIT_EXCEEDED`.
+///
+/// # Safety
+/// `cwf` is NULL or live; `dst` is NULL or valid for `capacity` values.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_cwf_copy_edit_interface_rings(
+    cwf: *const PleatCwf,
+    dst: *mut u32,
+    capacity: usize,
+) -> PleatStatus {
+    wrinkle_only!([cwf, dst, capacity] guard(|| imp::copy_interface_rings(cwf, dst, capacity)))
 }
 
 /// A region of `mesh`: the seed triangles and the triangles of the seed vertices (ring 1),
@@ -234,12 +345,13 @@ pub(super) mod imp {
     use super::*;
     use crate::ffi::boundary::{
         arg_out, arg_ref, arg_slice, bool_field, check_f64, check_range, read_versioned,
+        required_versioned_out,
     };
     use crate::ffi::mesh::mesh_ref;
     use crate::ffi::wrinkle::imp::knoppel_options;
     use crate::wrinkle::{
         design as design_rs, edit as edit_rs, grow_faces as grow_rs, Adjacency, DesignOptions,
-        EditOptions, FaceClass, PhaseCoupling, RegionEdit, WrinkleSource,
+        EditOptions, EditReport, FaceClass, PhaseCoupling, RegionEdit, WrinkleSource,
     };
     use crate::{Error, Result};
 
@@ -289,6 +401,24 @@ pub(super) mod imp {
             "finite, > 0",
         )?;
         check_range(p.max_iterations, 1, 1_000_000, "params->max_iterations")?;
+        check_f64(
+            p.edit_weight,
+            p.edit_weight.is_finite() && p.edit_weight >= 1.0,
+            "params->edit_weight",
+            "finite, ≥ 1",
+        )?;
+        check_f64(
+            p.compat_target,
+            p.compat_target.is_finite() && p.compat_target >= 0.0,
+            "params->compat_target",
+            "finite, ≥ 0 radians (0: the requested interface widths)",
+        )?;
+        check_range(
+            p.max_interface_rings,
+            1,
+            1_000_000,
+            "params->max_interface_rings",
+        )?;
         Ok(EditOptions {
             adjacency: adjacency(p.adjacency, "params->adjacency")?,
             phase: match p.phase {
@@ -306,7 +436,9 @@ pub(super) mod imp {
             eps_amplitude: p.eps_amplitude,
             gamma: p.gamma,
             tolerance: p.tolerance,
-            ..EditOptions::default()
+            edit_weight: p.edit_weight,
+            compat_target: p.compat_target,
+            max_interface_rings: p.max_interface_rings as usize,
         })
     }
 
@@ -338,6 +470,7 @@ pub(super) mod imp {
         out.put_boxed(PleatCwf {
             cwf,
             knoppel: Some(report.knoppel),
+            edit: None,
         });
         Ok(())
     }
@@ -389,7 +522,82 @@ pub(super) mod imp {
         out.put_boxed(PleatCwf {
             cwf: k1,
             knoppel: None,
+            edit: Some(Box::new(report)),
         });
+        Ok(())
+    }
+
+    /// The edit report kept in `cwf`, or an error naming why there is none.
+    ///
+    /// # Safety
+    /// `cwf` is NULL or live.
+    unsafe fn edit_report_of<'a>(cwf: *const PleatCwf) -> Result<&'a EditReport> {
+        let c = arg_ref(cwf, "cwf")?;
+        c.edit.as_deref().ok_or_else(|| {
+            Error::InvalidArgument(
+                "this field was not made by pleat_cwf_edit: no edit report".into(),
+            )
+        })
+    }
+
+    /// The C report of an edit.
+    pub(in crate::ffi) fn edit_report(r: &EditReport) -> PleatCwfEditReport {
+        let n32 = |n: usize| n.min(u32::MAX as usize) as u32;
+        let n64 = |c: [usize; 3]| c.map(|n| n as u64);
+        PleatCwfEditReport {
+            struct_size: 0,
+            attempts: n32(r.attempts),
+            region_count: n32(r.interface_rings.len()),
+            interface_rings_min: n32(r.interface_rings.iter().copied().min().unwrap_or(0)),
+            interface_rings_max: n32(r.interface_rings.iter().copied().max().unwrap_or(0)),
+            global: r.global as u32,
+            phase_fallback: r.phase_fallback as u32,
+            phase_iterations: n32(r.phase_iterations),
+            face_counts: n64(r.face_counts),
+            vertex_counts: n64(r.vertex_counts),
+            edge_counts: n64(r.edge_counts),
+            clamped: r.clamped as u64,
+            omega_residual: r.omega_residual,
+            amplitude_residual: r.amplitude_residual,
+            eigenvalue: r.eigenvalue,
+            phase_residual: r.phase_residual,
+            compat_rms: r.compat_rms,
+            compat_rms_edit: r.compat_rms_by_class[0],
+            compat_rms_interface: r.compat_rms_by_class[1],
+            compat_floor: r.compat_floor,
+            seconds: r.seconds,
+        }
+    }
+
+    /// # Safety
+    /// As `pleat_cwf_get_edit_report`.
+    pub(super) unsafe fn get_edit_report(
+        cwf: *const PleatCwf,
+        out: *mut PleatCwfEditReport,
+    ) -> Result<()> {
+        let out = required_versioned_out(out, "out")?;
+        out.write(edit_report(edit_report_of(cwf)?));
+        Ok(())
+    }
+
+    /// # Safety
+    /// As `pleat_cwf_copy_edit_interface_rings`.
+    pub(super) unsafe fn copy_interface_rings(
+        cwf: *const PleatCwf,
+        dst: *mut u32,
+        capacity: usize,
+    ) -> Result<()> {
+        let r = edit_report_of(cwf)?;
+        let dst = arg_out(dst, "dst")?;
+        let n = r.interface_rings.len();
+        if capacity < n {
+            return Err(Error::LimitExceeded(format!(
+                "dst holds {capacity} values, {n} are needed (one per region)"
+            )));
+        }
+        for (i, &w) in r.interface_rings.iter().enumerate() {
+            dst.add(i).put(w.min(u32::MAX as usize) as u32);
+        }
         Ok(())
     }
 

@@ -84,6 +84,14 @@ pub struct PleatWrinkleInterpParams {
     pub hessian: u32,
     /// Reserved, set to 0.
     pub reserved: u32,
+    /// 1 (default): vertices whose star (amplitude, z̃ and ω on the incident edges) is the
+    /// same bit for bit in both keyframes (the fixed part of an edit) are held at their
+    /// keyframe phase on every frame, so an edit's animation moves only where it changed
+    /// (README, "Wrinkle animation", C10); 0: every vertex is solved (the dissertation's
+    /// literal problem). Appended 2026-11-27: an older, shorter struct gets 1.
+    pub locality: u32,
+    /// Reserved, set to 0.
+    pub reserved2: u32,
 }
 
 /// What `pleat_cwf_interpolate` did. Set `struct_size = sizeof(PleatWrinkleInterpStats)`
@@ -114,6 +122,9 @@ pub struct PleatWrinkleInterpStats {
     pub g_ave: f64,
     /// The penalty c used.
     pub c: f64,
+    /// Vertices held at their keyframe phase by `params->locality` (0 when off). Appended
+    /// 2026-11-27: an older, shorter stats struct does not receive it.
+    pub pinned_vertices: u64,
 }
 
 /// The default interpolation parameters (50 guide frames, 4 sub-steps, 200 iterations,
@@ -146,6 +157,8 @@ impl From<&crate::wrinkle::InterpOptions> for PleatWrinkleInterpParams {
                 HessianModel::TrustRegion => PLEAT_INTERP_HESSIAN_TRUST_REGION,
             },
             reserved: 0,
+            locality: o.locality as u32,
+            reserved2: 0,
         }
     }
 }
@@ -163,6 +176,8 @@ pub(super) fn defaults_without_wrinkle() -> PleatWrinkleInterpParams {
         gradient_tolerance: 1e-6,
         hessian: PLEAT_INTERP_HESSIAN_TRUST_REGION,
         reserved: 0,
+        locality: 1,
+        reserved2: 0,
     }
 }
 
@@ -229,7 +244,11 @@ pub unsafe extern "C" fn pleat_cwf_animation_frame(
         let an = anim_ref(anim)?;
         let out = arg_out(out, "out")?;
         let cwf = an.anim.frame_at(t)?;
-        out.put_boxed(PleatCwf { cwf, knoppel: None });
+        out.put_boxed(PleatCwf {
+            cwf,
+            knoppel: None,
+            edit: None,
+        });
         Ok(())
     }))
 }
@@ -364,7 +383,7 @@ unsafe fn anim_ref<'a>(a: *const PleatCwfAnimation) -> Result<&'a PleatCwfAnimat
 #[cfg(feature = "wrinkle")]
 pub(super) mod imp {
     use super::*;
-    use crate::ffi::boundary::{check_range, read_versioned, versioned_out};
+    use crate::ffi::boundary::{bool_field, check_range, read_versioned, versioned_out};
     use crate::ffi::common::guard_progress;
     use crate::wrinkle::{interpolate_with_progress, HessianModel, InterpOptions, StopReason};
 
@@ -392,8 +411,7 @@ pub(super) mod imp {
             gradient_tolerance: p.gradient_tolerance,
             max_iterations: p.max_iterations as usize,
             hessian,
-            // C10 locality is on for C callers (no field in the params struct)
-            ..InterpOptions::default()
+            locality: bool_field(p.locality, "params->locality")?,
         })
     }
 
@@ -439,6 +457,7 @@ pub(super) mod imp {
                 unit_energy: report.unit_energy,
                 g_ave: report.g_ave,
                 c: report.c,
+                pinned_vertices: report.pinned_vertices as u64,
             };
             let history = report
                 .history

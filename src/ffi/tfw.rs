@@ -825,6 +825,7 @@ pub(super) mod imp {
         out.put_boxed(PleatCwf {
             cwf: r.cwf.clone(),
             knoppel: None,
+            edit: None,
         });
         Ok(())
     }

@@ -103,6 +103,9 @@ pub struct PleatCwf {
     pub(super) cwf: crate::wrinkle::Cwf,
     #[cfg(feature = "wrinkle")]
     pub(super) knoppel: Option<crate::wrinkle::KnoppelReport>,
+    /// The report of the `pleat_cwf_edit` call that made this field (None otherwise).
+    #[cfg(feature = "wrinkle")]
+    pub(super) edit: Option<Box<crate::wrinkle::EditReport>>,
 }
 
 /// Optional per-vertex (and per-edge) fields of one evaluation (opaque), requested with
@@ -923,6 +926,7 @@ pub(super) mod imp {
         out.put_boxed(PleatCwf {
             cwf,
             knoppel: report,
+            edit: None,
         });
         Ok(())
     }
@@ -1128,6 +1132,7 @@ pub(super) mod imp {
         out.put_boxed(PleatCwf {
             cwf,
             knoppel: Some(report),
+            edit: None,
         });
         Ok(())
     }
@@ -1143,7 +1148,11 @@ pub(super) mod imp {
         let path = c_str_arg(path, "path")?;
         let out = arg_out(out, "out")?;
         let cwf = crate::wrinkle::read_cwf(path, m.clone())?;
-        out.put_boxed(PleatCwf { cwf, knoppel: None });
+        out.put_boxed(PleatCwf {
+            cwf,
+            knoppel: None,
+            edit: None,
+        });
         Ok(())
     }
 

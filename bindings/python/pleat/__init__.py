@@ -177,11 +177,13 @@ _KnoppelReport = _struct("PleatKnoppelReport", _u32s("struct_size", "iterations"
                          + _f64s("eigenvalue", "residual", "shift"))
 _InterpParams = _struct("PleatWrinkleInterpParams",
                         _u32s("struct_size", "guide_frames", "substeps", "max_iterations")
-                        + _f64s("c_scale", "gradient_tolerance") + _u32s("hessian", "reserved"))
+                        + _f64s("c_scale", "gradient_tolerance") + _u32s("hessian", "reserved")
+                        + _u32s("locality", "reserved2"))
 _InterpStats = _struct("PleatWrinkleInterpStats",
                        _u32s("struct_size", "iterations", "stop_reason", "factorizations")
                        + _f64s("total_seconds", "final_gradient_norm", "smooth_energy",
-                               "compat_energy", "unit_energy", "g_ave", "c"))
+                               "compat_energy", "unit_energy", "g_ave", "c")
+                       + _u64s("pinned_vertices"))
 
 _WrinkleSource = _struct("PleatWrinkleSource", _u32s("vertex", "rings")
                          + [("wave_vector", _c.c_double * 3)] + _f64s("amplitude"))
@@ -193,7 +195,20 @@ _RegionEdit = _struct("PleatCwfRegionEdit", _u32s("struct_size", "interface_ring
                       + _f64s("rotate_radians", "frequency_scale", "amplitude_scale"))
 _EditParams = _struct("PleatCwfEditParams",
                       _u32s("struct_size", "adjacency", "phase", "max_iterations")
-                      + _f64s("eps_omega", "eps_amplitude", "gamma", "tolerance"))
+                      + _f64s("eps_omega", "eps_amplitude", "gamma", "tolerance")
+                      + _f64s("edit_weight", "compat_target")
+                      + _u32s("max_interface_rings", "reserved"))
+_EditReport = _struct("PleatCwfEditReport",
+                      _u32s("struct_size", "attempts", "region_count", "interface_rings_min",
+                            "interface_rings_max", "global", "phase_fallback",
+                            "phase_iterations")
+                      + [(n, _c.c_uint64 * 3) for n in ("face_counts", "vertex_counts",
+                                                        "edge_counts")]
+                      + _u64s("clamped")
+                      + _f64s("omega_residual", "amplitude_residual", "eigenvalue",
+                              "phase_residual", "compat_rms", "compat_rms_edit",
+                              "compat_rms_interface", "compat_floor")
+                      + [("seconds", _c.c_double * 4)])
 
 _PROGRESS_ARGS = (_PROGRESS_FN, _c.c_void_p)
 for _name, _res, _args in [
@@ -273,6 +288,8 @@ for _name, _res, _args in [
                                _c.POINTER(_KnoppelParams), _PP)),
     ("pleat_cwf_edit", _st, (_P, _c.POINTER(_RegionEdit), _sz, _c.POINTER(_EditParams), _PP,
                              _c.POINTER(_c.c_uint8))),
+    ("pleat_cwf_get_edit_report", _st, (_P, _c.POINTER(_EditReport))),
+    ("pleat_cwf_copy_edit_interface_rings", _st, (_P, _U, _sz)),
     ("pleat_mesh_grow_faces", _st, (_P, _U, _sz, _U, _sz, _u32, _u32, _c.POINTER(_c.c_uint8),
                                     _c.POINTER(_sz))),
 ]:
@@ -787,11 +804,17 @@ class Cwf(_Handle):
         return cls(h)
 
     def edit(self, regions, adjacency="vertex", phase="unit", eps_omega=1e-3,
-             eps_amplitude=1e-3, gamma=1.0):
+             eps_amplitude=1e-3, gamma=1.0, compat_target=0.0, max_interface_rings=8,
+             edit_weight=1.0):
         """Region edits (dissertation 3.6.2): ``regions`` is a list of dicts with ``faces``
         (triangle ids, e.g. from ``grow_faces``) and optional ``interface_rings`` (3),
         ``rotate`` (radians, 0), ``frequency_scale`` (1), ``amplitude_scale`` (1). Returns
-        ``(edited Cwf, labels)``: labels per triangle, 0 fixed, 1 edit, 2 interface."""
+        ``(edited Cwf, labels)``: labels per triangle, 0 fixed, 1 edit, 2 interface.
+
+        ``compat_target`` (radians, 0 = off): widen every interface band by one ring while the
+        compatibility RMS over edit + interface edges exceeds it, up to ``max_interface_rings``;
+        the edited Cwf's ``edit_report()`` says which widths were used. ``edit_weight`` (>= 1)
+        weights the edit edges' compatibility terms in the phase solve (eq. 3.28)."""
         keep = []
         arr = (_RegionEdit * max(len(regions), 1))()
         for i, r in enumerate(regions):
@@ -808,11 +831,29 @@ class Cwf(_Handle):
         p.adjacency = _ADJACENCY[adjacency]
         p.phase = {"unit": 0, "amplitude_weighted": 1}[phase]
         p.eps_omega, p.eps_amplitude, p.gamma = eps_omega, eps_amplitude, gamma
+        p.edit_weight, p.compat_target = float(edit_weight), float(compat_target)
+        p.max_interface_rings = int(max_interface_rings)
         labels = _np.zeros(max(self.triangle_count, 1), dtype=_np.uint8)
         h = _P()
         _check(_lib.pleat_cwf_edit(self._h, arr, len(regions), _c.byref(p), _c.byref(h),
                                    _ptr(labels, _c.c_uint8)))
         return Cwf(h), labels[:self.triangle_count]
+
+    def edit_report(self):
+        """dict of what ``edit`` did for this (edited) field: ``interface_rings`` (width used
+        per region), ``attempts``, ``compat_rms`` (edit + interface edges, radians),
+        ``compat_rms_edit``, ``compat_rms_interface``, ``compat_floor``, class counts, each
+        solve's residual and ``seconds``; PleatError INVALID_ARGUMENT when the field was not
+        made by ``edit``."""
+        r = _EditReport()
+        r.struct_size = _c.sizeof(r)
+        _check(_lib.pleat_cwf_get_edit_report(self._h, _c.byref(r)))
+        d = _as_dict(r, flags=("global", "phase_fallback"))
+        rings = _np.zeros(max(r.region_count, 1), dtype=_np.uint32)
+        _check(_lib.pleat_cwf_copy_edit_interface_rings(self._h, _ptr(rings, _c.c_uint32),
+                                                        rings.size))
+        d["interface_rings"] = [int(w) for w in rings[:r.region_count]]
+        return d
 
     def _copy(self, fn, n, per=1):
         out = _np.empty(max(per * n, 1), dtype=_np.float64)
@@ -896,11 +937,14 @@ class Cwf(_Handle):
                               corner_angle, progress, max_output_triangles)
 
     def interpolate(self, other, guide_frames=None, substeps=None, max_iterations=None,
-                    c_scale=None, gradient_tolerance=None, hessian=None, progress=None):
+                    c_scale=None, gradient_tolerance=None, hessian=None, progress=None,
+                    locality=True):
         """The Animation from this keyframe (t = 0) to ``other`` (t = 1) on the same base mesh
         (dissertation §3.4). Unset parameters keep the C defaults (50 guide frames, 4
         substeps, 200 iterations, c_scale 1000, tolerance 1e-6, hessian "trust_region"; also
-        "projected", "gauss_newton", "exact"). ``progress`` is called after each Newton
+        "projected", "gauss_newton", "exact"). ``locality`` (default True) holds vertices
+        whose star is the same in both keyframes (an edit's fixed part) at their keyframe
+        phase; False solves every vertex. ``progress`` is called after each Newton
         iteration; True cancels."""
         p = _lib.pleat_wrinkle_interp_params_default()
         for name, v in (("guide_frames", guide_frames), ("substeps", substeps),
@@ -913,6 +957,7 @@ class Cwf(_Handle):
             p.gradient_tolerance = float(gradient_tolerance)
         if hessian is not None:
             p.hessian = _HESSIAN[hessian]
+        p.locality = 1 if locality else 0
         stats = _InterpStats()
         stats.struct_size = _c.sizeof(stats)
         relay, out = _Relay(progress), _P()

@@ -50,3 +50,46 @@ def test_design_and_errors(grid):
         a.edit([{"faces": faces}, {"faces": faces}])
     with pytest.raises(pleat.PleatError):
         pleat.grow_faces(grid, seed_vertices=[centre], rings=0)
+
+
+def test_edit_compat_target_widens_the_interface(grid):
+    a = pleat.Cwf.plane_wave(grid, K / 2, 0.01)  # 2 waves: resolved on the grid
+    centre = (N // 2) * N + N // 2
+    faces = pleat.grow_faces(grid, seed_vertices=[centre], rings=3)
+    region = {"faces": faces, "interface_rings": 1, "rotate": math.pi / 2}
+    narrow, _ = a.edit([region])
+    rn = narrow.edit_report()
+    assert rn["interface_rings"] == [1] and rn["attempts"] == 1
+    assert rn["compat_rms"] > 0.3
+    wide, labels = a.edit([region], compat_target=0.3, max_interface_rings=6, edit_weight=1.0)
+    rw = wide.edit_report()
+    assert rw["attempts"] > 1 and 1 < rw["interface_rings"][0] <= 6
+    assert rw["interface_rings_max"] == rw["interface_rings"][0]
+    assert rw["compat_rms"] < rn["compat_rms"]
+    assert rw["compat_rms"] <= 0.3
+    assert (labels == 2).sum() > (narrow.edit([region])[1] == 2).sum()
+    for bad in ({"compat_target": float("nan")}, {"compat_target": -0.3},
+                {"edit_weight": 0.5}, {"max_interface_rings": 0}):
+        with pytest.raises(pleat.PleatError, match=next(iter(bad))):
+            a.edit([region], **bad)
+    with pytest.raises(pleat.PleatError):
+        a.edit_report()
+
+
+def test_interpolate_locality_flag(grid):
+    a = pleat.Cwf.plane_wave(grid, K, 0.01)
+    centre = (N // 2) * N + N // 2
+    faces = pleat.grow_faces(grid, seed_vertices=[centre], rings=2)
+    b, labels = a.edit([{"faces": faces, "interface_rings": 2, "rotate": math.pi / 2}])
+    tri = grid.triangles().astype(np.intp)
+    touched = np.zeros(grid.vertex_count, dtype=bool)
+    touched[tri[labels != 0].ravel()] = True
+    kw = dict(guide_frames=2, substeps=1, max_iterations=20)
+    anim_local, anim_free = a.interpolate(b, **kw), a.interpolate(b, locality=False, **kw)
+    assert anim_local.stats["pinned_vertices"] > 0
+    assert anim_free.stats["pinned_vertices"] == 0
+    local, free = anim_local.frame(0.5).zeta(), anim_free.frame(0.5).zeta()
+    far = ~touched
+    far[tri[touched[tri].any(axis=1)].ravel()] = False  # also away from the stars
+    assert np.array_equal(local[far], a.zeta()[far])
+    assert not np.array_equal(free, local)

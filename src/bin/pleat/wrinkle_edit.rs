@@ -167,29 +167,70 @@ pub fn run_design(
     Ok(())
 }
 
+/// The `pleat wrinkle edit` flags that set the solve's options (besides the regions).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EditTuning {
+    /// `--adjacency`: `vertex` or `edge` (ignored with `--reference` unless given).
+    pub adjacency: String,
+    /// `--reference`: start from [`EditOptions::reference`].
+    pub reference: bool,
+    /// `--compat-target` ([`EditOptions::compat_target`]).
+    pub compat_target: f64,
+    /// `--max-interface-rings` ([`EditOptions::max_interface_rings`]).
+    pub max_interface_rings: usize,
+    /// `--edit-weight` ([`EditOptions::edit_weight`]).
+    pub edit_weight: f64,
+}
+
+impl EditTuning {
+    /// Refuses NaN, negative or out-of-range values with a message naming the flag.
+    fn check(&self) -> Result<(), Fail> {
+        if !(self.compat_target.is_finite() && self.compat_target >= 0.0) {
+            return Err(bad(format!(
+                "--compat-target {}: must be finite and ≥ 0 radians (0: the requested widths)",
+                self.compat_target
+            )));
+        }
+        if self.max_interface_rings == 0 {
+            return Err(bad("--max-interface-rings 0: must be ≥ 1".into()));
+        }
+        if !(self.edit_weight.is_finite() && self.edit_weight >= 1.0) {
+            return Err(bad(format!(
+                "--edit-weight {}: must be finite and ≥ 1",
+                self.edit_weight
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// `pleat wrinkle edit`.
 pub fn run_edit(
     base: &Path,
     cwf: &Path,
     regions: &[String],
-    adjacency: &str,
-    reference: bool,
+    tuning: &EditTuning,
     labels: Option<&Path>,
     out: &Path,
 ) -> Result<(), Fail> {
     let mesh = read_mesh(base).map_err(classify)?;
     let k0 = read_cwf(cwf, mesh.clone()).map_err(classify)?;
+    let reference = tuning.reference;
     let mut opts = if reference {
         EditOptions::reference()
     } else {
         EditOptions::default()
     };
-    opts.adjacency = match adjacency {
+    opts.adjacency = match tuning.adjacency.as_str() {
         "vertex" => Adjacency::Vertex,
         "edge" => Adjacency::Edge,
         _ if reference => opts.adjacency,
         other => return Err(bad(format!("--adjacency {other:?}: vertex or edge"))),
     };
+    tuning.check()?;
+    opts.compat_target = tuning.compat_target;
+    opts.max_interface_rings = tuning.max_interface_rings;
+    opts.edit_weight = tuning.edit_weight;
     let mut edits = Vec::new();
     for s in regions {
         let spec = parse_region(s)?;
@@ -215,10 +256,18 @@ pub fn run_edit(
         rep.vertex_counts,
         rep.edge_counts
     );
-    eprintln!(
-        "  interface rings used {:?} ({} edit(s); widened while compat RMS > {} rad)",
-        rep.interface_rings, rep.attempts, opts.compat_target
-    );
+    if opts.compat_target > 0.0 {
+        eprintln!(
+            "  interface rings used {:?} ({} edit(s); widened while compat RMS > {} rad, up to \
+             {} rings)",
+            rep.interface_rings, rep.attempts, opts.compat_target, opts.max_interface_rings
+        );
+    } else {
+        eprintln!(
+            "  interface rings used {:?} (as requested; --compat-target off)",
+            rep.interface_rings
+        );
+    }
     eprintln!("  labels + ω¹   {:.4} s", rep.seconds[0]);
     eprintln!(
         "  ω (3.26)     {:.4} s  residual {:.2e}",
