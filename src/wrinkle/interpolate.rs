@@ -293,6 +293,8 @@ pub fn interpolate_with_progress(
     check_same_base(a, b)?;
     let mut stats = StageTimes::default();
     let setup = stats.time(InterpStage::Setup, || Setup::new(a, b, opts));
+    // cancellation points around the solve's own per-iteration ones (issue 15)
+    checkpoint(progress, "setup", 0.0)?;
     let n = opts.guide_frames;
     let omega_com: Vec<Vec<f64>> = (0..=n)
         .map(|i| setup.com.at(&a.topo, i as f64 / n as f64))
@@ -307,8 +309,10 @@ pub fn interpolate_with_progress(
         let problem = stats.time(InterpStage::Assemble, || {
             Problem::new(a, b, &setup, &omega_com, opts)
         })?;
+        checkpoint(progress, "assemble", 0.0)?;
         stats.time(InterpStage::Solve, || problem.solve(opts, start, progress))?
     };
+    checkpoint(progress, "frames", 1.0)?;
     let omega = if identical(a, b) {
         vec![a.omega().to_vec(); n + 1]
     } else {
@@ -323,6 +327,15 @@ pub fn interpolate_with_progress(
         opts.substeps,
     )?;
     Ok((anim, report))
+}
+
+/// One progress call; `Err(Cancelled)` when it answers `false`.
+fn checkpoint(progress: &mut ProgressFn<'_>, stage: &str, fraction: f64) -> Result<()> {
+    if progress(Progress { stage, fraction }) {
+        Ok(())
+    } else {
+        Err(Error::Cancelled)
+    }
 }
 
 /// `ω(t)` of the explicit path (B.34/B.46) between the keyframes' full one-forms, without the
@@ -810,7 +823,17 @@ impl Problem {
             if let Some(stop) = log.record(iterations, parts.total(), &grad, opts, progress)? {
                 break stop;
             }
-            match self.step(&mut hess, &mut x, &grad, parts.total(), &mut mu, opts)? {
+            // a cancellation point per damping trial: a stalling last step can try ~24 (issue 15)
+            let mut tick = || log.tick(progress);
+            match self.step(
+                &mut hess,
+                &mut x,
+                &grad,
+                parts.total(),
+                &mut mu,
+                opts,
+                &mut tick,
+            )? {
                 true => iterations += 1,
                 false => break StopReason::Stalled,
             }
@@ -820,6 +843,8 @@ impl Problem {
     }
 
     /// One damped Newton step with Armijo backtracking; `false` when no decrease is possible.
+    /// `tick` (a cancellation point) runs before each factorization after the first.
+    #[allow(clippy::too_many_arguments)]
     fn step(
         &self,
         hess: &mut Hessian,
@@ -828,10 +853,15 @@ impl Problem {
         f0: f64,
         mu: &mut f64,
         opts: &InterpOptions,
+        tick: &mut dyn FnMut() -> Result<()>,
     ) -> Result<bool> {
         const MU_MAX: f64 = 1e12;
         const MU_MIN: f64 = 1e-12;
+        let mut first = true;
         while *mu <= MU_MAX {
+            if !std::mem::take(&mut first) {
+                tick()?;
+            }
             let d = hess.newton_direction(self, x, grad, mu, opts.hessian)?;
             let slope: f64 = grad
                 .iter()
@@ -958,7 +988,12 @@ impl Problem {
             let mut radius = delta.unwrap_or(first_radius);
             // inexact Newton forcing term (superlinear near the solution)
             let tol = gnorm * gnorm.sqrt().min(0.5);
+            let mut first_trial = true;
             loop {
+                // a cancellation point per shrunk trial radius (issue 15)
+                if !std::mem::take(&mut first_trial) {
+                    log.tick(progress)?;
+                }
                 let st = steihaug(&g, &hv, &apply, radius, tol, MAX_CG);
                 cg_iterations += st.iterations;
                 last_cg = st.iterations;
@@ -1059,6 +1094,19 @@ impl IterationLog {
             return Err(Error::Cancelled);
         }
         Ok(None)
+    }
+
+    /// A progress call inside an iteration (stage `"interpolate"`, the fraction reported last):
+    /// a cancellation point between the per-iteration ones; `Err(Cancelled)` on `false`.
+    fn tick(&self, progress: &mut ProgressFn<'_>) -> Result<()> {
+        if progress(Progress {
+            stage: "interpolate",
+            fraction: self.best_fraction,
+        }) {
+            Ok(())
+        } else {
+            Err(Error::Cancelled)
+        }
     }
 
     /// Gradient norm of the last recorded iterate.
