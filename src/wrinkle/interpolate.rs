@@ -98,8 +98,8 @@ use super::report::InterpStage;
 use super::spacetime::FrameBlocks;
 use crate::report::{Progress, ProgressFn, StageTimes, StatEntries};
 use crate::solve::{
-    assemble, dot_n, entry_index, steihaug, sym_matvec_lower_into, Cholesky, CholeskyAnalysis,
-    Entry, Parallelism, SparseMatrix,
+    assemble, dot_n, entry_index, steihaug_with_stop, sym_matvec_lower_into, Cholesky,
+    CholeskyAnalysis, Entry, Parallelism, SparseMatrix,
 };
 use crate::{Error, Result};
 
@@ -839,11 +839,13 @@ impl Problem {
             }
         };
         let counts = [iterations, hess.factorizations, 0];
+        checkpoint(progress, "finish", log.best_fraction)?;
         Ok(self.finish(&x, stop, log.history, counts))
     }
 
     /// One damped Newton step with Armijo backtracking; `false` when no decrease is possible.
-    /// `tick` (a cancellation point) runs before each factorization after the first.
+    /// `tick` (a cancellation point) runs before each factorization after the first and before
+    /// each shortened trial.
     #[allow(clippy::too_many_arguments)]
     fn step(
         &self,
@@ -874,6 +876,9 @@ impl Problem {
             }
             let mut alpha = 1.0;
             while alpha >= 1.0 / 16.0 {
+                if alpha < 1.0 {
+                    tick()?;
+                }
                 let trial: Vec<Complex> = x
                     .iter()
                     .zip(&d)
@@ -936,6 +941,9 @@ impl Problem {
         // measured on the knight and the torus (50 frames): refactoring every iteration,
         // every 5 and every 20 gave 6.4 / 4.5 / 5.8 s and 16.6 / 9.2 / 8.9 s
         const REFACTOR_EVERY: usize = 5;
+        // CG iterations between two cancellation points (issue 15; one is a few milliseconds
+        // on 10⁴ unknowns per frame)
+        const CG_PER_TICK: usize = 16;
         let blocks = self.frame_blocks()?;
         let (mut factorizations, mut cg_iterations) = (0usize, 0usize);
         // initial guess: the minimizer of the quadratic part K alone (E_unit's projected
@@ -948,7 +956,18 @@ impl Problem {
             factorizations += self.n_frames - 1;
             let kv = |v: &[f64], y: &mut [f64]| blocks.k_matvec(v, y);
             let tol = 1e-6 * dot_n(&g, &g).sqrt();
-            let st = steihaug(&g, &kv, &|r| pre.apply(r), f64::INFINITY, tol, MAX_CG);
+            let st = steihaug_with_stop(
+                &g,
+                &kv,
+                &|r| pre.apply(r),
+                f64::INFINITY,
+                tol,
+                MAX_CG,
+                &mut |it| {
+                    it % CG_PER_TICK == 0 && checkpoint(progress, "interpolate", 0.0).is_err()
+                },
+            )
+            .ok_or(Error::Cancelled)?;
             cg_iterations += st.iterations;
             x.iter_mut()
                 .zip(to_complex(&st.step))
@@ -978,6 +997,7 @@ impl Problem {
                 })?);
                 factorizations += self.n_frames - 1;
                 since_factor = 0;
+                log.tick(progress)?;
             }
             since_factor += 1;
             let pre = pre.as_ref().expect("factored above");
@@ -994,7 +1014,11 @@ impl Problem {
                 if !std::mem::take(&mut first_trial) {
                     log.tick(progress)?;
                 }
-                let st = steihaug(&g, &hv, &apply, radius, tol, MAX_CG);
+                // and every `CG_PER_TICK` CG iterations (a last iteration can run hundreds)
+                let st = steihaug_with_stop(&g, &hv, &apply, radius, tol, MAX_CG, &mut |it| {
+                    it % CG_PER_TICK == 0 && log.tick(progress).is_err()
+                })
+                .ok_or(Error::Cancelled)?;
                 cg_iterations += st.iterations;
                 last_cg = st.iterations;
                 let mut hs = vec![0.0; g.len()];
@@ -1030,6 +1054,7 @@ impl Problem {
             }
         };
         let counts = [iterations, factorizations, cg_iterations];
+        checkpoint(progress, "finish", log.best_fraction)?;
         Ok(self.finish(&x, stop, log.history, counts))
     }
 }
