@@ -20,6 +20,12 @@
 //! candidate list is stored). The hits are sorted, so the result does not depend on the number
 //! of threads. [`has_self_intersection`] runs the same traversal but stops testing at the first
 //! hit.
+//!
+//! Stacked copies (issue 15): the counting pass behind `verify::MeshReport`
+//! (`count_self_intersections_welded`) and [`has_self_intersection`] group exact duplicates
+//! (the same welded vertex set) first and traverse one face per group, so `k` copies of a face
+//! cost one test, not `k(k−1)/2`. The listing functions return every pair, so their output (and
+//! time) stays quadratic in the copies.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
