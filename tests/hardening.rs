@@ -416,13 +416,20 @@ fn a_million_tiny_components_are_reported_and_baked() {
 fn a_million_coincident_vertices_are_reported_and_baked() {
     let m = coincident_tetrahedron(250_000);
     assert_eq!(m.vertex_count(), 1_000_000);
-    // Without the self-intersection pass: it enumerates every intersecting pair, and 250 000
-    // copies of a face are ~3·10¹⁰ pairs each (README "Security and robustness": not yet
-    // bounded).
-    let (plain, welded) = report_both(&m, "10^6 coincident vertices", false);
+    // The full report, self-intersection pass included: 250 000 stacked copies of each face
+    // are C(250 000, 2) intersecting pairs per face, counted per group of duplicates (the faces
+    // of the tetrahedron share edges, so no pair across groups intersects).
+    let (plain, welded) = report_both(&m, "10^6 coincident vertices", true);
+    let per_face = 250_000usize * 249_999 / 2;
+    for r in [&plain, &welded] {
+        assert_eq!(r.n_self_intersecting_pairs, Some(4 * per_face));
+        assert_eq!(r.n_degenerate_faces_welded, Some(0));
+        assert_eq!(r.self_intersection_free, Some(false));
+    }
     assert_eq!(plain.n_coincident_vertices, 1_000_000);
+    assert_eq!(plain.n_components, 250_000);
     assert_eq!(welded.n_components, 1);
-    assert!(welded.n_duplicate_faces > 0);
+    assert_eq!(welded.n_duplicate_faces, 4 * 249_999);
     #[cfg(feature = "lod")]
     lod_limits::bake_or_limit(&m, "10^6 coincident vertices");
 }

@@ -460,7 +460,14 @@ fn verify(
     stats: &mut OffsetReport,
     progress: &mut ProgressFn<'_>,
 ) -> Result<()> {
-    let report = MeshReport::compute_with(out, &ReportOptions::default());
+    // a progress call per phase and per batch of the self-intersection pass (issue 15)
+    let report = MeshReport::compute_with_progress(out, &ReportOptions::default(), &mut |f| {
+        progress(Progress {
+            stage: "verify",
+            fraction: 0.95 + 0.01 * f,
+        })
+    })
+    .ok_or(Error::Cancelled)?;
     let v = &mut stats.verified;
     v.watertight = Some(report.is_watertight);
     v.manifold = Some(report.is_manifold);

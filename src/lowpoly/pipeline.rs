@@ -317,7 +317,10 @@ pub(crate) fn run(
 ) -> Result<(TriMesh, LodReport)> {
     params.validate(input)?;
     let mut rep = Reporter::new(progress);
+    // cancellation points between the setup's trees (each about 1 s on a 10⁶-face input)
+    rep.check("setup", 0.0)?;
     let model = InputModel::new(input, mode == Mode::Cage);
+    rep.check("setup", 0.0)?;
     let level = Level::new(&model, input, mode);
     bake_level(&level, params, None, &mut rep, (0.0, 1.0))
 }
@@ -346,7 +349,10 @@ pub(crate) fn run_chain(
     let mut order: Vec<usize> = (0..screen_sizes.len()).collect();
     order.sort_by(|&a, &b| screen_sizes[b].total_cmp(&screen_sizes[a]).then(a.cmp(&b)));
     let mut rep = Reporter::new(progress);
+    // cancellation points between the setup's trees (each about 1 s on a 10⁶-face input)
+    rep.check("setup", 0.0)?;
     let model = InputModel::new(input, mode == Mode::Cage);
+    rep.check("setup", 0.0)?;
     let level = Level::new(&model, input, mode);
     let mut out: Vec<Option<(TriMesh, LodReport)>> = vec![None; screen_sizes.len()];
     let mut prev: Option<TriMesh> = None;
@@ -448,7 +454,7 @@ fn bake_level(
     rep.window(w0 + 0.9 * ws, 0.1 * ws);
     rep.check("verify", 0.0)?;
     let t0 = Instant::now();
-    let mut v = verify_level(&mesh, level);
+    let mut v = verify_level(&mesh, level, rep, (0.0, 0.5))?;
     let mut reruns = 0;
     if !v.self_intersection_free || !v.cage_ok {
         // §4.3.3: the normal-cone shortcut let an intersection through: rerun exactly.
@@ -457,7 +463,8 @@ fn bake_level(
         let (m2, ls2) = optimize(&start, model, &cfg, true, rep)?;
         mesh = m2;
         ls = ls2;
-        v = verify_level(&mesh, level);
+        rep.window(w0 + 0.9 * ws, 0.1 * ws);
+        v = verify_level(&mesh, level, rep, (0.0, 0.5))?;
     }
     let mut verify_s = t0.elapsed().as_secs_f64();
     rep.check("measure", 0.5)?;
@@ -482,7 +489,7 @@ fn bake_level(
             mesh = pre;
             sides = pre_sides;
             ls.fit_reverted = true;
-            v = verify_level(&mesh, level);
+            v = verify_level(&mesh, level, rep, (1.0, 1.0))?;
             verify_s += t0.elapsed().as_secs_f64();
         }
     }
@@ -578,20 +585,38 @@ struct Verification {
 }
 
 /// Pro.III by [`MeshReport`] (which shares none of the guard's shortcuts) and, in cage mode,
-/// the cage checks of `crate::verify::cage`.
-fn verify_level(mesh: &TriMesh, level: &Level<'_>) -> Verification {
-    let r = MeshReport::compute_with(mesh, &ReportOptions::default());
-    Verification {
+/// the cage checks of `crate::verify::cage`, reporting stage "verify" from `range.0` to
+/// `range.1` of the current window: a progress call (and cancellation point) per phase and per
+/// chunk of both (issue 15).
+fn verify_level(
+    mesh: &TriMesh,
+    level: &Level<'_>,
+    rep: &mut Reporter<'_, '_>,
+    range: (f64, f64),
+) -> Result<Verification> {
+    let (lo, span) = (range.0, range.1 - range.0);
+    let report_share = if level.cage_input.is_some() { 0.5 } else { 1.0 };
+    let r = MeshReport::compute_with_progress(mesh, &ReportOptions::default(), &mut |f| {
+        rep.report("verify", lo + span * report_share * f)
+    })
+    .ok_or(Error::Cancelled)?;
+    let cage_ok = match &level.cage_input {
+        None => true,
+        Some(c) => c
+            .check_with_progress(mesh, &mut |f| {
+                rep.report("verify", lo + span * (0.5 + 0.5 * f))
+            })
+            .ok_or(Error::Cancelled)?
+            .is_cage(),
+    };
+    Ok(Verification {
         manifold: r.is_manifold && r.consistently_oriented,
         watertight: r.is_watertight,
         self_intersection_free: r.self_intersection_free == Some(true),
         components: r.n_components,
         euler: r.euler_characteristic_total,
-        cage_ok: level
-            .cage_input
-            .as_ref()
-            .is_none_or(|c| c.check(mesh).is_cage()),
-    }
+        cage_ok,
+    })
 }
 
 /// Settings of the loop for one level.

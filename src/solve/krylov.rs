@@ -35,6 +35,22 @@ pub fn steihaug(
     tol: f64,
     max_iter: usize,
 ) -> TrustStep {
+    steihaug_with_stop(g, hess, precond, delta, tol, max_iter, &mut |_| false)
+        .expect("never stopped")
+}
+
+/// [`steihaug`] with `stop(iteration)` asked before each CG iteration after the first
+/// (a cancellation point for callers with a progress callback); `None` as soon as it answers
+/// `true`. When it never does, the same step as [`steihaug`].
+pub fn steihaug_with_stop(
+    g: &[f64],
+    hess: &dyn Fn(&[f64], &mut [f64]),
+    precond: &dyn Fn(&[f64]) -> Vec<f64>,
+    delta: f64,
+    tol: f64,
+    max_iter: usize,
+    stop: &mut dyn FnMut(usize) -> bool,
+) -> Option<TrustStep> {
     let n = g.len();
     let mut s = vec![0.0; n];
     let mut r = g.to_vec();
@@ -57,14 +73,17 @@ pub fn steihaug(
         }
     };
     if dot_n(&r, &r).sqrt() <= tol || ry <= 0.0 {
-        return TrustStep {
+        return Some(TrustStep {
             step: s,
             m_norm: 0.0,
             on_boundary: false,
             iterations: 0,
-        };
+        });
     }
     for it in 0..max_iter {
+        if it > 0 && stop(it) {
+            return None;
+        }
         hess(&d, &mut hd);
         let dhd = dot_n(&d, &hd);
         // negative curvature (followed to the boundary) or a step leaving the region
@@ -72,24 +91,24 @@ pub fn steihaug(
         let sms_next = sms + 2.0 * alpha * smd + alpha * alpha * dmd;
         if dhd.is_nan() || dhd <= 0.0 || sms_next >= delta * delta {
             to_boundary(&mut s, &d, sms, smd, dmd);
-            return TrustStep {
+            return Some(TrustStep {
                 step: s,
                 m_norm: delta,
                 on_boundary: true,
                 iterations: it + 1,
-            };
+            });
         }
         for i in 0..n {
             s[i] += alpha * d[i];
             r[i] += alpha * hd[i];
         }
         if dot_n(&r, &r).sqrt() <= tol {
-            return TrustStep {
+            return Some(TrustStep {
                 step: s,
                 m_norm: sms_next.sqrt(),
                 on_boundary: false,
                 iterations: it + 1,
-            };
+            });
         }
         y = precond(&r);
         let ry_next = dot_n(&r, &y);
@@ -102,12 +121,12 @@ pub fn steihaug(
             d[i] = -y[i] + beta * d[i];
         }
     }
-    TrustStep {
+    Some(TrustStep {
         step: s,
         m_norm: sms.sqrt(),
         on_boundary: false,
         iterations: max_iter,
-    }
+    })
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@ pub use eigen::{
     inverse_iteration, InverseIterationError, InverseIterationInfo, InverseIterationParams,
     ShiftedProblem,
 };
-pub use krylov::{dot_n, steihaug, TrustStep};
+pub use krylov::{dot_n, steihaug, steihaug_with_stop, TrustStep};
 pub use sparse::{
     assemble, entry_index, is_out_of_memory, sym_matvec_lower_into, Cholesky, CholeskyAnalysis,
     Entry, FactorInfo, LltError, Parallelism, ShiftSchedule, SolveScratch, SparseMatrix,

@@ -20,6 +20,12 @@
 //! candidate list is stored). The hits are sorted, so the result does not depend on the number
 //! of threads. [`has_self_intersection`] runs the same traversal but stops testing at the first
 //! hit.
+//!
+//! Stacked copies (issue 15): the counting pass behind `verify::MeshReport`
+//! (`count_self_intersections_welded`) and [`has_self_intersection`] group exact duplicates
+//! (the same welded vertex set) first and traverse one face per group, so `k` copies of a face
+//! cost one test, not `k(k−1)/2`. The listing functions return every pair, so their output (and
+//! time) stays quadratic in the copies.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -101,6 +107,116 @@ pub(crate) fn find_self_intersections_welded(
     (SelfIntersections { pairs, degenerate }, times)
 }
 
+/// What [`count_self_intersections_welded`] finds: the counts of
+/// [`find_self_intersections_welded`] without the list of pairs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct SelfIntersectionCounts {
+    /// Intersecting pairs of non-degenerate faces (`pairs.len()` of the listing pass).
+    pub pairs: u64,
+    /// Degenerate faces (`degenerate.len()` of the listing pass).
+    pub degenerate: usize,
+}
+
+/// The counts of [`find_self_intersections_welded`], in time linear in the number of stacked
+/// copies of a face rather than quadratic (issue 15): the non-degenerate faces are grouped by
+/// their welded vertex set (exact duplicates, in any corner order or orientation); the `k(k−1)/2`
+/// pairs inside a group of `k` are classified once, by the exact test of its first two faces
+/// (two faces on the same three welded vertices always intersect: CGAL counts duplicate faces),
+/// and only one representative per group enters the broad phase, a hit between the groups of
+/// sizes `k` and `m` counting `k·m` pairs. Faces of one group have the same corners and share
+/// the same vertices with any other face, so every one of those pairs gets the representatives'
+/// answer: the counts equal the listing pass's exactly.
+///
+/// `keep_going(fraction)` is called on the calling thread after the grouping, after the trees
+/// and after each batch of chunk pairs of the traversal; `None` as soon as it returns `false`.
+pub(crate) fn count_self_intersections_welded(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    weld: &ExactWeld,
+    keep_going: &mut dyn FnMut(f64) -> bool,
+) -> Option<(SelfIntersectionCounts, SelfIntersectionTimes)> {
+    let t0 = std::time::Instant::now();
+    let (welded, faces, degenerate) = split_degenerate(positions, triangles, weld);
+    let groups = DuplicateGroups::of(&welded, &faces);
+    let narrow = Narrow {
+        positions,
+        welded: &welded,
+    };
+    let inside = groups.pairs_inside(&narrow);
+    let prepare = t0.elapsed().as_secs_f64();
+    if !keep_going(0.1) {
+        return None;
+    }
+    let (chunks, bvh) = timed(|| ChunkedBvh::new(positions, &welded, &groups.reps, CHUNK_FACES));
+    if !keep_going(0.2) {
+        return None;
+    }
+    let t0 = std::time::Instant::now();
+    let across = chunks.weighted_count_where(
+        |f, g| narrow.intersect(f, g),
+        |f, g| u64::from(groups.size[f as usize]) * u64::from(groups.size[g as usize]),
+        &mut |f| keep_going(0.2 + 0.8 * f),
+    )?;
+    let times = SelfIntersectionTimes {
+        prepare,
+        bvh,
+        pairs_and_tests: t0.elapsed().as_secs_f64(),
+    };
+    let counts = SelfIntersectionCounts {
+        pairs: inside + across,
+        degenerate: degenerate.len(),
+    };
+    Some((counts, times))
+}
+
+/// Non-degenerate faces grouped by their welded vertex set (exact duplicates in any corner
+/// order or orientation).
+struct DuplicateGroups {
+    /// The smallest face of each group, sorted.
+    reps: Vec<u32>,
+    /// Per face: the size of its group when it is a representative, else 0.
+    size: Vec<u32>,
+    /// Per group of two or more faces: its first two faces and its size.
+    stacks: Vec<(u32, u32, u32)>,
+}
+
+impl DuplicateGroups {
+    fn of(welded: &[[u32; 3]], faces: &[u32]) -> DuplicateGroups {
+        let mut keyed: Vec<([u32; 3], u32)> = faces
+            .par_iter()
+            .map(|&f| {
+                let mut k = welded[f as usize];
+                k.sort_unstable();
+                (k, f)
+            })
+            .collect();
+        keyed.par_sort_unstable();
+        let mut size = vec![0u32; welded.len()];
+        let mut reps = Vec::new();
+        let mut stacks = Vec::new();
+        for run in keyed.chunk_by(|a, b| a.0 == b.0) {
+            let rep = run[0].1;
+            reps.push(rep);
+            size[rep as usize] = run.len() as u32;
+            if run.len() > 1 {
+                stacks.push((rep, run[1].1, run.len() as u32));
+            }
+        }
+        reps.par_sort_unstable();
+        DuplicateGroups { reps, size, stacks }
+    }
+
+    /// Intersecting pairs inside the groups: `k(k−1)/2` per group of `k` whose first two faces
+    /// intersect.
+    fn pairs_inside(&self, narrow: &Narrow<'_>) -> u64 {
+        self.stacks
+            .iter()
+            .filter(|&&(a, b, _)| narrow.intersect(a.min(b), a.max(b)))
+            .map(|&(_, _, k)| u64::from(k) * (u64::from(k) - 1) / 2)
+            .sum()
+    }
+}
+
 /// `f()` and its wall seconds.
 fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
     let t0 = std::time::Instant::now();
@@ -121,11 +237,16 @@ pub fn has_self_intersection_in(positions: &[[f64; 3]], triangles: &[[u32; 3]]) 
     if !degenerate.is_empty() {
         return true;
     }
-    let chunks = ChunkedBvh::new(positions, &welded, &faces, CHUNK_FACES);
+    // Stacked copies of a face are decided once per group (issue 15: not pair by pair).
+    let groups = DuplicateGroups::of(&welded, &faces);
     let narrow = Narrow {
         positions,
         welded: &welded,
     };
+    if groups.pairs_inside(&narrow) > 0 {
+        return true;
+    }
+    let chunks = ChunkedBvh::new(positions, &welded, &groups.reps, CHUNK_FACES);
     chunks.any_pair(|f, g| narrow.intersect(f, g))
 }
 
@@ -220,6 +341,42 @@ impl ChunkedBvh {
             .collect();
         pairs.par_sort_unstable();
         pairs
+    }
+
+    /// `Σ weight(f, g)` over the pairs `(f, g)`, `f < g`, of faces with touching boxes that
+    /// pass `test` (each visited once, as in [`pairs_where`](Self::pairs_where)). Chunk pairs
+    /// are processed in parallel in batches, with `keep_going(fraction)` on the calling thread
+    /// after each batch; `None` as soon as it returns `false`. An integer sum: the same
+    /// whatever the number of threads.
+    fn weighted_count_where(
+        &self,
+        test: impl Fn(u32, u32) -> bool + Sync,
+        weight: impl Fn(u32, u32) -> u64 + Sync,
+        keep_going: &mut dyn FnMut(f64) -> bool,
+    ) -> Option<u64> {
+        let n = self.trees.len();
+        let tasks: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
+        let mut total = 0u64;
+        let mut done = 0;
+        for batch in tasks.chunks(n.max(1)) {
+            total += batch
+                .par_iter()
+                .map(|&(i, j)| {
+                    let mut sum = 0u64;
+                    self.for_each_pair(i, j, |f, g| {
+                        if test(f, g) {
+                            sum += weight(f, g);
+                        }
+                    });
+                    sum
+                })
+                .sum::<u64>();
+            done += batch.len();
+            if !keep_going(done as f64 / tasks.len() as f64) {
+                return None;
+            }
+        }
+        Some(total)
     }
 
     /// Whether some pair of faces with touching boxes passes `test`. Chunk pairs are processed
@@ -364,6 +521,15 @@ mod tests {
                 single,
                 "chunk size {chunk_faces}"
             );
+            let mut calls = 0;
+            let count =
+                chunked.weighted_count_where(|_, _| true, |f, g| u64::from(f + g), &mut |_| {
+                    calls += 1;
+                    true
+                });
+            let want: u64 = single.iter().map(|&(f, g)| u64::from(f + g)).sum();
+            assert_eq!(count, Some(want), "chunk size {chunk_faces}");
+            assert!(calls >= chunked.trees.len().div_ceil(2));
         }
     }
 

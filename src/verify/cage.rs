@@ -74,29 +74,90 @@ impl<'a> CageInput<'a> {
 
     /// Contact and enclosure of `cage` (see [`CageCheck`]).
     pub fn check(&self, cage: &TriMesh) -> CageCheck {
-        CageCheck {
-            untouched: !self.touches(cage),
-            encloses: self.enclosed_by(cage),
-        }
+        self.check_with_progress(cage, &mut |_| true)
+            .expect("never cancelled")
+    }
+
+    /// [`CageInput::check`] with a progress callback, called on the calling thread between
+    /// chunks of [`super::hausdorff::FACES_PER_CHUNK`] cage triangles (contact) and of
+    /// `16 ×` that many input vertices (enclosure) with the fraction done; `None` as soon as it
+    /// returns `false` (issue 15). The result is the same as [`CageInput::check`]'s: each
+    /// property is an "any" / "all" over independent tests, which the chunking does not change.
+    pub fn check_with_progress(
+        &self,
+        cage: &TriMesh,
+        keep_going: &mut dyn FnMut(f64) -> bool,
+    ) -> Option<CageCheck> {
+        let touches = self.touches_with_progress(cage, &mut |f| keep_going(0.5 * f))?;
+        let encloses = self.enclosed_by_with_progress(cage, &mut |f| keep_going(0.5 + 0.5 * f))?;
+        Some(CageCheck {
+            untouched: !touches,
+            encloses,
+        })
     }
 
     /// True when some triangle of `cage` touches or intersects an input triangle (exact).
     pub fn touches(&self, cage: &TriMesh) -> bool {
+        self.touches_with_progress(cage, &mut |_| true)
+            .expect("never cancelled")
+    }
+
+    /// [`CageInput::touches`], in chunks of cage triangles with `keep_going(fraction)` after
+    /// each (stops at the first chunk with a contact).
+    fn touches_with_progress(
+        &self,
+        cage: &TriMesh,
+        keep_going: &mut dyn FnMut(f64) -> bool,
+    ) -> Option<bool> {
         let pos = cage.positions();
         let tris = cage.triangles();
-        (0..tris.len()).into_par_iter().any(|f| {
-            let tri = tris[f].map(|v| pos[v as usize]);
-            self.bvh
-                .query_triangle(&tri)
-                .any(|t| self.meets_triangle(&tri, t as usize))
-        })
+        let chunk = super::hausdorff::FACES_PER_CHUNK;
+        for (i, ts) in tris.chunks(chunk).enumerate() {
+            let hit = ts.par_iter().any(|t| {
+                let tri = t.map(|v| pos[v as usize]);
+                self.bvh
+                    .query_triangle(&tri)
+                    .any(|t| self.meets_triangle(&tri, t as usize))
+            });
+            if hit {
+                return Some(true);
+            }
+            if !keep_going(((i * chunk + ts.len()) as f64 / tris.len() as f64).min(1.0)) {
+                return None;
+            }
+        }
+        Some(false)
     }
 
     /// True when every referenced input vertex has winding number above 1/2 with respect to
     /// `cage` (accurate away from the cage surface, which the contact test guarantees).
     pub fn enclosed_by(&self, cage: &TriMesh) -> bool {
+        self.enclosed_by_with_progress(cage, &mut |_| true)
+            .expect("never cancelled")
+    }
+
+    /// [`CageInput::enclosed_by`], in chunks of input vertices with `keep_going(fraction)`
+    /// after the tree and after each chunk (stops at the first chunk with an outside vertex).
+    fn enclosed_by_with_progress(
+        &self,
+        cage: &TriMesh,
+        keep_going: &mut dyn FnMut(f64) -> bool,
+    ) -> Option<bool> {
         let fwn = FastWindingNumber::new(cage);
-        fwn.winding_numbers(&self.points).iter().all(|&w| w > 0.5)
+        if !keep_going(0.1) {
+            return None;
+        }
+        let chunk = 16 * super::hausdorff::FACES_PER_CHUNK;
+        for (i, ps) in self.points.chunks(chunk).enumerate() {
+            if !fwn.winding_numbers(ps).iter().all(|&w| w > 0.5) {
+                return Some(false);
+            }
+            let done = (i * chunk + ps.len()) as f64 / self.points.len() as f64;
+            if !keep_going(0.1 + 0.9 * done.min(1.0)) {
+                return None;
+            }
+        }
+        Some(true)
     }
 
     /// The exact minimum distance between the triangles of `cage` and the input's triangles, in

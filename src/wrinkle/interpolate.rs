@@ -98,8 +98,8 @@ use super::report::InterpStage;
 use super::spacetime::FrameBlocks;
 use crate::report::{Progress, ProgressFn, StageTimes, StatEntries};
 use crate::solve::{
-    assemble, dot_n, entry_index, steihaug, sym_matvec_lower_into, Cholesky, CholeskyAnalysis,
-    Entry, Parallelism, SparseMatrix,
+    assemble, dot_n, entry_index, steihaug_with_stop, sym_matvec_lower_into, Cholesky,
+    CholeskyAnalysis, Entry, Parallelism, SparseMatrix,
 };
 use crate::{Error, Result};
 
@@ -293,6 +293,8 @@ pub fn interpolate_with_progress(
     check_same_base(a, b)?;
     let mut stats = StageTimes::default();
     let setup = stats.time(InterpStage::Setup, || Setup::new(a, b, opts));
+    // cancellation points around the solve's own per-iteration ones (issue 15)
+    checkpoint(progress, "setup", 0.0)?;
     let n = opts.guide_frames;
     let omega_com: Vec<Vec<f64>> = (0..=n)
         .map(|i| setup.com.at(&a.topo, i as f64 / n as f64))
@@ -307,8 +309,10 @@ pub fn interpolate_with_progress(
         let problem = stats.time(InterpStage::Assemble, || {
             Problem::new(a, b, &setup, &omega_com, opts)
         })?;
+        checkpoint(progress, "assemble", 0.0)?;
         stats.time(InterpStage::Solve, || problem.solve(opts, start, progress))?
     };
+    checkpoint(progress, "frames", 1.0)?;
     let omega = if identical(a, b) {
         vec![a.omega().to_vec(); n + 1]
     } else {
@@ -323,6 +327,15 @@ pub fn interpolate_with_progress(
         opts.substeps,
     )?;
     Ok((anim, report))
+}
+
+/// One progress call; `Err(Cancelled)` when it answers `false`.
+fn checkpoint(progress: &mut ProgressFn<'_>, stage: &str, fraction: f64) -> Result<()> {
+    if progress(Progress { stage, fraction }) {
+        Ok(())
+    } else {
+        Err(Error::Cancelled)
+    }
 }
 
 /// `ω(t)` of the explicit path (B.34/B.46) between the keyframes' full one-forms, without the
@@ -810,16 +823,30 @@ impl Problem {
             if let Some(stop) = log.record(iterations, parts.total(), &grad, opts, progress)? {
                 break stop;
             }
-            match self.step(&mut hess, &mut x, &grad, parts.total(), &mut mu, opts)? {
+            // a cancellation point per damping trial: a stalling last step can try ~24 (issue 15)
+            let mut tick = || log.tick(progress);
+            match self.step(
+                &mut hess,
+                &mut x,
+                &grad,
+                parts.total(),
+                &mut mu,
+                opts,
+                &mut tick,
+            )? {
                 true => iterations += 1,
                 false => break StopReason::Stalled,
             }
         };
         let counts = [iterations, hess.factorizations, 0];
+        checkpoint(progress, "finish", log.best_fraction)?;
         Ok(self.finish(&x, stop, log.history, counts))
     }
 
     /// One damped Newton step with Armijo backtracking; `false` when no decrease is possible.
+    /// `tick` (a cancellation point) runs before each factorization after the first and before
+    /// each shortened trial.
+    #[allow(clippy::too_many_arguments)]
     fn step(
         &self,
         hess: &mut Hessian,
@@ -828,10 +855,15 @@ impl Problem {
         f0: f64,
         mu: &mut f64,
         opts: &InterpOptions,
+        tick: &mut dyn FnMut() -> Result<()>,
     ) -> Result<bool> {
         const MU_MAX: f64 = 1e12;
         const MU_MIN: f64 = 1e-12;
+        let mut first = true;
         while *mu <= MU_MAX {
+            if !std::mem::take(&mut first) {
+                tick()?;
+            }
             let d = hess.newton_direction(self, x, grad, mu, opts.hessian)?;
             let slope: f64 = grad
                 .iter()
@@ -844,6 +876,9 @@ impl Problem {
             }
             let mut alpha = 1.0;
             while alpha >= 1.0 / 16.0 {
+                if alpha < 1.0 {
+                    tick()?;
+                }
                 let trial: Vec<Complex> = x
                     .iter()
                     .zip(&d)
@@ -906,6 +941,9 @@ impl Problem {
         // measured on the knight and the torus (50 frames): refactoring every iteration,
         // every 5 and every 20 gave 6.4 / 4.5 / 5.8 s and 16.6 / 9.2 / 8.9 s
         const REFACTOR_EVERY: usize = 5;
+        // CG iterations between two cancellation points (issue 15; one is a few milliseconds
+        // on 10⁴ unknowns per frame)
+        const CG_PER_TICK: usize = 16;
         let blocks = self.frame_blocks()?;
         let (mut factorizations, mut cg_iterations) = (0usize, 0usize);
         // initial guess: the minimizer of the quadratic part K alone (E_unit's projected
@@ -918,7 +956,18 @@ impl Problem {
             factorizations += self.n_frames - 1;
             let kv = |v: &[f64], y: &mut [f64]| blocks.k_matvec(v, y);
             let tol = 1e-6 * dot_n(&g, &g).sqrt();
-            let st = steihaug(&g, &kv, &|r| pre.apply(r), f64::INFINITY, tol, MAX_CG);
+            let st = steihaug_with_stop(
+                &g,
+                &kv,
+                &|r| pre.apply(r),
+                f64::INFINITY,
+                tol,
+                MAX_CG,
+                &mut |it| {
+                    it % CG_PER_TICK == 0 && checkpoint(progress, "interpolate", 0.0).is_err()
+                },
+            )
+            .ok_or(Error::Cancelled)?;
             cg_iterations += st.iterations;
             x.iter_mut()
                 .zip(to_complex(&st.step))
@@ -948,6 +997,7 @@ impl Problem {
                 })?);
                 factorizations += self.n_frames - 1;
                 since_factor = 0;
+                log.tick(progress)?;
             }
             since_factor += 1;
             let pre = pre.as_ref().expect("factored above");
@@ -958,8 +1008,17 @@ impl Problem {
             let mut radius = delta.unwrap_or(first_radius);
             // inexact Newton forcing term (superlinear near the solution)
             let tol = gnorm * gnorm.sqrt().min(0.5);
+            let mut first_trial = true;
             loop {
-                let st = steihaug(&g, &hv, &apply, radius, tol, MAX_CG);
+                // a cancellation point per shrunk trial radius (issue 15)
+                if !std::mem::take(&mut first_trial) {
+                    log.tick(progress)?;
+                }
+                // and every `CG_PER_TICK` CG iterations (a last iteration can run hundreds)
+                let st = steihaug_with_stop(&g, &hv, &apply, radius, tol, MAX_CG, &mut |it| {
+                    it % CG_PER_TICK == 0 && log.tick(progress).is_err()
+                })
+                .ok_or(Error::Cancelled)?;
                 cg_iterations += st.iterations;
                 last_cg = st.iterations;
                 let mut hs = vec![0.0; g.len()];
@@ -995,6 +1054,7 @@ impl Problem {
             }
         };
         let counts = [iterations, factorizations, cg_iterations];
+        checkpoint(progress, "finish", log.best_fraction)?;
         Ok(self.finish(&x, stop, log.history, counts))
     }
 }
@@ -1059,6 +1119,19 @@ impl IterationLog {
             return Err(Error::Cancelled);
         }
         Ok(None)
+    }
+
+    /// A progress call inside an iteration (stage `"interpolate"`, the fraction reported last):
+    /// a cancellation point between the per-iteration ones; `Err(Cancelled)` on `false`.
+    fn tick(&self, progress: &mut ProgressFn<'_>) -> Result<()> {
+        if progress(Progress {
+            stage: "interpolate",
+            fraction: self.best_fraction,
+        }) {
+            Ok(())
+        } else {
+            Err(Error::Cancelled)
+        }
     }
 
     /// Gradient norm of the last recorded iterate.
