@@ -1194,6 +1194,16 @@ mod wrinkle_sqp {
                 "",
                 "panels[0].roll_radius",
             ),
+            (
+                r#"{"polygon": [[0,0],[1,0],[1,1]], "target_vertices": 50, "lens": 0}"#,
+                "",
+                "panels[0].lens",
+            ),
+            (
+                r#"{"rest": [[0,0],[1,0],[0,1]], "triangles": [[0,1,2]], "lens": 0.1}"#,
+                "",
+                "panels[0].lens",
+            ),
         ] {
             let e = Scene::from_json_str(&base(panel, dir))
                 .unwrap_err()
