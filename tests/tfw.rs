@@ -1665,8 +1665,7 @@ mod balloon_check {
             assert!(is_closed_and_oriented(&model.triangles), "{}", scene.name);
             let v0 = volume(&model.positions, &model.triangles);
             assert!(v0 > 0.0, "{}: volume {v0}", scene.name);
-            let mut opts = pleat::tfw::BaseOptions::default();
-            opts.max_iterations = 200;
+            let opts = pleat::tfw::BaseOptions::default(); // 200 Newton iterations
             let base = solve_base(&model, &opts, &mut no_progress()).unwrap();
             let v1 = volume(base.mesh.positions(), base.mesh.triangles());
             eprintln!(
