@@ -2,7 +2,8 @@
 //! Dirichlet conditions), its JSON format ([`Scene::from_json_str`]), validation that names the
 //! bad field, assembly of the panels into one stitched [`Model`] whose faces keep their own rest
 //! form `Ī_f` (spec "Model and variables"), and the built-in scenes ([`Scene::stretched_sheet`],
-//! [`Scene::twisted_cylinder`]).
+//! [`Scene::twisted_cylinder`], [`Scene::sheared_rectangle`], the balloons
+//! [`Scene::disk_balloon`] and [`Scene::torus_balloon`]).
 //!
 //! ## JSON format
 //!
