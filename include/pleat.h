@@ -171,6 +171,13 @@
 // `PleatTfwParams::w_rule`: the reference code's rule (`λ_c ≥ 0`, then vertex fill).
 #define PLEAT_TFW_W_RULE_REFERENCE 1
 
+// `PleatTfwParams::curvature`: `κ_f` by quadric fitting on the 5-ring (the default; spec and
+// reference code, S:2276).
+#define PLEAT_TFW_CURVATURE_QUADRIC_FIT 0
+
+// `PleatTfwParams::curvature`: `κ_f` per face from area-weighted vertex normals.
+#define PLEAT_TFW_CURVATURE_VERTEX_NORMALS 1
+
 // Doubles per iteration written by `pleat_tfw_result_copy_history`: energy (J), stationarity
 // residual (absolute), step `‖Δx‖∞`, wall seconds since the SQP started.
 #define PLEAT_TFW_HISTORY_COLUMNS 4
@@ -956,6 +963,12 @@ typedef struct PleatTfwParams {
   // Rest-area fraction of slack faces above which the scene is out of scope, in [0, 1];
   // default 0.5.
   double out_of_scope_slack_fraction;
+  // How the curvature along the tension direction is estimated:
+  // `PLEAT_TFW_CURVATURE_QUADRIC_FIT` (default) or `PLEAT_TFW_CURVATURE_VERTEX_NORMALS`.
+  // Appended 2026-11-27: a shorter struct (without it) gets the default.
+  uint32_t curvature;
+  // Reserved, set to 0.
+  uint32_t reserved2;
 } PleatTfwParams;
 
 // Material and loads of `pleat_tfw_scene_from_arrays` (SI units). Get the defaults from

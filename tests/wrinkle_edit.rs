@@ -1224,51 +1224,11 @@ fn cli_bad_input_is_refused_and_writes_nothing() {
 // ---------------------------------------------------------------------------------------------
 // issue part 4 / C10: edit → interpolate → evaluate → rendered frames (README pictures)
 
-/// A shaded surface for the project's rasterizer: smooth area-weighted vertex normals.
 #[cfg(feature = "bake")]
-struct Shaded {
-    mesh: TriMesh,
-    normals: Vec<pleat::geom::Vec3>,
-}
-
+#[path = "common/shaded.rs"]
+mod shaded;
 #[cfg(feature = "bake")]
-impl Shaded {
-    fn new(mesh: TriMesh) -> Shaded {
-        use pleat::geom::Vec3;
-        let p = mesh.positions();
-        let mut n = vec![Vec3::ZERO; p.len()];
-        for t in mesh.triangles() {
-            let [a, b, c] = t.map(|v| Vec3::from(p[v as usize]));
-            let fnrm = (b - a).cross(c - a);
-            for &v in t {
-                n[v as usize] += fnrm;
-            }
-        }
-        let normals = n
-            .into_iter()
-            .map(|v| pleat::geom::normalized(v).unwrap_or(Vec3::Z))
-            .collect();
-        Shaded { mesh, normals }
-    }
-}
-
-#[cfg(feature = "bake")]
-impl pleat::bake::render::Surface for Shaded {
-    fn positions(&self) -> &[[f64; 3]] {
-        self.mesh.positions()
-    }
-    fn triangles(&self) -> &[[u32; 3]] {
-        self.mesh.triangles()
-    }
-    fn base_color(&self, _: usize, _: [f64; 3]) -> [f64; 3] {
-        [1.0; 3]
-    }
-    fn normal(&self, t: usize, b: [f64; 3]) -> pleat::geom::Vec3 {
-        let tri = self.mesh.triangles()[t];
-        let n: pleat::geom::Vec3 = (0..3).map(|k| self.normals[tri[k] as usize] * b[k]).sum();
-        pleat::geom::normalized(n).unwrap_or(pleat::geom::Vec3::Z)
-    }
-}
+use shaded::Shaded;
 
 /// Vertices at least `rings` vertex rings away from every non-fixed vertex.
 fn far_fixed_vertices(c: &Cwf, face_class: &[FaceClass], rings: usize) -> Vec<usize> {

@@ -49,6 +49,12 @@ pub const PLEAT_TFW_W_RULE_TEXT: u32 = 0;
 /// `PleatTfwParams::w_rule`: the reference code's rule (`λ_c ≥ 0`, then vertex fill).
 pub const PLEAT_TFW_W_RULE_REFERENCE: u32 = 1;
 
+/// `PleatTfwParams::curvature`: `κ_f` by quadric fitting on the 5-ring (the default; spec and
+/// reference code, S:2276).
+pub const PLEAT_TFW_CURVATURE_QUADRIC_FIT: u32 = 0;
+/// `PleatTfwParams::curvature`: `κ_f` per face from area-weighted vertex normals.
+pub const PLEAT_TFW_CURVATURE_VERTEX_NORMALS: u32 = 1;
+
 /// Doubles per iteration written by `pleat_tfw_result_copy_history`: energy (J), stationarity
 /// residual (absolute), step `‖Δx‖∞`, wall seconds since the SQP started.
 pub const PLEAT_TFW_HISTORY_COLUMNS: u32 = 4;
@@ -114,6 +120,12 @@ pub struct PleatTfwParams {
     /// Rest-area fraction of slack faces above which the scene is out of scope, in [0, 1];
     /// default 0.5.
     pub out_of_scope_slack_fraction: f64,
+    /// How the curvature along the tension direction is estimated:
+    /// `PLEAT_TFW_CURVATURE_QUADRIC_FIT` (default) or `PLEAT_TFW_CURVATURE_VERTEX_NORMALS`.
+    /// Appended 2026-11-27: a shorter struct (without it) gets the default.
+    pub curvature: u32,
+    /// Reserved, set to 0.
+    pub reserved2: u32,
 }
 
 /// Material and loads of `pleat_tfw_scene_from_arrays` (SI units). Get the defaults from
@@ -224,6 +236,7 @@ pub extern "C" fn pleat_tfw_material_default() -> PleatTfwMaterial {
 #[cfg(feature = "tfw")]
 impl From<&crate::tfw::TfwParams> for PleatTfwParams {
     fn from(p: &crate::tfw::TfwParams) -> Self {
+        use crate::tfw::curvature::CurvatureMethod;
         use crate::tfw::wfree::WRule;
         let u32_of = |v: usize| v.min(u32::MAX as usize) as u32;
         let limit = p.sqp.time_limit_seconds;
@@ -248,6 +261,11 @@ impl From<&crate::tfw::TfwParams> for PleatTfwParams {
             sqp_initial_shift: p.sqp.initial_shift,
             sqp_time_limit_seconds: if limit.is_finite() { limit } else { 0.0 },
             out_of_scope_slack_fraction: p.out_of_scope_slack_fraction,
+            curvature: match p.curvature {
+                CurvatureMethod::QuadricFit => PLEAT_TFW_CURVATURE_QUADRIC_FIT,
+                CurvatureMethod::VertexNormals => PLEAT_TFW_CURVATURE_VERTEX_NORMALS,
+            },
+            reserved2: 0,
         }
     }
 }
@@ -274,6 +292,8 @@ pub(super) fn defaults_without_tfw() -> PleatTfwParams {
         sqp_initial_shift: 1e-6,
         sqp_time_limit_seconds: 0.0,
         out_of_scope_slack_fraction: 0.5,
+        curvature: PLEAT_TFW_CURVATURE_QUADRIC_FIT,
+        reserved2: 0,
     }
 }
 
@@ -533,6 +553,7 @@ pub(super) mod imp {
     };
     use crate::ffi::common::{c_str_arg, guard_progress};
     use crate::ffi::wrinkle::imp::eval_options;
+    use crate::tfw::curvature::CurvatureMethod;
     use crate::tfw::wfree::WRule;
     use crate::tfw::{
         BaseOptions, BaseStatus, Dirichlet, Material, Motion, Panel, Scene, SqpOptions, SqpStatus,
@@ -745,6 +766,16 @@ pub(super) mod imp {
             "params->sqp_time_limit_seconds",
             "0 (unlimited) or finite and > 0",
         )?;
+        let curvature = match p.curvature {
+            PLEAT_TFW_CURVATURE_QUADRIC_FIT => CurvatureMethod::QuadricFit,
+            PLEAT_TFW_CURVATURE_VERTEX_NORMALS => CurvatureMethod::VertexNormals,
+            c => {
+                return Err(Error::InvalidArgument(format!(
+                    "params->curvature is {c}; use PLEAT_TFW_CURVATURE_QUADRIC_FIT or \
+                     _VERTEX_NORMALS"
+                )))
+            }
+        };
         let f = p.out_of_scope_slack_fraction;
         let f_ok = (0.0..=1.0).contains(&f);
         check_f64(f, f_ok, "params->out_of_scope_slack_fraction", "in [0, 1]")?;
@@ -779,10 +810,9 @@ pub(super) mod imp {
                 initial_shift: positive(p.sqp_initial_shift, "params->sqp_initial_shift")?,
                 time_limit_seconds: if t > 0.0 { t } else { f64::INFINITY },
             },
+            curvature,
             knoppel: KnoppelOptions::default(),
             out_of_scope_slack_fraction: f,
-            // Not in the C struct yet: the Rust default (the quadric-fit curvature).
-            ..TfwParams::default()
         })
     }
 
@@ -1027,6 +1057,30 @@ mod tests {
             assert_eq!(pleat_set_thread_count(0), PleatStatus::Ok);
             (pos, amp, history)
         }
+    }
+
+    /// `curvature` (appended 2026-11-27): read from a full struct, defaulted for an older,
+    /// shorter one, and an unknown value is rejected with a message naming the field.
+    #[test]
+    fn curvature_field_is_versioned_and_checked() {
+        use crate::tfw::curvature::CurvatureMethod;
+        let read = |p: &PleatTfwParams| {
+            // SAFETY: `p` is a live struct of at least `p.struct_size` bytes.
+            let v = unsafe { crate::ffi::boundary::read_versioned(p, "params") }?;
+            imp::params(&v)
+        };
+        let mut p = pleat_tfw_params_default();
+        assert_eq!(p.curvature, PLEAT_TFW_CURVATURE_QUADRIC_FIT);
+        p.curvature = PLEAT_TFW_CURVATURE_VERTEX_NORMALS;
+        let full = read(&p).unwrap();
+        assert_eq!(full.curvature, CurvatureMethod::VertexNormals);
+        p.struct_size = std::mem::offset_of!(PleatTfwParams, curvature) as u32;
+        let old = read(&p).unwrap();
+        assert_eq!(old.curvature, CurvatureMethod::QuadricFit);
+        p.struct_size = std::mem::size_of::<PleatTfwParams>() as u32;
+        p.curvature = 7;
+        let e = read(&p).unwrap_err().to_string();
+        assert!(e.contains("params->curvature"), "{e}");
     }
 
     /// Same scene and parameters ⇒ the same bytes on 1 and 2 threads (the history's wall

@@ -2,7 +2,8 @@
 //! Dirichlet conditions), its JSON format ([`Scene::from_json_str`]), validation that names the
 //! bad field, assembly of the panels into one stitched [`Model`] whose faces keep their own rest
 //! form `Ī_f` (spec "Model and variables"), and the built-in scenes ([`Scene::stretched_sheet`],
-//! [`Scene::twisted_cylinder`]).
+//! [`Scene::twisted_cylinder`], [`Scene::sheared_rectangle`], the balloons
+//! [`Scene::disk_balloon`] and [`Scene::torus_balloon`]).
 //!
 //! ## JSON format
 //!
@@ -33,7 +34,10 @@
 //! not known in advance, so a Dirichlet condition may name vertices by
 //! `"rest_box": [[umin, vmin], [umax, vmax]]` (the panel's vertices whose rest position lies
 //! in the box, inclusive) instead of, or in addition to, `vertices`. Example:
-//! `examples/tfw/twisted_cylinder.json`. [`Scene::to_json_string`] writes the meshed panel.
+//! `examples/tfw/twisted_cylinder.json`. Balloons: `"lens": h` (m, nonzero; not with
+//! `roll_radius`) lifts the meshed panel into a thin lens ([`Panel::lens`]; `h < 0` also
+//! reverses its triangles); two panels with the same outline and `h`, `−h` sew into a closed
+//! balloon (`examples/tfw/disk_balloon.json`, `torus_balloon.json`). [`Scene::to_json_string`] writes the meshed panel.
 
 use serde_json::{Map, Value};
 
@@ -102,6 +106,52 @@ impl Panel {
             rest: m.rest,
             triangles: m.triangles,
             positions: None,
+        })
+    }
+
+    /// The panel meshed from an outline as [`from_polygon`](Self::from_polygon), lifted into a
+    /// thin tent-shaped lens: initial `z = height · d / d_max`, `d` the distance of the rest
+    /// position to the outline (outer ring and holes), `d_max` its largest value, so the
+    /// boundary vertices stay at `z = 0` (exactly) and the interior ones leave the plane.
+    /// `height < 0` also reverses the triangles (the panel then faces −z): two copies of the
+    /// same outline, `height` and `−height`, sew into a closed, outward-oriented balloon
+    /// (identical boundary samples, sewn; interior vertices apart). Errors as `from_polygon`,
+    /// or `InvalidArgument` when `height` is zero or not finite.
+    pub fn lens(polygon: &PolygonPanel, height: f64) -> Result<Panel> {
+        if !(height.is_finite() && height != 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "lens height is {height}; must be finite and nonzero"
+            )));
+        }
+        let m = mesh_polygon(polygon)?;
+        let d: Vec<f64> = m
+            .rest
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| {
+                if i < m.boundary_count {
+                    0.0
+                } else {
+                    distance_to_rings(p, &polygon.outer, &polygon.holes)
+                }
+            })
+            .collect();
+        let d_max = d.iter().fold(0.0f64, |a, &b| a.max(b));
+        let positions = m
+            .rest
+            .iter()
+            .zip(&d)
+            .map(|(p, &di)| [p[0], p[1], height * di / d_max.max(f64::MIN_POSITIVE)])
+            .collect();
+        let triangles = if height > 0.0 {
+            m.triangles
+        } else {
+            m.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect()
+        };
+        Ok(Panel {
+            rest: m.rest,
+            triangles,
+            positions: Some(positions),
         })
     }
 
@@ -582,6 +632,129 @@ impl Scene {
     }
 }
 
+impl Scene {
+    /// The Mylar balloon of S:750 ("two disks (radius 0.1m) sewn along their boundary"): two
+    /// identical disks of radius 0.1 m, meshed irregularly (same outline, target and seed, so
+    /// their rims get identical samples) with about `target_vertices_per_panel` vertices each,
+    /// sewn along the rim into a closed surface and inflated by `pressure` (Pa). Material as
+    /// the dissertation's torus balloon ("the same material parameters", S:750: ν 0.44,
+    /// Y 10 MPa); thickness 0.1 mm (not in the text; the spec's reference-code disk) and the
+    /// spec's 600 Pa are the defaults callers use. No Dirichlet condition: the rigid motions
+    /// are left to the base solve's diagonal shift (pressure and membrane are invariant).
+    /// Initial state ([`Panel::lens`]): a thin lens, `z = ±0.05 R (R − r)/R`; the rim is a
+    /// polygon of `target_vertices_per_panel / 3` corners (clamped to 24..4096).
+    pub fn disk_balloon(
+        target_vertices_per_panel: usize,
+        pressure: f64,
+        seed: u64,
+    ) -> Result<Scene> {
+        let r = 0.1;
+        let n = (target_vertices_per_panel / 3).clamp(24, 4096);
+        let outline = PolygonPanel {
+            outer: circle(r, n),
+            holes: vec![],
+            target_vertices: target_vertices_per_panel,
+            seed,
+        };
+        let panels = balloon_panels(&outline, 0.05 * r)?;
+        let name = format!(
+            "disk balloon r 0.1 m, 2 x {target_vertices_per_panel} v (seed {seed}), {pressure} Pa"
+        );
+        Ok(balloon_scene(name, panels, pressure))
+    }
+
+    /// The torus balloon of S:746: two annuli (inner radius 0.04 m, outer 0.1 m, ν 0.44,
+    /// Y 10 MPa; thickness 0.1 mm as [`disk_balloon`](Self::disk_balloon)) sewn along both
+    /// rims and inflated by `pressure` (Pa); about `target_vertices_per_panel` vertices per
+    /// annulus (the dissertation's mesh: 2k in all). Initial state ([`Panel::lens`]): a thin
+    /// tent, `z = ±0.05 w · d/(w/2)`, `w = r_o − r_i`, `d` the distance to the nearer rim; the
+    /// rims are polygons of `target_vertices_per_panel / 4` and `· r_i/r_o` corners.
+    pub fn torus_balloon(
+        target_vertices_per_panel: usize,
+        pressure: f64,
+        seed: u64,
+    ) -> Result<Scene> {
+        let (ri, ro) = (0.04, 0.1);
+        let n = (target_vertices_per_panel / 4).clamp(24, 4096);
+        let ni = ((n as f64 * ri / ro).round() as usize).max(12);
+        let outline = PolygonPanel {
+            outer: circle(ro, n),
+            holes: vec![circle(ri, ni)],
+            target_vertices: target_vertices_per_panel,
+            seed,
+        };
+        let panels = balloon_panels(&outline, 0.05 * (ro - ri))?;
+        let name = format!(
+            "torus balloon r 0.04-0.1 m, 2 x {target_vertices_per_panel} v (seed {seed}), \
+             {pressure} Pa"
+        );
+        Ok(balloon_scene(name, panels, pressure))
+    }
+}
+
+/// `n` corners of the circle of radius `r` about the origin, counter-clockwise.
+fn circle(r: f64, n: usize) -> Vec<[f64; 2]> {
+    (0..n)
+        .map(|k| {
+            let (s, c) = (2.0 * std::f64::consts::PI * k as f64 / n as f64).sin_cos();
+            [r * c, r * s]
+        })
+        .collect()
+}
+
+/// The two panels of a balloon: [`Panel::lens`] of `outline` at `+height` (top, facing +z)
+/// and `−height` (bottom, facing −z).
+fn balloon_panels(outline: &PolygonPanel, height: f64) -> Result<Vec<Panel>> {
+    Ok(vec![
+        Panel::lens(outline, height)?,
+        Panel::lens(outline, -height)?,
+    ])
+}
+
+/// Distance from `p` to the nearest edge of the closed rings `outer` and `holes`.
+fn distance_to_rings(p: [f64; 2], outer: &[[f64; 2]], holes: &[Vec<[f64; 2]>]) -> f64 {
+    let ring_distance = |r: &[[f64; 2]]| {
+        (0..r.len())
+            .map(|k| {
+                let (a, b) = (r[k], r[(k + 1) % r.len()]);
+                let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
+                let (px, py) = (p[0] - a[0], p[1] - a[1]);
+                let len2 = ex * ex + ey * ey;
+                let t = if len2 > 0.0 {
+                    ((px * ex + py * ey) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                (px - t * ex).hypot(py - t * ey)
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    holes
+        .iter()
+        .map(|h| ring_distance(h))
+        .fold(ring_distance(outer), f64::min)
+}
+
+/// A balloon scene: the panels, the balloon material of S:746–750 (ν 0.44, Y 10 MPa,
+/// h 0.1 mm, no density), `pressure`, no gravity, no Dirichlet condition, seams sewn within
+/// 1e-9 m (the twins are bit-identical).
+fn balloon_scene(name: String, panels: Vec<Panel>, pressure: f64) -> Scene {
+    Scene {
+        name,
+        material: Material {
+            young: 1e7,
+            poisson: 0.44,
+            thickness: 1e-4,
+            density: 0.0,
+        },
+        panels,
+        gravity: [0.0; 3],
+        pressure,
+        dirichlet: vec![],
+        seam_tolerance: 1e-9,
+    }
+}
+
 /// The cylinder scene around a rolled panel of the `2πr × hgt` pattern: bottom ring (rest
 /// v = 0) clamped, top ring (v = hgt) rotated about the z axis, height fixed.
 fn twisted_cylinder_scene(
@@ -864,6 +1037,20 @@ fn parse_polygon_panel(po: &Map<String, Value>, path: &str) -> Result<Panel> {
         Error::InvalidArgument(m) => bad(path, m),
         other => other,
     })?;
+    if let Some(h) = po.get("lens") {
+        let lp = join(path, "lens");
+        let h = number(h, &lp)?;
+        if h == 0.0 {
+            return Err(bad(&lp, "must be nonzero"));
+        }
+        if po.contains_key("roll_radius") {
+            return Err(bad(&lp, "not allowed with \"roll_radius\""));
+        }
+        return Panel::lens(&polygon, h).map_err(|e| match e {
+            Error::InvalidArgument(m) => bad(path, m),
+            other => other,
+        });
+    }
     if let Some(r) = po.get("roll_radius") {
         let rp = join(path, "roll_radius");
         let r = number(r, &rp)?;
@@ -932,13 +1119,14 @@ fn parse_scene(v: &Value) -> Result<Scene> {
                 "target_vertices",
                 "seed",
                 "roll_radius",
+                "lens",
             ],
         )?;
         if po.contains_key("polygon") {
             panels.push(parse_polygon_panel(po, &path)?);
             continue;
         }
-        for key in ["holes", "target_vertices", "seed", "roll_radius"] {
+        for key in ["holes", "target_vertices", "seed", "roll_radius", "lens"] {
             if po.contains_key(key) {
                 return Err(bad(&join(&path, key), "only allowed with \"polygon\""));
             }

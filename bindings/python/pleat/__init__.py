@@ -1367,7 +1367,8 @@ _TfwParams = _struct("PleatTfwParams",
                              "initial_amplitude", "sqp_stationarity_tolerance",
                              "sqp_energy_tolerance", "sqp_step_tolerance", "sqp_armijo",
                              "sqp_initial_shift", "sqp_time_limit_seconds",
-                             "out_of_scope_slack_fraction"))
+                             "out_of_scope_slack_fraction")
+                     + _u32s("curvature", "reserved2"))
 _TfwMaterial = _struct("PleatTfwMaterial", _u32s("struct_size", "reserved")
                        + _f64s("young", "poisson", "thickness", "density")
                        + [("gravity", _c.c_double * 3)] + _f64s("pressure"))
@@ -1407,15 +1408,20 @@ for _fn, _cls in [("pleat_tfw_params_default", _TfwParams),
 #: PleatTfwStats.status values.
 TFW_STATUS = {0: "converged", 1: "not_converged", 2: "no_compression", 3: "out_of_scope"}
 _TFW_W_RULE = {"text": 0, "reference": 1}
+_TFW_CURVATURE = {"quadric": 0, "normals": 1}
 _TFW_MATERIAL_KEYS = ("young", "poisson", "thickness", "density", "gravity", "pressure")
 
 
-def _tfw_params(w_rule="text", **kw):
+def _tfw_params(w_rule="text", curvature="quadric", **kw):
     p = _lib.pleat_tfw_params_default()
     if w_rule not in _TFW_W_RULE:
         raise PleatError(1, f"w_rule {w_rule!r}; known: {sorted(_TFW_W_RULE)}")
     p.w_rule = _TFW_W_RULE[w_rule]
-    names = {n for n, _ in _TfwParams._fields_} - {"struct_size", "reserved", "w_rule"}
+    if curvature not in _TFW_CURVATURE:
+        raise PleatError(1, f"curvature {curvature!r}; known: {sorted(_TFW_CURVATURE)}")
+    p.curvature = _TFW_CURVATURE[curvature]
+    names = {n for n, _ in _TfwParams._fields_} - {"struct_size", "reserved", "w_rule",
+                                                    "curvature", "reserved2"}
     for k, v in kw.items():
         if k not in names:
             raise PleatError(1, f"unknown TFW parameter {k!r}; known: {sorted(names)}")
@@ -1479,7 +1485,8 @@ class TfwScene(_Handle):
 
     def solve(self, progress=None, **params):
         """Solves the scene (base surface, wrinkle SQP, phase); keywords are PleatTfwParams
-        fields (e.g. ``sqp_max_iterations=50``, ``w_rule="reference"``).
+        fields (e.g. ``sqp_max_iterations=50``, ``w_rule="reference"``,
+        ``curvature="normals"``).
         ``progress(stage, fraction)`` returning True cancels (PleatError CANCELLED)."""
         p = _tfw_params(**params)
         relay, h = _Relay(progress), _P()
