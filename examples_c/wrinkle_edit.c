@@ -226,6 +226,11 @@ static void adaptive_width(void) {
     CHECK(wide_rep.compat_rms <= 0.3);
     CHECK_STATUS(pleat_cwf_copy_edit_interface_rings(wide, rings, 0), PLEAT_STATUS_LIMIT_EXCEEDED);
     CHECK_STATUS(pleat_cwf_get_edit_report(a, &wide_rep), PLEAT_STATUS_INVALID_ARGUMENT);
+    /* misuse: NULL handle or output */
+    CHECK_STATUS(pleat_cwf_get_edit_report(NULL, &wide_rep), PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(pleat_cwf_get_edit_report(wide, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(pleat_cwf_copy_edit_interface_rings(NULL, rings, 2), PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(pleat_cwf_copy_edit_interface_rings(wide, NULL, 2), PLEAT_STATUS_INVALID_ARGUMENT);
 
     /* a caller compiled before the three fields: whatever follows its struct is ignored */
     {
