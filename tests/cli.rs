@@ -657,7 +657,7 @@ fn wrinkle_edit_compat_target_widens_and_interp_no_locality() {
         args.extend_from_slice(&["-o", path_str(out)]);
         pleat(&args)
     };
-    let o = edit(&[], &k1);
+    let o = edit(&["--compat-target", "0"], &k1);
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     assert!(o.status.success(), "{err}");
     assert!(

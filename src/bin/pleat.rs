@@ -336,12 +336,12 @@ enum WrinkleCommand {
         #[arg(long)]
         labels: Option<PathBuf>,
         /// Adaptive interface width: widen every band by one ring while the compatibility RMS
-        /// over edit + interface edges exceeds RAD radians (0 = off: the requested widths; 0.3
-        /// is issue 14's smoothness target). The widths used are printed.
+        /// over edit + interface edges exceeds RAD radians (default 0.3, issue 14's smoothness
+        /// target; 0 = off: the requested widths). The widths used are printed.
         #[arg(
             long,
             value_name = "RAD",
-            default_value_t = 0.0,
+            default_value_t = pleat::wrinkle::DEFAULT_COMPAT_TARGET,
             allow_hyphen_values = true
         )]
         compat_target: f64,

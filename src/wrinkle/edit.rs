@@ -20,7 +20,7 @@
 //!    (s complex, see the spec), `z̃¹ = normalize(Pũ/s)` on the free vertices. Without any
 //!    fixed vertex (a global edit) the phase is plain Knöppel on `ω¹`.
 //! 7. The fixed entries of `ω`, `a`, `z̃` are copies of the input's.
-//! 8. Optional adaptive width ([`EditOptions::compat_target`], e.g. 0.3 rad): while the RMS
+//! 8. Adaptive width ([`EditOptions::compat_target`], default 0.3 rad, 0 = off): while the RMS
 //!    compatibility residual over edit + interface edges is above the target, every band is
 //!    widened by a ring and steps 1–7 redone (the residual is forced by the curl of the 3.26
 //!    blend across the band; a wider band spreads it).
@@ -42,13 +42,18 @@ use crate::solve::{
 };
 use crate::{Error, Result};
 
+/// Default [`EditOptions::compat_target`]: the RMS compatibility residual (radians) over edit and
+/// interface edges that issue 14 asks of a smooth interface.
+pub const DEFAULT_COMPAT_TARGET: f64 = 0.3;
+
 /// One edited region: its faces and the operation applied to the wrinkles in it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RegionEdit {
     /// The region's faces (e.g. from [`grow_faces`](super::grow_faces)); non-empty.
     pub faces: Vec<u32>,
     /// Width of the interface band around the region, in rings (≥ 1 unless the region covers
-    /// the mesh); default 3.
+    /// the mesh); default 3. The narrowest width: [`EditOptions::compat_target`] (on by
+    /// default) widens it while the interface is not smooth.
     pub interface_rings: usize,
     /// Rotation of the wrinkle direction about each face normal, counter-clockwise, radians.
     pub rotate: f64,
@@ -123,10 +128,12 @@ pub struct EditOptions {
     /// edit with the smallest residual is returned ([`EditReport::interface_rings`] says which
     /// widths). A widening that would leave no fixed vertex or make the layout invalid stops it.
     /// The residual is forced by the curl of the eq. 3.26 blend, which only a wider band
-    /// spreads (README, "Interface smoothness"); 0.3 is the issue's smoothness target (the
-    /// corpus torus needs 7 rings for it). Default 0 — the requested widths exactly, as the
-    /// reference code: a wider band shrinks the fixed region the user asked to keep, and the
-    /// widths set in a region are what the C API, the CLI and the reference layouts promise.
+    /// spreads (README, "Interface smoothness"); the corpus torus needs 7 rings for 0.3.
+    /// Default [`DEFAULT_COMPAT_TARGET`] = 0.3 rad, issue 14's smoothness target, so a default
+    /// edit has a smooth interface wherever a band of at most `max_interface_rings` rings can
+    /// give one (the widening takes rings from the fixed region, which stays bit-for-bit
+    /// copied; [`EditReport::interface_rings`] says how wide). 0 gives the requested widths
+    /// exactly, as the reference code does.
     pub compat_target: f64,
     /// Widest band the adaptive width may reach; default 8.
     pub max_interface_rings: usize,
@@ -143,20 +150,22 @@ impl Default for EditOptions {
             edit_weight: 1.0,
             max_iterations: 200,
             tolerance: 1e-12,
-            compat_target: 0.0,
+            compat_target: DEFAULT_COMPAT_TARGET,
             max_interface_rings: 8,
         }
     }
 }
 
 impl EditOptions {
-    /// The reference implementation's values: edge adjacency, γ = ¼, amplitude-weighted phase.
+    /// The reference implementation's values: edge adjacency, γ = ¼, amplitude-weighted phase,
+    /// the requested interface widths exactly (`compat_target` 0).
     pub fn reference() -> EditOptions {
         EditOptions {
             adjacency: Adjacency::Edge,
             gamma: 0.25,
             phase: PhaseCoupling::AmplitudeWeighted,
             edit_weight: 1.0,
+            compat_target: 0.0,
             ..EditOptions::default()
         }
     }

@@ -804,14 +804,14 @@ class Cwf(_Handle):
         return cls(h)
 
     def edit(self, regions, adjacency="vertex", phase="unit", eps_omega=1e-3,
-             eps_amplitude=1e-3, gamma=1.0, compat_target=0.0, max_interface_rings=8,
+             eps_amplitude=1e-3, gamma=1.0, compat_target=0.3, max_interface_rings=8,
              edit_weight=1.0):
         """Region edits (dissertation 3.6.2): ``regions`` is a list of dicts with ``faces``
         (triangle ids, e.g. from ``grow_faces``) and optional ``interface_rings`` (3),
         ``rotate`` (radians, 0), ``frequency_scale`` (1), ``amplitude_scale`` (1). Returns
         ``(edited Cwf, labels)``: labels per triangle, 0 fixed, 1 edit, 2 interface.
 
-        ``compat_target`` (radians, 0 = off): widen every interface band by one ring while the
+        ``compat_target`` (radians, default 0.3, 0 = off): widen every interface band by one ring while the
         compatibility RMS over edit + interface edges exceeds it, up to ``max_interface_rings``;
         the edited Cwf's ``edit_report()`` says which widths were used. ``edit_weight`` (>= 1)
         weights the edit edges' compatibility terms in the phase solve (eq. 3.28)."""
