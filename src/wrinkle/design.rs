@@ -26,7 +26,7 @@ use super::cwf::Cwf;
 use super::interpolate::checkpoint;
 use super::knoppel::{cotan_weights, cotan_weights_raw, KnoppelOptions, KnoppelReport};
 use super::region::{grow_mask, Adjacency};
-use super::spd::{push_hermitian, push_outer_lower, solve_spd};
+use super::spd::{push_hermitian, push_outer_lower, solve_spd, solve_spd_many};
 use super::topology::Topology;
 use crate::geom::Vec3;
 use crate::mesh::TriMesh;
@@ -116,7 +116,7 @@ pub fn design(
 
 /// As [`design`], calling `progress` (stage `"design"`, on the calling thread) after each step
 /// of the [module docs](self) and inside the long ones: after the topology, every 64 sources'
-/// regions, each of the vector heat method's factorizations and solves, the amplitude solve,
+/// regions, the vector heat method's vector solve and scalar solves, the amplitude solve,
 /// and in Knöppel's phase solve after its factorization and each inverse iteration (issue 15).
 /// The callback returning `false` stops with [`Error::Cancelled`](crate::Error::Cancelled).
 /// When not cancelled, the result is that of [`design`], bit for bit.
@@ -330,7 +330,8 @@ fn transport_angle(fk: &[Vec3; 3], fl: &[Vec3; 3]) -> f64 {
 
 /// The vector heat method (step 2): per vertex the extended wave vector (zero where the heat
 /// did not reach), and the complex solve's relative residual.
-/// `tick(fraction)` is a cancellation point, called after each of the three solves.
+/// `tick(fraction)` is a cancellation point, called before and after the vector solve (the
+/// two scalar solves share one factorization).
 fn vector_heat(
     topo: &Topology,
     x: &[[f64; 3]],
@@ -379,9 +380,10 @@ fn vector_heat(
     tick(0.1)?;
     let (xs, heat_residual) = solve_spd(2 * nv, &tc, &y, "the vector heat system")?;
     tick(0.3)?;
-    let (m, _) = solve_spd(nv, &tr, &y_abs, "the scalar heat system")?;
-    tick(0.4)?;
-    let (delta, _) = solve_spd(nv, &tr, &ind, "the scalar heat system")?;
+    // both scalar solves on one factorization
+    let mut scalar = solve_spd_many(nv, &tr, &[&y_abs, &ind], "the scalar heat system")?;
+    let (delta, _) = scalar.pop().expect("two solves");
+    let (m, _) = scalar.pop().expect("two solves");
     let v = (0..nv)
         .map(|j| {
             let z = Complex::new(xs[2 * j], xs[2 * j + 1]);
