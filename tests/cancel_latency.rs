@@ -66,7 +66,10 @@ impl Latency {
 
 /// One run of the operation under measurement with the given progress callback; `Ok(())` when
 /// it completed, `Err(Cancelled)` when cancelled.
-type Op<'a> = dyn FnMut(&mut dyn FnMut(Progress<'_>) -> bool) -> pleat::Result<()> + 'a;
+type Op<'a> = OpWith<'a, ()>;
+
+/// As [`Op`], with an output of type `T`.
+type OpWith<'a, T> = dyn FnMut(&mut dyn FnMut(Progress<'_>) -> bool) -> pleat::Result<T> + 'a;
 
 /// Measures the cancellation latency of `op` (module docs) and prints its table row.
 fn measure(name: &str, op: &mut Op<'_>) -> Latency {
@@ -303,7 +306,7 @@ mod lod {
 fn cancels_at_every_point<T>(
     what: &str,
     plain: &mut dyn FnMut() -> pleat::Result<T>,
-    op: &mut dyn FnMut(&mut dyn FnMut(Progress<'_>) -> bool) -> pleat::Result<T>,
+    op: &mut OpWith<'_, T>,
     bytes: &dyn Fn(&T) -> String,
 ) -> usize {
     let expected = bytes(&plain().expect("the plain run succeeds"));
@@ -340,11 +343,8 @@ fn cancels_at_every_point<T>(
 }
 
 #[cfg(feature = "wrinkle")]
-mod wrinkle_common;
-
-#[cfg(feature = "wrinkle")]
 mod wrinkle {
-    use super::wrinkle_common::hex_disk;
+    use super::shapes::icosphere;
     use super::*;
     use pleat::wrinkle::{
         animation_to_string, cwf_to_string, design, design_with_progress, edit, edit_with_progress,
@@ -417,7 +417,7 @@ mod wrinkle {
 
     #[test]
     fn interpolation_cancels_at_every_point_and_is_unchanged_otherwise() {
-        let m = hex_disk(6);
+        let m = icosphere(1.0, 2);
         let a = plane_wave(&m, [1.0, 0.0, 0.0], 2.0);
         let b = plane_wave(&m, [0.0, 1.0, 0.0], 2.0);
         // 19 unknown frames: three batches of the preconditioner's factorization
@@ -436,7 +436,7 @@ mod wrinkle {
 
     #[test]
     fn design_cancels_at_every_point_and_is_unchanged_otherwise() {
-        let m = hex_disk(8);
+        let m = icosphere(1.0, 3);
         let sources = spread_sources(&m, 3, 3);
         let opts = DesignOptions::default();
         let n = cancels_at_every_point(
@@ -450,9 +450,9 @@ mod wrinkle {
 
     #[test]
     fn edit_cancels_at_every_point_and_is_unchanged_otherwise() {
-        let m = hex_disk(8);
+        let m = icosphere(1.0, 3);
         let cwf = plane_wave(&m, [1.0, 0.0, 0.0], 3.0);
-        let centre = vertex_min_by(&m, |p| p[0] * p[0] + p[1] * p[1]);
+        let centre = vertex_min_by(&m, |p| -p[2]);
         let regions = [rotated_region(&m, centre, 2)];
         // a compatibility target that needs several attempts (wider interfaces)
         let opts = EditOptions {
