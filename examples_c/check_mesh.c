@@ -107,9 +107,84 @@ static void check_file(void) {
     pleat_mesh_destroy(m);
 }
 
+/* Counts progress calls and answers "cancel" (non-zero) from call `cancel_at` on (0: never). */
+typedef struct {
+    int calls, cancel_at;
+    double last_fraction;
+    int backwards;
+} Counter;
+
+static int count_calls(void *user_data, const PleatProgress *info) {
+    Counter *c = user_data;
+    c->calls++;
+    if (info->fraction < c->last_fraction) c->backwards++;
+    c->last_fraction = info->fraction;
+    CHECK(info->stage != NULL && strcmp(info->stage, "check") == 0);
+    return c->cancel_at > 0 && c->calls >= c->cancel_at;
+}
+
+/* pleat_mesh_check_with_progress: the same report as pleat_mesh_check with or without a
+ * callback, progress calls with non-decreasing fractions, a cancel from the callback gives
+ * PLEAT_STATUS_CANCELLED and leaves the output untouched (valgrind checks for leaks). */
+static void check_progress(void) {
+    double p[48];
+    uint32_t t[72];
+    int i, k, calls;
+    PleatMesh *m = NULL;
+    PleatMeshReport plain, r;
+    Counter c = {0, 0, 0.0, 0};
+    for (i = 0; i < 24; i++) {
+        p[i] = CUBE_P[i];
+        p[24 + i] = CUBE_P[i] + 0.5;
+    }
+    for (i = 0; i < 36; i++) {
+        t[i] = CUBE_T[i];
+        t[36 + i] = CUBE_T[i] + 8;
+    }
+    CHECK_STATUS(pleat_mesh_create_f64(p, 16, 0, t, 72, &m), PLEAT_STATUS_OK);
+    memset(&plain, 0, sizeof plain);
+    plain.struct_size = sizeof plain;
+    CHECK_STATUS(pleat_mesh_check(m, PLEAT_CHECK_WELD, &plain), PLEAT_STATUS_OK);
+    /* NULL callback */
+    memset(&r, 0, sizeof r);
+    r.struct_size = sizeof r;
+    CHECK_STATUS(pleat_mesh_check_with_progress(m, PLEAT_CHECK_WELD, NULL, NULL, &r),
+                 PLEAT_STATUS_OK);
+    CHECK(memcmp(&r, &plain, sizeof r) == 0);
+    /* counting callback */
+    memset(&r, 0, sizeof r);
+    r.struct_size = sizeof r;
+    CHECK_STATUS(pleat_mesh_check_with_progress(m, PLEAT_CHECK_WELD, count_calls, &c, &r),
+                 PLEAT_STATUS_OK);
+    CHECK(memcmp(&r, &plain, sizeof r) == 0);
+    printf("check with progress: %d calls, last fraction %g\n", c.calls, c.last_fraction);
+    CHECK(c.calls >= 7 && c.backwards == 0 && c.last_fraction <= 1.0);
+    calls = c.calls;
+    /* cancel at the first, a middle and the last call */
+    for (k = 0; k < 3; k++) {
+        Counter cc = {0, 0, 0.0, 0};
+        cc.cancel_at = k == 0 ? 1 : k == 1 ? calls / 2 : calls;
+        memset(&r, 0xAB, sizeof r);
+        r.struct_size = sizeof r;
+        CHECK_STATUS(pleat_mesh_check_with_progress(m, 0, count_calls, &cc, &r),
+                     PLEAT_STATUS_CANCELLED);
+        CHECK(cc.calls == cc.cancel_at);
+        CHECK(r.vertex_count == 0xABABABABABABABABull); /* not written */
+    }
+    /* misuse, as pleat_mesh_check */
+    CHECK_STATUS(pleat_mesh_check_with_progress(NULL, 0, count_calls, &c, &r),
+                 PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(pleat_mesh_check_with_progress(m, 0, NULL, NULL, NULL),
+                 PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(pleat_mesh_check_with_progress(m, 0x100, NULL, NULL, &r),
+                 PLEAT_STATUS_INVALID_ARGUMENT);
+    pleat_mesh_destroy(m);
+}
+
 int main(void) {
     check_cube();
     check_dirty();
     check_file();
+    check_progress();
     return finish("check_mesh");
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <vector>
 #include <unistd.h>
@@ -172,6 +173,19 @@ static void lods() {
     });
     PleatMeshReport r = lod.report();
     EXPECT(r.is_watertight && r.self_intersection_free && r.consistently_oriented);
+    // the report with progress: the same bytes; cancelling throws CANCELLED
+    int check_calls = 0;
+    PleatMeshReport rp = lod.report(0, [&](const char *stage, double) {
+        check_calls += std::string(stage) == "check";
+        return true;
+    });
+    EXPECT(std::memcmp(&rp, &r, sizeof r) == 0 && check_calls >= 7);
+    try {
+        lod.report(0, [](const char *, double) { return false; });
+        EXPECT(false);
+    } catch (const pleat::Error &err) {
+        EXPECT(err.status() == PLEAT_STATUS_CANCELLED);
+    }
     EXPECT(stats.watertight && stats.face_count == lod.triangle_count() && calls > 0);
     // positions into an interleaved buffer (xyz + one float of padding per vertex)
     std::vector<float> interleaved(4 * lod.vertex_count(), 7.0f);

@@ -1,7 +1,8 @@
 /* Resource exhaustion from C (issue 15): a soup of 10^6 tiny components and a soup of 10^6
  * coincident vertices each get a clear answer (a report, a LOD or PLEAT_STATUS_LIMIT_EXCEEDED)
  * within the memory budget, and a LOD bake cancelled from the progress callback returns
- * PLEAT_STATUS_CANCELLED promptly (the latency is printed, not asserted).
+ * PLEAT_STATUS_CANCELLED promptly, and so does pleat_mesh_check_with_progress (the latencies
+ * are printed, not asserted).
  * Runs natively (10^6-element inputs take minutes under valgrind's memcheck); .ci/asan.sh runs
  * it under ASan + UBSan. */
 #define _POSIX_C_SOURCE 199309L
@@ -169,6 +170,64 @@ static void cancellation_latency(PleatMesh *m) {
     printf("LOD cancellation from C: worst request-to-return %.3f s\n", worst);
 }
 
+/* Records the longest interval between progress calls (from `start`; never cancels). */
+typedef struct {
+    double start, last, longest;
+    int calls;
+} Gaps;
+
+static int record_gap(void *user_data, const PleatProgress *info) {
+    Gaps *g = user_data;
+    double t = now_s();
+    (void)info;
+    g->calls++;
+    if (t - g->last > g->longest) g->longest = t - g->last;
+    g->last = t;
+    return 0;
+}
+
+/* pleat_mesh_check_with_progress on `m` (self-intersections included): the longest interval
+ * between calls of an uncancelled run (to the return included), then cancels at several
+ * times; prints the worst request-to-return latency. The output is not written when
+ * cancelled. */
+static void check_cancellation_latency(const char *name, PleatMesh *m) {
+    static const double AFTER[] = {0.05, 0.5, 1.0, 2.0};
+    PleatMeshReport r;
+    Gaps g = {0, 0, 0, 0};
+    double worst = 0, end;
+    size_t i;
+    if (m == NULL) return;
+    memset(&r, 0, sizeof r);
+    r.struct_size = sizeof r;
+    g.start = g.last = now_s();
+    CHECK_STATUS(pleat_mesh_check_with_progress(m, 0, record_gap, &g, &r), PLEAT_STATUS_OK);
+    end = now_s();
+    if (end - g.last > g.longest) g.longest = end - g.last;
+    printf("%s: check with progress %.2f s, %d calls, longest gap %.3f s\n", name,
+           end - g.start, g.calls, g.longest);
+    CHECK(g.calls >= 7);
+    for (i = 0; i < sizeof AFTER / sizeof AFTER[0]; i++) {
+        CancelAt c = {0, 0, 0, 0};
+        PleatStatus st;
+        c.after = AFTER[i];
+        memset(&r, 0xAB, sizeof r);
+        r.struct_size = sizeof r;
+        c.start = now_s();
+        st = pleat_mesh_check_with_progress(m, 0, cancel_after, &c, &r);
+        end = now_s();
+        if (st == PLEAT_STATUS_OK) {
+            printf("  cancel after %.2f s: finished first (%.2f s)\n", AFTER[i], end - c.start);
+            continue;
+        }
+        CHECK_STATUS(st, PLEAT_STATUS_CANCELLED);
+        CHECK(r.vertex_count == 0xABABABABABABABABull);
+        printf("  cancel after %.2f s: returned %.3f s after the request (%d calls)\n", AFTER[i],
+               end - (c.start + c.after), c.calls);
+        if (end - (c.start + c.after) > worst) worst = end - (c.start + c.after);
+    }
+    printf("%s: check cancellation from C: worst request-to-return %.3f s\n", name, worst);
+}
+
 int main(void) {
     PleatMesh *comps;
     setvbuf(stdout, NULL, _IONBF, 0);
@@ -177,6 +236,8 @@ int main(void) {
     answer("10^6 tiny components", comps, 0, 1000000, 1000000, 0);
     /* 4 faces x C(250000, 2) stacked pairs */
     answer("10^6 coincident vertices", coinc, 0, 250000, 1, 4ull * (250000ull * 249999ull / 2));
+    check_cancellation_latency("10^6 tiny components", comps);
+    check_cancellation_latency("10^6 coincident vertices", coinc);
     cancellation_latency(comps);
     pleat_mesh_destroy(comps);
     pleat_mesh_destroy(coinc);

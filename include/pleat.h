@@ -1392,6 +1392,26 @@ PleatStatus pleat_cwf_design(const struct PleatMesh *base,
                              const struct PleatKnoppelParams *knoppel_params,
                              struct PleatCwf **out);
 
+// As `pleat_cwf_design`, with a progress callback that can cancel (issue 15).
+//
+// - `progress`, `user_data`: optional callback (NULL for none), called on this thread with
+//   stage `"design"` after each step (regions, each vector heat solve, ω, the amplitude) and
+//   in the phase solve after its factorization and each inverse iteration; a non-zero return
+//   cancels: `PLEAT_STATUS_CANCELLED`, `*out` not written.
+// - the other arguments: as `pleat_cwf_design`; the field is the same.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes described above; `progress` is a valid function
+// or NULL.
+PleatStatus pleat_cwf_design_with_progress(const struct PleatMesh *base,
+                                           const struct PleatWrinkleSource *sources,
+                                           size_t source_count,
+                                           const struct PleatCwfDesignParams *params,
+                                           const struct PleatKnoppelParams *knoppel_params,
+                                           PleatProgressFn progress,
+                                           void *user_data,
+                                           struct PleatCwf **out);
+
 // Edits regions of a keyframe (§3.6.2): per region rotate by `rotate_radians`, scale the
 // frequency by σ and the amplitude by μ; the interface band is solved (eqs. 3.26–3.28) and the
 // rest copied bit for bit. Regions must not share a vertex, and the interface must separate
@@ -1415,6 +1435,26 @@ PleatStatus pleat_cwf_edit(const struct PleatCwf *cwf,
                            const struct PleatCwfEditParams *params,
                            struct PleatCwf **out,
                            uint8_t *face_labels_out);
+
+// As `pleat_cwf_edit`, with a progress callback that can cancel (issue 15).
+//
+// - `progress`, `user_data`: optional callback (NULL for none), called on this thread with
+//   stage `"edit"` after each step of every attempt (labels, the interface ω and amplitude
+//   solves, the phase solve's factorization and each of its inverse iterations); a non-zero
+//   return cancels: `PLEAT_STATUS_CANCELLED`, `*out` and `face_labels_out` not written.
+// - the other arguments: as `pleat_cwf_edit`; the field and labels are the same.
+//
+// # Safety
+// Pointers are NULL or valid for the sizes described above; `progress` is a valid function
+// or NULL.
+PleatStatus pleat_cwf_edit_with_progress(const struct PleatCwf *cwf,
+                                         const struct PleatCwfRegionEdit *regions,
+                                         size_t region_count,
+                                         const struct PleatCwfEditParams *params,
+                                         PleatProgressFn progress,
+                                         void *user_data,
+                                         struct PleatCwf **out,
+                                         uint8_t *face_labels_out);
 
 // Fills `*out` with the report of the `pleat_cwf_edit` call that produced `cwf`.
 //
@@ -1809,13 +1849,30 @@ PleatStatus pleat_offset_surface(const struct PleatMesh *mesh,
 // - `out`: non-NULL, with `out->struct_size` set to `sizeof(PleatMeshReport)` (at least 8).
 //
 // Runs in parallel on pleat's thread pool; about 5 s for a million triangles on two cores with
-// the self-intersection test.
+// the self-intersection test. To report progress or cancel, use
+// `pleat_mesh_check_with_progress`.
 //
 // # Safety
 // `mesh` is NULL or live; `out` is NULL or points to `out->struct_size` writable bytes.
 PleatStatus pleat_mesh_check(const struct PleatMesh *mesh,
                              uint32_t flags,
                              struct PleatMeshReport *out);
+
+// As `pleat_mesh_check`, with a progress callback that can cancel (issue 15).
+//
+// - `progress`, `user_data`: optional callback (NULL for none), called on this thread with
+//   stage `"check"` after each topology phase and, in the self-intersection test, after each
+//   batch of face chunks (at most about 10⁶ faces' worth of work between two calls); a
+//   non-zero return cancels: `PLEAT_STATUS_CANCELLED`, and `*out` is not written.
+// - `mesh`, `flags`, `out`: as `pleat_mesh_check`; the report is the same.
+//
+// # Safety
+// `mesh` is NULL or live; `out` is NULL or points to `out->struct_size` writable bytes.
+PleatStatus pleat_mesh_check_with_progress(const struct PleatMesh *mesh,
+                                           uint32_t flags,
+                                           PleatProgressFn progress,
+                                           void *user_data,
+                                           struct PleatMeshReport *out);
 
 // Number of entries of `kind` (0 when `stats` is NULL).
 //

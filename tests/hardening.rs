@@ -11,6 +11,10 @@ use pleat::mesh::TriMesh;
 use pleat::verify::{MeshReport, ReportOptions};
 use pleat::Error;
 
+#[path = "common/shapes.rs"]
+mod shapes;
+use shapes::tiny_components;
+
 /// Runs `f`, asserting it returns within `secs` seconds.
 fn within<T>(secs: u64, what: &str, f: impl FnOnce() -> T) -> T {
     let t = Instant::now();
@@ -339,27 +343,6 @@ mod lod_limits {
             }
         }
     }
-}
-
-/// `n³` disjoint tiny right triangles (legs 10⁻³) on an `n × n × n` lattice of the unit cube:
-/// `n³` components, `3n³` vertices.
-fn tiny_components(n: u32) -> TriMesh {
-    let step = 1.0 / f64::from(n);
-    let mut p = Vec::with_capacity(3 * (n as usize).pow(3));
-    let mut t = Vec::with_capacity((n as usize).pow(3));
-    for i in 0..n {
-        for j in 0..n {
-            for k in 0..n {
-                let o = [i, j, k].map(|c| f64::from(c) * step);
-                let v = p.len() as u32;
-                p.push(o);
-                p.push([o[0] + 1e-3, o[1], o[2]]);
-                p.push([o[0], o[1] + 1e-3, o[2]]);
-                t.push([v, v + 1, v + 2]);
-            }
-        }
-    }
-    TriMesh::new(p, t).unwrap()
 }
 
 /// A unit tetrahedron whose 4 corners are each stored `copies` times (`4·copies` vertices at 4

@@ -243,11 +243,14 @@ class Mesh {
     }
 
     /// Validity report, pleat_mesh_check (PLEAT_CHECK_* flags: skip self-intersections,
-    /// weld first).
-    PleatMeshReport report(uint32_t flags = 0) const {
+    /// weld first); with a `progress` callback, pleat_mesh_check_with_progress (stage
+    /// "check"; returning false cancels).
+    PleatMeshReport report(uint32_t flags = 0, const Progress &progress = {}) const {
         PleatMeshReport r{};
         r.struct_size = sizeof r;
-        check(pleat_mesh_check(raw_, flags, &r));
+        detail::ProgressRelay relay(progress);
+        relay.finish(pleat_mesh_check_with_progress(raw_, flags, relay.callback(),
+                                                    relay.user_data(), &r));
         return r;
     }
 
@@ -417,23 +420,32 @@ class Cwf {
                                               params, &c));
         return Cwf(c);
     }
-    /// A keyframe designed from wrinkle sources (dissertation 3.6.1; `pleat_cwf_design`).
+    /// A keyframe designed from wrinkle sources (dissertation 3.6.1;
+    /// `pleat_cwf_design_with_progress`, stage "design"; `progress` returning false cancels).
     static Cwf design(const Mesh &base, const std::vector<PleatWrinkleSource> &sources,
                       const PleatCwfDesignParams *params = nullptr,
-                      const PleatKnoppelParams *knoppel = nullptr) {
+                      const PleatKnoppelParams *knoppel = nullptr,
+                      const Progress &progress = {}) {
         PleatCwf *c = nullptr;
-        check(pleat_cwf_design(base.get(), sources.data(), sources.size(), params, knoppel, &c));
+        detail::ProgressRelay relay(progress);
+        relay.finish(pleat_cwf_design_with_progress(base.get(), sources.data(), sources.size(),
+                                                    params, knoppel, relay.callback(),
+                                                    relay.user_data(), &c));
         return Cwf(c);
     }
-    /// This keyframe with `regions` edited (dissertation 3.6.2; `pleat_cwf_edit`); each
+    /// This keyframe with `regions` edited (dissertation 3.6.2;
+    /// `pleat_cwf_edit_with_progress`, stage "edit"; `progress` returning false cancels); each
     /// region's `struct_size` must be `sizeof(PleatCwfRegionEdit)`. `labels`, when given,
     /// receives PLEAT_FACE_* per triangle.
     Cwf edit(const std::vector<PleatCwfRegionEdit> &regions,
              const PleatCwfEditParams *params = nullptr,
-             std::vector<uint8_t> *labels = nullptr) const {
+             std::vector<uint8_t> *labels = nullptr, const Progress &progress = {}) const {
         PleatCwf *c = nullptr;
         std::vector<uint8_t> l(triangle_count() + 1);
-        check(pleat_cwf_edit(raw_, regions.data(), regions.size(), params, &c, l.data()));
+        detail::ProgressRelay relay(progress);
+        relay.finish(pleat_cwf_edit_with_progress(raw_, regions.data(), regions.size(), params,
+                                                  relay.callback(), relay.user_data(), &c,
+                                                  l.data()));
         l.pop_back();
         if (labels) *labels = std::move(l);
         return Cwf(c);

@@ -334,7 +334,6 @@ enum Msg {
 /// invoked on the calling thread: without a custom pool `f` runs on the calling thread; with a
 /// pool set by `pleat_set_thread_count`, `f` runs on a pool worker while the calling thread
 /// relays each progress report to `cb` and sends its answer back; the worker waits for it.
-#[cfg_attr(not(any(feature = "lod", feature = "wrinkle")), allow(dead_code))]
 pub(crate) fn guard_progress(
     cb: PleatProgressFn,
     user_data: *mut std::ffi::c_void,

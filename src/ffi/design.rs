@@ -3,14 +3,15 @@
 //! regions of a keyframe) and [`pleat_mesh_grow_faces`] (a region from seeds grown by rings).
 //! Outputs are ordinary immutable `PleatCwf` handles, so `pleat_cwf_interpolate` and
 //! `pleat_cwf_evaluate` take them unchanged. The calls take well under a second on meshes of a
-//! few thousand vertices and have no progress callback.
+//! few thousand vertices; on large meshes, [`pleat_cwf_design_with_progress`] and
+//! [`pleat_cwf_edit_with_progress`] report progress and can be cancelled (issue 15).
 
 #![allow(clippy::too_many_arguments)]
 
 use super::boundary::{full_size, requires, versioned};
 #[cfg(feature = "wrinkle")]
-use super::common::guard;
-use super::common::PleatStatus;
+use super::common::{guard, guard_progress};
+use super::common::{PleatProgressFn, PleatStatus};
 use super::mesh::PleatMesh;
 use super::wrinkle::{wrinkle_only, PleatCwf, PleatKnoppelParams};
 
@@ -241,8 +242,44 @@ pub unsafe extern "C" fn pleat_cwf_design(
     knoppel_params: *const PleatKnoppelParams,
     out: *mut *mut PleatCwf,
 ) -> PleatStatus {
-    wrinkle_only!([base, sources, source_count, params, knoppel_params, out]
-    guard(|| imp::design(base, sources, source_count, params, knoppel_params, out)))
+    pleat_cwf_design_with_progress(
+        base,
+        sources,
+        source_count,
+        params,
+        knoppel_params,
+        None,
+        std::ptr::null_mut(),
+        out,
+    )
+}
+
+/// As `pleat_cwf_design`, with a progress callback that can cancel (issue 15).
+///
+/// - `progress`, `user_data`: optional callback (NULL for none), called on this thread with
+///   stage `"design"` after each step (regions, each vector heat solve, ω, the amplitude) and
+///   in the phase solve after its factorization and each inverse iteration; a non-zero return
+///   cancels: `PLEAT_STATUS_CANCELLED`, `*out` not written.
+/// - the other arguments: as `pleat_cwf_design`; the field is the same.
+///
+/// # Safety
+/// Pointers are NULL or valid for the sizes described above; `progress` is a valid function
+/// or NULL.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_cwf_design_with_progress(
+    base: *const PleatMesh,
+    sources: *const PleatWrinkleSource,
+    source_count: usize,
+    params: *const PleatCwfDesignParams,
+    knoppel_params: *const PleatKnoppelParams,
+    progress: PleatProgressFn,
+    user_data: *mut std::ffi::c_void,
+    out: *mut *mut PleatCwf,
+) -> PleatStatus {
+    wrinkle_only!([base, sources, source_count, params, knoppel_params, progress, user_data, out]
+    guard_progress(progress, user_data, |relay| {
+        imp::design(base, sources, source_count, params, knoppel_params, relay, out)
+    }))
 }
 
 /// Edits regions of a keyframe (§3.6.2): per region rotate by `rotate_radians`, scale the
@@ -271,8 +308,44 @@ pub unsafe extern "C" fn pleat_cwf_edit(
     out: *mut *mut PleatCwf,
     face_labels_out: *mut u8,
 ) -> PleatStatus {
-    wrinkle_only!([cwf, regions, region_count, params, out, face_labels_out]
-    guard(|| imp::edit(cwf, regions, region_count, params, out, face_labels_out)))
+    pleat_cwf_edit_with_progress(
+        cwf,
+        regions,
+        region_count,
+        params,
+        None,
+        std::ptr::null_mut(),
+        out,
+        face_labels_out,
+    )
+}
+
+/// As `pleat_cwf_edit`, with a progress callback that can cancel (issue 15).
+///
+/// - `progress`, `user_data`: optional callback (NULL for none), called on this thread with
+///   stage `"edit"` after each step of every attempt (labels, the interface ω and amplitude
+///   solves, the phase solve's factorization and each of its inverse iterations); a non-zero
+///   return cancels: `PLEAT_STATUS_CANCELLED`, `*out` and `face_labels_out` not written.
+/// - the other arguments: as `pleat_cwf_edit`; the field and labels are the same.
+///
+/// # Safety
+/// Pointers are NULL or valid for the sizes described above; `progress` is a valid function
+/// or NULL.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_cwf_edit_with_progress(
+    cwf: *const PleatCwf,
+    regions: *const PleatCwfRegionEdit,
+    region_count: usize,
+    params: *const PleatCwfEditParams,
+    progress: PleatProgressFn,
+    user_data: *mut std::ffi::c_void,
+    out: *mut *mut PleatCwf,
+    face_labels_out: *mut u8,
+) -> PleatStatus {
+    wrinkle_only!([cwf, regions, region_count, params, progress, user_data, out, face_labels_out]
+    guard_progress(progress, user_data, |relay| {
+        imp::edit(cwf, regions, region_count, params, relay, out, face_labels_out)
+    }))
 }
 
 /// Fills `*out` with the report of the `pleat_cwf_edit` call that produced `cwf`.
@@ -350,8 +423,9 @@ pub(super) mod imp {
     };
     use crate::ffi::mesh::mesh_ref;
     use crate::ffi::wrinkle::imp::knoppel_options;
+    use crate::report::ProgressFn;
     use crate::wrinkle::{
-        design as design_rs, edit as edit_rs, grow_faces as grow_rs, Adjacency, DesignOptions,
+        design_with_progress, edit_with_progress, grow_faces as grow_rs, Adjacency, DesignOptions,
         EditOptions, EditReport, FaceClass, PhaseCoupling, RegionEdit, WrinkleSource,
     };
     use crate::{Error, Result};
@@ -451,6 +525,7 @@ pub(super) mod imp {
         source_count: usize,
         params: *const PleatCwfDesignParams,
         knoppel_params: *const PleatKnoppelParams,
+        progress: &mut ProgressFn<'_>,
         out: *mut *mut PleatCwf,
     ) -> Result<()> {
         let out = arg_out(out, "out")?;
@@ -467,7 +542,7 @@ pub(super) mod imp {
                 rings: s.rings as usize,
             })
             .collect();
-        let (cwf, report) = design_rs(m.clone(), &rs, &opts)?;
+        let (cwf, report) = design_with_progress(m.clone(), &rs, &opts, progress)?;
         out.put_boxed(PleatCwf {
             cwf,
             knoppel: Some(report.knoppel),
@@ -483,6 +558,7 @@ pub(super) mod imp {
         regions: *const PleatCwfRegionEdit,
         region_count: usize,
         params: *const PleatCwfEditParams,
+        progress: &mut ProgressFn<'_>,
         out: *mut *mut PleatCwf,
         face_labels_out: *mut u8,
     ) -> Result<()> {
@@ -508,7 +584,7 @@ pub(super) mod imp {
                 amplitude_scale: r.amplitude_scale,
             });
         }
-        let (k1, report) = edit_rs(&c.cwf, &edits, &opts)?;
+        let (k1, report) = edit_with_progress(&c.cwf, &edits, &opts, progress)?;
         if !face_labels_out.is_null() {
             // SAFETY: the caller provides triangle_count bytes (documented contract)
             let labels = std::slice::from_raw_parts_mut(face_labels_out, report.face_class.len());

@@ -102,6 +102,18 @@ pub fn inverse_iteration<F: Fn(&[f64]) -> Vec<f64>>(
     start: Vec<f64>,
     params: &InverseIterationParams,
 ) -> Result<(Vec<f64>, InverseIterationInfo), InverseIterationError> {
+    inverse_iteration_with_stop(problem, start, params, &mut |_| false).expect("never stopped")
+}
+
+/// [`inverse_iteration`] with a cancellation point: `stop(it)` runs before step `it` (from the
+/// second step on) and `None` is returned as soon as it answers `true`. When it never does,
+/// the result is that of [`inverse_iteration`], bit for bit.
+pub fn inverse_iteration_with_stop<F: Fn(&[f64]) -> Vec<f64>>(
+    problem: &ShiftedProblem<'_, F>,
+    start: Vec<f64>,
+    params: &InverseIterationParams,
+    stop: &mut dyn FnMut(usize) -> bool,
+) -> Option<Result<(Vec<f64>, InverseIterationInfo), InverseIterationError>> {
     let p = problem;
     let mut u = start;
     normalize_b(&mut u, p);
@@ -113,13 +125,16 @@ pub fn inverse_iteration<F: Fn(&[f64]) -> Vec<f64>>(
         converged: false,
     };
     for it in 1..=params.max_iterations.max(1) {
+        if it > 1 && stop(it) {
+            return None;
+        }
         let rhs: Vec<f64> = u.iter().zip(p.mass).map(|(v, m)| m * v).collect();
         u = p.shifted.solve(&rhs);
         if !u.iter().all(|v| v.is_finite()) {
-            return Err(InverseIterationError::NonFinite {
+            return Some(Err(InverseIterationError::NonFinite {
                 iteration: it,
                 residual: info.residual,
-            });
+            }));
         }
         normalize_b(&mut u, p);
         let au = (p.apply_a)(&u);
@@ -143,7 +158,7 @@ pub fn inverse_iteration<F: Fn(&[f64]) -> Vec<f64>>(
             break;
         }
     }
-    Ok((u, info))
+    Some(Ok((u, info)))
 }
 
 /// Scales each group of `u` to unit B-norm (a group of norm 0 is left as it is).

@@ -17,8 +17,8 @@ pub mod krylov;
 pub mod sparse;
 
 pub use eigen::{
-    inverse_iteration, InverseIterationError, InverseIterationInfo, InverseIterationParams,
-    ShiftedProblem,
+    inverse_iteration, inverse_iteration_with_stop, InverseIterationError, InverseIterationInfo,
+    InverseIterationParams, ShiftedProblem,
 };
 pub use krylov::{dot_n, steihaug, steihaug_with_stop, TrustStep};
 pub use sparse::{

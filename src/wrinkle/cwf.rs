@@ -5,7 +5,7 @@
 
 use super::areas::barycentric_areas;
 use super::complex::Complex;
-use super::knoppel::{knoppel_phase, KnoppelOptions, KnoppelReport};
+use super::knoppel::{knoppel_phase_with_tick, KnoppelOptions, KnoppelReport};
 use super::report::CwfStage;
 use super::topology::Topology;
 use crate::geom::Vec3;
@@ -100,13 +100,28 @@ impl Cwf {
         amplitude: Vec<f64>,
         opts: &KnoppelOptions,
     ) -> Result<(Cwf, KnoppelReport)> {
+        Cwf::from_one_form_with_progress(base, omega, amplitude, opts, &mut || Ok(()))
+    }
+
+    /// As [`Cwf::from_one_form`], with a cancellation point: `tick` runs after the validation,
+    /// after Knöppel's factorization and before each of its inverse iterations after the first
+    /// (issue 15); its error is returned as is. When it never fails, the result is that of
+    /// [`Cwf::from_one_form`], bit for bit.
+    pub fn from_one_form_with_progress(
+        base: TriMesh,
+        omega: Vec<f64>,
+        amplitude: Vec<f64>,
+        opts: &KnoppelOptions,
+        tick: &mut dyn FnMut() -> Result<()>,
+    ) -> Result<(Cwf, KnoppelReport)> {
         let n = base.vertex_count();
         let mut stages = StageTimes::default();
         let mut cwf = stages.time(CwfStage::Validate, || {
             Cwf::new(base, omega, amplitude, vec![Complex::ONE; n])
         })?;
+        tick()?;
         let (zeta, mut report) = stages.time(CwfStage::Knoppel, || {
-            knoppel_phase(&cwf.topo, cwf.base.positions(), &cwf.omega, opts)
+            knoppel_phase_with_tick(&cwf.topo, cwf.base.positions(), &cwf.omega, opts, tick)
         })?;
         report.stages = stages;
         cwf.zeta = zeta;

@@ -23,12 +23,14 @@ use std::time::Instant;
 use super::areas::barycentric_areas;
 use super::complex::Complex;
 use super::cwf::Cwf;
+use super::interpolate::checkpoint;
 use super::knoppel::{cotan_weights, cotan_weights_raw, KnoppelOptions, KnoppelReport};
 use super::region::{grow_mask, Adjacency};
-use super::spd::{push_hermitian, push_outer_lower, solve_spd};
+use super::spd::{push_hermitian, push_outer_lower, solve_spd, solve_spd_many};
 use super::topology::Topology;
 use crate::geom::Vec3;
 use crate::mesh::TriMesh;
+use crate::report::ProgressFn;
 use crate::solve::Entry;
 use crate::Result;
 
@@ -109,15 +111,35 @@ pub fn design(
     sources: &[WrinkleSource],
     opts: &DesignOptions,
 ) -> Result<(Cwf, DesignReport)> {
+    design_with_progress(base, sources, opts, &mut |_| true)
+}
+
+/// As [`design`], calling `progress` (stage `"design"`, on the calling thread) after each step
+/// of the [module docs](self) and inside the long ones: after the topology, every 64 sources'
+/// regions, the vector heat method's vector solve and scalar solves, the amplitude solve,
+/// and in Knöppel's phase solve after its factorization and each inverse iteration (issue 15).
+/// The callback returning `false` stops with [`Error::Cancelled`](crate::Error::Cancelled).
+/// When not cancelled, the result is that of [`design`], bit for bit.
+pub fn design_with_progress(
+    base: TriMesh,
+    sources: &[WrinkleSource],
+    opts: &DesignOptions,
+    progress: &mut ProgressFn<'_>,
+) -> Result<(Cwf, DesignReport)> {
     let t0 = Instant::now();
+    let mut tick = |fraction: f64| checkpoint(progress, "design", fraction);
     let topo = Topology::from_mesh(&base, &base.edges())?;
     check_sources(&topo, sources, opts)?;
+    tick(0.05)?;
     let x = base.positions();
     let nv = topo.n_vertices;
     // (1) regions
     let mut in_i = Vec::with_capacity(sources.len());
     let mut in_f = vec![false; topo.n_faces()];
-    for s in sources {
+    for (i, s) in sources.iter().enumerate() {
+        if i > 0 && i % 64 == 0 {
+            tick(0.05)?;
+        }
         let mask = grow_mask(&topo, &[], &[s.vertex], s.rings, opts.adjacency)?;
         let mut verts = vec![false; nv];
         for (f, _) in mask.iter().enumerate().filter(|(_, &m)| m) {
@@ -136,9 +158,10 @@ pub fn design(
                 .any(|&f| f != super::topology::NONE && in_f[f as usize])
         })
         .collect();
+    tick(0.1)?;
     // (2) vector heat
     let h = mean_edge_length(&topo, x);
-    let (v, heat_residual) = vector_heat(&topo, x, sources, opts.heat_time * h * h)?;
+    let (v, heat_residual) = vector_heat(&topo, x, sources, opts.heat_time * h * h, &mut tick)?;
     // (3) ω
     let omega: Vec<f64> = topo
         .edges
@@ -152,13 +175,16 @@ pub fn design(
             0.5 * (v[a as usize] + v[b as usize]).dot(ev)
         })
         .collect();
+    tick(0.5)?;
     let t1 = Instant::now();
     // (4) amplitude
     let (amp, amplitude_residual, clamped) =
         design_amplitude(&topo, x, sources, &in_i, &in_v, &in_f, &omega, h, opts)?;
+    tick(0.6)?;
     let t2 = Instant::now();
     // (5) phase
-    let (cwf, knoppel) = Cwf::from_one_form(base, omega, amp, &opts.knoppel)?;
+    let (cwf, knoppel) =
+        Cwf::from_one_form_with_progress(base, omega, amp, &opts.knoppel, &mut || tick(0.8))?;
     let t3 = Instant::now();
     let report = DesignReport {
         influenced: [
@@ -304,11 +330,14 @@ fn transport_angle(fk: &[Vec3; 3], fl: &[Vec3; 3]) -> f64 {
 
 /// The vector heat method (step 2): per vertex the extended wave vector (zero where the heat
 /// did not reach), and the complex solve's relative residual.
+/// `tick(fraction)` is a cancellation point, called before and after the vector solve (the
+/// two scalar solves share one factorization).
 fn vector_heat(
     topo: &Topology,
     x: &[[f64; 3]],
     sources: &[WrinkleSource],
     t: f64,
+    tick: &mut dyn FnMut(f64) -> Result<()>,
 ) -> Result<(Vec<Vec3>, f64)> {
     let nv = topo.n_vertices;
     let frames = vertex_frames(topo, x);
@@ -348,9 +377,13 @@ fn vector_heat(
         y_abs[j] += z.abs();
         ind[j] = 1.0;
     }
+    tick(0.1)?;
     let (xs, heat_residual) = solve_spd(2 * nv, &tc, &y, "the vector heat system")?;
-    let (m, _) = solve_spd(nv, &tr, &y_abs, "the scalar heat system")?;
-    let (delta, _) = solve_spd(nv, &tr, &ind, "the scalar heat system")?;
+    tick(0.3)?;
+    // both scalar solves on one factorization
+    let mut scalar = solve_spd_many(nv, &tr, &[&y_abs, &ind], "the scalar heat system")?;
+    let (delta, _) = scalar.pop().expect("two solves");
+    let (m, _) = scalar.pop().expect("two solves");
     let v = (0..nv)
         .map(|j| {
             let z = Complex::new(xs[2 * j], xs[2 * j + 1]);

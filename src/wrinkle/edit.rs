@@ -30,15 +30,20 @@ use std::time::Instant;
 use super::areas::barycentric_areas;
 use super::complex::Complex;
 use super::cwf::{wrap_to_pi, Cwf};
-use super::knoppel::{components, cotan_weights_raw, knoppel_phase, KnoppelOptions, PhaseWeights};
+use super::interpolate::checkpoint;
+use super::knoppel::{
+    components, cotan_weights_raw, iterate_with_tick, knoppel_phase_with_tick, KnoppelOptions,
+    PhaseWeights,
+};
 use super::omega_path::{corner_vector, face_unit_normal};
 use super::region::{classify, Adjacency, FaceClass, Labels};
 use super::spd::{matvec_full, push_hermitian, push_outer_lower, solve_spd};
 use super::topology::{Topology, NONE};
 use crate::geom::Vec3;
+use crate::report::ProgressFn;
 use crate::solve::{
-    assemble, inverse_iteration, CholeskyAnalysis, Entry, InverseIterationParams, Parallelism,
-    ShiftSchedule, ShiftedProblem,
+    assemble, CholeskyAnalysis, Entry, InverseIterationParams, Parallelism, ShiftSchedule,
+    ShiftedProblem,
 };
 use crate::{Error, Result};
 
@@ -229,8 +234,27 @@ pub struct EditReport {
 /// to separate edited and fixed vertices, a non-finite rotation, σ ≤ 0 or non-finite, μ < 0 or
 /// non-finite, invalid options.
 pub fn edit(cwf: &Cwf, regions: &[RegionEdit], opts: &EditOptions) -> Result<(Cwf, EditReport)> {
+    edit_with_progress(cwf, regions, opts, &mut |_| true)
+}
+
+/// As [`edit`], calling `progress` (stage `"edit"`, on the calling thread) after each step of
+/// every attempt (labels and ω, the interface ω and amplitude solves, the phase solve's
+/// factorization and each of its inverse iterations, the compatibility measures; issue 15).
+/// The callback returning `false` stops with [`Error::Cancelled`]. When not cancelled, the
+/// result is that of [`edit`], bit for bit.
+pub fn edit_with_progress(
+    cwf: &Cwf,
+    regions: &[RegionEdit],
+    opts: &EditOptions,
+    progress: &mut ProgressFn<'_>,
+) -> Result<(Cwf, EditReport)> {
     check_inputs(regions, opts)?;
-    let mut best = edit_with_rings(cwf, regions, opts)?;
+    // attempt k reports its steps in [1 − 1/k, 1 − 1/(k+1)): fractions never go back
+    let mut tick = |k: usize, f: f64| {
+        let k = k as f64;
+        checkpoint(progress, "edit", 1.0 - 1.0 / k + f / (k * (k + 1.0)))
+    };
+    let mut best = edit_with_rings(cwf, regions, opts, &mut |f| tick(1, f))?;
     if opts.compat_target <= 0.0 || best.1.global {
         return Ok(best);
     }
@@ -248,7 +272,8 @@ pub fn edit(cwf: &Cwf, regions: &[RegionEdit], opts: &EditOptions) -> Result<(Cw
             break;
         }
         attempts += 1;
-        match edit_with_rings(cwf, &wide, opts) {
+        match edit_with_rings(cwf, &wide, opts, &mut |f| tick(attempts, f)) {
+            Err(Error::Cancelled) => return Err(Error::Cancelled),
             Ok(next) if !next.1.global && next.1.vertex_counts[0] > 0 => {
                 if next.1.compat_rms < best.1.compat_rms {
                     best = next;
@@ -261,11 +286,14 @@ pub fn edit(cwf: &Cwf, regions: &[RegionEdit], opts: &EditOptions) -> Result<(Cw
     Ok(best)
 }
 
-/// One edit with the regions' interface widths as given (steps 1–7 of the module docs).
+/// One edit with the regions' interface widths as given (steps 1–7 of the module docs);
+/// `tick(fraction of this edit)` is a cancellation point between the steps and inside the
+/// phase solve.
 fn edit_with_rings(
     cwf: &Cwf,
     regions: &[RegionEdit],
     opts: &EditOptions,
+    tick: &mut dyn FnMut(f64) -> Result<()>,
 ) -> Result<(Cwf, EditReport)> {
     let t0 = Instant::now();
     let topo = &cwf.topo;
@@ -283,14 +311,18 @@ fn edit_with_rings(
             }
         }
     }
+    tick(0.1)?;
     let t1 = Instant::now();
     let cot = cotan_weights_raw(topo, x);
     let omega_residual = solve_interface_omega(topo, &cot, cwf.omega(), &mut omega, &labels, opts)?;
+    tick(0.3)?;
     let t2 = Instant::now();
     let (amplitude_residual, clamped) =
         solve_interface_amplitude(topo, &cot, &omega, cwf.amplitude(), &mut amp, &labels, opts)?;
+    tick(0.5)?;
     let t3 = Instant::now();
-    let phase = solve_phase(cwf, &omega, &amp, &labels, opts)?;
+    let phase = solve_phase(cwf, &omega, &amp, &labels, opts, &mut || tick(0.7))?;
+    tick(0.9)?;
     let t4 = Instant::now();
     let mut zeta = phase.zeta;
     for (j, z) in zeta.iter_mut().enumerate() {
@@ -600,13 +632,16 @@ struct Phase {
     global: bool,
 }
 
-/// Eq. 3.28 (augmented pencil), or Knöppel on `ω¹` when nothing is fixed.
+/// Eq. 3.28 (augmented pencil), or Knöppel on `ω¹` when nothing is fixed; `tick` is a
+/// cancellation point after the factorization and before each inverse iteration after the
+/// first.
 fn solve_phase(
     cwf: &Cwf,
     omega: &[f64],
     amp: &[f64],
     labels: &Labels,
     opts: &EditOptions,
+    tick: &mut dyn FnMut() -> Result<()>,
 ) -> Result<Phase> {
     let topo = &cwf.topo;
     let x = cwf.base().positions();
@@ -618,7 +653,7 @@ fn solve_phase(
             tolerance: opts.tolerance,
             ..KnoppelOptions::default()
         };
-        let (zeta, rep) = knoppel_phase(topo, x, omega, &kopts)?;
+        let (zeta, rep) = knoppel_phase_with_tick(topo, x, omega, &kopts, tick)?;
         return Ok(Phase {
             zeta,
             eigenvalue: rep.eigenvalue,
@@ -765,7 +800,8 @@ fn solve_phase(
         max_iterations: opts.max_iterations,
         tolerance: opts.tolerance,
     };
-    let (u, info) = inverse_iteration(&problem, start, &params)?;
+    tick()?;
+    let (u, info) = iterate_with_tick(&problem, start, &params, tick)?;
     let mut s = Complex::new(u[2 * s_idx], u[2 * s_idx + 1]);
     let mut fallback = false;
     let mut ut: Vec<Complex> = (0..m)

@@ -280,8 +280,11 @@ pub fn interpolate(a: &Cwf, b: &Cwf, opts: &InterpOptions) -> Result<(CwfAnimati
     interpolate_with_progress(a, b, opts, &mut |_| true)
 }
 
-/// As [`interpolate`], reporting progress after each iteration (stage `"interpolate"`); the
-/// callback returning `false` stops with [`Error::Cancelled`].
+/// As [`interpolate`], reporting progress after each iteration (stage `"interpolate"`) and,
+/// as cancellation points, inside it (trust region: every 4 CG iterations, between batches of
+/// 8 frames of a preconditioner refactor, after each trial evaluation; issue 15); the callback
+/// returning `false` stops with [`Error::Cancelled`]. When not cancelled, the result is that of
+/// [`interpolate`], bit for bit.
 pub fn interpolate_with_progress(
     a: &Cwf,
     b: &Cwf,
@@ -330,7 +333,7 @@ pub fn interpolate_with_progress(
 }
 
 /// One progress call; `Err(Cancelled)` when it answers `false`.
-fn checkpoint(progress: &mut ProgressFn<'_>, stage: &str, fraction: f64) -> Result<()> {
+pub(super) fn checkpoint(progress: &mut ProgressFn<'_>, stage: &str, fraction: f64) -> Result<()> {
     if progress(Progress { stage, fraction }) {
         Ok(())
     } else {
@@ -941,18 +944,23 @@ impl Problem {
         // measured on the knight and the torus (50 frames): refactoring every iteration,
         // every 5 and every 20 gave 6.4 / 4.5 / 5.8 s and 16.6 / 9.2 / 8.9 s
         const REFACTOR_EVERY: usize = 5;
-        // CG iterations between two cancellation points (issue 15; one is a few milliseconds
-        // on 10⁴ unknowns per frame)
-        const CG_PER_TICK: usize = 16;
+        // CG iterations between two cancellation points (issue 15): one took 22–30 ms at load
+        // 7 on spot 1k × 50 frames, so 16 left gaps of 0.5 s; 4 keep them near 0.1 s
+        const CG_PER_TICK: usize = 4;
         let blocks = self.frame_blocks()?;
+        checkpoint(progress, "interpolate", 0.0)?;
         let (mut factorizations, mut cg_iterations) = (0usize, 0usize);
         // initial guess: the minimizer of the quadratic part K alone (E_unit's projected
         // Hessian vanishes at z = 0), normalized per vertex
         let mut x = self.start_vector();
         {
             let (_, g0) = self.evaluate(&x, true);
+            checkpoint(progress, "interpolate", 0.0)?;
             let g = to_real(&g0);
-            let pre = blocks.factor(|_, _| [0.0; 3])?;
+            let pre = blocks.factor(|_, _| [0.0; 3], &mut || {
+                checkpoint(progress, "interpolate", 0.0)
+            })?;
+            checkpoint(progress, "interpolate", 0.0)?;
             factorizations += self.n_frames - 1;
             let kv = |v: &[f64], y: &mut [f64]| blocks.k_matvec(v, y);
             let tol = 1e-6 * dot_n(&g, &g).sqrt();
@@ -991,10 +999,13 @@ impl Problem {
             // The preconditioner only shapes CG and the trust region: it is refactored when it is
             // `REFACTOR_EVERY` iterations old or CG needed many iterations with it.
             if pre.is_none() || since_factor >= REFACTOR_EVERY || last_cg > 20 {
-                pre = Some(blocks.factor(|n, j| {
-                    let u = (n - 1) * self.n_v + j;
-                    self.unit_block_at(u, x[u], HessianModel::Projected)
-                })?);
+                pre = Some(blocks.factor(
+                    |n, j| {
+                        let u = (n - 1) * self.n_v + j;
+                        self.unit_block_at(u, x[u], HessianModel::Projected)
+                    },
+                    &mut || log.tick(progress),
+                )?);
                 factorizations += self.n_frames - 1;
                 since_factor = 0;
                 log.tick(progress)?;
@@ -1030,6 +1041,8 @@ impl Problem {
                     .map(|(&xi, d)| xi + Complex::new(d[0], d[1]))
                     .collect();
                 let f1 = self.evaluate(&trial, false).0.total();
+                // after the trial's evaluation: the next one (with gradient) follows (issue 15)
+                log.tick(progress)?;
                 let rho = if predicted > 0.0 {
                     (f0 - f1) / predicted
                 } else {

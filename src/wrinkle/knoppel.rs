@@ -30,8 +30,8 @@ use super::topology::Topology;
 use crate::geom::Vec3;
 use crate::report::{StageTimes, StatEntries};
 use crate::solve::{
-    assemble, inverse_iteration, Cholesky, CholeskyAnalysis, Entry, InverseIterationParams,
-    Parallelism, ShiftSchedule, ShiftedProblem,
+    assemble, inverse_iteration_with_stop, Cholesky, CholeskyAnalysis, Entry, InverseIterationInfo,
+    InverseIterationParams, Parallelism, ShiftSchedule, ShiftedProblem,
 };
 use crate::{Error, Result};
 
@@ -108,11 +108,16 @@ impl KnoppelReport {
 
 /// Knöppel et al. 2015 phase `z̃` (unit per vertex) for the one-form `omega` (EdgeList
 /// orientation) on the mesh of `topo` with positions `x`. See the [module docs](self).
-pub(crate) fn knoppel_phase(
+///
+/// `tick` is a cancellation point (issue 15), run after the factorization and before each
+/// inverse iteration after the first; its error is returned as is. It does not change the
+/// result.
+pub(crate) fn knoppel_phase_with_tick(
     topo: &Topology,
     x: &[[f64; 3]],
     omega: &[f64],
     opts: &KnoppelOptions,
+    tick: &mut dyn FnMut() -> Result<()>,
 ) -> Result<(Vec<Complex>, KnoppelReport)> {
     let n = topo.n_vertices;
     let (edge_area, vertex_area) = barycentric_areas(topo, x);
@@ -124,6 +129,7 @@ pub(crate) fn knoppel_phase(
     // the real form: both reals of vertex j carry its mass and its component
     let mass2: Vec<f64> = (0..2 * n).map(|i| mass[i / 2]).collect();
     let llt = factor_shifted(topo, &w, omega, &mass2, opts.shift)?;
+    tick()?;
     let sigma = llt.info().shift;
     let (comp, n_comp) = components(topo);
     let problem = ShiftedProblem {
@@ -141,7 +147,7 @@ pub(crate) fn knoppel_phase(
         max_iterations: opts.max_iterations,
         tolerance: opts.tolerance,
     };
-    let (u, info) = inverse_iteration(&problem, start, &params)?;
+    let (u, info) = iterate_with_tick(&problem, start, &params, tick)?;
     let report = KnoppelReport {
         eigenvalue: info
             .eigenvalues
@@ -154,6 +160,29 @@ pub(crate) fn knoppel_phase(
         stages: StageTimes::default(),
     };
     Ok((normalize_per_vertex(&u), report))
+}
+
+/// [`inverse_iteration_with_stop`] with `tick` as its cancellation point: the error of `tick`
+/// when it fails, the iteration's (as [`Error::Numerical`](crate::Error)) when a step is not
+/// finite.
+pub(crate) fn iterate_with_tick<F: Fn(&[f64]) -> Vec<f64>>(
+    problem: &ShiftedProblem<'_, F>,
+    start: Vec<f64>,
+    params: &InverseIterationParams,
+    tick: &mut dyn FnMut() -> Result<()>,
+) -> Result<(Vec<f64>, InverseIterationInfo)> {
+    let mut stopped = None;
+    let mut stop = |_| match tick() {
+        Ok(()) => false,
+        Err(e) => {
+            stopped = Some(e);
+            true
+        }
+    };
+    match inverse_iteration_with_stop(problem, start, params, &mut stop) {
+        Some(r) => Ok(r?),
+        None => Err(stopped.unwrap_or(crate::Error::Cancelled)),
+    }
 }
 
 /// `L_ω u` in the interleaved real form.

@@ -60,8 +60,11 @@ pub use animation::{
 };
 pub use complex::Complex;
 pub use cwf::{one_form_from_vectors, Cwf, FrequencyField, OmegaDecomposition};
-pub use design::{design, DesignOptions, DesignReport, WrinkleSource};
-pub use edit::{edit, EditOptions, EditReport, PhaseCoupling, RegionEdit, DEFAULT_COMPAT_TARGET};
+pub use design::{design, design_with_progress, DesignOptions, DesignReport, WrinkleSource};
+pub use edit::{
+    edit, edit_with_progress, EditOptions, EditReport, PhaseCoupling, RegionEdit,
+    DEFAULT_COMPAT_TARGET,
+};
 pub use evaluate::{EvalOptions, Evaluated};
 pub use interpolate::{
     explicit_omega, interpolate, interpolate_with_progress, linear_interpolation,

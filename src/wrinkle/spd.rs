@@ -20,8 +20,20 @@ pub(crate) fn solve_spd(
     rhs: &[f64],
     what: &str,
 ) -> Result<(Vec<f64>, f64)> {
+    let mut x = solve_spd_many(dim, entries, &[rhs], what)?;
+    Ok(x.pop().expect("one right-hand side"))
+}
+
+/// [`solve_spd`] for several right-hand sides on one factorization (each result as
+/// [`solve_spd`] would give it, bit for bit).
+pub(crate) fn solve_spd_many(
+    dim: usize,
+    entries: &[Entry],
+    rhs: &[&[f64]],
+    what: &str,
+) -> Result<Vec<(Vec<f64>, f64)>> {
     if dim == 0 {
-        return Ok((Vec::new(), 0.0));
+        return Ok(rhs.iter().map(|_| (Vec::new(), 0.0)).collect());
     }
     let a = assemble(dim, entries, what)?;
     let an = CholeskyAnalysis::new(&a)?;
@@ -42,20 +54,34 @@ pub(crate) fn solve_spd(
                 })?
         }
     };
-    let x = llt.solve(rhs);
-    if !x.iter().all(|v| v.is_finite()) {
-        return Err(Error::Numerical(format!("{what}: the solve is not finite")));
-    }
-    let mut nx = vec![0.0; dim];
-    sym_matvec_lower_into(&a, &x, &mut nx);
+    rhs.iter()
+        .map(|b| {
+            let x = llt.solve(b);
+            if !x.iter().all(|v| v.is_finite()) {
+                return Err(Error::Numerical(format!("{what}: the solve is not finite")));
+            }
+            let residual = relative_residual(&a, &x, b);
+            Ok((x, residual))
+        })
+        .collect()
+}
+
+/// `‖N x − b‖ / ‖b‖` (`‖N x‖` when `b = 0`) for `N` stored as its lower triangle.
+fn relative_residual(a: &SparseMatrix, x: &[f64], b: &[f64]) -> f64 {
+    let mut nx = vec![0.0; x.len()];
+    sym_matvec_lower_into(a, x, &mut nx);
     let num = nx
         .iter()
-        .zip(rhs)
+        .zip(b)
         .map(|(p, q)| (p - q) * (p - q))
         .sum::<f64>()
         .sqrt();
-    let den = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
-    Ok((x, if den > 0.0 { num / den } else { num }))
+    let den = b.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if den > 0.0 {
+        num / den
+    } else {
+        num
+    }
 }
 
 /// The diagonal of a square sparse matrix.

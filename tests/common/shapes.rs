@@ -143,3 +143,24 @@ pub fn scaled(m: &TriMesh, s: [f64; 3]) -> TriMesh {
         .collect();
     TriMesh::new(p, m.triangles().to_vec()).unwrap()
 }
+
+/// `n³` disjoint tiny right triangles (legs 10⁻³) on an `n × n × n` lattice of the unit cube:
+/// `n³` components, `3n³` vertices.
+pub fn tiny_components(n: u32) -> TriMesh {
+    let step = 1.0 / f64::from(n);
+    let mut p = Vec::with_capacity(3 * (n as usize).pow(3));
+    let mut t = Vec::with_capacity((n as usize).pow(3));
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let o = [i, j, k].map(|c| f64::from(c) * step);
+                let v = p.len() as u32;
+                p.push(o);
+                p.push([o[0] + 1e-3, o[1], o[2]]);
+                p.push([o[0], o[1] + 1e-3, o[2]]);
+                t.push([v, v + 1, v + 2]);
+            }
+        }
+    }
+    TriMesh::new(p, t).unwrap()
+}

@@ -233,6 +233,8 @@ for _name, _res, _args in [
     ("pleat_mesh_read_file", _st, (_c.c_char_p, _PP)),
     ("pleat_mesh_write_file", _st, (_P, _c.c_char_p)),
     ("pleat_mesh_check", _st, (_P, _u32, _c.POINTER(_Report))),
+    ("pleat_mesh_check_with_progress", _st, (_P, _u32) + _PROGRESS_ARGS
+     + (_c.POINTER(_Report),)),
     # LOD, cage, offset, stats
     ("pleat_lod_params_default", _LodParams, ()),
     ("pleat_lod_generate", _st, (_P, _c.POINTER(_LodParams)) + _PROGRESS_ARGS
@@ -288,6 +290,13 @@ for _name, _res, _args in [
                                _c.POINTER(_KnoppelParams), _PP)),
     ("pleat_cwf_edit", _st, (_P, _c.POINTER(_RegionEdit), _sz, _c.POINTER(_EditParams), _PP,
                              _c.POINTER(_c.c_uint8))),
+    ("pleat_cwf_design_with_progress", _st, (_P, _c.POINTER(_WrinkleSource), _sz,
+                                             _c.POINTER(_DesignParams),
+                                             _c.POINTER(_KnoppelParams)) + _PROGRESS_ARGS
+     + (_PP,)),
+    ("pleat_cwf_edit_with_progress", _st, (_P, _c.POINTER(_RegionEdit), _sz,
+                                           _c.POINTER(_EditParams)) + _PROGRESS_ARGS
+     + (_PP, _c.POINTER(_c.c_uint8))),
     ("pleat_cwf_get_edit_report", _st, (_P, _c.POINTER(_EditReport))),
     ("pleat_cwf_copy_edit_interface_rings", _st, (_P, _U, _sz)),
     ("pleat_mesh_grow_faces", _st, (_P, _U, _sz, _U, _sz, _u32, _u32, _c.POINTER(_c.c_uint8),
@@ -584,14 +593,22 @@ class Mesh(_Handle):
         _check(_lib.pleat_mesh_copy_edges(self._h, _ptr(out, _c.c_uint32), n))
         return out[:n]
 
-    def check(self, self_intersections=True, weld=False):
+    def check(self, self_intersections=True, weld=False, progress=None):
         """Validity report as a dict: the fields of PleatMeshReport (counts as int, yes/no as
-        bool, bbox_min/bbox_max as tuples). ``weld`` merges exactly coincident vertices first."""
+        bool, bbox_min/bbox_max as tuples). ``weld`` merges exactly coincident vertices first.
+        ``progress(stage, fraction)`` is called on this thread after each phase (stage
+        "check"); return True to cancel (raises PleatError CANCELLED)."""
         r = _Report()
         r.struct_size = _c.sizeof(_Report)
         flags = (0 if self_intersections else _CHECK_SKIP_SELF_INTERSECTIONS) | \
             (_CHECK_WELD if weld else 0)
-        _check(_lib.pleat_mesh_check(self._h, flags, _c.byref(r)))
+        if progress is None:
+            _check(_lib.pleat_mesh_check(self._h, flags, _c.byref(r)))
+        else:
+            relay = _Relay(progress)
+            st = _lib.pleat_mesh_check_with_progress(self._h, flags, relay.fn, None,
+                                                     _c.byref(r))
+            relay.finish(st)
         return _as_dict(r, flags=_REPORT_FLAGS)
 
     def _bake(self, fn, screen_size, progress, kw):
@@ -786,10 +803,12 @@ class Cwf(_Handle):
 
     @classmethod
     def design(cls, base, sources, adjacency="vertex", pin_sources=True, heat_time=1.0,
-               kappa=1.0, gamma=1.0, data_weight=1.0):
+               kappa=1.0, gamma=1.0, data_weight=1.0, progress=None):
         """A keyframe designed from sources (dissertation 3.6.1): ``sources`` is a list of
         ``(vertex, (kx, ky, kz), amplitude, rings)``; omega by the vector heat method,
-        amplitude by eq. 3.25, phase by Knoppel; zero outside the sources' regions."""
+        amplitude by eq. 3.25, phase by Knoppel; zero outside the sources' regions.
+        ``progress(stage, fraction)`` is called on this thread after each step (stage
+        "design"); return True to cancel (raises PleatError CANCELLED)."""
         arr = (_WrinkleSource * max(len(sources), 1))()
         for i, (v, k, a, rings) in enumerate(sources):
             arr[i].vertex, arr[i].rings, arr[i].amplitude = int(v), int(rings), float(a)
@@ -798,14 +817,15 @@ class Cwf(_Handle):
         p.adjacency = _ADJACENCY[adjacency]
         p.pin_sources = 1 if pin_sources else 0
         p.heat_time, p.kappa, p.gamma, p.data_weight = heat_time, kappa, gamma, data_weight
-        h = _P()
-        _check(_lib.pleat_cwf_design(base._h, arr, len(sources), _c.byref(p), None,
-                                     _c.byref(h)))
+        h, relay = _P(), _Relay(progress)
+        st = _lib.pleat_cwf_design_with_progress(base._h, arr, len(sources), _c.byref(p), None,
+                                                 relay.fn, None, _c.byref(h))
+        relay.finish(st)
         return cls(h)
 
     def edit(self, regions, adjacency="vertex", phase="unit", eps_omega=1e-3,
              eps_amplitude=1e-3, gamma=1.0, compat_target=0.3, max_interface_rings=8,
-             edit_weight=1.0):
+             edit_weight=1.0, progress=None):
         """Region edits (dissertation 3.6.2): ``regions`` is a list of dicts with ``faces``
         (triangle ids, e.g. from ``grow_faces``) and optional ``interface_rings`` (3),
         ``rotate`` (radians, 0), ``frequency_scale`` (1), ``amplitude_scale`` (1). Returns
@@ -814,7 +834,9 @@ class Cwf(_Handle):
         ``compat_target`` (radians, default 0.3, 0 = off): widen every interface band by one ring while the
         compatibility RMS over edit + interface edges exceeds it, up to ``max_interface_rings``;
         the edited Cwf's ``edit_report()`` says which widths were used. ``edit_weight`` (>= 1)
-        weights the edit edges' compatibility terms in the phase solve (eq. 3.28)."""
+        weights the edit edges' compatibility terms in the phase solve (eq. 3.28).
+        ``progress(stage, fraction)`` is called on this thread after each step (stage "edit");
+        return True to cancel (raises PleatError CANCELLED)."""
         keep = []
         arr = (_RegionEdit * max(len(regions), 1))()
         for i, r in enumerate(regions):
@@ -834,9 +856,10 @@ class Cwf(_Handle):
         p.edit_weight, p.compat_target = float(edit_weight), float(compat_target)
         p.max_interface_rings = int(max_interface_rings)
         labels = _np.zeros(max(self.triangle_count, 1), dtype=_np.uint8)
-        h = _P()
-        _check(_lib.pleat_cwf_edit(self._h, arr, len(regions), _c.byref(p), _c.byref(h),
-                                   _ptr(labels, _c.c_uint8)))
+        h, relay = _P(), _Relay(progress)
+        st = _lib.pleat_cwf_edit_with_progress(self._h, arr, len(regions), _c.byref(p), relay.fn,
+                                               None, _c.byref(h), _ptr(labels, _c.c_uint8))
+        relay.finish(st)
         return Cwf(h), labels[:self.triangle_count]
 
     def edit_report(self):

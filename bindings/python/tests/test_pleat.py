@@ -111,6 +111,18 @@ def test_check_report(tet):
     assert not r["is_closed"] and r["boundary_edge_count"] == 12 and r["total_genus"] == -1
 
 
+def test_check_progress_and_cancel():
+    soup = pleat.Mesh.from_arrays(*two_boxes())
+    calls = []
+    r = soup.check(weld=True, progress=lambda stage, f: calls.append((stage, f)))
+    assert r == soup.check(weld=True)
+    assert len(calls) >= 7 and all(s == "check" for s, _ in calls)
+    assert [f for _, f in calls] == sorted(f for _, f in calls)
+    with pytest.raises(pleat.PleatError) as e:
+        soup.check(progress=lambda stage, f: True)
+    assert e.value.status == "CANCELLED"
+
+
 def test_weld():
     # the tetrahedron with every triangle on its own vertices: closed only after welding
     V = TET_V[TET_F.ravel()]

@@ -93,3 +93,25 @@ def test_interpolate_locality_flag(grid):
     far[tri[touched[tri].any(axis=1)].ravel()] = False  # also away from the stars
     assert np.array_equal(local[far], a.zeta()[far])
     assert not np.array_equal(free, local)
+
+
+def test_design_and_edit_progress_and_cancel(grid):
+    centre = (N // 2) * N + N // 2
+    calls = []
+    d = pleat.Cwf.design(grid, [(centre, K, 0.02, 4)],
+                         progress=lambda stage, f: calls.append((stage, f)))
+    assert np.array_equal(d.zeta(), pleat.Cwf.design(grid, [(centre, K, 0.02, 4)]).zeta())
+    assert len(calls) > 3 and all(s == "design" for s, _ in calls)
+    with pytest.raises(pleat.PleatError) as e:
+        pleat.Cwf.design(grid, [(centre, K, 0.02, 4)], progress=lambda s, f: True)
+    assert e.value.status == "CANCELLED"
+    a = pleat.Cwf.plane_wave(grid, K, 0.01)
+    faces = pleat.grow_faces(grid, seed_vertices=[centre], rings=3)
+    region = {"faces": faces, "rotate": math.pi / 2}
+    calls.clear()
+    b, labels = a.edit([region], progress=lambda stage, f: calls.append((stage, f)))
+    assert np.array_equal(b.zeta(), a.edit([region])[0].zeta())
+    assert len(calls) > 3 and all(s == "edit" for s, _ in calls)
+    with pytest.raises(pleat.PleatError) as e:
+        a.edit([region], progress=lambda s, f: True)
+    assert e.value.status == "CANCELLED"
