@@ -203,6 +203,9 @@ pub(crate) struct Guard<'a> {
     /// Leaf updates since the BVH was last built (it is rebuilt when they exceed the face
     /// count: incremental edits degrade the tree).
     edits: usize,
+    /// Faces changed by committed collapses whose BVH leaves are not updated yet (see
+    /// [`flush_bvh`](Self::flush_bvh)).
+    pending: Vec<FaceId>,
     pub stats: GuardCounts,
 }
 
@@ -228,6 +231,7 @@ impl<'a> Guard<'a> {
             cone_cos: CONE_HALF_ANGLE.cos(),
             scratch: GuardScratch::default(),
             edits: 0,
+            pending: Vec::new(),
             stats: GuardCounts::default(),
         }
     }
@@ -264,6 +268,7 @@ impl<'a> Guard<'a> {
 
     /// Moves vertex `v` to `p` if the result passes every check; returns whether it did.
     pub fn try_move(&mut self, v: VertexId, p: [f64; 3]) -> Result<(), Reject> {
+        self.flush_bvh();
         let old_p = self.mesh.position(v);
         let mut s = std::mem::take(&mut self.scratch);
         s.old_patch.clear();
@@ -316,14 +321,17 @@ impl<'a> Guard<'a> {
         self.stats.add(&st);
         self.scratch = s;
         r?;
-        Ok(self.commit_collapse(h, p))
+        let rec = self.commit_collapse(h, p);
+        self.flush_bvh();
+        Ok(rec)
     }
 
     /// Checks 2–4 of the module docs for collapsing `h` to `p`, **without changing anything**:
     /// the state after the collapse is read through the unchanged mesh (faces around the
     /// endpoints with the target renamed to the origin, the origin at `p`), so checks of
     /// collapses with disjoint neighbourhoods can run in parallel. `h` must pass
-    /// [`HalfEdgeMesh::can_collapse`]. `st` counts the work.
+    /// [`HalfEdgeMesh::can_collapse`], and the BVH must be current (no commit since the last
+    /// [`flush_bvh`](Self::flush_bvh)). `st` counts the work.
     pub fn check_collapse(
         &self,
         h: HalfedgeId,
@@ -331,51 +339,87 @@ impl<'a> Guard<'a> {
         s: &mut GuardScratch,
         st: &mut GuardCounts,
     ) -> Result<(), Reject> {
+        debug_assert!(self.pending.is_empty(), "check against a stale BVH");
         self.fill_collapse(h, p, s);
         self.check(s, st)
     }
 
-    /// Applies the collapse of `h` to `p` and updates the BVH. Only for a collapse that
+    /// Applies the collapse of `h` to `p`; the BVH follows at the next
+    /// [`flush_bvh`](Self::flush_bvh). Only for a collapse that
     /// `check_collapse` accepted on the current mesh — or on a mesh
     /// that differs from it only by operations outside the collapse's `M_1` whose new faces
     /// were then tested against its `M_e` (see [`patches_intersect`]).
+    ///
+    /// The two removed faces stay in the BVH as dead leaves until its next rebuild (they count
+    /// as edits towards it): every query of the tree skips dead faces, and a parry removal
+    /// (a tree restructuring on the sequential path of the pass) cost more than the skipped
+    /// candidates do.
     pub fn commit_collapse(&mut self, h: HalfedgeId, p: [f64; 3]) -> CollapseRecord {
         let rec = self
             .mesh
             .collapse_edge(h, p)
             .expect("a collapse that passed the guard's checks");
-        for &f in &rec.removed_faces {
-            self.bvh.remove(f.raw());
-        }
         for &f in &rec.modified_faces {
             self.tris[f] = raw_corners(&self.mesh, f);
         }
-        self.bvh.update(
-            self.mesh.positions(),
-            self.tris.as_slice(),
-            FaceId::raw_slice(&rec.modified_faces),
-        );
-        self.note_edits(rec.modified_faces.len() + rec.removed_faces.len());
+        self.pending.extend_from_slice(&rec.modified_faces);
+        self.edits += rec.modified_faces.len() + rec.removed_faces.len();
         rec
+    }
+
+    /// Brings the BVH up to date with the collapses committed since the last flush (leaf
+    /// updates, or a rebuild when the edits exceed the face count). Every check of the guard
+    /// needs it; `try_move` and `try_flip` flush first themselves.
+    pub fn flush_bvh(&mut self) {
+        if !self.pending.is_empty() || self.edits > rebuild_threshold(&self.mesh) {
+            flush_bvh_parts(
+                &self.mesh,
+                &self.tris,
+                &mut self.bvh,
+                &mut self.pending,
+                &mut self.edits,
+            );
+        }
+    }
+
+    /// [`flush_bvh`](Self::flush_bvh) on one thread of the pool while `work` runs on another
+    /// with read access to the mesh (the simplification forms its next batch of collapses,
+    /// which needs no BVH, meanwhile). Returns `work`'s result.
+    pub fn flush_bvh_alongside<R: Send>(
+        &mut self,
+        work: impl FnOnce(&HalfEdgeMesh) -> R + Send,
+    ) -> R {
+        if self.pending.is_empty() && self.edits <= rebuild_threshold(&self.mesh) {
+            return work(&self.mesh);
+        }
+        let Guard {
+            mesh,
+            tris,
+            bvh,
+            pending,
+            edits,
+            ..
+        } = self;
+        let mesh = &*mesh;
+        rayon::join(
+            || flush_bvh_parts(mesh, tris, bvh, pending, edits),
+            || work(mesh),
+        )
+        .1
     }
 
     /// Counts leaf edits and rebuilds the BVH when they exceed the live face count.
     fn note_edits(&mut self, n: usize) {
         self.edits += n;
-        if self.edits > self.mesh.face_count().max(64) {
-            let live: Vec<FaceId> = self.mesh.faces().collect();
-            self.bvh = TriangleBvh::from_subset(
-                self.mesh.positions(),
-                self.tris.as_slice(),
-                FaceId::raw_slice(&live),
-            );
-            self.edits = 0;
+        if self.edits > rebuild_threshold(&self.mesh) {
+            rebuild_bvh(&self.mesh, &self.tris, &mut self.bvh, &mut self.edits);
         }
     }
 
     /// Flips the edge of half-edge `h` (the fit's flips, `fit.rs`) if the result passes every
     /// check; the mesh is unchanged on `Err` (the flip is undone exactly).
     pub fn try_flip(&mut self, h: HalfedgeId) -> Result<(), Reject> {
+        self.flush_bvh();
         if self.mesh.can_flip(h).is_err() {
             self.stats.checks += 1;
             self.stats.rejected_topology += 1;
@@ -663,6 +707,48 @@ impl<'a> Guard<'a> {
         }
         Ok(())
     }
+}
+
+/// Leaf edits after which the guard's BVH is rebuilt rather than updated: the live face count
+/// (at least 64).
+fn rebuild_threshold(mesh: &HalfEdgeMesh) -> usize {
+    mesh.face_count().max(64)
+}
+
+/// Rebuilds the guard's BVH over the live faces (dropping the dead leaves of removed faces).
+fn rebuild_bvh(
+    mesh: &HalfEdgeMesh,
+    tris: &FaceData<[u32; 3]>,
+    bvh: &mut TriangleBvh,
+    edits: &mut usize,
+) {
+    let live: Vec<FaceId> = mesh.faces().collect();
+    *bvh = TriangleBvh::from_subset(mesh.positions(), tris.as_slice(), FaceId::raw_slice(&live));
+    *edits = 0;
+}
+
+/// The work of [`Guard::flush_bvh`] on the guard's parts: a rebuild when due, else the leaf
+/// updates of the pending live faces.
+fn flush_bvh_parts(
+    mesh: &HalfEdgeMesh,
+    tris: &FaceData<[u32; 3]>,
+    bvh: &mut TriangleBvh,
+    pending: &mut Vec<FaceId>,
+    edits: &mut usize,
+) {
+    if *edits > rebuild_threshold(mesh) {
+        rebuild_bvh(mesh, tris, bvh, edits);
+    } else {
+        pending.sort_unstable();
+        pending.dedup();
+        pending.retain(|&f| mesh.is_face_live(f));
+        bvh.update(
+            mesh.positions(),
+            tris.as_slice(),
+            FaceId::raw_slice(pending),
+        );
+    }
+    pending.clear();
 }
 
 /// Plane separations below this fraction of `l` never skip a candidate of the clearance

@@ -44,6 +44,7 @@ use super::guard::{bbox, boxes_overlap, patches_intersect, Guard, GuardScratch};
 use super::report::{GuardCounts, SimplifyCounts};
 use crate::geom::{normalized, tri_normal, Vec3};
 use crate::mesh::halfedge::{EdgeData, EdgeId, FaceData, FaceId, HalfedgeId, VertexData, VertexId};
+use crate::mesh::HalfEdgeMesh;
 use crate::spatial::closest::{for_each_sample, point_triangle_distance, sample_resolution};
 use crate::{Error, Result};
 
@@ -231,6 +232,7 @@ struct Queue {
 
 impl Queue {
     /// A queue for edge ids below `edges`.
+    #[cfg(test)]
     fn with_capacity(edges: usize) -> Queue {
         Queue {
             v: Vec::with_capacity(edges),
@@ -240,6 +242,23 @@ impl Queue {
 
     fn len(&self) -> usize {
         self.v.len()
+    }
+
+    /// A queue holding `entries` (one per edge, edge ids below `edges`), built bottom-up in
+    /// linear time. Entries are totally ordered by [`Entry::before`], so the pops are the same
+    /// as after pushing them one by one.
+    fn from_entries(edges: usize, entries: Vec<Entry>) -> Queue {
+        let mut q = Queue {
+            v: entries,
+            slot: EdgeData::filled(edges, NOT_QUEUED),
+        };
+        for (i, e) in q.v.iter().enumerate() {
+            q.slot[e.edge] = i as u32;
+        }
+        for i in (0..q.v.len().div_ceil(4)).rev() {
+            q.sift_down(i);
+        }
+        q
     }
 
     /// Queues `e.edge` with cost `e.cost`, or moves it there when already queued.
@@ -338,11 +357,21 @@ struct Pass<'g, 'a> {
     opt: SimplifyOptions,
     quadrics: VertexData<Quadric>,
     targets: EdgeData<Vec3>,
-    heap: Queue,
+    /// The queue and the batch formation.
+    batcher: Batcher,
     /// Sampled distance to the input per face (NaN mean = not computed yet).
     face_dist: FaceData<FaceDist>,
     /// Distance to the input per vertex (NaN = not computed yet).
     vert_dist: VertexData<f64>,
+    scratch: GuardScratch,
+    report: SimplifyCounts,
+}
+
+/// The collapse queue and the formation of batches from it (see [`Pass::run`]). Needs only
+/// read access to the mesh, so a batch is formed while the guard's BVH catches up with the
+/// previous one ([`Guard::flush_bvh_alongside`]).
+struct Batcher {
+    heap: Queue,
     /// Vertex marks of the batch being formed: `mark_w[v] == epoch` ⇔ `v` is written by a
     /// selected collapse (endpoint or one-ring), `mark_r[v] == epoch` ⇔ `v` is read by one (its
     /// two-ring, which holds the vertices of its `M_1`).
@@ -351,8 +380,87 @@ struct Pass<'g, 'a> {
     epoch: u32,
     /// Scratch: the vertices `W` of a candidate's footprint.
     footprint: Vec<VertexId>,
-    scratch: GuardScratch,
-    report: SimplifyCounts,
+    /// Entries popped so far (cancellation polling).
+    pops: u64,
+    /// Scratch: popped entries that overlap the batch.
+    deferred: Vec<Entry>,
+}
+
+impl Batcher {
+    /// Forms the next batch into `batch` (see [`Pass::run`]): pops entries in queue order,
+    /// skips dead edges, keeps up to `cap` collapses with disjoint neighbourhoods (any one
+    /// when `cap` is 1) and puts the overlapping ones (at most `cap`) back.
+    fn form(&mut self, m: &HalfEdgeMesh, cap: usize, batch: &mut Vec<EdgeId>) {
+        self.new_epoch();
+        batch.clear();
+        let mut deferred = std::mem::take(&mut self.deferred);
+        while batch.len() < cap && deferred.len() < cap {
+            let Some(entry) = self.heap.pop() else { break };
+            self.pops += 1;
+            let e = entry.edge;
+            if !m.is_edge_live(e) {
+                continue;
+            }
+            if cap > 1 && !self.reserve(m, e) {
+                deferred.push(entry);
+                continue;
+            }
+            batch.push(e);
+        }
+        for d in deferred.drain(..) {
+            self.heap.push(d);
+        }
+        self.deferred = deferred;
+    }
+
+    /// Starts a new batch (clears the vertex marks).
+    fn new_epoch(&mut self) {
+        self.epoch = self.epoch.wrapping_add(1);
+        if self.epoch == 0 {
+            self.mark_w.fill(0);
+            self.mark_r.fill(0);
+            self.epoch = 1;
+        }
+    }
+
+    /// Adds the collapse of edge `e` to the batch being formed if its neighbourhood is
+    /// disjoint from the batch's: it writes its endpoints and their one-ring `W` (positions,
+    /// connectivity, cached distances) and reads `W`'s one-ring `R` (the vertices of its guard
+    /// neighbourhood `M_1`). It joins when `W ∩ R' = ∅` and `R ∩ W' = ∅` for the batch's `W'`,
+    /// `R'`; then no collapse of the batch changes anything another one reads except through
+    /// the BVH, which [`Pass::run`] handles.
+    fn reserve(&mut self, m: &HalfEdgeMesh, e: EdgeId) -> bool {
+        let h = m.edge_halfedge(e);
+        let (a, b) = (m.origin(h), m.target(h));
+        let ep = self.epoch;
+        // W first, then the rest of R (with repeats).
+        let mut fp = std::mem::take(&mut self.footprint);
+        fp.clear();
+        fp.extend([a, b]);
+        fp.extend(m.vertex_neighbors(a));
+        fp.extend(m.vertex_neighbors(b));
+        let n_w = fp.len();
+        let mut free = true;
+        for i in 0..n_w {
+            let v = fp[i];
+            if self.mark_r[v] == ep {
+                free = false;
+                break;
+            }
+            fp.extend(m.vertex_neighbors(v));
+        }
+        free = free && fp[n_w..].iter().all(|&u| self.mark_w[u] != ep);
+        if free {
+            for &v in &fp[..n_w] {
+                self.mark_w[v] = ep;
+            }
+            for &v in &fp {
+                self.mark_r[v] = ep;
+            }
+        }
+        self.footprint = fp;
+        free
+    }
 }
 
 /// A candidate collapse that passed every check (see [`Pass::evaluate`]).
@@ -361,6 +469,8 @@ struct Accepted {
     a: VertexId,
     b: VertexId,
     x: Vec3,
+    /// Distance of `x` to the input (becomes `a`'s cached distance).
+    dx: f64,
     new: Patch,
     new_face_dist: Vec<FaceDist>,
 }
@@ -410,22 +520,47 @@ impl<'g, 'a> Pass<'g, 'a> {
             targets: EdgeData::filled(m.edge_capacity(), Vec3::ZERO),
             face_dist: FaceData::filled(m.face_capacity(), FaceDist::UNKNOWN),
             vert_dist: VertexData::filled(m.vertex_capacity(), f64::NAN),
-            mark_w: VertexData::filled(m.vertex_capacity(), 0),
-            mark_r: VertexData::filled(m.vertex_capacity(), 0),
-            epoch: 0,
-            footprint: Vec::new(),
-            heap: Queue::with_capacity(m.edge_capacity()),
+            batcher: Batcher {
+                heap: Queue::default(),
+                mark_w: VertexData::filled(m.vertex_capacity(), 0),
+                mark_r: VertexData::filled(m.vertex_capacity(), 0),
+                epoch: 0,
+                footprint: Vec::new(),
+                pops: 0,
+                deferred: Vec::new(),
+            },
             scratch: GuardScratch::default(),
             quadrics,
             opt,
             report: SimplifyCounts::default(),
             g,
         };
-        let edges: Vec<EdgeId> = pass.g.mesh().edges().collect();
-        for e in edges {
-            pass.push(e);
-        }
+        pass.queue_all_edges();
         pass
+    }
+
+    /// Fills the queue with every edge: targets and costs computed in parallel (each depends
+    /// only on its edge), then one bottom-up heap build.
+    fn queue_all_edges(&mut self) {
+        let m = self.g.mesh();
+        let edges: Vec<EdgeId> = m.edges().collect();
+        let quadrics = &self.quadrics;
+        let targets: Vec<(Vec3, f64)> = edges
+            .par_iter()
+            .with_min_len(1024)
+            .map(|&e| {
+                let h = m.edge_halfedge(e);
+                let (a, b) = (m.origin(h), m.target(h));
+                let q = quadrics[a].add(&quadrics[b]);
+                collapse_target(&q, m.position(a).into(), m.position(b).into())
+            })
+            .collect();
+        let mut entries = Vec::with_capacity(edges.len());
+        for (&e, &(target, cost)) in edges.iter().zip(&targets) {
+            self.targets[e] = target;
+            entries.push(Entry { cost, edge: e });
+        }
+        self.batcher.heap = Queue::from_entries(m.edge_capacity(), entries);
     }
 
     fn target_reached(&self) -> bool {
@@ -441,7 +576,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         let q = self.quadrics[a].add(&self.quadrics[b]);
         let (target, cost) = collapse_target(&q, m.position(a).into(), m.position(b).into());
         self.targets[e] = target;
-        self.heap.push(Entry { cost, edge: e });
+        self.batcher.heap.push(Entry { cost, edge: e });
     }
 
     /// The queue loop. Candidates are taken in cost order in **batches** of collapses whose
@@ -456,11 +591,20 @@ impl<'g, 'a> Pass<'g, 'a> {
     /// candidate is evaluated again against the current mesh. The batches depend only on the
     /// queue and the mesh, never on the thread count, so the output is the same for any number
     /// of threads.
+    ///
+    /// The guard's BVH follows the collapses of a batch while the next batch is formed (the
+    /// formation reads only the mesh and the queue), and before any re-evaluation.
     fn run(&mut self, keep_going: &mut dyn FnMut(f64) -> bool) -> Result<()> {
-        let total = self.heap.len().max(1) as f64;
-        let mut pops = 0u64;
+        let r = self.run_batches(keep_going);
+        self.g.flush_bvh();
+        r
+    }
+
+    /// The loop of [`run`](Self::run); the BVH may be stale when it returns.
+    fn run_batches(&mut self, keep_going: &mut dyn FnMut(f64) -> bool) -> Result<()> {
+        let total = self.batcher.heap.len().max(1) as f64;
+        let mut polled = 0u64;
         let mut batch: Vec<EdgeId> = Vec::with_capacity(BATCH);
-        let mut deferred: Vec<Entry> = Vec::with_capacity(BATCH);
         let mut applied: Vec<(Vec<[[f64; 3]; 3]>, Aabb)> = Vec::with_capacity(BATCH);
         'pass: while !self.target_reached() {
             let cap = if self.g.mesh().face_count() >= BATCH_MIN_FACES {
@@ -468,27 +612,15 @@ impl<'g, 'a> Pass<'g, 'a> {
             } else {
                 1
             };
-            self.new_epoch();
-            batch.clear();
-            deferred.clear();
-            while batch.len() < cap && deferred.len() < cap {
-                let Some(entry) = self.heap.pop() else { break };
-                pops += 1;
-                if pops % 512 == 0 && !keep_going((pops as f64 / total).min(1.0)) {
+            let batcher = &mut self.batcher;
+            let out = &mut batch;
+            self.g.flush_bvh_alongside(|m| batcher.form(m, cap, out));
+            let pops = self.batcher.pops;
+            if pops / 512 > polled {
+                polled = pops / 512;
+                if !keep_going((pops as f64 / total).min(1.0)) {
                     return Err(Error::Cancelled);
                 }
-                let e = entry.edge;
-                if !self.g.mesh().is_edge_live(e) {
-                    continue;
-                }
-                if cap > 1 && !self.reserve(e) {
-                    deferred.push(entry);
-                    continue;
-                }
-                batch.push(e);
-            }
-            for d in deferred.drain(..) {
-                self.heap.push(d);
             }
             if batch.is_empty() {
                 break;
@@ -524,6 +656,7 @@ impl<'g, 'a> Pass<'g, 'a> {
                 if meets {
                     self.report.rechecked += 1;
                     self.fill_caches(&mut ev);
+                    self.g.flush_bvh();
                     let mut s = std::mem::take(&mut self.scratch);
                     ev = self.evaluate(e, &mut s);
                     self.scratch = s;
@@ -536,56 +669,6 @@ impl<'g, 'a> Pass<'g, 'a> {
             }
         }
         Ok(())
-    }
-
-    /// Starts a new batch (clears the vertex marks).
-    fn new_epoch(&mut self) {
-        self.epoch = self.epoch.wrapping_add(1);
-        if self.epoch == 0 {
-            self.mark_w.fill(0);
-            self.mark_r.fill(0);
-            self.epoch = 1;
-        }
-    }
-
-    /// Adds the collapse of edge `e` to the batch being formed if its neighbourhood is
-    /// disjoint from the batch's: it writes its endpoints and their one-ring `W` (positions,
-    /// connectivity, cached distances) and reads `W`'s one-ring `R` (the vertices of its guard
-    /// neighbourhood `M_1`). It joins when `W ∩ R' = ∅` and `R ∩ W' = ∅` for the batch's `W'`,
-    /// `R'`; then no collapse of the batch changes anything another one reads except through
-    /// the BVH, which [`run`](Self::run) handles.
-    fn reserve(&mut self, e: EdgeId) -> bool {
-        let m = self.g.mesh();
-        let h = m.edge_halfedge(e);
-        let (a, b) = (m.origin(h), m.target(h));
-        let ep = self.epoch;
-        // W first, then the rest of R (with repeats).
-        let mut fp = std::mem::take(&mut self.footprint);
-        fp.clear();
-        fp.extend([a, b]);
-        fp.extend(m.vertex_neighbors(a));
-        fp.extend(m.vertex_neighbors(b));
-        let n_w = fp.len();
-        let mut free = true;
-        for i in 0..n_w {
-            let v = fp[i];
-            if self.mark_r[v] == ep {
-                free = false;
-                break;
-            }
-            fp.extend(m.vertex_neighbors(v));
-        }
-        free = free && fp[n_w..].iter().all(|&u| self.mark_w[u] != ep);
-        if free {
-            for &v in &fp[..n_w] {
-                self.mark_w[v] = ep;
-            }
-            for &v in &fp {
-                self.mark_r[v] = ep;
-            }
-        }
-        self.footprint = fp;
-        free
     }
 
     /// Checks the collapse of edge `e` without changing anything, trying the quadric optimum
@@ -651,7 +734,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         if !self.within_hausdorff(a, b, x, &old, &new) {
             return Err(Rejection::Hausdorff);
         }
-        let Some(new_face_dist) = self.distance_not_increased(a, b, x, &old, &new, ev) else {
+        let Some((new_face_dist, dx)) = self.distance_not_increased(a, b, x, &old, &new, ev) else {
             return Err(Rejection::Distance);
         };
         self.g
@@ -662,6 +745,7 @@ impl<'g, 'a> Pass<'g, 'a> {
             a,
             b,
             x,
+            dx,
             new,
             new_face_dist,
         })
@@ -684,13 +768,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         match ev.outcome {
             Ok(acc) => {
                 let rec = self.g.commit_collapse(acc.h, acc.x.to_array());
-                self.commit(
-                    acc.a,
-                    acc.b,
-                    &rec.modified_faces,
-                    &acc.new,
-                    &acc.new_face_dist,
-                );
+                self.commit(&acc, &rec.modified_faces);
             }
             Err(Rejection::Fold) => self.report.rejected_fold += 1,
             Err(Rejection::Hausdorff) => self.report.rejected_hausdorff += 1,
@@ -869,7 +947,7 @@ impl<'g, 'a> Pass<'g, 'a> {
     /// the old patch's (or the slack). The patch distance is the area-weighted mean of the
     /// faces' sampled mean distances (see the module docs for why not the maximum). Also the
     /// drift cap: no new sample farther than `max(DRIFT_CAP·d, old patch's farthest sample)`.
-    /// Returns the new faces' distances when both hold.
+    /// Returns the new faces' distances and the distance of `x` when both hold.
     fn distance_not_increased(
         &self,
         a: VertexId,
@@ -878,7 +956,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         old: &Patch,
         new: &Patch,
         ev: &mut Eval,
-    ) -> Option<Vec<FaceDist>> {
+    ) -> Option<(Vec<FaceDist>, f64)> {
         let (mut old_sum, mut old_area, mut old_max) = (0.0, 0.0, 0.0f64);
         for i in 0..old.ids.len() {
             let w = area_vector(&old.tris[i]).length();
@@ -925,23 +1003,19 @@ impl<'g, 'a> Pass<'g, 'a> {
         } else {
             0.0
         };
-        (new_mean <= limit).then_some(out)
+        (new_mean <= limit).then_some((out, dx))
     }
 
-    /// Book-keeping after an accepted collapse of `b` into `a`.
-    fn commit(
-        &mut self,
-        a: VertexId,
-        b: VertexId,
-        modified: &[FaceId],
-        new: &Patch,
-        fd: &[FaceDist],
-    ) {
+    /// Book-keeping after the accepted collapse `acc` of `b` into `a`. The distance of `a`'s
+    /// new position was computed by the check (`InputModel::distance_bounded` returns the
+    /// exact distance whatever the bound), so it is cached rather than queried again.
+    fn commit(&mut self, acc: &Accepted, modified: &[FaceId]) {
+        let (a, b, new) = (acc.a, acc.b, &acc.new);
         self.report.collapses += 1;
         self.quadrics[a] = self.quadrics[a].add(&self.quadrics[b]);
-        self.vert_dist[a] = f64::NAN;
+        self.vert_dist[a] = acc.dx;
         for (i, &f) in new.ids.iter().enumerate() {
-            self.face_dist[f] = fd[i];
+            self.face_dist[f] = acc.new_face_dist[i];
         }
         debug_assert!(modified.iter().all(|f| new.ids.contains(f)));
         let m = self.g.mesh();
@@ -1052,6 +1126,36 @@ mod tests {
             live.remove(&want.1);
         }
         assert!(live.is_empty());
+    }
+
+    /// The bottom-up build pops exactly what pushing the entries one by one pops.
+    #[test]
+    fn queue_built_at_once_pops_like_pushes() {
+        let mut x = 777u64;
+        let mut next = || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            x >> 33
+        };
+        for n in [0usize, 1, 2, 5, 17, 1000] {
+            let entries: Vec<Entry> = (0..n as u32)
+                .map(|i| Entry {
+                    cost: (next() % 40) as f64,
+                    edge: EdgeId::new(i),
+                })
+                .collect();
+            let mut pushed = Queue::with_capacity(n);
+            for &e in &entries {
+                pushed.push(e);
+            }
+            let mut built = Queue::from_entries(n, entries);
+            while let Some(want) = pushed.pop() {
+                let got = built.pop().unwrap();
+                assert_eq!((got.cost, got.edge), (want.cost, want.edge));
+            }
+            assert!(built.pop().is_none());
+        }
     }
 
     #[test]
