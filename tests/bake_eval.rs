@@ -294,15 +294,18 @@ fn distance(p: &[[f64; 2]; 3], c: [f64; 2]) -> f64 {
 }
 
 /// Chart of every level-0 texel: the chart whose triangle covers its centre, or lies within
-/// [`REACH`] of it (the bake samples those too), else (gutter)
-/// the chart of the nearest covered texel by a 4-neighbour breadth-first search — which chart
-/// a correct dilation copies there. Charts are the components of triangles sharing an edge
-/// with the same UVs at both ends.
+/// [`REACH`] of it (the bake samples those too), else (gutter) the chart whose texel the
+/// bake's documented dilation copies there: a 4-neighbour breadth-first search from the
+/// covered texels in which a texel of a `2^m`-block owned by one chart's bilinear footprint
+/// (`pleat::bake::atlas::footprint_owners`, `m` = the rule's deepest mip 2) takes only
+/// that chart's texels, then the nearest assigned texel for what is left. Charts are the
+/// components of triangles sharing a vertex UV.
 fn texel_charts(level: &BakedLevel) -> (Vec<u32>, Vec<u32>) {
+    use pleat::bake::atlas::{footprint_owners, BLOCK_FREE, BLOCK_SHARED};
     let uvs = level.uvs.as_ref().unwrap();
     let side = level.material.base_color.as_ref().unwrap().width as usize;
     let tris = &level.triangles;
-    // Union-find over triangles by shared UV edges.
+    // Union-find over triangles by shared UV points.
     let mut parent: Vec<u32> = (0..tris.len() as u32).collect();
     fn find(p: &mut [u32], mut x: u32) -> u32 {
         while p[x as usize] != x {
@@ -312,16 +315,14 @@ fn texel_charts(level: &BakedLevel) -> (Vec<u32>, Vec<u32>) {
         x
     }
     let key = |v: u32| uvs[v as usize].map(f32::to_bits);
-    let mut edges = std::collections::HashMap::new();
+    let mut first = std::collections::HashMap::new();
     for (t, tri) in tris.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (key(tri[k]), key(tri[(k + 1) % 3]));
-            let e = if a < b { (a, b) } else { (b, a) };
-            if let Some(&o) = edges.get(&e) {
+        for &v in tri {
+            if let Some(&o) = first.get(&key(v)) {
                 let (x, y) = (find(&mut parent, o), find(&mut parent, t as u32));
                 parent[x.max(y) as usize] = x.min(y);
             } else {
-                edges.insert(e, t as u32);
+                first.insert(key(v), t as u32);
             }
         }
     }
@@ -358,27 +359,40 @@ fn texel_charts(level: &BakedLevel) -> (Vec<u32>, Vec<u32>) {
             }
         }
     }
+    let m = pleat::bake::atlas::deepest_mip(2.0);
+    let uv = |v: u32| uvs[v as usize].map(|c| f64::from(c) * s);
+    let blocks = footprint_owners(side as u32, m, tris, &uv, &chart);
+    let (b, nb) = (1usize << m, side.div_ceil(1 << m));
+    let takes = |k: usize, c: u32| {
+        let o = blocks[(k / side / b) * nb + (k % side) / b];
+        o == BLOCK_FREE || o == BLOCK_SHARED || o == c
+    };
     let mut queue: std::collections::VecDeque<usize> =
         (0..owner.len()).filter(|&k| owner[k] != u32::MAX).collect();
-    while let Some(k) = queue.pop_front() {
-        let (i, j) = (k % side, k / side);
-        let mut near = vec![];
-        if i > 0 {
-            near.push(k - 1);
+    for pass in 0..2 {
+        if pass == 1 {
+            queue.extend((0..owner.len()).filter(|&k| owner[k] != u32::MAX));
         }
-        if i + 1 < side {
-            near.push(k + 1);
-        }
-        if j > 0 {
-            near.push(k - side);
-        }
-        if j + 1 < side {
-            near.push(k + side);
-        }
-        for m in near {
-            if owner[m] == u32::MAX {
-                owner[m] = owner[k];
-                queue.push_back(m);
+        while let Some(k) = queue.pop_front() {
+            let (i, j) = (k % side, k / side);
+            let mut near = vec![];
+            if i > 0 {
+                near.push(k - 1);
+            }
+            if i + 1 < side {
+                near.push(k + 1);
+            }
+            if j > 0 {
+                near.push(k - side);
+            }
+            if j + 1 < side {
+                near.push(k + side);
+            }
+            for n in near {
+                if owner[n] == u32::MAX && (pass == 1 || takes(n, owner[k])) {
+                    owner[n] = owner[k];
+                    queue.push_back(n);
+                }
             }
         }
     }
@@ -674,5 +688,76 @@ fn chain_speed() {
             sum(|r| r.measure_seconds),
             (g + chain.bake_seconds + png) / g
         );
+    }
+}
+
+// ------------------------------------------------------------------------- seam levers --
+
+/// The n_p = 200 LOD of `app` (as `bake_chain` makes it), cached bit-exactly as PLY in
+/// `target/bake_eval/lod_<name>_200.ply` so parameter sweeps of the bake skip the geometry.
+fn cached_lod(name: &str, app: &Appearance) -> pleat::mesh::TriMesh {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/bake_eval");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("lod_{name}_200.ply"));
+    if let Ok(m) = pleat::mesh::io::read_mesh(&path) {
+        return m;
+    }
+    let chain =
+        pleat::lowpoly::generate_chain(&app.mesh, &[200.0], &LodParams::default(), &mut |_| true)
+            .unwrap();
+    let lod = chain.into_iter().next().unwrap().0;
+    pleat::mesh::io::write_mesh(&path, &lod).unwrap();
+    lod
+}
+
+/// Sweep of the gutter levers (`PLEAT_ASSETS` picks assets, `PLEAT_LEVERS` the
+/// `padding:block_align` pairs, e.g. `15:0,8:0,8:1`): per asset and lever, the texture size,
+/// charts, padding used, mip-2 mixing and PSNR at n_p = 200 (the README's lever table).
+#[test]
+#[ignore = "parameter sweep for the README; run with --release"]
+fn seam_levers() {
+    let Some(dir) = assets() else { return };
+    let names = std::env::var("PLEAT_ASSETS").unwrap_or("gen_teapot_vertexcolor.glb".into());
+    let levers = std::env::var("PLEAT_LEVERS").unwrap_or("15:0".into());
+    for name in names.split(',') {
+        let app = read_appearance(&dir.join(name)).unwrap();
+        let lod = cached_lod(name, &app);
+        let index = pleat::bake::InputIndex::new(&app.mesh);
+        for lever in levers.split(',').filter(|s| !s.is_empty()) {
+            let (p, b) = lever.split_once(':').unwrap();
+            let mut params = eval_params();
+            params.atlas.padding = p.parse().unwrap();
+            params.atlas.block_align = b == "1";
+            let level = pleat::bake::bake_level(&app, &index, &lod, 200.0, &params).unwrap();
+            let r = &level.report;
+            let mixed: Vec<String> = (0..=3)
+                .map(|l| {
+                    let (bad, total) = seam_violations(&level, l);
+                    format!("{:.2}", 100.0 * bad as f64 / total as f64)
+                })
+                .collect();
+            let zero = level
+                .triangles
+                .iter()
+                .filter(|t| {
+                    let u = t.map(|v| level.uvs.as_ref().unwrap()[v as usize].map(f64::from));
+                    (u[1][0] - u[0][0]) * (u[2][1] - u[0][1])
+                        == (u[2][0] - u[0][0]) * (u[1][1] - u[0][1])
+                })
+                .count();
+            println!(
+                "{name} padding {p} align {b}: {}² charts {} used {} clean mip {:?} overlapping {} \
+                 zero-area {zero} mixed % mip0..3 {} PSNR {:.2} ref {:.2} bake {:.2} s",
+                r.texture_size,
+                r.charts,
+                r.atlas_padding,
+                r.seam_clean_mip,
+                r.overlapping_texels,
+                mixed.join("/"),
+                r.appearance_psnr_db.unwrap_or(f64::NAN),
+                r.appearance_psnr_reference_db.unwrap_or(f64::NAN),
+                r.total_seconds
+            );
+        }
     }
 }
