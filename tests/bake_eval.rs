@@ -237,13 +237,22 @@ fn publish_targets() {
     }
     println!(
         "| asset | faces in | LOD faces | texels | bake s | PSNR dB | reference dB | loss dB | \
-         normal gain dB | seams clean to mip | mip 2 mixed |"
+         normal gain dB | seams clean to mip | mip 2 mixed | padding | report clean mip | \
+         zero-UV slivers |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for (name, app) in &cases {
-        let level = bake_one(app, 200.0, &eval_params());
+        // The LOD as `bake_chain` makes it, cached (see `cached_lod`), baked as `bake_chain` does.
+        let lod = cached_lod(name, app);
+        let index = pleat::bake::InputIndex::new(&app.mesh);
+        let level = pleat::bake::bake_level(app, &index, &lod, 200.0, &eval_params()).unwrap();
         let r = &level.report;
         let f = |x: Option<f64>| x.map_or("–".into(), |v| format!("{v:.2}"));
+        let slivers = if level.uvs.is_some() {
+            zero_uv_area(&level).to_string()
+        } else {
+            "–".into()
+        };
         let (seams, mixed) = if level.uvs.is_some() {
             let clean = (0..=4)
                 .take_while(|&l| seam_violations(&level, l).0 == 0)
@@ -255,7 +264,8 @@ fn publish_targets() {
             ("(vertex colours)".into(), "–".into())
         };
         println!(
-            "| {name} | {} | {} | {}² | {:.2} | {} | {} | {} | {} | {seams} | {mixed} |",
+            "| {name} | {} | {} | {}² | {:.2} | {} | {} | {} | {} | {seams} | {mixed} | {} | {} | \
+             {slivers} |",
             app.mesh.triangle_count(),
             level.triangles.len(),
             r.texture_size,
@@ -266,6 +276,8 @@ fn publish_targets() {
                 .zip(r.appearance_psnr_db)
                 .map(|(a, b)| a - b)),
             f(r.normal_map_gain_db),
+            r.atlas_padding,
+            r.seam_clean_mip.map_or("none".into(), |m| m.to_string()),
         );
     }
 }
@@ -402,7 +414,8 @@ fn texel_charts(level: &BakedLevel) -> (Vec<u32>, Vec<u32>) {
 /// At mip level `l` (box filter: mip texel `(I, J)` averages level-0 texels
 /// `[2^l I, 2^l (I+1))²`), the texels bilinear filtering reads at points of every triangle
 /// (corners, edge points, centroid) — those with non-zero weight — must average only level-0
-/// texels of the triangle's own chart. Returns (violating samples, samples).
+/// texels of the triangle's own chart. Triangles of zero UV area are left out (see
+/// [`zero_uv_area`]). Returns (violating samples, samples).
 fn seam_violations(level: &BakedLevel, l: u32) -> (usize, usize) {
     let (owner, chart) = texel_charts(level);
     let uvs = level.uvs.as_ref().unwrap();
@@ -432,6 +445,12 @@ fn seam_violations(level: &BakedLevel, l: u32) -> (usize, usize) {
         [1.0 / 3.0; 3],
     ];
     for (t, tri) in level.triangles.iter().enumerate() {
+        // Zero UV area: a sliver chart xatlas collapsed to a point; it covers no texel and is
+        // counted apart (`zero_uv_area`).
+        let p = tri.map(|v| uvs[v as usize].map(f64::from));
+        if pleat::bake::atlas::uv_area(&p) == 0.0 {
+            continue;
+        }
         for b in bary {
             let uv = [0, 1].map(|a| {
                 (0..3)
@@ -458,6 +477,18 @@ fn seam_violations(level: &BakedLevel, l: u32) -> (usize, usize) {
         }
     }
     (bad, total)
+}
+
+/// Triangles of `level` with zero UV area: LOD slivers (~10⁻⁶ of the median face area)
+/// whose chart xatlas collapsed to a point; they cover no texel, so the seam check leaves
+/// them out and the tables count them.
+fn zero_uv_area(level: &BakedLevel) -> usize {
+    let uvs = level.uvs.as_ref().unwrap();
+    level
+        .triangles
+        .iter()
+        .filter(|t| pleat::bake::atlas::uv_area(&t.map(|v| uvs[v as usize].map(f64::from))) == 0.0)
+        .count()
 }
 
 /// The mip level the texel rule implies: the atlas gives `k = 2` texels per screen pixel at
@@ -736,15 +767,7 @@ fn seam_levers() {
                     format!("{:.2}", 100.0 * bad as f64 / total as f64)
                 })
                 .collect();
-            let zero = level
-                .triangles
-                .iter()
-                .filter(|t| {
-                    let u = t.map(|v| level.uvs.as_ref().unwrap()[v as usize].map(f64::from));
-                    (u[1][0] - u[0][0]) * (u[2][1] - u[0][1])
-                        == (u[2][0] - u[0][0]) * (u[1][1] - u[0][1])
-                })
-                .count();
+            let zero = zero_uv_area(&level);
             println!(
                 "{name} padding {p} align {b}: {}² charts {} used {} clean mip {:?} overlapping {} \
                  zero-area {zero} mixed % mip0..3 {} PSNR {:.2} ref {:.2} bake {:.2} s",

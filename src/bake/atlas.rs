@@ -572,8 +572,10 @@ pub fn triangle_charts(a: &Atlas) -> Vec<u32> {
 /// Bilinear filtering at mip `m` of a point `s` (level-0 texel units) reads the 2×2 mip texels
 /// whose centres surround it, i.e. exactly the blocks meeting the open square
 /// `s ± 2^(m−1)`; a chart's footprint is its triangles grown by that square. `uv(v)` is vertex
-/// `v`'s UV in texels, `chart[t]` triangle `t`'s chart. Degenerate triangles claim their
-/// bounding box (conservative). When no block is shared, a dilation that fills every block
+/// `v`'s UV in texels, `chart[t]` triangle `t`'s chart. Triangles of zero UV area are
+/// skipped: they cover no texel (xatlas collapses a chart whose parametric area rounds to
+/// zero — a LOD sliver of ~10⁻⁶ the median face area — to one point, and reserves no space
+/// for it). When no block is shared, a dilation that fills every block
 /// with its owner's texels keeps every bilinear read of a chart point at mips `0 … mip` inside
 /// that chart's own texels (see the [gutter rule](self)).
 pub fn footprint_owners(
@@ -592,7 +594,7 @@ pub fn footprint_owners(
         let p = tri.map(uv);
         let lo = [0, 1].map(|a| p[0][a].min(p[1][a]).min(p[2][a]));
         let hi = [0, 1].map(|a| p[0][a].max(p[1][a]).max(p[2][a]));
-        if !(lo.iter().chain(&hi).all(|c| c.is_finite())) {
+        if !(lo.iter().chain(&hi).all(|c| c.is_finite())) || uv_area(&p) == 0.0 {
             continue;
         }
         for bj in cell(lo[1] - half)..=cell(hi[1] + half) {
@@ -614,6 +616,11 @@ pub fn footprint_owners(
     owner
 }
 
+/// Twice the signed area of 2D triangle `p` (positive counter-clockwise).
+pub fn uv_area(p: &[[f64; 2]; 3]) -> f64 {
+    (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1])
+}
+
 /// Whether the open axis-aligned square `(lo, hi)` meets the closed triangle `p` (separating
 /// axes: the square's two, the triangle's three edge normals; a degenerate triangle counts as
 /// its bounding box).
@@ -627,8 +634,7 @@ fn square_meets_triangle(lo: [f64; 2], hi: [f64; 2], p: &[[f64; 2]; 3]) -> bool 
             return false;
         }
     }
-    let area =
-        (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+    let area = uv_area(p);
     if area == 0.0 {
         return true;
     }

@@ -32,8 +32,8 @@ use rayon::prelude::*;
 
 use super::appearance::{linear_to_srgb, Appearance, MaterialSample};
 use super::atlas::{
-    build_atlas_growing, deepest_mip, footprint_owners, triangle_charts, Atlas, AtlasParams,
-    Gutter, BLOCK_SHARED,
+    build_atlas_growing, deepest_mip, footprint_owners, triangle_charts, uv_area, Atlas,
+    AtlasParams, Gutter, BLOCK_SHARED,
 };
 use super::level::{BakeReport, BakedLevel, BakedMaterial, Image8};
 use super::provenance::{vertex_normals, InputIndex, ProvenanceParams};
@@ -972,6 +972,11 @@ fn rasterize(atlas: &Atlas) -> Coverage {
     const REACH: f64 = 0.7072;
     for (t, tri) in atlas.triangles.iter().enumerate() {
         let uv = tri.map(|v| atlas.uv[v as usize].map(f64::from));
+        // A triangle of zero UV area (a sliver chart xatlas collapsed to a point) covers no
+        // texel and claims no border: the point may lie in another chart's gutter.
+        if uv_area(&uv) == 0.0 {
+            continue;
+        }
         let lo = [0, 1].map(|a| {
             (uv[0][a].min(uv[1][a]).min(uv[2][a]) - 1.0)
                 .floor()
