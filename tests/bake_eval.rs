@@ -625,7 +625,7 @@ fn readme_picture() {
 
 /// The speed target: a 1024² bake of a ~1k-face LOD of `target/bake_eval/sphere_100k.glb`
 /// (`write_sphere_100k`), stage by stage, best of 3. The LOD (`PLEAT_NP`, default 400) is
-/// cached as `target/bake_eval/sphere_100k_lod<n_p>.obj`.
+/// cached as `target/bake_eval/sphere_100k_lod<n_p>.obj`; `PLEAT_PADDING` overrides the gutter.
 #[test]
 #[ignore = "speed benchmark; run with --release after write_sphere_100k"]
 fn bake_speed() {
@@ -650,6 +650,13 @@ fn bake_speed() {
     };
     let mut params = BakeParams::default();
     params.atlas.size = Some(1024);
+    // `PLEAT_PADDING` compares gutters (default: the rule's).
+    if let Some(p) = std::env::var("PLEAT_PADDING")
+        .ok()
+        .and_then(|s| s.parse().ok())
+    {
+        params.atlas.padding = p;
+    }
     let t = std::time::Instant::now();
     let index = pleat::bake::InputIndex::new(&app.mesh);
     eprintln!("input index {:.3} s", t.elapsed().as_secs_f64());

@@ -28,13 +28,15 @@
 //! points by more than `padding`: **`padding = 2B = 2^(m+1)`** ([`gutter_for_mip`], 8 by
 //! default) keeps every block single-owned, whatever the charts' alignment to blocks. The
 //! bake checks it ([`BakeReport::seam_clean_mip`](super::level::BakeReport::seam_clean_mip):
-//! the deepest mip with no shared block) and falls back to the next shallower mip when a
-//! packing with a halved padding leaves shared blocks. Measured (`tests/bake_eval.rs`
+//! the deepest mip with no shared block, lower when a packing with a halved padding or a
+//! caller's smaller padding leaves shared blocks; those blocks take the nearest texel, the
+//! others stay single-owned). Measured (`tests/bake_eval.rs`
 //! `seam_levers`, bilinear reads at mips 0–3 of every triangle's corners, edge midpoints and
-//! centroid; 2026-11-27): padding 8 clean at mip 2 on the teapot, spot and elephant LODs;
-//! 6 with xatlas's 4×4 block alignment ([`AtlasParams::block_align`]) mixed 0.9–15 % of mip-2
-//! samples (alignment only helps charts facing each other along an axis; diagonal and nested
-//! neighbours keep arbitrary offsets), and 8 with alignment gained nothing over 8 without.
+//! centroid; 2026-11-27): padding 8 clean at mip 2 on every shared asset's LOD; 6 mixed up to
+//! 1.9 % of mip-2 samples, 1.2 % with xatlas's 4×4 block alignment
+//! ([`AtlasParams::block_align`], which only aligns charts facing each other along an axis;
+//! diagonal and nested neighbours keep arbitrary offsets), and 8 with alignment gained nothing
+//! over 8 without.
 //! Before this rule the dilation gave each gutter texel to the nearest chart, which needed
 //! charts `3B` apart plus one mip texel for xatlas's one-sided reservation (`4 · 2^m − 1` = 15).
 
