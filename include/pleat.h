@@ -423,7 +423,7 @@ typedef struct PleatBakeParams {
   uint32_t texture_size;
   // Screen size n_p the LOD was made for (default 200). Finite and > 0.
   double screen_size;
-  // Gutter between charts in texels (default 15: `4 · 2^m − 1` for the deepest mip `m = 2`
+  // Gutter between charts in texels (default 8: `2^(m+1)` for the deepest mip `m = 2`
   // a ×2 chain reads at 2 texels per pixel), at most 64.
   uint32_t padding;
   // Worker threads for this call: 0 (default) = the pool of `pleat_set_thread_count`.

@@ -16,17 +16,29 @@
 //! **Gutter rule.** At its own `n_p` a level is read at mip `log2 k` (1 for `k = 2`); it stays
 //! on screen down to `n_p / 2`, where the next level of a ×2 chain takes over, so the deepest
 //! mip it needs is `m = ⌈log2 k⌉ + 1` ([`deepest_mip`], 2 by default). Bilinear filtering at
-//! mip `m` reads the two mip texels around a point, i.e. level-0 texels up to `1.5 · 2^m` away
-//! from it; the dilation gives every gutter texel to the nearest chart, so the texels a chart's
-//! edge reads stay its own when charts are at least `3 · 2^m` texels apart. xatlas (this
-//! version) reserves a chart's gutter on its right and top side only (it rasterises the chart
-//! `padding` texels in from its bit image's corner but places the UVs at the corner), so two
-//! charts can come within about `padding` texels of each other at some points, and texel
-//! centres round the ownership border by up to one more texel: the rule adds one mip texel,
-//! `padding = 4 · 2^m − 1` ([`gutter_for_mip`], 15 by default). Measured with
-//! `tests/bake_eval.rs` (bilinear reads at mip 2 of every triangle's corners, edge midpoints
-//! and centroid): padding 11 (`3 · 2^m − 1`) left 5 of 630 samples of a sphere reading a
-//! neighbour chart, 15 none on the sphere and the four shared assets checked.
+//! mip `m` of a point `s` reads the 2×2 mip texels whose centres surround it: exactly the
+//! `B × B` blocks of level-0 texels (`B = 2^m`) that meet the open square `s ± B/2`. The bake
+//! gives every block to one chart — the chart whose points' squares reach it
+//! ([`footprint_owners`]) — and dilates each chart's texels only into its own blocks, so a
+//! mip-`m` texel a chart reads averages only that chart's texels as long as no block is
+//! reached from two charts. Two charts' points `a`, `b` reach a common block only when
+//! `|a − b| < B/2 + B + B/2 = 2B` along both axes. xatlas (this version) reserves for each
+//! chart its texels dilated by `padding` (8-neighbour) on its right and top side within its
+//! bit image, so two charts' texels differ by more than `padding` along some axis and their
+//! points by more than `padding`: **`padding = 2B = 2^(m+1)`** ([`gutter_for_mip`], 8 by
+//! default) keeps every block single-owned, whatever the charts' alignment to blocks. The
+//! bake checks it ([`BakeReport::seam_clean_mip`](super::level::BakeReport::seam_clean_mip):
+//! the deepest mip with no shared block, lower when a packing with a halved padding or a
+//! caller's smaller padding leaves shared blocks; those blocks take the nearest texel, the
+//! others stay single-owned). Measured (`tests/bake_eval.rs`
+//! `seam_levers`, bilinear reads at mips 0–3 of every triangle's corners, edge midpoints and
+//! centroid; 2026-11-27): padding 8 clean at mip 2 on every shared asset's LOD; 6 mixed up to
+//! 1.9 % of mip-2 samples, 1.2 % with xatlas's 4×4 block alignment
+//! ([`AtlasParams::block_align`], which only aligns charts facing each other along an axis;
+//! diagonal and nested neighbours keep arbitrary offsets), and 8 with alignment gained nothing
+//! over 8 without.
+//! Before this rule the dilation gave each gutter texel to the nearest chart, which needed
+//! charts `3B` apart plus one mip texel for xatlas's one-sided reservation (`4 · 2^m − 1` = 15).
 
 use crate::mesh::TriMesh;
 use crate::{Error, Result};
@@ -43,8 +55,12 @@ pub struct AtlasParams {
     /// Largest side the rule may choose (power of two). Default 4096.
     pub max_size: u32,
     /// Gutter between charts, in texels. Default [`gutter_for_mip`]`(`[`deepest_mip`]`(2))`
-    /// = 15, the [gutter rule](self) for the default `texels_per_pixel`.
+    /// = 8, the [gutter rule](self) for the default `texels_per_pixel`.
     pub padding: u32,
+    /// Place charts on 4×4-texel blocks (xatlas `blockAlign`: chart origins on multiples of
+    /// 4 texels, extents rounded so a chart's texels end one texel before a block boundary).
+    /// Default `false`: measured no gain at the [gutter rule](self)'s padding (see there).
+    pub block_align: bool,
 }
 
 /// The deepest mip level a level made with `texels_per_pixel = k` texels per pixel is read
@@ -58,10 +74,10 @@ pub fn deepest_mip(texels_per_pixel: f64) -> u32 {
     }
 }
 
-/// xatlas padding that keeps bilinear reads at mip `m` inside their chart's own texels:
-/// `4 · 2^m − 1` (the [gutter rule](self)).
+/// xatlas padding that keeps bilinear reads at mip `m` inside their chart's own texels with
+/// the bake's block-owning dilation: `2^(m+1)` (the [gutter rule](self)).
 pub fn gutter_for_mip(m: u32) -> u32 {
-    4 * (1u32 << m.min(16)) - 1
+    2 * (1u32 << m.min(16))
 }
 
 impl Default for AtlasParams {
@@ -72,6 +88,7 @@ impl Default for AtlasParams {
             min_size: 32,
             max_size: 4096,
             padding: gutter_for_mip(deepest_mip(2.0)),
+            block_align: false,
         }
     }
 }
@@ -127,7 +144,47 @@ pub struct Atlas {
 /// Errors: `InvalidArgument` for a zero side; `Internal` when xatlas drops a face or produces
 /// a non-finite UV.
 pub fn build_atlas(mesh: &TriMesh, side: u32, padding: u32) -> Result<Atlas> {
-    build_atlas_growing(mesh, side, padding, None)
+    build_atlas_growing(mesh, side, Gutter::plain(padding), None)
+}
+
+/// The gutter of a packing: `padding` texels between charts, charts on 4×4 blocks or not
+/// ([`AtlasParams::block_align`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Gutter {
+    /// Texels between charts (xatlas `padding`).
+    pub padding: u32,
+    /// Charts on 4×4-texel blocks (xatlas `blockAlign`).
+    pub block_align: bool,
+}
+
+impl Gutter {
+    /// `padding` texels, no block alignment.
+    pub fn plain(padding: u32) -> Self {
+        Gutter {
+            padding,
+            block_align: false,
+        }
+    }
+
+    /// The gutter of `params`.
+    pub fn of(params: &AtlasParams) -> Self {
+        Gutter {
+            padding: params.padding,
+            block_align: params.block_align,
+        }
+    }
+
+    /// The same gutter with another padding.
+    fn with_padding(self, padding: u32) -> Self {
+        Gutter { padding, ..self }
+    }
+
+    /// Texels a chart's reservation adds to its extent along one axis, besides its own
+    /// texels: the padding, one texel of extent rounding, and with block alignment up to
+    /// 3 more texels of extent rounding (to `4k − 2`) plus up to 3 of position rounding.
+    fn reserve(self) -> u32 {
+        self.padding + 1 + if self.block_align { 3 } else { 0 }
+    }
 }
 
 /// [`build_atlas`] that may grow the side so the gutters do not eat the texel density: with
@@ -142,7 +199,7 @@ pub fn build_atlas(mesh: &TriMesh, side: u32, padding: u32) -> Result<Atlas> {
 pub fn build_atlas_growing(
     mesh: &TriMesh,
     side: u32,
-    padding: u32,
+    gutter: Gutter,
     grow: Option<(f64, u32)>,
 ) -> Result<Atlas> {
     if side == 0 {
@@ -158,9 +215,10 @@ pub fn build_atlas_growing(
     // Gutters are what a huge chart count cannot afford (a soup's LOD can have thousands of
     // charts): when no packing fits at the requested padding, halve it rather than fail, and
     // say so in `Atlas::padding` (the bake reports it; seams then hold to a shallower mip).
-    let mut pad = padding;
+    let mut pad = gutter.padding;
     loop {
-        if let Some(a) = best_of_thresholds(&positions, &indices, area, side, pad, grow)? {
+        let g = gutter.with_padding(pad);
+        if let Some(a) = best_of_thresholds(&positions, &indices, area, side, g, grow)? {
             return Ok(a);
         }
         if pad == 0 {
@@ -182,7 +240,7 @@ fn best_of_thresholds(
     indices: &[u32],
     area: f64,
     side: u32,
-    padding: u32,
+    gutter: Gutter,
     grow: Option<(f64, u32)>,
 ) -> Result<Option<Atlas>> {
     // xatlas (this version) can leave a chart whose LSCM boundary self-intersects; such
@@ -190,12 +248,12 @@ fn best_of_thresholds(
     // (smaller charts), keeping the one with the fewest overlaps.
     let mut best: Option<Atlas> = None;
     for threshold in [2.0f32, 1.0, 0.5, 0.25] {
-        let Some(mut a) = charts_packed(positions, indices, area, side, padding, threshold, grow)?
+        let Some(mut a) = charts_packed(positions, indices, area, side, gutter, threshold, grow)?
         else {
             continue;
         };
         a.overlapping_texels = overlapping_texels(&a);
-        a.padding = padding;
+        a.padding = gutter.padding;
         let done = a.overlapping_texels == 0;
         if best
             .as_ref()
@@ -238,9 +296,9 @@ fn retry_scale(spill: f64) -> f64 {
 /// rounding, `g = padding + 1`) adds about `4 g √(a_c) d + 4 g²` (a square chart's ring), and
 /// `Σ √(a_c) ≤ √(charts · area)`. With `x = d √area` the plan is
 /// `x² + 4 g √charts · x + 4 g² charts = PACK_FILL · side²`, a quadratic in `x`.
-fn pack_density(area: f64, charts: u32, side: u32, padding: u32) -> f64 {
+fn pack_density(area: f64, charts: u32, side: u32, gutter: Gutter) -> f64 {
     let s2 = PACK_FILL * f64::from(side) * f64::from(side);
-    let g = f64::from(padding) + 1.0;
+    let g = f64::from(gutter.reserve());
     let n = f64::from(charts.max(1));
     let b = 2.0 * g * n.sqrt(); // half the linear coefficient
     let c = 4.0 * g * g * n - s2;
@@ -257,30 +315,30 @@ fn pack_density(area: f64, charts: u32, side: u32, padding: u32) -> f64 {
 /// Whether the gutters of `charts` charts alone (`4 g² charts` texels, `g = padding + 1`, see
 /// [`pack_density`]) leave room in the planned [`PACK_FILL`] of a `side`² atlas. When they do
 /// not, [`pack_density`]'s fallback density says nothing about fitting, so the side must grow.
-fn gutters_fit(charts: u32, side: u32, padding: u32) -> bool {
-    let g = f64::from(padding) + 1.0;
+fn gutters_fit(charts: u32, side: u32, gutter: Gutter) -> bool {
+    let g = f64::from(gutter.reserve());
     4.0 * g * g * f64::from(charts.max(1)) < PACK_FILL * f64::from(side) * f64::from(side)
 }
 
 /// False when `charts` charts certainly cannot share one `side`² atlas with `padding`-texel
 /// gutters: xatlas reserves at least `(1 + 1 + padding)²` texels per chart (one texel of
 /// extent, one of conservative rasterisation, the gutter), so the packing attempts are skipped.
-fn could_fit(charts: u32, side: u32, padding: u32) -> bool {
-    let per_chart = (u64::from(padding) + 2).pow(2);
+fn could_fit(charts: u32, side: u32, gutter: Gutter) -> bool {
+    let per_chart = (u64::from(gutter.reserve()) + 1).pow(2);
     u64::from(charts) * per_chart <= u64::from(side) * u64::from(side)
 }
 
 /// The side [`build_atlas_growing`] packs `charts` charts of total area `area` into: `side`
 /// doubled while [`pack_density`] is below half the rule's density and the side is below the
 /// cap.
-fn grown_side(area: f64, charts: u32, side: u32, padding: u32, grow: Option<(f64, u32)>) -> u32 {
+fn grown_side(area: f64, charts: u32, side: u32, gutter: Gutter, grow: Option<(f64, u32)>) -> u32 {
     let Some((rho, max_side)) = grow else {
         return side;
     };
     let mut side = side;
     while side < max_side
-        && (!gutters_fit(charts, side, padding)
-            || pack_density(area, charts, side, padding) < 0.5 * rho)
+        && (!gutters_fit(charts, side, gutter)
+            || pack_density(area, charts, side, gutter) < 0.5 * rho)
     {
         side = side.saturating_mul(2).min(max_side);
     }
@@ -295,20 +353,20 @@ fn charts_packed(
     indices: &[u32],
     area: f64,
     side: u32,
-    padding: u32,
+    gutter: Gutter,
     max_threshold: f32,
     grow: Option<(f64, u32)>,
 ) -> Result<Option<Atlas>> {
     let atlas = parameterised_charts(positions, indices, max_threshold)?;
     // SAFETY: `atlas` is live; ParameterizeCharts has set its chart count.
     let charts = unsafe { (*atlas.0).chart_count };
-    let side = grown_side(area, charts, side, padding, grow);
-    if !could_fit(charts, side, padding) {
+    let side = grown_side(area, charts, side, gutter, grow);
+    if !could_fit(charts, side, gutter) {
         return Ok(None);
     }
-    let mut density = pack_density(area, charts, side, padding);
+    let mut density = pack_density(area, charts, side, gutter);
     for _ in 0..12 {
-        match pack(&atlas, side, padding, density as f32)? {
+        match pack(&atlas, side, gutter, density as f32)? {
             Packed::One(a) => {
                 check_atlas(&a, indices)?;
                 return Ok(Some(a));
@@ -385,13 +443,14 @@ enum Packed {
 
 /// One packing of the parameterised charts of `atlas` at `texels_per_unit`. xatlas restores the charts' parameterisation before
 /// each packing, so packings of the same atlas are independent.
-fn pack(atlas: &ffi::Handle, side: u32, padding: u32, texels_per_unit: f32) -> Result<Packed> {
+fn pack(atlas: &ffi::Handle, side: u32, gutter: Gutter, texels_per_unit: f32) -> Result<Packed> {
+    let padding = gutter.padding;
     let pack = ffi::PackOptions {
         attempts: 4096,
         texels_per_unit,
         resolution: side,
-        max_chart_size: max_chart_size(side, padding),
-        block_align: false,
+        max_chart_size: max_chart_size(side, gutter),
+        block_align: gutter.block_align,
         conservative: padding > 0,
         padding,
     };
@@ -420,8 +479,8 @@ fn pack(atlas: &ffi::Handle, side: u32, padding: u32, texels_per_unit: f32) -> R
 /// `maxChartSize = side − padding − 1` the bit image fits (`w + 1 + padding ≤ side`) and every
 /// UV is below `side − padding − 0.5`. A chart that large is baked at a lower density than the
 /// others rather than failing the bake.
-fn max_chart_size(side: u32, padding: u32) -> u32 {
-    side.saturating_sub(padding + 1).max(1)
+fn max_chart_size(side: u32, gutter: Gutter) -> u32 {
+    side.saturating_sub(gutter.reserve()).max(1)
 }
 
 /// Summed utilisation of all atlases of a packing over that of the first; infinite when
@@ -473,6 +532,123 @@ pub fn overlapping_texels(a: &Atlas) -> u64 {
         }
     }
     count
+}
+
+/// A block no chart's bilinear footprint reaches (see [`footprint_owners`]).
+pub const BLOCK_FREE: u32 = u32::MAX;
+
+/// A block the bilinear footprints of two or more charts reach (see [`footprint_owners`]).
+pub const BLOCK_SHARED: u32 = u32::MAX - 1;
+
+/// Chart of every atlas triangle: the components of triangles sharing an atlas vertex
+/// (xatlas splits vertices at chart seams, so these are its charts).
+pub fn triangle_charts(a: &Atlas) -> Vec<u32> {
+    let mut parent: Vec<u32> = (0..a.triangles.len() as u32).collect();
+    fn root(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            p[x as usize] = p[p[x as usize] as usize];
+            x = p[x as usize];
+        }
+        x
+    }
+    let mut first = vec![u32::MAX; a.uv.len()];
+    for (t, tri) in a.triangles.iter().enumerate() {
+        for &v in tri {
+            let f = &mut first[v as usize];
+            if *f == u32::MAX {
+                *f = t as u32;
+            } else {
+                let (x, y) = (root(&mut parent, *f), root(&mut parent, t as u32));
+                parent[x.max(y) as usize] = x.min(y);
+            }
+        }
+    }
+    (0..a.triangles.len() as u32)
+        .map(|t| root(&mut parent, t))
+        .collect()
+}
+
+/// Owner of every `2^mip × 2^mip`-texel block (a mip-`mip` texel; row-major,
+/// `⌈side / 2^mip⌉` per row) of a `side`² atlas: the chart whose **bilinear footprint at mip
+/// `mip`** reaches the block, [`BLOCK_FREE`] when none does, [`BLOCK_SHARED`] when several do.
+/// Bilinear filtering at mip `m` of a point `s` (level-0 texel units) reads the 2×2 mip texels
+/// whose centres surround it, i.e. exactly the blocks meeting the open square
+/// `s ± 2^(m−1)`; a chart's footprint is its triangles grown by that square. `uv(v)` is vertex
+/// `v`'s UV in texels, `chart[t]` triangle `t`'s chart. Triangles of zero UV area are
+/// skipped: they cover no texel (xatlas collapses a chart whose parametric area rounds to
+/// zero — a LOD sliver of ~10⁻⁶ the median face area — to one point, and reserves no space
+/// for it). When no block is shared, a dilation that fills every block
+/// with its owner's texels keeps every bilinear read of a chart point at mips `0 … mip` inside
+/// that chart's own texels (see the [gutter rule](self)).
+pub fn footprint_owners(
+    side: u32,
+    mip: u32,
+    triangles: &[[u32; 3]],
+    uv: &dyn Fn(u32) -> [f64; 2],
+    chart: &[u32],
+) -> Vec<u32> {
+    let block = f64::from(1u32 << mip.min(16));
+    let half = 0.5 * block;
+    let nb = side.div_ceil(1 << mip.min(16)).max(1) as usize;
+    let mut owner = vec![BLOCK_FREE; nb * nb];
+    let cell = |x: f64| ((x / block).floor().max(0.0) as usize).min(nb - 1);
+    for (t, tri) in triangles.iter().enumerate() {
+        let p = tri.map(uv);
+        let lo = [0, 1].map(|a| p[0][a].min(p[1][a]).min(p[2][a]));
+        let hi = [0, 1].map(|a| p[0][a].max(p[1][a]).max(p[2][a]));
+        if !(lo.iter().chain(&hi).all(|c| c.is_finite())) || uv_area(&p) == 0.0 {
+            continue;
+        }
+        for bj in cell(lo[1] - half)..=cell(hi[1] + half) {
+            for bi in cell(lo[0] - half)..=cell(hi[0] + half) {
+                let sq_lo = [bi as f64 * block - half, bj as f64 * block - half];
+                let sq_hi = [sq_lo[0] + 2.0 * block, sq_lo[1] + 2.0 * block];
+                if !square_meets_triangle(sq_lo, sq_hi, &p) {
+                    continue;
+                }
+                let o = &mut owner[bj * nb + bi];
+                *o = match *o {
+                    BLOCK_FREE => chart[t],
+                    c if c == chart[t] => c,
+                    _ => BLOCK_SHARED,
+                };
+            }
+        }
+    }
+    owner
+}
+
+/// Twice the signed area of 2D triangle `p` (positive counter-clockwise).
+pub fn uv_area(p: &[[f64; 2]; 3]) -> f64 {
+    (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1])
+}
+
+/// Whether the open axis-aligned square `(lo, hi)` meets the closed triangle `p` (separating
+/// axes: the square's two, the triangle's three edge normals; a degenerate triangle counts as
+/// its bounding box).
+fn square_meets_triangle(lo: [f64; 2], hi: [f64; 2], p: &[[f64; 2]; 3]) -> bool {
+    for a in 0..2 {
+        let (mn, mx) = (
+            p[0][a].min(p[1][a]).min(p[2][a]),
+            p[0][a].max(p[1][a]).max(p[2][a]),
+        );
+        if mx <= lo[a] || mn >= hi[a] {
+            return false;
+        }
+    }
+    let area = uv_area(p);
+    if area == 0.0 {
+        return true;
+    }
+    let corners = [lo, [hi[0], lo[1]], [lo[0], hi[1]], hi];
+    (0..3).all(|k| {
+        let (a, b) = (p[k], p[(k + 1) % 3]);
+        // Positive on the triangle's side of edge a→b.
+        let side = |c: [f64; 2]| {
+            area.signum() * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]))
+        };
+        corners.iter().any(|&c| side(c) > 0.0)
+    })
 }
 
 /// Copies xatlas's single output mesh; `None` when it produced more than one atlas.
@@ -743,7 +919,7 @@ mod tests {
     #[test]
     fn pack_density_without_gutter_fills_the_plan() {
         let (area, side) = (3.0, 512u32);
-        let d = pack_density(area, 1, side, 0);
+        let d = pack_density(area, 1, side, Gutter::plain(0));
         // g = 1 even without padding (extent rounding): solve the quadratic's residual.
         let x = d * area.sqrt();
         let plan = PACK_FILL * f64::from(side * side);
@@ -755,14 +931,14 @@ mod tests {
     #[test]
     fn pack_density_solves_the_gutter_quadratic() {
         let (area, side, n, p) = (2.0, 1024u32, 60u32, 4u32);
-        let d = pack_density(area, n, side, p);
+        let d = pack_density(area, n, side, Gutter::plain(p));
         let (x, g, nf) = (d * area.sqrt(), f64::from(p) + 1.0, f64::from(n));
         let plan = PACK_FILL * f64::from(side * side);
         let lhs = x * x + 4.0 * g * nf.sqrt() * x + 4.0 * g * g * nf;
         assert!((lhs - plan).abs() < 1e-6 * plan, "{lhs} vs {plan}");
-        assert!(pack_density(area, 2 * n, side, p) < d);
-        assert!(pack_density(area, n, side, 2 * p) < d);
-        assert!(pack_density(area, 1_000_000, 64, 8) > 0.0);
+        assert!(pack_density(area, 2 * n, side, Gutter::plain(p)) < d);
+        assert!(pack_density(area, n, side, Gutter::plain(2 * p)) < d);
+        assert!(pack_density(area, 1_000_000, 64, Gutter::plain(8)) > 0.0);
     }
 
     /// A planar strip 40 times longer than wide is one chart whose extent at the planned
@@ -797,16 +973,19 @@ mod tests {
             );
             assert_eq!(a.overlapping_texels, 0);
         }
-        assert_eq!(max_chart_size(64, 4), 59);
+        assert_eq!(max_chart_size(64, Gutter::plain(4)), 59);
         // Growth: 7 charts with 15-texel gutters cannot keep half of ρ in 64²; they can in a
         // larger side, never beyond the cap, and never without `grow`.
         let (area, rho) = (1.0, 55.0);
-        let g = grown_side(area, 7, 64, 15, Some((rho, 4096)));
-        assert!(g > 64 && pack_density(area, 7, g, 15) >= 0.5 * rho);
-        assert!(pack_density(area, 7, g / 2, 15) < 0.5 * rho);
-        assert_eq!(grown_side(area, 7, 64, 15, Some((rho, 64))), 64);
-        assert_eq!(grown_side(area, 7, 64, 15, None), 64);
-        assert_eq!(max_chart_size(4, 8), 1);
+        let g = grown_side(area, 7, 64, Gutter::plain(15), Some((rho, 4096)));
+        assert!(g > 64 && pack_density(area, 7, g, Gutter::plain(15)) >= 0.5 * rho);
+        assert!(pack_density(area, 7, g / 2, Gutter::plain(15)) < 0.5 * rho);
+        assert_eq!(
+            grown_side(area, 7, 64, Gutter::plain(15), Some((rho, 64))),
+            64
+        );
+        assert_eq!(grown_side(area, 7, 64, Gutter::plain(15), None), 64);
+        assert_eq!(max_chart_size(4, Gutter::plain(8)), 1);
     }
 
     /// `n` disjoint unit squares (two triangles each) in a row: `n` charts.
@@ -833,13 +1012,16 @@ mod tests {
     /// gutters fit, and without growth the padding shrinks instead of failing.
     #[test]
     fn thousands_of_charts_grow_the_side_or_shrink_the_gutter() {
-        assert!(!gutters_fit(150, 64, 15));
-        assert!(gutters_fit(150, 512, 15));
-        let g = grown_side(150.0, 150, 64, 15, Some((1.0, 4096)));
-        assert!(g >= 512 && gutters_fit(150, g, 15), "grew to {g}");
-        assert!(!could_fit(150, 64, 15) && could_fit(150, 64, 3));
+        assert!(!gutters_fit(150, 64, Gutter::plain(15)));
+        assert!(gutters_fit(150, 512, Gutter::plain(15)));
+        let g = grown_side(150.0, 150, 64, Gutter::plain(15), Some((1.0, 4096)));
+        assert!(
+            g >= 512 && gutters_fit(150, g, Gutter::plain(15)),
+            "grew to {g}"
+        );
+        assert!(!could_fit(150, 64, Gutter::plain(15)) && could_fit(150, 64, Gutter::plain(3)));
         let mesh = squares(150);
-        let grown = build_atlas_growing(&mesh, 64, 15, Some((1.0, 4096))).unwrap();
+        let grown = build_atlas_growing(&mesh, 64, Gutter::plain(15), Some((1.0, 4096))).unwrap();
         assert_eq!(grown.padding, 15);
         assert!(grown.size >= 512);
         assert_eq!(grown.overlapping_texels, 0);
@@ -853,16 +1035,61 @@ mod tests {
         assert_eq!(build_atlas(&squares(3), 128, 15).unwrap().padding, 15);
     }
 
-    /// The gutter rule: mip 2 for the default 2 texels per pixel, 15 texels of padding.
+    /// The footprint rule: two charts whose points are more than `2B = gutter_for_mip(m)`
+    /// apart along an axis never reach a common block, at any offset against the block grid;
+    /// closer than that, some offset makes them share one.
+    #[test]
+    fn charts_more_than_two_blocks_apart_own_their_blocks() {
+        let m = 2;
+        let gap = f64::from(gutter_for_mip(m));
+        let shared_at = |offset: f64, gap: f64| {
+            // Chart 0: a 3-texel right triangle at x = offset; chart 1: the same `gap` to its right.
+            let x1 = offset + 3.0 + gap;
+            let p = [
+                [offset, 10.0],
+                [offset + 3.0, 10.0],
+                [offset + 3.0, 13.0],
+                [x1, 10.0],
+                [x1 + 3.0, 10.0],
+                [x1, 13.0],
+            ];
+            let tris = [[0, 1, 2], [3, 4, 5]];
+            let owners = footprint_owners(64, m, &tris, &|v| p[v as usize], &[0, 1]);
+            assert!(owners.contains(&0) && owners.contains(&1));
+            owners.contains(&BLOCK_SHARED)
+        };
+        for k in 0..32 {
+            let offset = 8.0 + f64::from(k) / 8.0;
+            assert!(!shared_at(offset, gap + 1e-3), "offset {offset}");
+        }
+        assert!((0..32).any(|k| shared_at(8.0 + f64::from(k) / 8.0, gap - 0.5)));
+        // A point just below a block centre (18, 18) reads that block and the ones left/above.
+        let tiny = [[17.99, 17.99], [18.0, 17.99], [17.99, 18.0]];
+        let owners = footprint_owners(64, m, &[[0, 1, 2]], &|v| tiny[v as usize], &[7]);
+        let owned: Vec<usize> = (0..owners.len()).filter(|&k| owners[k] == 7).collect();
+        assert_eq!(owned, vec![3 * 16 + 3, 3 * 16 + 4, 4 * 16 + 3, 4 * 16 + 4]);
+    }
+
+    /// Separating axes: a triangle's bounding box overlapping the square is not enough.
+    #[test]
+    fn square_meets_triangle_by_separating_axes() {
+        let t = [[0.0, 0.0], [4.0, 0.0], [0.0, 4.0]];
+        assert!(square_meets_triangle([1.0, 1.0], [2.0, 2.0], &t));
+        assert!(!square_meets_triangle([3.0, 3.0], [4.0, 4.0], &t));
+        assert!(!square_meets_triangle([4.0, 0.0], [5.0, 1.0], &t));
+        assert!(square_meets_triangle([-1.0, -1.0], [0.5, 0.5], &t));
+    }
+
+    /// The gutter rule: mip 2 for the default 2 texels per pixel, 8 texels of padding.
     #[test]
     fn the_default_gutter_follows_the_mip_rule() {
         assert_eq!(deepest_mip(2.0), 2);
         assert_eq!(deepest_mip(1.0), 1);
         assert_eq!(deepest_mip(4.0), 3);
         assert_eq!(deepest_mip(f64::NAN), 1);
-        assert_eq!(gutter_for_mip(1), 7);
-        assert_eq!(gutter_for_mip(2), 15);
-        assert_eq!(AtlasParams::default().padding, 15);
+        assert_eq!(gutter_for_mip(1), 4);
+        assert_eq!(gutter_for_mip(2), 8);
+        assert_eq!(AtlasParams::default().padding, 8);
     }
 
     /// A retry plans the spilled charts into `RETRY_FILL` of one atlas, lowers the density by

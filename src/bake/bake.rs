@@ -31,7 +31,10 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::appearance::{linear_to_srgb, Appearance, MaterialSample};
-use super::atlas::{build_atlas_growing, Atlas, AtlasParams};
+use super::atlas::{
+    build_atlas_growing, deepest_mip, footprint_owners, triangle_charts, uv_area, Atlas,
+    AtlasParams, Gutter, BLOCK_SHARED,
+};
 use super::level::{BakeReport, BakedLevel, BakedMaterial, Image8};
 use super::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 use crate::geom::{normalized, Vec3};
@@ -648,7 +651,7 @@ fn bake_textured(
         let rho = params.atlas.texels_per_pixel * screen_size / diag;
         (rho, params.atlas.max_size.max(side))
     });
-    let atlas = build_atlas_growing(lod, side, params.atlas.padding, grow)?;
+    let atlas = build_atlas_growing(lod, side, Gutter::of(&params.atlas), grow)?;
     let side = atlas.size;
     report.atlas_seconds = t.elapsed().as_secs_f64();
     report.texture_size = side;
@@ -746,7 +749,12 @@ fn bake_textured(
 
     steps.check("bake: dilation", 0.9)?;
     let t = Instant::now();
-    let source = dilation_sources(&cov);
+    let chart = triangle_charts(&atlas);
+    let deepest = deepest_mip(params.atlas.texels_per_pixel);
+    let uv = |v: u32| atlas.uv[v as usize].map(f64::from);
+    let owners = footprint_owners(side, deepest, &atlas.triangles, &uv, &chart);
+    report.seam_clean_mip = clean_mip(&atlas, &chart, deepest, &owners);
+    let source = dilation_sources(&cov, &chart, &owners, deepest);
     for img in [&mut base, &mut mr, &mut occ, &mut emi, &mut nrm] {
         if !img.is_empty() {
             apply_dilation(img, &source);
@@ -964,6 +972,11 @@ fn rasterize(atlas: &Atlas) -> Coverage {
     const REACH: f64 = 0.7072;
     for (t, tri) in atlas.triangles.iter().enumerate() {
         let uv = tri.map(|v| atlas.uv[v as usize].map(f64::from));
+        // A triangle of zero UV area (a sliver chart xatlas collapsed to a point) covers no
+        // texel and claims no border: the point may lie in another chart's gutter.
+        if uv_area(&uv) == 0.0 {
+            continue;
+        }
         let lo = [0, 1].map(|a| {
             (uv[0][a].min(uv[1][a]).min(uv[2][a]) - 1.0)
                 .floor()
@@ -1036,9 +1049,15 @@ fn closest_in_triangle(t: &[[f64; 2]; 3], c: [f64; 2]) -> ([f64; 3], f64) {
 }
 
 /// For every texel, the covered texel whose value it takes (itself when covered; `u32::MAX`
-/// when nothing is covered at all).
-fn dilation_sources(cov: &Coverage) -> Vec<u32> {
+/// when nothing is covered at all), with the blocks of mip `mip` owned by one chart each:
+/// a breadth-first search from all covered texels (4-neighbours, fixed order) where a texel
+/// of a block [`footprint_owners`] gives to chart `c` takes only `c`'s texels (free and shared
+/// blocks take any); texels that search cannot reach (a chart's blocks cut off by shared
+/// ones) then take the nearest assigned texel.
+fn dilation_sources(cov: &Coverage, chart: &[u32], owners: &[u32], mip: u32) -> Vec<u32> {
     let n = cov.size as usize;
+    let b = 1usize << mip.min(16);
+    let nb = n.div_ceil(b).max(1);
     let mut src = vec![u32::MAX; n * n];
     let mut queue = std::collections::VecDeque::new();
     for (k, &t) in cov.tri.iter().enumerate() {
@@ -1047,28 +1066,56 @@ fn dilation_sources(cov: &Coverage) -> Vec<u32> {
             queue.push_back(k);
         }
     }
-    while let Some(k) = queue.pop_front() {
-        let (i, j) = (k % n, k / n);
-        let mut visit = |m: usize| {
-            if src[m] == u32::MAX {
-                src[m] = src[k];
-                queue.push_back(m);
-            }
-        };
-        if i > 0 {
-            visit(k - 1);
-        }
-        if i + 1 < n {
-            visit(k + 1);
-        }
-        if j > 0 {
-            visit(k - n);
-        }
-        if j + 1 < n {
-            visit(k + n);
-        }
+    let allowed = |m: usize, s: u32| {
+        let o = owners[(m / n / b) * nb + (m % n) / b];
+        o >= BLOCK_SHARED || o == chart[cov.tri[s as usize] as usize]
+    };
+    spread(&mut src, &mut queue, n, &allowed);
+    if src.contains(&u32::MAX) {
+        queue.extend((0..n * n).filter(|&k| src[k] != u32::MAX));
+        spread(&mut src, &mut queue, n, &|_, _| true);
     }
     src
+}
+
+/// Breadth-first spread of `src` from the texels in `queue` to unassigned 4-neighbours
+/// (left, right, up, down) that `allowed(texel, source)` lets take the source.
+fn spread(
+    src: &mut [u32],
+    queue: &mut std::collections::VecDeque<usize>,
+    n: usize,
+    allowed: &dyn Fn(usize, u32) -> bool,
+) {
+    while let Some(k) = queue.pop_front() {
+        let (i, j) = (k % n, k / n);
+        let s = src[k];
+        let near = [
+            (i > 0).then(|| k - 1),
+            (i + 1 < n).then(|| k + 1),
+            (j > 0).then(|| k - n),
+            (j + 1 < n).then(|| k + n),
+        ];
+        for m in near.into_iter().flatten() {
+            if src[m] == u32::MAX && allowed(m, s) {
+                src[m] = s;
+                queue.push_back(m);
+            }
+        }
+    }
+}
+
+/// The deepest mip `m ≤ deepest` at which no block is reached by two charts' bilinear
+/// footprints ([`footprint_owners`]; `owners` are those of mip `deepest`, reused when they
+/// have no shared block); `None` when even mip 0 has shared texels (charts touching or
+/// overlapping).
+fn clean_mip(atlas: &Atlas, chart: &[u32], deepest: u32, owners: &[u32]) -> Option<u32> {
+    if !owners.contains(&BLOCK_SHARED) {
+        return Some(deepest);
+    }
+    let uv = |v: u32| atlas.uv[v as usize].map(f64::from);
+    (0..deepest).rev().find(|&m| {
+        !footprint_owners(atlas.size, m, &atlas.triangles, &uv, chart).contains(&BLOCK_SHARED)
+    })
 }
 
 fn apply_dilation(img: &mut [u8], src: &[u32]) {

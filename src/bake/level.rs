@@ -34,6 +34,12 @@ pub struct BakeReport {
     /// Gutter between charts in texels, as used: the requested padding unless the charts did
     /// not fit with it (thousands of charts), then less, and seams hold to a shallower mip.
     pub atlas_padding: u32,
+    /// The deepest mip level, up to [`deepest_mip`](super::atlas::deepest_mip) of the texel
+    /// rule, whose bilinear reads at any point of a chart stay in that chart's texels by
+    /// construction (no 2^m-texel block reached by two charts' footprints, see
+    /// [`footprint_owners`](super::atlas::footprint_owners)); `None` for vertex colours or
+    /// when even mip 0 mixes charts.
+    pub seam_clean_mip: Option<u32>,
     /// Fraction of samples whose provenance came from the closest-point fallback, in [0, 1].
     pub fallback_fraction: f64,
     /// Mean appearance error: |baked base colour − input base colour at the closest input

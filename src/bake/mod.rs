@@ -32,7 +32,7 @@ pub use appearance::{
     read_appearance_bytes, read_gltf_appearance, Appearance, AppearanceBuffers, BufferMaterial,
     ImageBuffer, MaterialSample, UvBuffer,
 };
-pub use atlas::{build_atlas, build_atlas_growing, Atlas, AtlasParams};
+pub use atlas::{build_atlas, build_atlas_growing, Atlas, AtlasParams, Gutter};
 pub use bake::{bake_level, bake_level_with_progress, BakeParams, VertexColors};
 pub use level::{BakeReport, BakedLevel, BakedMaterial, Image8};
 pub use obj::read_obj_appearance;

@@ -165,7 +165,7 @@ pub struct PleatBakeParams {
     pub texture_size: u32,
     /// Screen size n_p the LOD was made for (default 200). Finite and > 0.
     pub screen_size: f64,
-    /// Gutter between charts in texels (default 15: `4 · 2^m − 1` for the deepest mip `m = 2`
+    /// Gutter between charts in texels (default 8: `2^(m+1)` for the deepest mip `m = 2`
     /// a ×2 chain reads at 2 texels per pixel), at most 64.
     pub padding: u32,
     /// Worker threads for this call: 0 (default) = the pool of `pleat_set_thread_count`.
@@ -303,7 +303,7 @@ pub extern "C" fn pleat_bake_params_default() -> PleatBakeParams {
         texture_size: 0,
         screen_size: 200.0,
         // `bake::atlas::gutter_for_mip(deepest_mip(2.0))` (the defaults test checks it).
-        padding: 15,
+        padding: 8,
         threads: 0,
         texels_per_pixel: 2.0,
         envelope_d: 3.0,

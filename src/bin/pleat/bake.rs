@@ -147,9 +147,17 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
             let requested_padding = params.atlas.padding;
             if r.texture_size > 0 && r.atlas_padding < requested_padding {
                 println!(
-                    "  warning: {} charts needed a {}-texel gutter instead of {requested_padding} \
-                     (seams hold to a shallower mip level)",
+                    "  warning: {} charts needed a {}-texel gutter instead of {requested_padding}",
                     r.charts, r.atlas_padding
+                );
+            }
+            let rule_mip = pleat::bake::atlas::deepest_mip(params.atlas.texels_per_pixel);
+            if r.texture_size > 0 && r.seam_clean_mip.is_none_or(|m| m < rule_mip) {
+                println!(
+                    "  warning: chart seams are clean down to mip {} only (the texel rule reads \
+                     mip {rule_mip})",
+                    r.seam_clean_mip
+                        .map_or("none".to_string(), |m| m.to_string())
                 );
             }
             if r.overlapping_texels > 0 {
