@@ -1216,43 +1216,24 @@ mod wrinkle_sqp {
 mod stretched_sheet_check {
     use super::*;
     use pleat::mesh::TriMesh;
+    use pleat::tfw::measure::{section_waves, Section};
     use pleat::tfw::{solve, TfwParams};
     use pleat::wrinkle::EvalOptions;
 
-    /// Points `(y, z)` where the mesh crosses the plane `x = 0`, sorted by `y`.
-    fn mid_line(mesh: &TriMesh) -> Vec<(f64, f64)> {
-        let p = mesh.positions();
-        let mut pts = Vec::new();
-        for t in mesh.triangles() {
-            for k in 0..3 {
-                let (a, b) = (p[t[k] as usize], p[t[(k + 1) % 3] as usize]);
-                if (a[0] < 0.0) != (b[0] < 0.0) {
-                    let s = a[0] / (a[0] - b[0]);
-                    pts.push((a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2])));
-                }
-            }
-        }
-        pts.sort_by(|x, y| x.0.total_cmp(&y.0));
-        pts
-    }
-
     /// Independent wave counter: sign changes of the normal displacement (z: the base stays
-    /// in the plane z = 0) along the mid line, ignoring values below 1% of the peak; periods
-    /// = crossings / 2.
-    fn periods_and_peak(pts: &[(f64, f64)]) -> (f64, f64) {
-        let peak = pts.iter().fold(0.0f64, |m, p| m.max(p.1.abs()));
-        let mut last = 0.0;
-        let mut crossings = 0;
-        for &(_, z) in pts {
-            if z.abs() < 0.01 * peak {
-                continue;
-            }
-            if last != 0.0 && (z > 0.0) != (last > 0.0) {
-                crossings += 1;
-            }
-            last = z;
-        }
-        (crossings as f64 / 2.0, peak)
+    /// in the plane z = 0) where the wrinkled mesh crosses the plane x = 0, ordered across the
+    /// width, values below 1% of the peak ignored (the library's
+    /// [`pleat::tfw::measure::section_waves`]); periods = crossings / 2. Returns (periods,
+    /// peak |z|).
+    fn periods_and_peak(mesh: &TriMesh) -> (f64, f64) {
+        let z: Vec<f64> = mesh.positions().iter().map(|p| p[2]).collect();
+        let c = section_waves(
+            mesh.positions(),
+            mesh.triangles(),
+            &z,
+            &Section::line([0.0; 3], [1.0, 0.0, 0.0]),
+        );
+        (c.waves, c.peak)
     }
 
     /// Solves issue 13's stretched sheet (0.25 × 0.1 m, h 0.1 mm, ν 0.5, Y 1 MPa, 37 × 14 =
@@ -1267,7 +1248,7 @@ mod stretched_sheet_check {
             ..EvalOptions::default()
         };
         let (ev, _) = r.cwf.evaluate(3, &opts).unwrap();
-        let (periods, peak_z) = periods_and_peak(&mid_line(&ev.mesh));
+        let (periods, peak_z) = periods_and_peak(&ev.mesh);
         let max_a = r.cwf.amplitude().iter().fold(0.0f64, |m, &a| m.max(a));
         eprintln!(
             "stretch {stretch}: {:?} / {:?} in {} it, {:.2}s (base {:.2}s, sqp {:.2}s); \
@@ -1311,7 +1292,6 @@ mod stretched_sheet_check {
 mod twisted_cylinder_check {
     use super::*;
     use pleat::tfw::{solve, TfwParams};
-    use pleat::wrinkle::EvalOptions;
 
     /// Base-surface measurements on the mid-height ring (|z − 2.5| ≤ 0.25 m): mean radius,
     /// mean angle between the tension direction and the axis (degrees), mean |κ| along it,
@@ -1367,44 +1347,16 @@ mod twisted_cylinder_check {
     }
 
     /// Waves around a ring: sign changes of `Re z` where the evaluated mesh (2 Loop levels)
-    /// crosses the plane z = `plane_z` at a distance ≥ `min_radius` from the z axis, sorted
-    /// by angle about the axis, values below 1% of the peak ignored; waves = crossings / 2.
+    /// crosses the plane z = `plane_z` at a distance ≥ `min_radius` from the z axis, ordered
+    /// by angle about the axis, values below 1% of the peak ignored; waves = crossings / 2
+    /// (the library's [`pleat::tfw::measure::count_waves`]).
     pub fn ring_waves(cwf: &pleat::wrinkle::Cwf, plane_z: f64, min_radius: f64) -> f64 {
-        let opts = EvalOptions {
-            want_z: true,
-            ..EvalOptions::default()
+        use pleat::tfw::measure::{count_waves, Section};
+        let section = Section {
+            min_radius,
+            ..Section::ring([0.0, 0.0, plane_z], [0.0, 0.0, 1.0])
         };
-        let (ev, _) = cwf.evaluate(2, &opts).unwrap();
-        let z = ev.z.as_ref().unwrap();
-        let x = ev.smooth_positions.as_ref().unwrap();
-        let mut pts: Vec<(f64, f64)> = Vec::new();
-        for t in ev.mesh.triangles() {
-            for k in 0..3 {
-                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-                let (ha, hb) = (x[a][2] - plane_z, x[b][2] - plane_z);
-                if (ha < 0.0) != (hb < 0.0) {
-                    let s = ha / (ha - hb);
-                    let px = x[a][0] + s * (x[b][0] - x[a][0]);
-                    let py = x[a][1] + s * (x[b][1] - x[a][1]);
-                    if px.hypot(py) < min_radius {
-                        continue;
-                    }
-                    pts.push((py.atan2(px), z[a].re + s * (z[b].re - z[a].re)));
-                }
-            }
-        }
-        pts.sort_by(|p, q| p.0.total_cmp(&q.0));
-        let peak = pts.iter().fold(0.0f64, |m, p| m.max(p.1.abs()));
-        let signs: Vec<bool> = pts
-            .iter()
-            .filter(|p| p.1.abs() >= 0.01 * peak)
-            .map(|p| p.1 > 0.0)
-            .collect();
-        let mut crossings = signs.windows(2).filter(|w| w[0] != w[1]).count();
-        if signs.len() > 1 && signs[0] != signs[signs.len() - 1] {
-            crossings += 1; // closing the ring
-        }
-        crossings as f64 / 2.0
+        count_waves(cwf, 2, &section).unwrap().waves
     }
 
     /// Solves `scene` and prints the base measurements and the wave count; returns the count.
@@ -1549,30 +1501,16 @@ mod sheared_rectangle_check {
     use pleat::tfw::{solve, TfwParams};
     use pleat::wrinkle::EvalOptions;
 
-    /// Wrinkles across the horizontal mid-line (y = 64 mm) of the evaluated mesh (3 Loop
-    /// levels, v2 on): sign changes of z (the base stays in z = 0) sorted by x, values below
-    /// 1% of the peak ignored; wrinkles = crossings / 2.
+    /// Wrinkles across the horizontal mid-line (y = `y0`) of the evaluated mesh (3 Loop
+    /// levels, v2 on): sign changes of z (the base stays in z = 0) ordered along x, values
+    /// below 1% of the peak ignored; wrinkles = crossings / 2 (the library's
+    /// [`pleat::tfw::measure::section_waves`]). Returns (wrinkles, peak |z|).
     fn mid_line_wrinkles(mesh: &pleat::mesh::TriMesh, y0: f64) -> (f64, f64) {
-        let p = mesh.positions();
-        let mut pts = Vec::new();
-        for t in mesh.triangles() {
-            for k in 0..3 {
-                let (a, b) = (p[t[k] as usize], p[t[(k + 1) % 3] as usize]);
-                if (a[1] < y0) != (b[1] < y0) {
-                    let s = (y0 - a[1]) / (b[1] - a[1]);
-                    pts.push((a[0] + s * (b[0] - a[0]), a[2] + s * (b[2] - a[2])));
-                }
-            }
-        }
-        pts.sort_by(|p, q| p.0.total_cmp(&q.0));
-        let peak = pts.iter().fold(0.0f64, |m, p| m.max(p.1.abs()));
-        let signs: Vec<bool> = pts
-            .iter()
-            .filter(|p| p.1.abs() >= 0.01 * peak)
-            .map(|p| p.1 > 0.0)
-            .collect();
-        let crossings = signs.windows(2).filter(|w| w[0] != w[1]).count();
-        (crossings as f64 / 2.0, peak)
+        use pleat::tfw::measure::{section_waves, Section};
+        let z: Vec<f64> = mesh.positions().iter().map(|p| p[2]).collect();
+        let section = Section::line([0.0, y0, 0.0], [0.0, 1.0, 0.0]);
+        let c = section_waves(mesh.positions(), mesh.triangles(), &z, &section);
+        (c.waves, c.peak)
     }
 
     /// The Wong–Pellegrino sheared rectangle ([`Scene::sheared_rectangle`]: 380 × 128 mm,

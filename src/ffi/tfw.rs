@@ -809,6 +809,7 @@ pub(super) mod imp {
                 armijo,
                 initial_shift: positive(p.sqp_initial_shift, "params->sqp_initial_shift")?,
                 time_limit_seconds: if t > 0.0 { t } else { f64::INFINITY },
+                ..SqpOptions::default()
             },
             curvature,
             knoppel: KnoppelOptions::default(),

@@ -67,7 +67,9 @@ pub mod delaunay;
 mod dense;
 pub mod energy;
 pub mod material;
+pub mod measure;
 pub mod pipeline;
+pub mod pnewton;
 pub mod scene;
 pub mod sqp;
 pub mod wfree;
@@ -79,4 +81,4 @@ pub use base::{
 pub use material::{Branch, Lame};
 pub use pipeline::{solve, TfwParams, TfwResult, TfwSeconds, TfwStatus};
 pub use scene::{Dirichlet, Material, Model, Motion, Panel, Rotation, Scene};
-pub use sqp::{SqpIteration, SqpOptions, SqpResult, SqpStatus};
+pub use sqp::{QpMethod, SqpIteration, SqpOptions, SqpResult, SqpStatus};
