@@ -19,8 +19,10 @@
 //!
 //! **Step.** In `y = (a_free, u, c)` the only constraints left are `a ≥ 0`: Bertsekas'
 //! projected Newton — amplitudes at 0 with a positive gradient are held (their rows and columns
-//! replaced by the mean diagonal), the rest take the Newton step of `Bᵀ H B` (H the per-face
-//! PSD-projected Hessian of the SQP, plus the same relative shift schedule), and the Armijo line
+//! replaced by the mean diagonal), the rest take the Newton step of `Bᵀ (H + σ W) B` (H the
+//! per-face PSD-projected Hessian of the SQP, `W` the first iteration's diagonal of H and σ the
+//! SQP's shift schedule: exactly the clarabel QP's `σ I` in its scaled variables, so without
+//! active bounds both solvers take the same step), and the Armijo line
 //! search runs along the projected arc `max(0, a + t d_a)` with the slope `gᵀ(y(t) − y)`.
 //! `Bᵀ H B` keeps one sparsity pattern (held entries are stored as zeros), so faer's symbolic
 //! analysis is done once. Every iterate is `x = B y`, curl-free to rounding by construction.
@@ -388,6 +390,12 @@ pub(super) fn run(
     };
     let initial_energy = eval.energy;
     let shape = qp_shape(problem, &eval, initial_energy);
+    // W = E₀ / D² = the first iteration's diagonal of H (floored), per free unknown
+    let weights: Vec<f64> = shape
+        .scale
+        .iter()
+        .map(|d| shape.energy_scale / (d * d))
+        .collect();
     let mut x = scatter(&y);
     let mut eval = e.evaluate(&x, WfTerms::ALL, HessianMode::ProjectedPerFace);
     let grad_y = |eval: &WfEval| -> Vec<f64> {
@@ -420,7 +428,16 @@ pub(super) fn run(
         let held: Vec<bool> = (0..basis.ny)
             .map(|i| i < na && y[i] <= 0.0 && g[i] > 0.0)
             .collect();
-        let step = newton_direction(problem, &basis, &eval, &g, &held, &mut analysis, &mut shift)?;
+        let step = newton_direction(
+            problem,
+            &basis,
+            &eval,
+            &g,
+            &held,
+            &weights,
+            &mut analysis,
+            &mut shift,
+        )?;
         qp_seconds += t0.elapsed().as_secs_f64();
         let Some((d, attempts)) = step else {
             status = SqpStatus::QpFailed;
@@ -507,21 +524,36 @@ pub(super) fn run(
 }
 
 /// The projected Newton direction in `y` (held unknowns: 0) and the factorizations tried, or
-/// `None` when the factorization fails even with a relative shift above 1e4. The symbolic
-/// analysis is made on the first call and reused.
+/// `None` when the factorization fails even with a relative shift above 1e4 (doubled per
+/// failure, as the clarabel QP's). The symbolic analysis is made on the first call and reused.
 fn newton_direction(
     problem: &SqpProblem,
     basis: &CurlFreeBasis,
     eval: &WfEval,
     g: &[f64],
     held: &[bool],
+    weights: &[f64],
     analysis: &mut Option<CholeskyAnalysis>,
     shift: &mut f64,
 ) -> Result<Option<(Vec<f64>, u32)>> {
     let ny = basis.ny;
     let (mut entries, mean) = reduced_hessian(problem, basis, &eval.hessian, held);
-    let first_diag = entries.len();
-    entries.extend((0..ny).map(|i| Entry::new(i, i, 0.0)));
+    // the shift σ Bᵀ W B (W = the first iteration's diagonal of H: the clarabel QP's σ I in
+    // its scaled variables), then one diagonal entry per unknown for the held ones
+    let first_shift = entries.len();
+    let mut shift_base = Vec::new();
+    for (row, &w) in basis.rows.iter().zip(weights) {
+        for &(i, bi) in row {
+            for &(j, bj) in row {
+                if i >= j {
+                    let v = if held[i] || held[j] { 0.0 } else { w * bi * bj };
+                    entries.push(Entry::new(i, j, 0.0));
+                    shift_base.push(v);
+                }
+            }
+        }
+    }
+    entries.extend((0..ny).map(|i| Entry::new(i, i, if held[i] { mean } else { 0.0 })));
     let rhs: Vec<f64> = g
         .iter()
         .zip(held)
@@ -530,8 +562,8 @@ fn newton_direction(
     let mut attempts = 0;
     loop {
         attempts += 1;
-        for (i, en) in entries[first_diag..].iter_mut().enumerate() {
-            en.val = if held[i] { mean } else { *shift * mean };
+        for (en, &b) in entries[first_shift..].iter_mut().zip(&shift_base) {
+            en.val = *shift * b;
         }
         let h = assemble(ny, &entries, "tfw projected Newton")?;
         if analysis.is_none() {
@@ -544,7 +576,7 @@ fn newton_direction(
                 return Ok(Some((d, attempts)));
             }
         }
-        *shift *= 10.0;
+        *shift *= 2.0;
         if *shift > 1e4 {
             return Ok(None);
         }

@@ -372,7 +372,7 @@ pub(super) struct QpShape {
     pub(super) scale: Vec<f64>,
     /// The QP objective is divided by this (`E₀`), so the QP data do not depend on the units
     /// of energy (Young's modulus).
-    energy_scale: f64,
+    pub(super) energy_scale: f64,
 }
 
 /// The QP scaling of the first iteration (module docs: `D = (E₀/diag H)^{1/2}`, objective
