@@ -727,6 +727,7 @@ pub(super) mod imp {
             pressure,
             dirichlet,
             seam_tolerance: 1e-6,
+            obstacles: Vec::new(),
         };
         scene.validate()?;
         out.put_boxed(PleatTfwScene { scene });
