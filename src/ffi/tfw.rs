@@ -1039,11 +1039,12 @@ mod tests {
 
     /// Base positions, amplitudes and the history of a small sheet solved through the C API
     /// on `threads` worker threads.
-    fn solve_small(threads: u32) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    fn solve_small(threads: u32, qp: u32) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let json =
             CString::new(crate::tfw::Scene::stretched_sheet(9, 4, 0.05).to_json_string()).unwrap();
         let mut params = pleat_tfw_params_default();
         params.sqp_max_iterations = 10;
+        params.qp = qp;
         // SAFETY: valid pointers throughout; every handle is destroyed once.
         unsafe {
             assert_eq!(pleat_set_thread_count(threads), PleatStatus::Ok);
@@ -1150,8 +1151,14 @@ mod tests {
     /// times aside).
     #[test]
     fn c_api_solve_is_thread_count_independent() {
-        let (p1, a1, h1) = solve_small(1);
-        let (p2, a2, h2) = solve_small(2);
+        for qp in [PLEAT_TFW_QP_CLARABEL, PLEAT_TFW_QP_PROJECTED_NEWTON] {
+            solve_is_thread_count_independent(qp);
+        }
+    }
+
+    fn solve_is_thread_count_independent(qp: u32) {
+        let (p1, a1, h1) = solve_small(1, qp);
+        let (p2, a2, h2) = solve_small(2, qp);
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&p1), bits(&p2));
         assert_eq!(bits(&a1), bits(&a2));

@@ -15,6 +15,7 @@
 //! scene files that name no section).
 
 use crate::mesh::TriMesh;
+use crate::tfw::dense::{dot, sub};
 use crate::wrinkle::{Cwf, EvalOptions};
 use crate::Result;
 
@@ -67,14 +68,6 @@ pub struct WaveCount {
     pub peak: f64,
     /// Number of section samples (crossed edges).
     pub samples: usize,
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// Two unit vectors spanning the plane orthogonal to unit `n`.

@@ -307,9 +307,8 @@ fn generator_form(
     h
 }
 
-/// `Bᵀ H B` as lower-triangle entries (held unknowns: off-diagonal entries stored as 0), the
-/// diagonal of each unknown listed once more for the shift, and the mean positive diagonal of
-/// the unheld unknowns.
+/// `Bᵀ H B` as lower-triangle entries (entries touching a held unknown stored as 0, so the
+/// pattern never changes) and the mean positive diagonal of the unheld unknowns.
 fn reduced_hessian(
     problem: &SqpProblem,
     basis: &CurlFreeBasis,
@@ -408,8 +407,10 @@ pub(super) fn run(
     if options.snapshot_every > 0 {
         snapshots.push((0, x.clone()));
     }
-    let mut analysis: Option<CholeskyAnalysis> = None;
-    let mut shift = options.initial_shift;
+    let mut state = NewtonState {
+        analysis: None,
+        shift: options.initial_shift,
+    };
     let mut history = Vec::new();
     let mut qp_seconds = 0.0;
     let mut status = SqpStatus::MaxIterations;
@@ -428,16 +429,7 @@ pub(super) fn run(
         let held: Vec<bool> = (0..basis.ny)
             .map(|i| i < na && y[i] <= 0.0 && g[i] > 0.0)
             .collect();
-        let step = newton_direction(
-            problem,
-            &basis,
-            &eval,
-            &g,
-            &held,
-            &weights,
-            &mut analysis,
-            &mut shift,
-        )?;
+        let step = newton_direction(problem, &basis, &eval, &g, &held, &weights, &mut state)?;
         qp_seconds += t0.elapsed().as_secs_f64();
         let Some((d, attempts)) = step else {
             status = SqpStatus::QpFailed;
@@ -489,7 +481,7 @@ pub(super) fn run(
             stationarity: r,
             step_norm,
             step_length: t,
-            shift,
+            shift: state.shift,
             qp_iterations: attempts,
             curl_residual: problem.curl_residual(&x),
             seconds: start.elapsed().as_secs_f64(),
@@ -497,7 +489,7 @@ pub(super) fn run(
         if options.snapshot_every > 0 && history.len() % options.snapshot_every == 0 {
             snapshots.push((history.len(), x.clone()));
         }
-        shift = (shift * 0.5).max(1e-16);
+        state.shift = (state.shift * 0.5).max(1e-16);
         if r <= options.stationarity_tolerance * r0 {
             status = SqpStatus::Stationary;
             break;
@@ -523,6 +515,12 @@ pub(super) fn run(
     })
 }
 
+/// What the Newton steps carry over: the symbolic analysis and the relative shift σ.
+struct NewtonState {
+    analysis: Option<CholeskyAnalysis>,
+    shift: f64,
+}
+
 /// The projected Newton direction in `y` (held unknowns: 0) and the factorizations tried, or
 /// `None` when the factorization fails even with a relative shift above 1e4 (doubled per
 /// failure, as the clarabel QP's). The symbolic analysis is made on the first call and reused.
@@ -533,9 +531,9 @@ fn newton_direction(
     g: &[f64],
     held: &[bool],
     weights: &[f64],
-    analysis: &mut Option<CholeskyAnalysis>,
-    shift: &mut f64,
+    state: &mut NewtonState,
 ) -> Result<Option<(Vec<f64>, u32)>> {
+    let NewtonState { analysis, shift } = state;
     let ny = basis.ny;
     let (mut entries, mean) = reduced_hessian(problem, basis, &eval.hessian, held);
     // the shift σ Bᵀ W B (W = the first iteration's diagonal of H: the clarabel QP's σ I in
