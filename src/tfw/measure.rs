@@ -192,12 +192,19 @@ pub fn section_waves(
 /// the section cut through the smooth (wrinkle-free) positions; `peak` is the peak |Re z|
 /// on the section (m). Errors: those of [`Cwf::evaluate`].
 pub fn count_waves(cwf: &Cwf, levels: usize, section: &Section) -> Result<WaveCount> {
-    let (positions, triangles, re) = evaluated_re_z(cwf, levels)?;
-    Ok(section_waves(&positions, &triangles, &re, section))
+    let e = evaluated_re_z(cwf, levels)?;
+    Ok(section_waves(&e.positions, &e.triangles, &e.re, section))
 }
 
-/// Smooth positions, triangles and `Re z` of the `levels`-level evaluation.
-fn evaluated_re_z(cwf: &Cwf, levels: usize) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<f64>)> {
+/// Smooth positions, triangles and `Re z` of an evaluation.
+struct ReZ {
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    re: Vec<f64>,
+}
+
+/// [`ReZ`] of the `levels`-level evaluation.
+fn evaluated_re_z(cwf: &Cwf, levels: usize) -> Result<ReZ> {
     let opts = EvalOptions {
         want_z: true,
         ..EvalOptions::default()
@@ -211,7 +218,11 @@ fn evaluated_re_z(cwf: &Cwf, levels: usize) -> Result<(Vec<[f64; 3]>, Vec<[u32; 
         .smooth_positions
         .clone()
         .unwrap_or_else(|| ev.mesh.positions().to_vec());
-    Ok((positions, ev.mesh.triangles().to_vec(), re))
+    Ok(ReZ {
+        positions,
+        triangles: ev.mesh.triangles().to_vec(),
+        re,
+    })
 }
 
 /// The three candidate sections of [`count_waves_auto`] for `mesh`: per coordinate axis, the
@@ -250,10 +261,10 @@ pub fn candidate_sections(mesh: &TriMesh) -> Vec<Section> {
 /// The section (among [`candidate_sections`] of the cwf's base mesh) crossing the most waves
 /// of `Re z` at `levels`, and its count (ties: the lower axis). One evaluation.
 pub fn count_waves_auto(cwf: &Cwf, levels: usize) -> Result<(Section, WaveCount)> {
-    let (positions, triangles, re) = evaluated_re_z(cwf, levels)?;
+    let e = evaluated_re_z(cwf, levels)?;
     let mut best: Option<(Section, WaveCount)> = None;
     for s in candidate_sections(cwf.base()) {
-        let c = section_waves(&positions, &triangles, &re, &s);
+        let c = section_waves(&e.positions, &e.triangles, &e.re, &s);
         if best.as_ref().is_none_or(|b| c.waves > b.1.waves) {
             best = Some((s, c));
         }

@@ -69,7 +69,11 @@ impl CurlFreeBasis {
             .flat_map(|e| e.iter().copied())
             .max()
             .map_or(0, |m| m + 1);
-        let (tree, in_tree, roots) = spanning_forest(nv, ends);
+        let Forest {
+            tree,
+            in_tree,
+            roots,
+        } = spanning_forest(nv, ends);
         let mut u_index = vec![NONE; nv];
         let mut ny = na;
         let mut in_complex = vec![false; nv];
@@ -184,13 +188,19 @@ impl CurlFreeBasis {
     }
 }
 
+/// A spanning forest of the vertex graph.
+struct Forest {
+    /// Tree edges `(vertex, parent, edge)` in breadth-first order.
+    tree: Vec<(usize, usize, usize)>,
+    /// Per edge, whether it is in the forest.
+    in_tree: Vec<bool>,
+    /// Per vertex, whether it roots a component.
+    roots: Vec<bool>,
+}
+
 /// Breadth-first spanning forest of the vertex graph of the free edges, vertices in increasing
-/// order: `(tree edges (vertex, parent, edge) in BFS order, per edge "in tree", per vertex
-/// "is a root")`.
-fn spanning_forest(
-    nv: usize,
-    ends: &[[usize; 2]],
-) -> (Vec<(usize, usize, usize)>, Vec<bool>, Vec<bool>) {
+/// order.
+fn spanning_forest(nv: usize, ends: &[[usize; 2]]) -> Forest {
     let mut adj: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nv];
     for (j, &[t, h]) in ends.iter().enumerate() {
         adj[t].push((h, j));
@@ -219,7 +229,11 @@ fn spanning_forest(
             }
         }
     }
-    (tree, in_tree, roots)
+    Forest {
+        tree,
+        in_tree,
+        roots,
+    }
 }
 
 /// Breadth-first spanning forest of the dual graph (curl rows as nodes, non-tree edges as dual
