@@ -192,6 +192,20 @@ static void arrays_scene(void) {
     pleat_tfw_result_destroy(r);
     r = NULL;
 
+    /* the other SQP step solver (qp, appended 2026-11-27): the same sheet, curl <= 1e-10 */
+    saved = st.peak_amplitude;
+    p.qp = p.qp == PLEAT_TFW_QP_CLARABEL ? PLEAT_TFW_QP_PROJECTED_NEWTON : PLEAT_TFW_QP_CLARABEL;
+    CHECK_STATUS(pleat_tfw_solve(s, &p, NULL, NULL, &r), PLEAT_STATUS_OK);
+    memset(&st, 0, sizeof st);
+    st.struct_size = sizeof st;
+    CHECK_STATUS(pleat_tfw_result_get_stats(r, &st), PLEAT_STATUS_OK);
+    CHECK(st.peak_amplitude > 0 && st.curl_residual <= 1e-10);
+    CHECK(fabs(st.peak_amplitude - saved) <= 0.05 * saved);
+    printf("arrays sheet, qp %u: %u SQP iterations, peak amplitude %.3f mm\n", p.qp,
+           st.sqp_iterations, st.peak_amplitude * 1e3);
+    pleat_tfw_result_destroy(r);
+    r = NULL;
+
     /* bad parameters */
     p = pleat_tfw_params_default();
     p.struct_size = 4;
@@ -204,6 +218,9 @@ static void arrays_scene(void) {
     CHECK_STATUS(pleat_tfw_solve(s, &p, NULL, NULL, &r), PLEAT_STATUS_INVALID_ARGUMENT);
     p = pleat_tfw_params_default();
     p.w_rule = 7;
+    CHECK_STATUS(pleat_tfw_solve(s, &p, NULL, NULL, &r), PLEAT_STATUS_INVALID_ARGUMENT);
+    p = pleat_tfw_params_default();
+    p.qp = 7;
     CHECK_STATUS(pleat_tfw_solve(s, &p, NULL, NULL, &r), PLEAT_STATUS_INVALID_ARGUMENT);
     CHECK_STATUS(pleat_tfw_solve(NULL, NULL, NULL, NULL, &r), PLEAT_STATUS_INVALID_ARGUMENT);
     CHECK_STATUS(pleat_tfw_solve(s, NULL, NULL, NULL, NULL), PLEAT_STATUS_INVALID_ARGUMENT);

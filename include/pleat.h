@@ -178,6 +178,14 @@
 // `PleatTfwParams::curvature`: `κ_f` per face from area-weighted vertex normals.
 #define PLEAT_TFW_CURVATURE_VERTEX_NORMALS 1
 
+// `PleatTfwParams::qp`: each SQP step is a QP with the curl constraint, solved by clarabel
+// (interior point).
+#define PLEAT_TFW_QP_CLARABEL 0
+
+// `PleatTfwParams::qp`: the curl constraint eliminated (tree–cotree basis), each step a
+// projected Newton step on `a ≥ 0` with a sparse Cholesky.
+#define PLEAT_TFW_QP_PROJECTED_NEWTON 1
+
 // Doubles per iteration written by `pleat_tfw_result_copy_history`: energy (J), stationarity
 // residual (absolute), step `‖Δx‖∞`, wall seconds since the SQP started.
 #define PLEAT_TFW_HISTORY_COLUMNS 4
@@ -969,6 +977,12 @@ typedef struct PleatTfwParams {
   uint32_t curvature;
   // Reserved, set to 0.
   uint32_t reserved2;
+  // The SQP step solver: `PLEAT_TFW_QP_CLARABEL` or `PLEAT_TFW_QP_PROJECTED_NEWTON`
+  // (the default is `pleat_tfw_params_default()`'s). Appended 2026-11-27: a shorter
+  // struct (without it) gets the default.
+  uint32_t qp;
+  // Reserved, set to 0.
+  uint32_t reserved3;
 } PleatTfwParams;
 
 // Material and loads of `pleat_tfw_scene_from_arrays` (SI units). Get the defaults from

@@ -559,13 +559,21 @@ fn bench_tfw_writes_csv_and_svg() {
         assert_eq!(r.len(), rows[0].len(), "{scenes}");
         let peak: f64 = r[9].parse().unwrap();
         assert!(peak > 0.0 && peak < 5e-3, "{scenes}");
+        let waves: f64 = r[12].parse().unwrap();
+        assert!(waves >= 0.0, "{scenes}");
     }
     let iters = std::fs::read_to_string(dir.join("tfw_iterations.csv")).unwrap();
     let mut last: Option<(String, f64)> = None;
     for l in iters.lines().skip(1) {
         let f: Vec<&str> = l.split(',').collect();
-        assert_eq!(f.len(), 7, "{l}");
-        let v: Vec<f64> = f[2..].iter().map(|x| x.parse().unwrap()).collect();
+        assert_eq!(f.len(), 9, "{l}");
+        let v: Vec<f64> = f[2..7].iter().map(|x| x.parse().unwrap()).collect();
+        // waves, peak amplitude: empty or measured (at the start, every 10 it., the end)
+        assert!(f[7].is_empty() == f[8].is_empty(), "{l}");
+        if f[1] == "0" {
+            let (w, p): (f64, f64) = (f[7].parse().unwrap(), f[8].parse().unwrap());
+            assert!(w >= 0.0 && p > 0.0, "{l}");
+        }
         assert!(v.iter().all(|x| x.is_finite()), "{l}");
         if let Some((s, e)) = &last {
             if s == f[0] {

@@ -54,6 +54,12 @@ pub const PLEAT_TFW_W_RULE_REFERENCE: u32 = 1;
 pub const PLEAT_TFW_CURVATURE_QUADRIC_FIT: u32 = 0;
 /// `PleatTfwParams::curvature`: `κ_f` per face from area-weighted vertex normals.
 pub const PLEAT_TFW_CURVATURE_VERTEX_NORMALS: u32 = 1;
+/// `PleatTfwParams::qp`: each SQP step is a QP with the curl constraint, solved by clarabel
+/// (interior point).
+pub const PLEAT_TFW_QP_CLARABEL: u32 = 0;
+/// `PleatTfwParams::qp`: the curl constraint eliminated (tree–cotree basis), each step a
+/// projected Newton step on `a ≥ 0` with a sparse Cholesky.
+pub const PLEAT_TFW_QP_PROJECTED_NEWTON: u32 = 1;
 
 /// Doubles per iteration written by `pleat_tfw_result_copy_history`: energy (J), stationarity
 /// residual (absolute), step `‖Δx‖∞`, wall seconds since the SQP started.
@@ -126,6 +132,12 @@ pub struct PleatTfwParams {
     pub curvature: u32,
     /// Reserved, set to 0.
     pub reserved2: u32,
+    /// The SQP step solver: `PLEAT_TFW_QP_CLARABEL` or `PLEAT_TFW_QP_PROJECTED_NEWTON`
+    /// (the default is `pleat_tfw_params_default()`'s). Appended 2026-11-27: a shorter
+    /// struct (without it) gets the default.
+    pub qp: u32,
+    /// Reserved, set to 0.
+    pub reserved3: u32,
 }
 
 /// Material and loads of `pleat_tfw_scene_from_arrays` (SI units). Get the defaults from
@@ -266,6 +278,11 @@ impl From<&crate::tfw::TfwParams> for PleatTfwParams {
                 CurvatureMethod::VertexNormals => PLEAT_TFW_CURVATURE_VERTEX_NORMALS,
             },
             reserved2: 0,
+            qp: match p.sqp.qp {
+                crate::tfw::QpMethod::Clarabel => PLEAT_TFW_QP_CLARABEL,
+                crate::tfw::QpMethod::ProjectedNewton => PLEAT_TFW_QP_PROJECTED_NEWTON,
+            },
+            reserved3: 0,
         }
     }
 }
@@ -294,6 +311,8 @@ pub(super) fn defaults_without_tfw() -> PleatTfwParams {
         out_of_scope_slack_fraction: 0.5,
         curvature: PLEAT_TFW_CURVATURE_QUADRIC_FIT,
         reserved2: 0,
+        qp: PLEAT_TFW_QP_CLARABEL,
+        reserved3: 0,
     }
 }
 
@@ -555,6 +574,7 @@ pub(super) mod imp {
     use crate::ffi::wrinkle::imp::eval_options;
     use crate::tfw::curvature::CurvatureMethod;
     use crate::tfw::wfree::WRule;
+    use crate::tfw::QpMethod;
     use crate::tfw::{
         BaseOptions, BaseStatus, Dirichlet, Material, Motion, Panel, Scene, SqpOptions, SqpStatus,
         TfwParams, TfwResult, TfwStatus,
@@ -707,6 +727,7 @@ pub(super) mod imp {
             pressure,
             dirichlet,
             seam_tolerance: 1e-6,
+            obstacles: Vec::new(),
         };
         scene.validate()?;
         out.put_boxed(PleatTfwScene { scene });
@@ -776,6 +797,16 @@ pub(super) mod imp {
                 )))
             }
         };
+        let qp = match p.qp {
+            PLEAT_TFW_QP_CLARABEL => QpMethod::Clarabel,
+            PLEAT_TFW_QP_PROJECTED_NEWTON => QpMethod::ProjectedNewton,
+            q => {
+                return Err(Error::InvalidArgument(format!(
+                    "params->qp is {q}; use PLEAT_TFW_QP_CLARABEL or \
+                     PLEAT_TFW_QP_PROJECTED_NEWTON"
+                )))
+            }
+        };
         let f = p.out_of_scope_slack_fraction;
         let f_ok = (0.0..=1.0).contains(&f);
         check_f64(f, f_ok, "params->out_of_scope_slack_fraction", "in [0, 1]")?;
@@ -809,6 +840,8 @@ pub(super) mod imp {
                 armijo,
                 initial_shift: positive(p.sqp_initial_shift, "params->sqp_initial_shift")?,
                 time_limit_seconds: if t > 0.0 { t } else { f64::INFINITY },
+                qp,
+                snapshot_every: 0,
             },
             curvature,
             knoppel: KnoppelOptions::default(),
@@ -1006,11 +1039,12 @@ mod tests {
 
     /// Base positions, amplitudes and the history of a small sheet solved through the C API
     /// on `threads` worker threads.
-    fn solve_small(threads: u32) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    fn solve_small(threads: u32, qp: u32) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let json =
             CString::new(crate::tfw::Scene::stretched_sheet(9, 4, 0.05).to_json_string()).unwrap();
         let mut params = pleat_tfw_params_default();
         params.sqp_max_iterations = 10;
+        params.qp = qp;
         // SAFETY: valid pointers throughout; every handle is destroyed once.
         unsafe {
             assert_eq!(pleat_set_thread_count(threads), PleatStatus::Ok);
@@ -1083,12 +1117,48 @@ mod tests {
         assert!(e.contains("params->curvature"), "{e}");
     }
 
+    /// `qp` (appended 2026-11-27): read from a full struct, defaulted for an older, shorter
+    /// one, an unknown value rejected with a message naming the field.
+    #[test]
+    fn qp_field_is_versioned_and_checked() {
+        use crate::tfw::QpMethod;
+        let read = |p: &PleatTfwParams| {
+            // SAFETY: `p` is a live struct of at least `p.struct_size` bytes.
+            let v = unsafe { crate::ffi::boundary::read_versioned(p, "params") }?;
+            imp::params(&v)
+        };
+        let mut p = pleat_tfw_params_default();
+        let default = crate::tfw::TfwParams::default().sqp.qp;
+        assert_eq!(read(&p).unwrap().sqp.qp, default);
+        p.qp = PLEAT_TFW_QP_PROJECTED_NEWTON;
+        assert_eq!(read(&p).unwrap().sqp.qp, QpMethod::ProjectedNewton);
+        p.qp = PLEAT_TFW_QP_CLARABEL;
+        assert_eq!(read(&p).unwrap().sqp.qp, QpMethod::Clarabel);
+        p.qp = if default == QpMethod::Clarabel {
+            PLEAT_TFW_QP_PROJECTED_NEWTON
+        } else {
+            PLEAT_TFW_QP_CLARABEL
+        };
+        p.struct_size = std::mem::offset_of!(PleatTfwParams, qp) as u32;
+        assert_eq!(read(&p).unwrap().sqp.qp, default);
+        p.struct_size = std::mem::size_of::<PleatTfwParams>() as u32;
+        p.qp = 9;
+        let e = read(&p).unwrap_err().to_string();
+        assert!(e.contains("params->qp"), "{e}");
+    }
+
     /// Same scene and parameters ⇒ the same bytes on 1 and 2 threads (the history's wall
     /// times aside).
     #[test]
     fn c_api_solve_is_thread_count_independent() {
-        let (p1, a1, h1) = solve_small(1);
-        let (p2, a2, h2) = solve_small(2);
+        for qp in [PLEAT_TFW_QP_CLARABEL, PLEAT_TFW_QP_PROJECTED_NEWTON] {
+            solve_is_thread_count_independent(qp);
+        }
+    }
+
+    fn solve_is_thread_count_independent(qp: u32) {
+        let (p1, a1, h1) = solve_small(1, qp);
+        let (p2, a2, h2) = solve_small(2, qp);
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&p1), bits(&p2));
         assert_eq!(bits(&a1), bits(&a2));

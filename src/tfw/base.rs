@@ -39,7 +39,7 @@ use crate::report::{Progress, ProgressFn};
 use crate::solve::{assemble, CholeskyAnalysis, Entry, Parallelism, ShiftSchedule};
 use crate::tfw::dense::project_psd;
 use crate::tfw::material::{principal_strains, relaxed_density_in_form, Branch, Lame};
-use crate::tfw::scene::Model;
+use crate::tfw::scene::{Model, Obstacle};
 use crate::{Error, Result};
 
 /// Which energy terms to evaluate (all by default).
@@ -53,6 +53,8 @@ pub struct Terms {
     pub pressure: bool,
     /// Gravity.
     pub gravity: bool,
+    /// Obstacle penalties ([`crate::tfw::Obstacle`]).
+    pub obstacles: bool,
 }
 
 impl Terms {
@@ -62,6 +64,7 @@ impl Terms {
         bending: true,
         pressure: true,
         gravity: true,
+        obstacles: true,
     };
     /// No term (start from this and switch one on).
     pub const NONE: Terms = Terms {
@@ -69,6 +72,7 @@ impl Terms {
         bending: false,
         pressure: false,
         gravity: false,
+        obstacles: false,
     };
 }
 
@@ -164,6 +168,8 @@ pub struct TermEnergies {
     pub pressure: f64,
     /// Gravity energy (J).
     pub gravity: f64,
+    /// Obstacle penalty energy (J).
+    pub obstacles: f64,
 }
 
 /// Per-face strain state of a base surface.
@@ -226,6 +232,7 @@ pub struct BaseProblem {
     density: f64,
     gravity: [f64; 3],
     pressure: f64,
+    obstacles: Vec<Obstacle>,
     /// Rows of the corrected cotan Laplacian.
     laplacian: Vec<Vec<(u32, f64)>>,
     bending_coefficient: f64,
@@ -265,6 +272,7 @@ impl BaseProblem {
             density: model.material.density,
             gravity: model.gravity,
             pressure: model.pressure,
+            obstacles: model.obstacles.clone(),
             laplacian,
             bending_coefficient,
             bending_matrix,
@@ -310,6 +318,7 @@ impl BaseProblem {
             bending,
             pressure: -self.pressure * volume,
             gravity,
+            obstacles: self.obstacle_energy(x),
         }
     }
 
@@ -321,10 +330,12 @@ impl BaseProblem {
             + pick(terms.bending, e.bending)
             + pick(terms.pressure, e.pressure)
             + pick(terms.gravity, e.gravity)
+            + pick(terms.obstacles, e.obstacles)
     }
 
     /// Energy, gradient and Hessian of the selected terms at `x`. The pressure Hessian is
-    /// projected face by face onto the PSD cone unless `exact_pressure`.
+    /// projected face by face onto the PSD cone unless `exact_pressure` (which also keeps the
+    /// obstacle penalties' exact, indefinite Hessian; see `obstacle_terms`).
     pub fn evaluate(&self, x: &[f64], terms: Terms, exact_pressure: bool) -> BaseEval {
         let n3 = x.len();
         let mut gradient = vec![0.0; n3];
@@ -381,11 +392,64 @@ impl BaseProblem {
                 }
             }
         }
+        if terms.obstacles {
+            energy += self.obstacle_terms(x, exact_pressure, &mut gradient, &mut hessian);
+        }
         BaseEval {
             energy,
             gradient,
             hessian,
         }
+    }
+
+    /// The obstacle penalty `Σ_o Σ_i k_o Ā_i (m_o − d_o(x_i))³₊` ([`Obstacle`]).
+    fn obstacle_energy(&self, x: &[f64]) -> f64 {
+        let mut e = 0.0;
+        for o in &self.obstacles {
+            for (i, a) in self.vertex_areas.iter().enumerate() {
+                let s = o.margin - o.distance(vec3(x, i as u32)).0;
+                if s > 0.0 {
+                    e += o.stiffness * a * s * s * s;
+                }
+            }
+        }
+        e
+    }
+
+    /// Adds the obstacle penalties' gradient and Hessian (lower 3×3 blocks) and returns their
+    /// energy. With `s = m − d > 0`: `∇E = −3kĀs² ∇d`, `∇²E = 6kĀs ∇d∇dᵀ − 3kĀs² ∇²d`; the
+    /// second part (negative semidefinite for a sphere: `∇²d = (I − uuᵀ)/ρ`) is dropped unless
+    /// `exact`, so the Newton matrix stays PSD.
+    fn obstacle_terms(
+        &self,
+        x: &[f64],
+        exact: bool,
+        gradient: &mut [f64],
+        hessian: &mut Vec<(usize, usize, f64)>,
+    ) -> f64 {
+        let mut energy = 0.0;
+        for o in &self.obstacles {
+            for (i, a) in self.vertex_areas.iter().enumerate() {
+                let (d, n, dd) = o.distance(vec3(x, i as u32));
+                let s = o.margin - d;
+                if s <= 0.0 {
+                    continue;
+                }
+                let ka = o.stiffness * a;
+                energy += ka * s * s * s;
+                for r in 0..3 {
+                    gradient[3 * i + r] -= 3.0 * ka * s * s * n[r];
+                    for c in 0..=r {
+                        let mut h = 6.0 * ka * s * n[r] * n[c];
+                        if exact {
+                            h -= 3.0 * ka * s * s * dd[r][c];
+                        }
+                        hessian.push((3 * i + r, 3 * i + c, h));
+                    }
+                }
+            }
+        }
+        energy
     }
 
     /// Per-face branch counts and area fractions at `x`.
@@ -591,6 +655,7 @@ pub fn solve_base(
     let mut relative_gradient = 0.0;
     let mut analysis: Option<CholeskyAnalysis> = None;
     let mut last_shift = 0.0;
+    let step_cap = obstacle_step_cap(model);
     for step in 1..=options.load_steps {
         let s = step as f64 / options.load_steps as f64;
         for &(v, m) in &model.clamps {
@@ -674,6 +739,13 @@ pub fn solve_base(
                 d = g.iter().map(|v| -v / diag_scale).collect();
                 slope = g.iter().zip(&d).map(|(a, b)| a * b).sum();
                 gradient_step = true;
+            }
+            if let Some(cap) = step_cap {
+                let scale = cap / max_vertex_move(&d, &reduced, n).max(f64::MIN_POSITIVE);
+                if scale < 1.0 {
+                    d.iter_mut().for_each(|v| *v *= scale);
+                    slope *= scale;
+                }
             }
             // Armijo backtracking (c = 0.2, ρ = 0.5; spec step 2).
             let slack = 4.0 * f64::EPSILON * ev.energy.abs();
@@ -831,6 +903,48 @@ fn normal_matrix(n: usize, rows: &[Vec<(u32, f64)>], areas: &[f64]) -> Vec<(u32,
     }
     debug_assert!(out.iter().all(|&(j, _, _)| (j as usize) < n));
     out
+}
+
+/// With obstacles, the largest vertex displacement of one Newton step: a quarter of the
+/// smallest sphere radius and of the initial bounding-box diagonal, so that no step can carry
+/// a vertex through an obstacle (a free surface's rigid modes have a near-zero Hessian: its
+/// first Newton steps are huge). `None` without obstacles (no cap: results unchanged).
+fn obstacle_step_cap(model: &Model) -> Option<f64> {
+    if model.obstacles.is_empty() {
+        return None;
+    }
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in &model.positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let diag = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    let radius = model
+        .obstacles
+        .iter()
+        .filter_map(|o| match o.shape {
+            crate::tfw::scene::ObstacleShape::Sphere { radius, .. } => Some(radius),
+            crate::tfw::scene::ObstacleShape::Plane { .. } => None,
+        })
+        .fold(diag, f64::min);
+    Some(0.25 * radius)
+}
+
+/// The largest per-vertex displacement `|d_v|` of a reduced step `d` (free coordinates).
+fn max_vertex_move(d: &[f64], reduced: &[usize], n: usize) -> f64 {
+    (0..n)
+        .map(|v| {
+            (0..3)
+                .map(|k| reduced[3 * v + k])
+                .filter(|&r| r != usize::MAX)
+                .map(|r| d[r] * d[r])
+                .sum::<f64>()
+                .sqrt()
+        })
+        .fold(0.0, f64::max)
 }
 
 fn vec3(x: &[f64], v: u32) -> [f64; 3] {

@@ -33,7 +33,13 @@
 //!   phase), with a report; the wrinkled mesh comes from [`crate::wrinkle::Cwf::evaluate`]
 //!   with [`crate::wrinkle::EvalOptions::in_plane_v2`] (the v2 term of eq. 2.19).
 //!
-//! **Not implemented yet**: obstacles, period snapping on non-contractible loops.
+//! - [`pnewton`]: the SQP step by projected Newton with the curl constraint eliminated
+//!   (exact part + tree–cotree cohomology basis; [`sqp::QpMethod::ProjectedNewton`]).
+//! - [`measure`]: wave counts of an evaluated field along a plane section (ring or line).
+//! - Obstacles: planes and spheres by a one-sided cubic penalty in the base energy
+//!   ([`scene::Obstacle`], [`base`]).
+//!
+//! **Not implemented yet**: period snapping on non-contractible loops.
 //!
 //! **Departures from the spec, and why:**
 //! - The built-in stretched sheet and [`Scene::twisted_cylinder`] use structured grids with
@@ -67,7 +73,9 @@ pub mod delaunay;
 mod dense;
 pub mod energy;
 pub mod material;
+pub mod measure;
 pub mod pipeline;
+pub mod pnewton;
 pub mod scene;
 pub mod sqp;
 pub mod wfree;
@@ -78,5 +86,8 @@ pub use base::{
 };
 pub use material::{Branch, Lame};
 pub use pipeline::{solve, TfwParams, TfwResult, TfwSeconds, TfwStatus};
-pub use scene::{Dirichlet, Material, Model, Motion, Panel, Rotation, Scene};
-pub use sqp::{SqpIteration, SqpOptions, SqpResult, SqpStatus};
+pub use scene::{
+    Dirichlet, Material, Model, Motion, Obstacle, ObstacleShape, Panel, Rotation, Scene,
+    DEFAULT_OBSTACLE_STIFFNESS,
+};
+pub use sqp::{QpMethod, SqpIteration, SqpOptions, SqpResult, SqpStatus};

@@ -20,6 +20,11 @@
 //!                    "rotation": { "axis": [0, 0, 1], "origin": [0, 0, 0], "degrees": 10 } } ]
 //! }
 //! ```
+//! Optional `"obstacles": [ {"type": "sphere", "centre": [0, 0, 0], "radius": 0.2},
+//! {"type": "plane", "point": [0, 0, -1], "normal": [0, 0, 1], "stiffness": 1e9, "margin": 0} ]`
+//! ([`Obstacle`]: a one-sided cubic penalty in the base solve; `stiffness` in J/m⁵, default
+//! [`DEFAULT_OBSTACLE_STIFFNESS`]; `margin` in m, default 0; errors name the field, e.g.
+//! `scene: obstacles[0].radius: must be > 0`).
 //! SI units. `loads`, `seam_tolerance`, `name`, `dirichlet`, a panel's `positions` (default:
 //! the rest position at z = 0), a condition's `translation` and `rotation`, and
 //! `material.density` (default 0) are optional. Unknown keys are errors. Panels are sewn by
@@ -234,6 +239,155 @@ pub struct Scene {
     pub dirichlet: Vec<Dirichlet>,
     /// Vertices whose initial positions are closer than this (m) are sewn into one.
     pub seam_tolerance: f64,
+    /// Rigid obstacles kept out by a penalty in the base solve (JSON `obstacles`).
+    pub obstacles: Vec<Obstacle>,
+}
+
+/// The default [`Obstacle::stiffness`] (J/m⁵ = Pa/m²): under a normal load `q` (Pa) a surface
+/// resting on an obstacle sinks in by about `√(q / (3k))` (the cubic penalty's balance):
+/// 26 µm for the sphere drape's weight `ρ h g ≈ 2 Pa`, 0.45 mm for 600 Pa.
+pub const DEFAULT_OBSTACLE_STIFFNESS: f64 = 1e9;
+
+/// The shape of an [`Obstacle`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ObstacleShape {
+    /// The half-space behind a plane: the surface is kept on the side the normal points to.
+    Plane {
+        /// A point of the plane.
+        point: [f64; 3],
+        /// The normal (any nonzero length), pointing to the allowed side.
+        normal: [f64; 3],
+    },
+    /// A solid ball: the surface is kept outside.
+    Sphere {
+        /// The centre.
+        centre: [f64; 3],
+        /// The radius (> 0).
+        radius: f64,
+    },
+}
+
+/// A rigid obstacle of the base solve (spec: "Obstacles (drapes) by penalty"): every vertex
+/// `i` with signed distance `d_i < margin` from the obstacle's surface (positive outside)
+/// pays `k · Ā_i · (margin − d_i)³` (`Ā_i` its barycentric rest area): a one-sided penalty,
+/// twice continuously differentiable, zero outside the margin ([`crate::tfw::base`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Obstacle {
+    /// Plane or sphere.
+    pub shape: ObstacleShape,
+    /// Penalty stiffness `k` (J/m⁵; default [`DEFAULT_OBSTACLE_STIFFNESS`]).
+    pub stiffness: f64,
+    /// Distance from the obstacle's surface where the penalty starts (m, ≥ 0; default 0).
+    pub margin: f64,
+}
+
+impl Obstacle {
+    /// Signed distance of `x` from the obstacle's surface (positive outside), its gradient and
+    /// the Hessian of the distance (0 for a plane; `(I − uuᵀ)/|x − c|` for a sphere).
+    pub fn distance(&self, x: [f64; 3]) -> (f64, [f64; 3], [[f64; 3]; 3]) {
+        match self.shape {
+            ObstacleShape::Plane { point, normal } => {
+                let l =
+                    (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt();
+                let n = normal.map(|c| c / l);
+                let d = (0..3).map(|k| (x[k] - point[k]) * n[k]).sum();
+                (d, n, [[0.0; 3]; 3])
+            }
+            ObstacleShape::Sphere { centre, radius } => {
+                let r = [x[0] - centre[0], x[1] - centre[1], x[2] - centre[2]];
+                let rho = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt().max(1e-300);
+                let u = r.map(|c| c / rho);
+                let h = std::array::from_fn(|a| {
+                    std::array::from_fn(|b| (f64::from(u8::from(a == b)) - u[a] * u[b]) / rho)
+                });
+                (rho - radius, u, h)
+            }
+        }
+    }
+
+    fn validate(&self, path: &str) -> Result<()> {
+        match self.shape {
+            ObstacleShape::Plane { point, normal } => {
+                finite3(&format!("{path}.point"), point)?;
+                finite3(&format!("{path}.normal"), normal)?;
+                if normal.iter().all(|&c| c == 0.0) {
+                    return Err(bad(&format!("{path}.normal"), "must be nonzero"));
+                }
+            }
+            ObstacleShape::Sphere { centre, radius } => {
+                finite3(&format!("{path}.centre"), centre)?;
+                if finite(&format!("{path}.radius"), radius)? <= 0.0 {
+                    return Err(bad(&format!("{path}.radius"), "must be > 0"));
+                }
+            }
+        }
+        if finite(&format!("{path}.stiffness"), self.stiffness)? <= 0.0 {
+            return Err(bad(&format!("{path}.stiffness"), "must be > 0"));
+        }
+        if finite(&format!("{path}.margin"), self.margin)? < 0.0 {
+            return Err(bad(&format!("{path}.margin"), "must be >= 0"));
+        }
+        Ok(())
+    }
+
+    fn to_json(self) -> Value {
+        let mut o = match self.shape {
+            ObstacleShape::Plane { point, normal } => {
+                serde_json::json!({"type": "plane", "point": point, "normal": normal})
+            }
+            ObstacleShape::Sphere { centre, radius } => {
+                serde_json::json!({"type": "sphere", "centre": centre, "radius": radius})
+            }
+        };
+        o["stiffness"] = Value::from(self.stiffness);
+        o["margin"] = Value::from(self.margin);
+        o
+    }
+}
+
+fn parse_obstacle(v: &Value, path: &str) -> Result<Obstacle> {
+    let kind = v
+        .get("type")
+        .ok_or_else(|| {
+            bad(
+                &format!("{path}.type"),
+                "missing (required): plane or sphere",
+            )
+        })?
+        .as_str()
+        .ok_or_else(|| bad(&format!("{path}.type"), "expected \"plane\" or \"sphere\""))?;
+    let shape = match kind {
+        "plane" => {
+            let o = object(v, path, &["type", "point", "normal", "stiffness", "margin"])?;
+            ObstacleShape::Plane {
+                point: fixed::<3>(required(o, path, "point")?, &format!("{path}.point"))?,
+                normal: fixed::<3>(required(o, path, "normal")?, &format!("{path}.normal"))?,
+            }
+        }
+        "sphere" => {
+            let o = object(
+                v,
+                path,
+                &["type", "centre", "radius", "stiffness", "margin"],
+            )?;
+            ObstacleShape::Sphere {
+                centre: fixed::<3>(required(o, path, "centre")?, &format!("{path}.centre"))?,
+                radius: number(required(o, path, "radius")?, &format!("{path}.radius"))?,
+            }
+        }
+        other => {
+            return Err(bad(
+                &format!("{path}.type"),
+                format!("unknown obstacle type {other:?} (plane or sphere)"),
+            ))
+        }
+    };
+    let o = v.as_object().expect("checked by object()");
+    Ok(Obstacle {
+        shape,
+        stiffness: opt_number(o, path, "stiffness", DEFAULT_OBSTACLE_STIFFNESS)?,
+        margin: opt_number(o, path, "margin", 0.0)?,
+    })
 }
 
 /// The assembled problem: panels stitched into one mesh whose faces keep their rest forms.
@@ -254,6 +408,8 @@ pub struct Model {
     pub gravity: [f64; 3],
     /// Pressure (Pa).
     pub pressure: f64,
+    /// Obstacles (penalty in the base solve).
+    pub obstacles: Vec<Obstacle>,
     /// Clamped vertices with their motion (each stitched vertex at most once; the last
     /// condition naming a vertex wins).
     pub clamps: Vec<(u32, Motion)>,
@@ -319,6 +475,9 @@ impl Scene {
         }
         finite3("loads.gravity", self.gravity)?;
         finite("loads.pressure", self.pressure)?;
+        for (k, o) in self.obstacles.iter().enumerate() {
+            o.validate(&format!("obstacles[{k}]"))?;
+        }
         if finite("seam_tolerance", self.seam_tolerance)? < 0.0 {
             return Err(bad("seam_tolerance", "must be >= 0"));
         }
@@ -424,6 +583,7 @@ impl Scene {
             material: self.material,
             gravity: self.gravity,
             pressure: self.pressure,
+            obstacles: self.obstacles.clone(),
             clamps,
             panel_vertices,
             warnings,
@@ -505,6 +665,12 @@ impl Scene {
             })
             .collect();
         o.insert("dirichlet".into(), Value::Array(dir));
+        if !self.obstacles.is_empty() {
+            o.insert(
+                "obstacles".into(),
+                Value::Array(self.obstacles.iter().map(|ob| ob.to_json()).collect()),
+            );
+        }
         serde_json::to_string_pretty(&Value::Object(o)).expect("JSON values serialize")
     }
 
@@ -544,6 +710,7 @@ impl Scene {
                 motion: Motion::default(),
             }],
             seam_tolerance: 1e-6,
+            obstacles: Vec::new(),
         }
     }
 
@@ -752,6 +919,7 @@ fn balloon_scene(name: String, panels: Vec<Panel>, pressure: f64) -> Scene {
         pressure,
         dirichlet: vec![],
         seam_tolerance: 1e-9,
+        obstacles: Vec::new(),
     }
 }
 
@@ -814,6 +982,7 @@ fn bottom_clamped_top_moved(
             },
         ],
         seam_tolerance: 1e-6,
+        obstacles: Vec::new(),
     }
 }
 
@@ -1073,6 +1242,7 @@ fn parse_scene(v: &Value) -> Result<Scene> {
             "seam_tolerance",
             "panels",
             "dirichlet",
+            "obstacles",
         ],
     )?;
     let name = match top.get("name") {
@@ -1103,6 +1273,12 @@ fn parse_scene(v: &Value) -> Result<Scene> {
         pressure = opt_number(lo, "loads", "pressure", 0.0)?;
     }
     let seam_tolerance = opt_number(top, "", "seam_tolerance", 1e-6)?;
+    let mut obstacles = Vec::new();
+    if let Some(ov) = top.get("obstacles") {
+        for (k, o) in array(ov, "obstacles")?.iter().enumerate() {
+            obstacles.push(parse_obstacle(o, &format!("obstacles[{k}]"))?);
+        }
+    }
     let pv = array(required(top, "", "panels")?, "panels")?;
     let mut panels = Vec::with_capacity(pv.len());
     for (p, v) in pv.iter().enumerate() {
@@ -1258,5 +1434,6 @@ fn parse_scene(v: &Value) -> Result<Scene> {
         pressure,
         dirichlet,
         seam_tolerance,
+        obstacles,
     })
 }

@@ -32,7 +32,7 @@
 
 use crate::report::{Progress, ProgressFn};
 use crate::solve::{assemble, CholeskyAnalysis, Entry, Parallelism};
-use crate::tfw::energy::{HessianMode, WfTerms, WrinkleEnergy};
+use crate::tfw::energy::{HessianMode, WfEval, WfTerms, WrinkleEnergy};
 use crate::{Error, Result};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
@@ -55,10 +55,29 @@ pub struct SqpOptions {
     pub initial_shift: f64,
     /// Wall-time budget in seconds (default: unlimited); stops with [`SqpStatus::TimeLimit`].
     pub time_limit_seconds: f64,
+    /// How each step is computed (default [`QpMethod::Clarabel`]).
+    pub qp: QpMethod,
+    /// Keep a copy of `x` in [`SqpResult::snapshots`] at the start and every this many
+    /// iterations (0 = none; the last iterate is always [`SqpResult::x`]). For wave counts
+    /// against time (`pleat bench tfw`); costs one vector per snapshot, no evaluation.
+    pub snapshot_every: usize,
+}
+
+/// How [`run_sqp`] computes a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum QpMethod {
+    /// The QP with the curl rows as equality constraints, by clarabel (interior point).
+    #[default]
+    Clarabel,
+    /// The curl constraint eliminated (ω = exact part + cohomology part on the complex of
+    /// faces outside W, tree–cotree basis), leaving only `a ≥ 0`: projected Newton on faer's
+    /// sparse Cholesky ([`crate::tfw::pnewton`]).
+    ProjectedNewton,
 }
 
 impl Default for SqpOptions {
-    /// 1000 iterations, r/r₀ 1e-6, ΔE/E 1e-10, step 1e-10, Armijo 0.2, δ₀ 1e-6, no time limit.
+    /// 1000 iterations, r/r₀ 1e-6, ΔE/E 1e-10, step 1e-10, Armijo 0.2, δ₀ 1e-6, no time limit,
+    /// clarabel, no snapshots.
     fn default() -> Self {
         SqpOptions {
             max_iterations: 1000,
@@ -68,6 +87,8 @@ impl Default for SqpOptions {
             armijo: 0.2,
             initial_shift: 1e-6,
             time_limit_seconds: f64::INFINITY,
+            qp: QpMethod::Clarabel,
+            snapshot_every: 0,
         }
     }
 }
@@ -130,7 +151,8 @@ pub struct SqpIteration {
     pub step_length: f64,
     /// Relative Hessian shift δ used.
     pub shift: f64,
-    /// Clarabel interior-point iterations of the QP.
+    /// Clarabel interior-point iterations of the QP (projected Newton: Cholesky
+    /// factorizations tried).
     pub qp_iterations: u32,
     /// Max curl residual over the faces outside W after the step.
     pub curl_residual: f64,
@@ -151,10 +173,14 @@ pub struct SqpResult {
     pub initial_stationarity: f64,
     /// Every iteration.
     pub history: Vec<SqpIteration>,
-    /// Seconds in clarabel.
+    /// Seconds in the step solver (clarabel, or the projected Newton's assembly,
+    /// factorization and solve).
     pub qp_seconds: f64,
     /// Total seconds.
     pub seconds: f64,
+    /// `(iterations done, x)` at the start and every [`SqpOptions::snapshot_every`]
+    /// iterations (empty unless asked for).
+    pub snapshots: Vec<(usize, Vec<f64>)>,
 }
 
 /// The constraint structure of the SQP: free unknowns and curl rows.
@@ -162,13 +188,16 @@ pub struct SqpResult {
 pub struct SqpProblem {
     energy: WrinkleEnergy,
     /// Free unknowns (global indices, increasing).
-    free: Vec<usize>,
+    pub(super) free: Vec<usize>,
     /// Per global index, its free index or `usize::MAX`.
-    slot: Vec<usize>,
+    pub(super) slot: Vec<usize>,
     /// Number of free amplitudes (they come first in `free`).
-    n_free_a: usize,
+    pub(super) n_free_a: usize,
     /// Curl rows: three `(free index, sign)` per face outside W.
-    curl: Vec<[(usize, f64); 3]>,
+    pub(super) curl: Vec<[(usize, f64); 3]>,
+    /// Per free edge (free index − `n_free_a`), its vertices `[tail, head]` (ω integrated
+    /// tail → head, pleat's edge orientation).
+    pub(super) edge_ends: Vec<[usize; 2]>,
 }
 
 impl SqpProblem {
@@ -226,12 +255,17 @@ impl SqpProblem {
                 std::array::from_fn(|i| (slot[nv + fe[i] as usize], f64::from(fs[i])))
             })
             .collect();
+        let edge_ends = free[n_free_a..]
+            .iter()
+            .map(|&g| el.edges[g - nv].0.map(|v| v as usize))
+            .collect();
         SqpProblem {
             energy,
             free,
             slot,
             n_free_a,
             curl,
+            edge_ends,
         }
     }
 
@@ -333,12 +367,41 @@ impl Projector {
 }
 
 /// The QP data that does not change between iterations.
-struct QpShape {
+pub(super) struct QpShape {
     /// `D` per free unknown.
-    scale: Vec<f64>,
+    pub(super) scale: Vec<f64>,
     /// The QP objective is divided by this (`E₀`), so the QP data do not depend on the units
     /// of energy (Young's modulus).
-    energy_scale: f64,
+    pub(super) energy_scale: f64,
+}
+
+/// The QP scaling of the first iteration (module docs: `D = (E₀/diag H)^{1/2}`, objective
+/// divided by `E₀`).
+pub(super) fn qp_shape(problem: &SqpProblem, eval: &WfEval, initial_energy: f64) -> QpShape {
+    let mut diag = vec![0.0; problem.free.len()];
+    for &(r, c, v) in &eval.hessian {
+        if r == c && problem.slot[r] != usize::MAX {
+            diag[problem.slot[r]] += v;
+        }
+    }
+    let pos: Vec<f64> = diag.iter().copied().filter(|&d| d > 0.0).collect();
+    let mean = if pos.is_empty() {
+        1.0
+    } else {
+        pos.iter().sum::<f64>() / pos.len() as f64
+    };
+    let energy_scale = if initial_energy > 0.0 && initial_energy.is_finite() {
+        initial_energy
+    } else {
+        1.0
+    };
+    QpShape {
+        scale: diag
+            .iter()
+            .map(|&d| (energy_scale / d.max(1e-8 * mean)).sqrt())
+            .collect(),
+        energy_scale,
+    }
 }
 
 /// Upper-triangular CSC of a symmetric matrix given as lower triplets over `n` unknowns.
@@ -379,10 +442,9 @@ pub fn run_sqp(
     let mut x = x0.to_vec();
     projector.apply(problem, &mut x);
     let e = &problem.energy;
-    let nfree = problem.free.len();
     let mut eval = e.evaluate(&x, WfTerms::ALL, HessianMode::ProjectedPerFace);
     let initial_energy = eval.energy;
-    let done = |status, x, history, r0, qp_seconds| SqpResult {
+    let done = |status, x, history, r0, qp_seconds, snapshots| SqpResult {
         x,
         status,
         initial_energy,
@@ -390,11 +452,26 @@ pub fn run_sqp(
         history,
         qp_seconds,
         seconds: start.elapsed().as_secs_f64(),
+        snapshots,
     };
     if problem.n_free_a == 0 {
         let mut x = x;
         x.iter_mut().for_each(|v| *v = 0.0);
-        return Ok(done(SqpStatus::NoFreeUnknowns, x, Vec::new(), 0.0, 0.0));
+        return Ok(done(
+            SqpStatus::NoFreeUnknowns,
+            x,
+            Vec::new(),
+            0.0,
+            0.0,
+            Vec::new(),
+        ));
+    }
+    if options.qp == QpMethod::ProjectedNewton {
+        return crate::tfw::pnewton::run(problem, x, eval, options, progress, start);
+    }
+    let mut snapshots = Vec::new();
+    if options.snapshot_every > 0 {
+        snapshots.push((0, x.clone()));
     }
     let ncurl = problem.curl.len();
     let na = problem.n_free_a;
@@ -413,32 +490,7 @@ pub fn run_sqp(
         r.iter().fold(0.0f64, |m, v| m.max(v.abs()))
     };
     let r0 = stationarity(&eval.gradient, &duals);
-    let shape = {
-        let mut diag = vec![0.0; nfree];
-        for &(r, c, v) in &eval.hessian {
-            if r == c && problem.slot[r] != usize::MAX {
-                diag[problem.slot[r]] += v;
-            }
-        }
-        let pos: Vec<f64> = diag.iter().copied().filter(|&d| d > 0.0).collect();
-        let mean = if pos.is_empty() {
-            1.0
-        } else {
-            pos.iter().sum::<f64>() / pos.len() as f64
-        };
-        let energy_scale = if initial_energy > 0.0 && initial_energy.is_finite() {
-            initial_energy
-        } else {
-            1.0
-        };
-        QpShape {
-            scale: diag
-                .iter()
-                .map(|&d| (energy_scale / d.max(1e-8 * mean)).sqrt())
-                .collect(),
-            energy_scale,
-        }
-    };
+    let shape = qp_shape(problem, &eval, initial_energy);
     let mut shift = options.initial_shift;
     let mut history = Vec::new();
     let mut qp_seconds = 0.0;
@@ -510,6 +562,9 @@ pub fn run_sqp(
             curl_residual: problem.curl_residual(&x),
             seconds: start.elapsed().as_secs_f64(),
         });
+        if options.snapshot_every > 0 && history.len() % options.snapshot_every == 0 {
+            snapshots.push((history.len(), x.clone()));
+        }
         shift = (shift * 0.5).max(1e-16);
         if r <= options.stationarity_tolerance * r0 {
             status = SqpStatus::Stationary;
@@ -524,7 +579,7 @@ pub fn run_sqp(
             break;
         }
     }
-    Ok(done(status, x, history, r0, qp_seconds))
+    Ok(done(status, x, history, r0, qp_seconds, snapshots))
 }
 
 /// One QP (module docs) in scaled variables; returns the step over the free unknowns, the

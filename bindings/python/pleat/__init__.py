@@ -1391,7 +1391,7 @@ _TfwParams = _struct("PleatTfwParams",
                              "sqp_energy_tolerance", "sqp_step_tolerance", "sqp_armijo",
                              "sqp_initial_shift", "sqp_time_limit_seconds",
                              "out_of_scope_slack_fraction")
-                     + _u32s("curvature", "reserved2"))
+                     + _u32s("curvature", "reserved2", "qp", "reserved3"))
 _TfwMaterial = _struct("PleatTfwMaterial", _u32s("struct_size", "reserved")
                        + _f64s("young", "poisson", "thickness", "density")
                        + [("gravity", _c.c_double * 3)] + _f64s("pressure"))
@@ -1432,10 +1432,11 @@ for _fn, _cls in [("pleat_tfw_params_default", _TfwParams),
 TFW_STATUS = {0: "converged", 1: "not_converged", 2: "no_compression", 3: "out_of_scope"}
 _TFW_W_RULE = {"text": 0, "reference": 1}
 _TFW_CURVATURE = {"quadric": 0, "normals": 1}
+_TFW_QP = {"clarabel": 0, "newton": 1}
 _TFW_MATERIAL_KEYS = ("young", "poisson", "thickness", "density", "gravity", "pressure")
 
 
-def _tfw_params(w_rule="text", curvature="quadric", **kw):
+def _tfw_params(w_rule="text", curvature="quadric", qp=None, **kw):
     p = _lib.pleat_tfw_params_default()
     if w_rule not in _TFW_W_RULE:
         raise PleatError(1, f"w_rule {w_rule!r}; known: {sorted(_TFW_W_RULE)}")
@@ -1443,8 +1444,13 @@ def _tfw_params(w_rule="text", curvature="quadric", **kw):
     if curvature not in _TFW_CURVATURE:
         raise PleatError(1, f"curvature {curvature!r}; known: {sorted(_TFW_CURVATURE)}")
     p.curvature = _TFW_CURVATURE[curvature]
+    if qp is not None:
+        if qp not in _TFW_QP:
+            raise PleatError(1, f"qp {qp!r}; known: {sorted(_TFW_QP)}")
+        p.qp = _TFW_QP[qp]
     names = {n for n, _ in _TfwParams._fields_} - {"struct_size", "reserved", "w_rule",
-                                                    "curvature", "reserved2"}
+                                                    "curvature", "reserved2", "qp",
+                                                    "reserved3"}
     for k, v in kw.items():
         if k not in names:
             raise PleatError(1, f"unknown TFW parameter {k!r}; known: {sorted(names)}")
@@ -1509,7 +1515,7 @@ class TfwScene(_Handle):
     def solve(self, progress=None, **params):
         """Solves the scene (base surface, wrinkle SQP, phase); keywords are PleatTfwParams
         fields (e.g. ``sqp_max_iterations=50``, ``w_rule="reference"``,
-        ``curvature="normals"``).
+        ``curvature="normals"``, ``qp="newton"`` or ``"clarabel"``; default: the library's).
         ``progress(stage, fraction)`` returning True cancels (PleatError CANCELLED)."""
         p = _tfw_params(**params)
         relay, h = _Relay(progress), _P()

@@ -81,3 +81,20 @@ def test_cancel_and_errors(tmp_path):
     with pytest.raises(pleat.PleatError) as e:
         pleat.TfwScene.read(tmp_path / "missing.json")
     assert e.value.status == "IO"
+
+
+def test_both_step_solvers():
+    """``qp`` (PleatTfwParams.qp, appended 2026-11-27): both SQP step solvers give a
+    curl-free field with about the same peak amplitude; an unknown name is an error."""
+    uv, tris, pos, clamped = sheet_arrays()
+    scene = pleat.TfwScene.from_arrays(uv, tris, pos, clamped, young=1e6, poisson=0.5,
+                                       thickness=1e-4)
+    peaks = []
+    for qp in ("clarabel", "newton"):
+        s = scene.solve(sqp_max_iterations=40, qp=qp).stats
+        assert s["curl_residual"] <= 1e-10 and s["energy"] <= s["initial_energy"]
+        peaks.append(s["peak_amplitude"])
+    assert abs(peaks[0] - peaks[1]) <= 0.05 * peaks[0]
+    with pytest.raises(pleat.PleatError) as e:
+        scene.solve(qp="simplex")
+    assert "qp" in str(e.value)

@@ -5,10 +5,16 @@
 //! and writes into `--out-dir`:
 //! - `tfw_iterations.csv`: one row per SQP iteration: scene, iteration, wall seconds since the
 //!   start of the whole solve (base included), energy `E^wf` (J), stationarity residual `r`,
-//!   `r / r₀`, step `‖Δx‖∞`;
+//!   `r / r₀`, step `‖Δx‖∞`, then (appended 2026-11-27) `waves` and `peak_amplitude` (m, max a)
+//!   on the rows of the SQP's start, every `--wave-every` iterations and the last one (empty
+//!   elsewhere): the iterate is turned into a `Cwf` (Knöppel phase) and its waves counted by
+//!   [`pleat::tfw::measure::count_waves`] (2 Loop levels) along the section that
+//!   [`pleat::tfw::measure::count_waves_auto`] picks for the final field — after the solve, so
+//!   the timings do not include it;
 //! - `tfw_scenes.csv`: one row per scene: vertices, triangles, base seconds and Newton
 //!   iterations, SQP seconds and iterations, total seconds, status (or the error), peak
-//!   amplitude (m), final energy and relative residual;
+//!   amplitude (m), final energy and relative residual, then (appended) the final `waves`, the
+//!   `section` they were counted on and the step solver `qp`;
 //! - `tfw_bench.svg`: two panels, `r / r₀` and `E / E₀` (log) against wall seconds, one line per
 //!   scene (the plot writer of `pleat bench wrinkle`).
 //!
@@ -19,7 +25,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use pleat::tfw::{solve, Scene, TfwParams, TfwResult};
+use pleat::tfw::measure::{count_waves, count_waves_auto, Section};
+use pleat::tfw::{solve, QpMethod, Scene, TfwParams, TfwResult};
+use pleat::wrinkle::Cwf;
 
 use super::interp_bench::{svg_plot, Series};
 use super::{progress_bar, show_progress, EXIT_FAILED, EXIT_INPUT};
@@ -46,6 +54,12 @@ pub struct TfwBenchArgs {
     /// SQP wall-time budget per scene in seconds (0 = none).
     #[arg(long, default_value_t = 0.0)]
     pub time_limit: f64,
+    /// Count waves every N SQP iterations (0 = only at the start and the end).
+    #[arg(long, default_value_t = 10)]
+    pub wave_every: usize,
+    /// The SQP step solver: `clarabel` or `newton` (projected Newton, curl eliminated).
+    #[arg(long, default_value = "default")]
+    pub qp: String,
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
@@ -62,6 +76,10 @@ struct Outcome {
     name: String,
     result: pleat::Result<TfwResult>,
     seconds: f64,
+    /// Per measured iteration: (iteration, waves, peak amplitude).
+    waves: Vec<(usize, f64, f64)>,
+    /// The section the waves were counted on (empty when not measured).
+    section: String,
 }
 
 /// The built-in scene `name`.
@@ -122,6 +140,16 @@ pub fn run(args: &TfwBenchArgs) -> ExitCode {
     };
     let mut params = TfwParams::default();
     params.sqp.max_iterations = args.max_iterations;
+    params.sqp.snapshot_every = args.wave_every;
+    params.sqp.qp = match args.qp.as_str() {
+        "default" => params.sqp.qp,
+        "clarabel" => QpMethod::Clarabel,
+        "newton" => QpMethod::ProjectedNewton,
+        other => {
+            eprintln!("pleat bench tfw: --qp {other:?}: expected clarabel or newton");
+            return ExitCode::from(EXIT_INPUT);
+        }
+    };
     if args.time_limit > 0.0 {
         params.sqp.time_limit_seconds = args.time_limit;
     }
@@ -143,17 +171,24 @@ pub fn run(args: &TfwBenchArgs) -> ExitCode {
                     )
                 })
             });
+            let seconds = t.elapsed().as_secs_f64();
+            let (waves, section) = match &result {
+                Ok(r) => wave_history(r, &params),
+                Err(_) => (Vec::new(), String::new()),
+            };
             Outcome {
                 name: c.name,
                 result,
-                seconds: t.elapsed().as_secs_f64(),
+                seconds,
+                waves,
+                section,
             }
         })
         .collect();
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    match write_outputs(&args.out_dir, &outcomes) {
+    match write_outputs(&args.out_dir, &outcomes, params.sqp.qp) {
         Ok(()) => {
             print_summary(&outcomes);
             println!(
@@ -169,10 +204,53 @@ pub fn run(args: &TfwBenchArgs) -> ExitCode {
     }
 }
 
-fn write_outputs(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<()> {
+/// Levels of the evaluation the waves are counted on.
+const WAVE_LEVELS: usize = 2;
+
+/// Waves and peak amplitude at the SQP's snapshots and at the end (module docs), and the
+/// section used. Measurement failures leave the rows empty.
+fn wave_history(r: &TfwResult, params: &TfwParams) -> (Vec<(usize, f64, f64)>, String) {
+    let Ok((section, last)) = count_waves_auto(&r.cwf, WAVE_LEVELS) else {
+        return (Vec::new(), String::new());
+    };
+    let peak = |a: &[f64]| a.iter().fold(0.0f64, |m, &v| m.max(v));
+    let mut out = Vec::new();
+    let nv = r.base.mesh.vertex_count();
+    let iterations = r.sqp.as_ref().map_or(0, |s| s.history.len());
+    if let Some(s) = &r.sqp {
+        for (k, x) in &s.snapshots {
+            if *k == iterations {
+                continue;
+            }
+            let (a, w) = x.split_at(nv);
+            let counted =
+                Cwf::from_one_form(r.base.mesh.clone(), w.to_vec(), a.to_vec(), &params.knoppel)
+                    .ok()
+                    .and_then(|(cwf, _)| count_waves(&cwf, WAVE_LEVELS, &section).ok());
+            if let Some(c) = counted {
+                out.push((*k, c.waves, peak(a)));
+            }
+        }
+    }
+    out.push((iterations, last.waves, peak(r.cwf.amplitude())));
+    (out, describe(&section))
+}
+
+/// `ring n=(…) at (…)` / `line n=(…) at (…)`.
+fn describe(s: &Section) -> String {
+    let v = |p: [f64; 3]| format!("{:.4} {:.4} {:.4}", p[0], p[1], p[2]);
+    format!(
+        "{} normal ({}) through ({})",
+        if s.closed { "ring" } else { "line" },
+        v(s.normal),
+        v(s.point)
+    )
+}
+
+fn write_outputs(dir: &Path, outcomes: &[Outcome], qp: QpMethod) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     std::fs::write(dir.join("tfw_iterations.csv"), iterations_csv(outcomes))?;
-    std::fs::write(dir.join("tfw_scenes.csv"), scenes_csv(outcomes))?;
+    std::fs::write(dir.join("tfw_scenes.csv"), scenes_csv(outcomes, qp))?;
     std::fs::write(dir.join("tfw_bench.svg"), svg(outcomes))
 }
 
@@ -197,10 +275,17 @@ struct IterRow {
     relative: f64,
     /// `‖Δx‖∞` of the accepted step.
     step: f64,
+    /// Waves and peak amplitude when measured at this iteration.
+    waves: Option<(f64, f64)>,
 }
 
 /// Per SQP iteration, the row of [`IterRow`]; row 0 is the SQP's starting point.
 fn iteration_rows(r: &TfwResult) -> Vec<IterRow> {
+    iteration_rows_with(r, &[])
+}
+
+/// [`iteration_rows`] with the measured waves (iteration, waves, peak) filled in.
+fn iteration_rows_with(r: &TfwResult, waves: &[(usize, f64, f64)]) -> Vec<IterRow> {
     let Some(s) = &r.sqp else {
         return Vec::new();
     };
@@ -213,6 +298,7 @@ fn iteration_rows(r: &TfwResult) -> Vec<IterRow> {
         residual: r0,
         relative: rel(r0),
         step: 0.0,
+        waves: None,
     }];
     rows.extend(s.history.iter().map(|it| IterRow {
         seconds: t0 + it.seconds,
@@ -220,18 +306,29 @@ fn iteration_rows(r: &TfwResult) -> Vec<IterRow> {
         residual: it.stationarity,
         relative: rel(it.stationarity),
         step: it.step_norm,
+        waves: None,
     }));
+    for &(k, w, p) in waves {
+        if let Some(row) = rows.get_mut(k) {
+            row.waves = Some((w, p));
+        }
+    }
     rows
 }
 
 fn iterations_csv(outcomes: &[Outcome]) -> String {
-    let mut s = String::from("scene,iteration,seconds,energy,residual,relative_residual,step\n");
+    let mut s = String::from(
+        "scene,iteration,seconds,energy,residual,relative_residual,step,waves,peak_amplitude\n",
+    );
     for o in outcomes {
         let Ok(r) = &o.result else { continue };
-        for (i, row) in iteration_rows(r).into_iter().enumerate() {
+        for (i, row) in iteration_rows_with(r, &o.waves).into_iter().enumerate() {
+            let waves = row
+                .waves
+                .map_or_else(|| ",".to_string(), |(w, p)| format!("{w},{p:e}"));
             let _ = writeln!(
                 s,
-                "{},{i},{:.6},{:e},{:e},{:e},{:e}",
+                "{},{i},{:.6},{:e},{:e},{:e},{:e},{waves}",
                 csv_field(&o.name),
                 row.seconds,
                 row.energy,
@@ -244,10 +341,10 @@ fn iterations_csv(outcomes: &[Outcome]) -> String {
     s
 }
 
-fn scenes_csv(outcomes: &[Outcome]) -> String {
+fn scenes_csv(outcomes: &[Outcome], qp: QpMethod) -> String {
     let mut s = String::from(
         "scene,vertices,triangles,base_seconds,base_iterations,sqp_seconds,sqp_iterations,\
-         total_seconds,status,peak_amplitude,energy,relative_residual\n",
+         total_seconds,status,peak_amplitude,energy,relative_residual,waves,section,qp\n",
     );
     for o in outcomes {
         let name = csv_field(&o.name);
@@ -257,9 +354,10 @@ fn scenes_csv(outcomes: &[Outcome]) -> String {
                 let iters = r.sqp.as_ref().map_or(0, |q| q.history.len());
                 let rel = iteration_rows(r).last().map_or(0.0, |row| row.relative);
                 let peak = r.cwf.amplitude().iter().fold(0.0f64, |a, &b| a.max(b));
+                let waves = o.waves.last().map_or(String::new(), |w| w.1.to_string());
                 let _ = writeln!(
                     s,
-                    "{name},{},{},{:.6},{},{:.6},{iters},{:.6},{:?},{peak:e},{:e},{rel:e}",
+                    "{name},{},{},{:.6},{},{:.6},{iters},{:.6},{:?},{peak:e},{:e},{rel:e},{waves},{},{:?}",
                     m.vertex_count(),
                     m.triangle_count(),
                     r.seconds.base,
@@ -268,11 +366,13 @@ fn scenes_csv(outcomes: &[Outcome]) -> String {
                     o.seconds,
                     r.status,
                     r.energy,
+                    csv_field(&o.section),
+                    qp,
                 );
             }
             Err(e) => {
                 let status = csv_field(&format!("error: {e}"));
-                let _ = writeln!(s, "{name},,,,,,,{:.6},{status},,,", o.seconds);
+                let _ = writeln!(s, "{name},,,,,,,{:.6},{status},,,,,,", o.seconds);
             }
         }
     }
@@ -319,16 +419,17 @@ fn svg(outcomes: &[Outcome]) -> String {
 
 fn print_summary(outcomes: &[Outcome]) {
     println!(
-        "{:<16} {:>6} {:>8} {:>8} {:>6} {:>10} {:>10}  status",
-        "scene", "verts", "base s", "SQP s", "iters", "peak mm", "r/r0"
+        "{:<16} {:>6} {:>8} {:>8} {:>6} {:>10} {:>10} {:>6}  status",
+        "scene", "verts", "base s", "SQP s", "iters", "peak mm", "r/r0", "waves"
     );
     for o in outcomes {
         match &o.result {
             Ok(r) => {
                 let rel = iteration_rows(r).last().map_or(0.0, |row| row.relative);
                 let peak = r.cwf.amplitude().iter().fold(0.0f64, |a, &b| a.max(b));
+                let waves = o.waves.last().map_or(f64::NAN, |w| w.1);
                 println!(
-                    "{:<16} {:>6} {:>8.3} {:>8.3} {:>6} {:>10.4} {:>10.2e}  {:?}",
+                    "{:<16} {:>6} {:>8.3} {:>8.3} {:>6} {:>10.4} {:>10.2e} {:>6}  {:?}",
                     o.name,
                     r.base.mesh.vertex_count(),
                     r.seconds.base,
@@ -336,6 +437,7 @@ fn print_summary(outcomes: &[Outcome]) {
                     r.sqp.as_ref().map_or(0, |q| q.history.len()),
                     peak * 1e3,
                     rel,
+                    waves,
                     r.status
                 );
             }

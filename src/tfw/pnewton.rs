@@ -1,0 +1,658 @@
+//! The wrinkle SQP's step by **projected Newton with the curl constraint eliminated** (spec
+//! Risk 8's fallback; [`crate::tfw::sqp::QpMethod::ProjectedNewton`]).
+//!
+//! **Elimination.** The one-forms on the free edges that are curl-free on every face outside W
+//! are exactly `ω = G u + Σ_g c_g h_g` (Hodge: exact part + cohomology part of the complex of
+//! faces outside W): `G` the vertex-to-edge difference (`ω_e = u_head − u_tail`, pleat's edge
+//! orientation), `u` one value per vertex of the complex with one vertex per connected
+//! component pinned to 0 (the gauge), and `h_g` a **tree–cotree** basis of the closed,
+//! non-exact forms: a spanning forest T of the vertex graph (breadth first, in vertex order),
+//! a spanning forest T* of the dual graph over the remaining edges with one virtual node for
+//! "outside" joined to every boundary edge (so holes and W islands need no special case), and
+//! one generator per edge in neither; `h_g` is 1 on its generator edge, 0 on T and on the
+//! other generators, and its cotree values follow face by face from the leaves of T* to its
+//! roots, each solving that face's curl row exactly. Dimension count: `(V − P) + (E − V + P −
+//! (F − F_closed)) = E − rank C`, so the map is a basis of `ker C` (P primal components,
+//! F_closed the faces that root a closed component, whose curl row is implied). On the
+//! cylinder the one generator carries the period around the ring (the wave count), which an
+//! exact part alone would freeze.
+//!
+//! **Step.** In `y = (a_free, u, c)` the only constraints left are `a ≥ 0`: Bertsekas'
+//! projected Newton — amplitudes at 0 with a positive gradient are held (their rows and columns
+//! replaced by the mean diagonal), the rest take the Newton step of `Bᵀ (H + σ W) B` (H the
+//! per-face PSD-projected Hessian of the SQP, `W` the first iteration's diagonal of H and σ the
+//! SQP's shift schedule: exactly the clarabel QP's `σ I` in its scaled variables, so without
+//! active bounds both solvers take the same step), and the Armijo line
+//! search runs along the projected arc `max(0, a + t d_a)` with the slope `gᵀ(y(t) − y)`.
+//! `Bᵀ H B` keeps one sparsity pattern (held entries are stored as zeros), so faer's symbolic
+//! analysis is done once. Every iterate is `x = B y`, curl-free to rounding by construction.
+//! The stationarity residual is the projected gradient in `y` (`∇_y E`, with `min(g, 0)` for
+//! amplitudes at 0), relative to its starting value; the other stop tests are those of
+//! [`crate::tfw::sqp`].
+
+use crate::report::{Progress, ProgressFn};
+use crate::solve::{assemble, CholeskyAnalysis, Entry, Parallelism};
+use crate::tfw::energy::{HessianMode, WfEval, WfTerms};
+use crate::tfw::sqp::{qp_shape, SqpIteration, SqpOptions, SqpProblem, SqpResult, SqpStatus};
+use crate::{Error, Result};
+use std::collections::VecDeque;
+use std::time::Instant;
+
+const NONE: usize = usize::MAX;
+
+/// The map `x_free = B y` from the reduced unknowns `y = (a_free, u, c)` to the free unknowns
+/// of an [`SqpProblem`] (module docs).
+#[derive(Debug, Clone)]
+pub struct CurlFreeBasis {
+    /// Free amplitudes (first in both `x_free` and `y`).
+    na: usize,
+    /// Reduced unknowns.
+    ny: usize,
+    /// Per free unknown, its row of `B`: `(y index, coefficient)`.
+    rows: Vec<Vec<(usize, f64)>>,
+    /// Spanning-forest edges in breadth-first order: `(vertex, parent vertex, free edge)`.
+    tree: Vec<(usize, usize, usize)>,
+    /// Per vertex, its `u` index in `y` (`NONE`: pinned root or not in the complex).
+    u_index: Vec<usize>,
+    /// The generator edges (free edge indices), one per `c`.
+    generator_edges: Vec<usize>,
+}
+
+impl CurlFreeBasis {
+    /// The tree–cotree basis of `problem`'s curl-free one-forms (module docs).
+    pub fn new(problem: &SqpProblem) -> CurlFreeBasis {
+        let na = problem.n_free_a;
+        let ends = &problem.edge_ends;
+        let ne = ends.len();
+        let nv = ends
+            .iter()
+            .flat_map(|e| e.iter().copied())
+            .max()
+            .map_or(0, |m| m + 1);
+        let Forest {
+            tree,
+            in_tree,
+            roots,
+        } = spanning_forest(nv, ends);
+        let mut u_index = vec![NONE; nv];
+        let mut ny = na;
+        let mut in_complex = vec![false; nv];
+        for e in ends {
+            in_complex[e[0]] = true;
+            in_complex[e[1]] = true;
+        }
+        for v in 0..nv {
+            if in_complex[v] && !roots[v] {
+                u_index[v] = ny;
+                ny += 1;
+            }
+        }
+        let (order, parent_edge) = dual_forest(problem, ne, &in_tree);
+        let mut is_cotree = vec![false; ne];
+        for &p in &parent_edge {
+            if p != NONE {
+                is_cotree[p] = true;
+            }
+        }
+        let generator_edges: Vec<usize> =
+            (0..ne).filter(|&j| !in_tree[j] && !is_cotree[j]).collect();
+        let mut rows: Vec<Vec<(usize, f64)>> = (0..na).map(|k| vec![(k, 1.0)]).collect();
+        rows.extend(ends.iter().map(|&[t, h]| {
+            let mut r = Vec::with_capacity(2);
+            if u_index[h] != NONE {
+                r.push((u_index[h], 1.0));
+            }
+            if u_index[t] != NONE {
+                r.push((u_index[t], -1.0));
+            }
+            r
+        }));
+        for &g in &generator_edges {
+            let h = generator_form(problem, ne, g, &order, &parent_edge);
+            for (j, v) in h.into_iter().enumerate() {
+                if v != 0.0 {
+                    rows[na + j].push((ny, v));
+                }
+            }
+            ny += 1;
+        }
+        CurlFreeBasis {
+            na,
+            ny,
+            rows,
+            tree,
+            u_index,
+            generator_edges,
+        }
+    }
+
+    /// Number of reduced unknowns `y`.
+    pub fn dimension(&self) -> usize {
+        self.ny
+    }
+
+    /// Number of cohomology generators (closed, non-exact basis forms).
+    pub fn generators(&self) -> usize {
+        self.generator_edges.len()
+    }
+
+    /// `x_free = B y`.
+    pub fn x_of(&self, y: &[f64]) -> Vec<f64> {
+        self.rows
+            .iter()
+            .map(|r| r.iter().map(|&(i, c)| c * y[i]).sum())
+            .collect()
+    }
+
+    /// The `y` with `B y = x_free` for a curl-free `x_free` (integrates ω along the tree; the
+    /// generator coefficients are ω's residual on the generator edges).
+    pub fn y_of(&self, x_free: &[f64]) -> Vec<f64> {
+        let na = self.na;
+        let mut u = vec![0.0; self.u_index.len()];
+        for &(v, parent, j) in &self.tree {
+            // ω_j = u_head − u_tail; the row of j says which end v is
+            let sign = self.rows[na + j]
+                .iter()
+                .find(|&&(i, _)| i == self.u_index[v])
+                .map_or(1.0, |&(_, c)| c);
+            u[v] = u[parent] + sign * x_free[na + j];
+        }
+        let mut y = vec![0.0; self.ny];
+        y[..na].copy_from_slice(&x_free[..na]);
+        for (v, &i) in self.u_index.iter().enumerate() {
+            if i != NONE {
+                y[i] = u[v];
+            }
+        }
+        let first_c = self.ny - self.generator_edges.len();
+        for (g, &j) in self.generator_edges.iter().enumerate() {
+            let exact: f64 = self.rows[na + j]
+                .iter()
+                .filter(|&&(i, _)| i < first_c)
+                .map(|&(i, c)| c * y[i])
+                .sum();
+            y[first_c + g] = x_free[na + j] - exact;
+        }
+        y
+    }
+
+    /// `Bᵀ v` for `v` over the free unknowns.
+    fn transpose_times(&self, v: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.ny];
+        for (r, &vk) in self.rows.iter().zip(v) {
+            for &(i, c) in r {
+                out[i] += c * vk;
+            }
+        }
+        out
+    }
+}
+
+/// A spanning forest of the vertex graph.
+struct Forest {
+    /// Tree edges `(vertex, parent, edge)` in breadth-first order.
+    tree: Vec<(usize, usize, usize)>,
+    /// Per edge, whether it is in the forest.
+    in_tree: Vec<bool>,
+    /// Per vertex, whether it roots a component.
+    roots: Vec<bool>,
+}
+
+/// Breadth-first spanning forest of the vertex graph of the free edges, vertices in increasing
+/// order.
+fn spanning_forest(nv: usize, ends: &[[usize; 2]]) -> Forest {
+    let mut adj: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nv];
+    for (j, &[t, h]) in ends.iter().enumerate() {
+        adj[t].push((h, j));
+        adj[h].push((t, j));
+    }
+    let mut seen = vec![false; nv];
+    let mut roots = vec![false; nv];
+    let mut in_tree = vec![false; ends.len()];
+    let mut tree = Vec::new();
+    let mut queue = VecDeque::new();
+    for s in 0..nv {
+        if seen[s] || adj[s].is_empty() {
+            continue;
+        }
+        seen[s] = true;
+        roots[s] = true;
+        queue.push_back(s);
+        while let Some(v) = queue.pop_front() {
+            for &(w, j) in &adj[v] {
+                if !seen[w] {
+                    seen[w] = true;
+                    in_tree[j] = true;
+                    tree.push((w, v, j));
+                    queue.push_back(w);
+                }
+            }
+        }
+    }
+    Forest {
+        tree,
+        in_tree,
+        roots,
+    }
+}
+
+/// Breadth-first spanning forest of the dual graph (curl rows as nodes, non-tree edges as dual
+/// edges, one virtual node joined to every boundary edge): `(rows in BFS order, per row its
+/// parent edge or NONE for the root of a closed component)`.
+fn dual_forest(problem: &SqpProblem, ne: usize, in_tree: &[bool]) -> (Vec<usize>, Vec<usize>) {
+    let na = problem.n_free_a;
+    let nf = problem.curl.len();
+    let mut edge_rows: Vec<Vec<usize>> = vec![Vec::new(); ne];
+    for (r, row) in problem.curl.iter().enumerate() {
+        for &(k, _) in row {
+            edge_rows[k - na].push(r);
+        }
+    }
+    let mut parent = vec![NONE; nf];
+    let mut seen = vec![false; nf];
+    let mut order = Vec::with_capacity(nf);
+    let mut queue = VecDeque::new();
+    // the virtual node's neighbours first: boundary edges in edge order
+    for (j, rows) in edge_rows.iter().enumerate() {
+        if !in_tree[j] && rows.len() == 1 && !seen[rows[0]] {
+            seen[rows[0]] = true;
+            parent[rows[0]] = j;
+            queue.push_back(rows[0]);
+        }
+    }
+    let mut next_root = 0;
+    loop {
+        while let Some(f) = queue.pop_front() {
+            order.push(f);
+            for &(k, _) in &problem.curl[f] {
+                let j = k - na;
+                if in_tree[j] {
+                    continue;
+                }
+                for &g in &edge_rows[j] {
+                    if !seen[g] {
+                        seen[g] = true;
+                        parent[g] = j;
+                        queue.push_back(g);
+                    }
+                }
+            }
+        }
+        while next_root < nf && seen[next_root] {
+            next_root += 1;
+        }
+        if next_root == nf {
+            break;
+        }
+        seen[next_root] = true;
+        queue.push_back(next_root);
+    }
+    (order, parent)
+}
+
+/// The closed form of generator edge `g` (module docs): 1 on `g`, cotree values solved from the
+/// leaves of the dual forest to its roots.
+fn generator_form(
+    problem: &SqpProblem,
+    ne: usize,
+    g: usize,
+    order: &[usize],
+    parent_edge: &[usize],
+) -> Vec<f64> {
+    let na = problem.n_free_a;
+    let mut h = vec![0.0; ne];
+    h[g] = 1.0;
+    for &f in order.iter().rev() {
+        let p = parent_edge[f];
+        if p == NONE {
+            continue;
+        }
+        let mut rest = 0.0;
+        let mut sp = 0.0;
+        for &(k, s) in &problem.curl[f] {
+            if k - na == p {
+                sp = s;
+            } else {
+                rest += s * h[k - na];
+            }
+        }
+        h[p] = -rest / sp;
+    }
+    h
+}
+
+/// `Bᵀ H B` as lower-triangle entries (entries touching a held unknown stored as 0, so the
+/// pattern never changes) and the mean positive diagonal of the unheld unknowns.
+fn reduced_hessian(
+    problem: &SqpProblem,
+    basis: &CurlFreeBasis,
+    hessian: &[(usize, usize, f64)],
+    held: &[bool],
+) -> (Vec<Entry>, f64) {
+    let mut entries: Vec<Entry> = Vec::with_capacity(4 * hessian.len() + basis.ny);
+    let mut diag = vec![0.0; basis.ny];
+    for &(r, c, v) in hessian {
+        let (sr, sc) = (problem.slot[r], problem.slot[c]);
+        if sr == NONE || sc == NONE {
+            continue;
+        }
+        let off = r != c;
+        for &(i, bi) in &basis.rows[sr] {
+            for &(j, bj) in &basis.rows[sc] {
+                if !off && i < j {
+                    continue;
+                }
+                let mut w = v * bi * bj;
+                if i == j && off {
+                    w *= 2.0;
+                }
+                if held[i] || held[j] {
+                    w = 0.0;
+                }
+                if i == j {
+                    diag[i] += w;
+                }
+                entries.push(Entry::new(i.max(j), i.min(j), w));
+            }
+        }
+    }
+    let pos: Vec<f64> = diag.iter().copied().filter(|&d| d > 0.0).collect();
+    let mean = if pos.is_empty() {
+        1.0
+    } else {
+        pos.iter().sum::<f64>() / pos.len() as f64
+    };
+    (entries, mean)
+}
+
+/// The projected gradient's max norm: `g` on unknowns off the bound, `min(g, 0)` at `a = 0`.
+fn projected_gradient_norm(g: &[f64], y: &[f64], na: usize) -> f64 {
+    g.iter()
+        .enumerate()
+        .map(|(i, &gi)| {
+            if i < na && y[i] <= 0.0 {
+                gi.min(0.0).abs()
+            } else {
+                gi.abs()
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Runs the SQP by projected Newton (module docs) from the feasible `x` with its evaluation
+/// `eval`; the rest as [`crate::tfw::sqp::run_sqp`].
+pub(super) fn run(
+    problem: &SqpProblem,
+    x: Vec<f64>,
+    eval: WfEval,
+    options: &SqpOptions,
+    progress: &mut ProgressFn<'_>,
+    start: Instant,
+) -> Result<SqpResult> {
+    let e = problem.energy();
+    let na = problem.n_free_a;
+    let basis = CurlFreeBasis::new(problem);
+    let x_free: Vec<f64> = problem.free.iter().map(|&g| x[g]).collect();
+    let mut y = basis.y_of(&x_free);
+    let scatter = |y: &[f64]| -> Vec<f64> {
+        let mut out = vec![0.0; x.len()];
+        for (&g, v) in problem.free.iter().zip(basis.x_of(y)) {
+            out[g] = v;
+        }
+        out
+    };
+    let initial_energy = eval.energy;
+    let shape = qp_shape(problem, &eval, initial_energy);
+    // W = E₀ / D² = the first iteration's diagonal of H (floored), per free unknown
+    let weights: Vec<f64> = shape
+        .scale
+        .iter()
+        .map(|d| shape.energy_scale / (d * d))
+        .collect();
+    let mut x = scatter(&y);
+    let mut eval = e.evaluate(&x, WfTerms::ALL, HessianMode::ProjectedPerFace);
+    let grad_y = |eval: &WfEval| -> Vec<f64> {
+        let g_free: Vec<f64> = problem.free.iter().map(|&g| eval.gradient[g]).collect();
+        basis.transpose_times(&g_free)
+    };
+    let mut g = grad_y(&eval);
+    let r0 = projected_gradient_norm(&g, &y, na);
+    let mut snapshots = Vec::new();
+    if options.snapshot_every > 0 {
+        snapshots.push((0, x.clone()));
+    }
+    let mut state = NewtonState {
+        analysis: None,
+        shift: options.initial_shift,
+    };
+    let mut history = Vec::new();
+    let mut qp_seconds = 0.0;
+    let mut status = SqpStatus::MaxIterations;
+    for it in 0..options.max_iterations {
+        if !progress(Progress {
+            stage: "tfw wrinkle SQP",
+            fraction: it as f64 / options.max_iterations as f64,
+        }) {
+            return Err(Error::Cancelled);
+        }
+        if start.elapsed().as_secs_f64() > options.time_limit_seconds {
+            status = SqpStatus::TimeLimit;
+            break;
+        }
+        let t0 = Instant::now();
+        let held: Vec<bool> = (0..basis.ny)
+            .map(|i| i < na && y[i] <= 0.0 && g[i] > 0.0)
+            .collect();
+        let step = newton_direction(problem, &basis, &eval, &g, &held, &weights, &mut state)?;
+        qp_seconds += t0.elapsed().as_secs_f64();
+        let Some((d, attempts)) = step else {
+            status = SqpStatus::QpFailed;
+            break;
+        };
+        // Armijo along the projected arc
+        let mut t = 1.0;
+        let accepted = loop {
+            let mut cand: Vec<f64> = y.iter().zip(&d).map(|(a, b)| a + t * b).collect();
+            for v in &mut cand[..na] {
+                *v = v.max(0.0);
+            }
+            let slope: f64 = g
+                .iter()
+                .zip(cand.iter().zip(&y))
+                .map(|(gi, (c, o))| gi * (c - o))
+                .sum();
+            let xc = scatter(&cand);
+            let ec = e.energy(&xc, WfTerms::ALL);
+            if ec <= eval.energy + options.armijo * slope.min(0.0) && ec <= eval.energy {
+                break Some((cand, xc, ec));
+            }
+            t *= 0.5;
+            if t < 1e-10 {
+                break None;
+            }
+        };
+        let Some((yn, xn, en)) = accepted else {
+            status = SqpStatus::LineSearchFailed;
+            break;
+        };
+        let (step_norm, scaled_step) =
+            problem
+                .free
+                .iter()
+                .enumerate()
+                .fold((0.0f64, 0.0f64), |(m, s), (k, &gi)| {
+                    let dx = (xn[gi] - x[gi]).abs();
+                    (m.max(dx), s.max(dx / shape.scale[k]))
+                });
+        let de = eval.energy - en;
+        y = yn;
+        x = xn;
+        eval = e.evaluate(&x, WfTerms::ALL, HessianMode::ProjectedPerFace);
+        g = grad_y(&eval);
+        let r = projected_gradient_norm(&g, &y, na);
+        history.push(SqpIteration {
+            energy: en,
+            stationarity: r,
+            step_norm,
+            step_length: t,
+            shift: state.shift,
+            qp_iterations: attempts,
+            curl_residual: problem.curl_residual(&x),
+            seconds: start.elapsed().as_secs_f64(),
+        });
+        if options.snapshot_every > 0 && history.len() % options.snapshot_every == 0 {
+            snapshots.push((history.len(), x.clone()));
+        }
+        state.shift = (state.shift * 0.5).max(1e-16);
+        if r <= options.stationarity_tolerance * r0 {
+            status = SqpStatus::Stationary;
+            break;
+        }
+        if de.abs() <= options.energy_tolerance * en.abs() {
+            status = SqpStatus::EnergyConverged;
+            break;
+        }
+        if scaled_step <= options.step_tolerance {
+            status = SqpStatus::StepConverged;
+            break;
+        }
+    }
+    Ok(SqpResult {
+        x,
+        status,
+        initial_energy,
+        initial_stationarity: r0,
+        history,
+        qp_seconds,
+        seconds: start.elapsed().as_secs_f64(),
+        snapshots,
+    })
+}
+
+/// What the Newton steps carry over: the symbolic analysis and the relative shift σ.
+struct NewtonState {
+    analysis: Option<CholeskyAnalysis>,
+    shift: f64,
+}
+
+/// The projected Newton direction in `y` (held unknowns: 0) and the factorizations tried, or
+/// `None` when the factorization fails even with a relative shift above 1e4 (doubled per
+/// failure, as the clarabel QP's). The symbolic analysis is made on the first call and reused.
+fn newton_direction(
+    problem: &SqpProblem,
+    basis: &CurlFreeBasis,
+    eval: &WfEval,
+    g: &[f64],
+    held: &[bool],
+    weights: &[f64],
+    state: &mut NewtonState,
+) -> Result<Option<(Vec<f64>, u32)>> {
+    let NewtonState { analysis, shift } = state;
+    let ny = basis.ny;
+    let (mut entries, mean) = reduced_hessian(problem, basis, &eval.hessian, held);
+    // the shift σ Bᵀ W B (W = the first iteration's diagonal of H: the clarabel QP's σ I in
+    // its scaled variables), then one diagonal entry per unknown for the held ones
+    let first_shift = entries.len();
+    let mut shift_base = Vec::new();
+    for (row, &w) in basis.rows.iter().zip(weights) {
+        for &(i, bi) in row {
+            for &(j, bj) in row {
+                if i >= j {
+                    let v = if held[i] || held[j] { 0.0 } else { w * bi * bj };
+                    entries.push(Entry::new(i, j, 0.0));
+                    shift_base.push(v);
+                }
+            }
+        }
+    }
+    entries.extend((0..ny).map(|i| Entry::new(i, i, if held[i] { mean } else { 0.0 })));
+    let rhs: Vec<f64> = g
+        .iter()
+        .zip(held)
+        .map(|(&gi, &h)| if h { 0.0 } else { -gi })
+        .collect();
+    let mut attempts = 0;
+    loop {
+        attempts += 1;
+        for (en, &b) in entries[first_shift..].iter_mut().zip(&shift_base) {
+            en.val = *shift * b;
+        }
+        let h = assemble(ny, &entries, "tfw projected Newton")?;
+        if analysis.is_none() {
+            *analysis = Some(CholeskyAnalysis::new(&h)?);
+        }
+        let an = analysis.as_ref().expect("analysed above");
+        if let Ok(chol) = an.factor(&h, Parallelism::Global) {
+            let d = chol.solve(&rhs);
+            if d.iter().all(|v| v.is_finite()) {
+                return Ok(Some((d, attempts)));
+            }
+        }
+        *shift *= 2.0;
+        if *shift > 1e4 {
+            return Ok(None);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 3 × 3-vertex grid has a disk complex (no generator); removing nothing, the basis
+    /// reproduces a random curl-free form exactly.
+    #[test]
+    fn basis_has_the_dimension_of_the_kernel_and_round_trips() {
+        // annulus: a ring of 8 quads (16 triangles) between radius 1 and 2
+        let n = 8;
+        let mut p = Vec::new();
+        for r in [1.0, 2.0] {
+            for k in 0..n {
+                let th = std::f64::consts::TAU * k as f64 / n as f64;
+                p.push([r * th.cos(), r * th.sin(), 0.0]);
+            }
+        }
+        let mut t = Vec::new();
+        for k in 0..n as u32 {
+            let k1 = (k + 1) % n as u32;
+            t.push([k, k1, k1 + n as u32]);
+            t.push([k, k1 + n as u32, k + n as u32]);
+        }
+        let mesh = crate::mesh::TriMesh::new(p, t).unwrap();
+        let nv = mesh.vertex_count();
+        let nf = mesh.triangle_count();
+        let zeros = vec![0.0; nf];
+        let forms: Vec<[f64; 3]> = vec![[1.0, 0.0, 1.0]; nf];
+        let strains = crate::tfw::wfree::face_strains(&forms, &mesh);
+        let energy = crate::tfw::energy::WrinkleEnergy::new(
+            &mesh,
+            &forms,
+            &strains,
+            &zeros,
+            crate::tfw::Lame {
+                alpha: 1.0,
+                beta: 1.0,
+            },
+            1e-3,
+        );
+        let problem = SqpProblem::new(energy, &mesh, &vec![false; nf], &vec![false; nv]);
+        let basis = CurlFreeBasis::new(&problem);
+        // annulus: one generator; y = a (16) + u (16 − 1) + c (1)
+        assert_eq!(basis.generators(), 1);
+        assert_eq!(basis.dimension(), nv + nv - 1 + 1);
+        // B y is curl-free for any y, and y_of inverts it
+        let y: Vec<f64> = (0..basis.dimension())
+            .map(|i| ((i * 7919) % 113) as f64 / 50.0 - 1.0)
+            .collect();
+        let xf = basis.x_of(&y);
+        let mut x = vec![0.0; nv + mesh.edges().edges.len()];
+        for (&g, v) in problem.free.iter().zip(&xf) {
+            x[g] = *v;
+        }
+        assert!(problem.curl_residual(&x) < 1e-12);
+        let back = basis.y_of(&xf);
+        for (a, b) in y.iter().zip(&back) {
+            assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+        }
+    }
+}
