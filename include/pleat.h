@@ -555,11 +555,12 @@ typedef struct PleatCwfEditParams {
   // 2026-11-27: an older, shorter struct gets the default.
   double edit_weight;
   // Adaptive interface width: target RMS compatibility residual over edit + interface edges,
-  // radians, finite, ≥ 0; 0 (default) = off, the regions' `interface_rings` exactly. While the
+  // radians, finite, ≥ 0; default 0.3 (issue 14's smoothness target; also what an older,
+  // shorter struct gets), 0 = off: the regions' `interface_rings` exactly. While the
   // residual exceeds it, every band is widened by one ring (up to `max_interface_rings`) and
   // the edit redone; the edit with the smallest residual is returned
-  // (`pleat_cwf_get_edit_report`, `pleat_cwf_copy_edit_interface_rings`). 0.3 is issue 14's
-  // smoothness target. Appended 2026-11-27.
+  // (`pleat_cwf_get_edit_report`, `pleat_cwf_copy_edit_interface_rings`). Appended
+  // 2026-11-27; default 0.3 since 2026-11-27 b (was 0).
   double compat_target;
   // Widest band the adaptive width may reach, 1 to 1,000,000; default 8. Appended 2026-11-27.
   uint32_t max_interface_rings;

@@ -8,8 +8,9 @@ use crate::report::{Progress, ProgressFn};
 use crate::tfw::base::{solve_base, BaseOptions, BaseResult, BaseStatus};
 use crate::tfw::curvature::{tension_curvature_by, CurvatureMethod};
 use crate::tfw::energy::{WfTerms, WrinkleEnergy};
+use crate::tfw::pnewton::run_sqp_projected_newton;
 use crate::tfw::scene::Scene;
-use crate::tfw::sqp::{run_sqp, SqpOptions, SqpProblem, SqpResult, SqpStatus};
+use crate::tfw::sqp::{run_sqp, QpMethod, SqpOptions, SqpProblem, SqpResult, SqpStatus};
 use crate::tfw::wfree::{
     face_strains, helmholtz_projection, initial_face_field, wrinkle_free_faces, WRule,
 };
@@ -209,7 +210,12 @@ pub fn solve(
                 fraction: 0.35 + 0.6 * p.fraction,
             })
         };
-        run_sqp(&problem, &x0, &params.sqp, &mut sub)?
+        match params.sqp.qp {
+            QpMethod::Clarabel => run_sqp(&problem, &x0, &params.sqp, &mut sub)?,
+            QpMethod::ProjectedNewton => {
+                run_sqp_projected_newton(&problem, &x0, &params.sqp, &mut sub)?
+            }
+        }
     };
     seconds.sqp = t.elapsed().as_secs_f64();
     let t = Instant::now();

@@ -33,7 +33,10 @@
 use crate::report::{Progress, ProgressFn};
 use crate::solve::{assemble, CholeskyAnalysis, Entry, Parallelism};
 use crate::tfw::energy::{HessianMode, WfEval, WfTerms};
-use crate::tfw::sqp::{qp_shape, SqpIteration, SqpOptions, SqpProblem, SqpResult, SqpStatus};
+use crate::tfw::sqp::{
+    feasible_start, qp_shape, FeasibleStart, SqpIteration, SqpOptions, SqpProblem, SqpResult,
+    SqpStatus,
+};
 use crate::{Error, Result};
 use std::collections::VecDeque;
 use std::time::Instant;
@@ -379,9 +382,25 @@ fn projected_gradient_norm(g: &[f64], y: &[f64], na: usize) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Runs the SQP by projected Newton (module docs) from the feasible `x` with its evaluation
-/// `eval`; the rest as [`crate::tfw::sqp::run_sqp`].
-pub(super) fn run(
+/// Runs the SQP by projected Newton (module docs, [`crate::tfw::QpMethod::ProjectedNewton`]) from `x0 =
+/// [a | ω]` (made feasible first), whatever `options.qp` says; otherwise as
+/// [`crate::tfw::sqp::run_sqp`].
+pub fn run_sqp_projected_newton(
+    problem: &SqpProblem,
+    x0: &[f64],
+    options: &SqpOptions,
+    progress: &mut ProgressFn<'_>,
+) -> Result<SqpResult> {
+    match feasible_start(problem, x0)? {
+        FeasibleStart::Run { x, eval, start, .. } => {
+            run(problem, x, eval, options, progress, start)
+        }
+        FeasibleStart::Done(r) => Ok(r),
+    }
+}
+
+/// [`run_sqp_projected_newton`] from the feasible `x` with its evaluation `eval`.
+fn run(
     problem: &SqpProblem,
     x: Vec<f64>,
     eval: WfEval,

@@ -299,7 +299,7 @@ impl SqpProblem {
 }
 
 /// Exact feasibility: clamps amplitudes at 0, zeroes fixed unknowns, projects ω onto ker C.
-struct Projector {
+pub(crate) struct Projector {
     chol: Option<crate::solve::Cholesky>,
 }
 
@@ -429,7 +429,58 @@ fn upper_csc(n: usize, lower: &[(usize, usize, f64)]) -> CscMatrix<f64> {
     CscMatrix::new(n, n, colptr, rowval, nzval)
 }
 
-/// Runs the SQP from `x0 = [a | ω]` (made feasible first). `progress` may cancel
+/// Where both step solvers start: `x0` projected onto the curl constraint, its evaluation and
+/// the clock; or the finished result when no amplitude is free.
+pub(crate) enum FeasibleStart {
+    /// Run the SQP from here.
+    Run {
+        /// The feasible start.
+        x: Vec<f64>,
+        /// Its evaluation (projected per-face Hessian).
+        eval: WfEval,
+        /// When the run started.
+        start: Instant,
+        /// The projector onto `C x = 0` (its `CCᵀ` factorization), for the line search.
+        projector: Projector,
+    },
+    /// No free amplitude: `a ≡ 0` ([`SqpStatus::NoFreeUnknowns`]).
+    Done(SqpResult),
+}
+
+/// The common start of [`run_sqp`] and the projected-Newton SQP (`tfw::pnewton`): projects
+/// `x0` onto `C x = 0` and evaluates it. Errors on a failed factorization of `CCᵀ`.
+pub(crate) fn feasible_start(problem: &SqpProblem, x0: &[f64]) -> Result<FeasibleStart> {
+    let start = Instant::now();
+    let projector = Projector::new(problem)?;
+    let mut x = x0.to_vec();
+    projector.apply(problem, &mut x);
+    let eval = problem
+        .energy
+        .evaluate(&x, WfTerms::ALL, HessianMode::ProjectedPerFace);
+    if problem.n_free_a == 0 {
+        x.iter_mut().for_each(|v| *v = 0.0);
+        return Ok(FeasibleStart::Done(SqpResult {
+            x,
+            status: SqpStatus::NoFreeUnknowns,
+            initial_energy: eval.energy,
+            initial_stationarity: 0.0,
+            history: Vec::new(),
+            qp_seconds: 0.0,
+            seconds: start.elapsed().as_secs_f64(),
+            snapshots: Vec::new(),
+        }));
+    }
+    Ok(FeasibleStart::Run {
+        x,
+        eval,
+        start,
+        projector,
+    })
+}
+
+/// Runs the SQP with clarabel QP steps ([`QpMethod::Clarabel`]) from `x0 = [a | ω]` (made
+/// feasible first), whatever `options.qp` says (`tfw::solve` dispatches on it; the
+/// projected-Newton SQP is `tfw::pnewton::run_sqp_projected_newton`). `progress` may cancel
 /// ([`Error::Cancelled`]). Errors on a failed factorization of `CCᵀ`.
 pub fn run_sqp(
     problem: &SqpProblem,
@@ -437,12 +488,16 @@ pub fn run_sqp(
     options: &SqpOptions,
     progress: &mut ProgressFn<'_>,
 ) -> Result<SqpResult> {
-    let start = Instant::now();
-    let projector = Projector::new(problem)?;
-    let mut x = x0.to_vec();
-    projector.apply(problem, &mut x);
+    let (mut x, mut eval, start, projector) = match feasible_start(problem, x0)? {
+        FeasibleStart::Run {
+            x,
+            eval,
+            start,
+            projector,
+        } => (x, eval, start, projector),
+        FeasibleStart::Done(r) => return Ok(r),
+    };
     let e = &problem.energy;
-    let mut eval = e.evaluate(&x, WfTerms::ALL, HessianMode::ProjectedPerFace);
     let initial_energy = eval.energy;
     let done = |status, x, history, r0, qp_seconds, snapshots| SqpResult {
         x,
@@ -454,21 +509,6 @@ pub fn run_sqp(
         seconds: start.elapsed().as_secs_f64(),
         snapshots,
     };
-    if problem.n_free_a == 0 {
-        let mut x = x;
-        x.iter_mut().for_each(|v| *v = 0.0);
-        return Ok(done(
-            SqpStatus::NoFreeUnknowns,
-            x,
-            Vec::new(),
-            0.0,
-            0.0,
-            Vec::new(),
-        ));
-    }
-    if options.qp == QpMethod::ProjectedNewton {
-        return crate::tfw::pnewton::run(problem, x, eval, options, progress, start);
-    }
     let mut snapshots = Vec::new();
     if options.snapshot_every > 0 {
         snapshots.push((0, x.clone()));
