@@ -1053,7 +1053,10 @@ fn corpus_interfaces_are_smooth_and_singularities_pair() {
                 rep.interface_rings, rep.attempts
             );
             check_interface(&format!("{name}, adaptive width"), &k0, &k1, &rep);
+            // over edit + interface edges and over the interface alone (the wording)
             assert!(rep.compat_rms <= 0.3, "{name}: {}", rep.compat_rms);
+            let band = rep.compat_rms_by_class[1];
+            assert!(band <= 0.3, "{name}: interface-only {band}");
         }
     }
 }
