@@ -34,8 +34,8 @@ use crate::report::{Progress, ProgressFn};
 use crate::solve::{assemble, CholeskyAnalysis, Entry, Parallelism};
 use crate::tfw::energy::{HessianMode, WfEval, WfTerms};
 use crate::tfw::sqp::{
-    feasible_start, qp_shape, FeasibleStart, SqpIteration, SqpOptions, SqpProblem, SqpResult,
-    SqpStatus,
+    feasible_start, qp_shape, step_sizes, FeasibleStart, SqpIteration, SqpOptions, SqpProblem,
+    SqpResult, SqpStatus,
 };
 use crate::{Error, Result};
 use std::collections::VecDeque;
@@ -494,15 +494,7 @@ fn run(
             status = SqpStatus::LineSearchFailed;
             break;
         };
-        let (step_norm, scaled_step) =
-            problem
-                .free
-                .iter()
-                .enumerate()
-                .fold((0.0f64, 0.0f64), |(m, s), (k, &gi)| {
-                    let dx = (xn[gi] - x[gi]).abs();
-                    (m.max(dx), s.max(dx / shape.scale[k]))
-                });
+        let (step_norm, scaled_step) = step_sizes(problem, &shape, &x, &xn);
         let de = eval.energy - en;
         y = yn;
         x = xn;

@@ -375,6 +375,24 @@ pub(super) struct QpShape {
     pub(super) energy_scale: f64,
 }
 
+/// The largest change of a free unknown from `x` to `xn`, plain and divided by its scale in
+/// `shape` (the step tests of both step solvers).
+pub(super) fn step_sizes(
+    problem: &SqpProblem,
+    shape: &QpShape,
+    x: &[f64],
+    xn: &[f64],
+) -> (f64, f64) {
+    problem
+        .free
+        .iter()
+        .enumerate()
+        .fold((0.0f64, 0.0f64), |(m, s), (k, &gi)| {
+            let d = (xn[gi] - x[gi]).abs();
+            (m.max(d), s.max(d / shape.scale[k]))
+        })
+}
+
 /// The QP scaling of the first iteration (module docs: `D = (E₀/diag H)^{1/2}`, objective
 /// divided by `E₀`).
 pub(super) fn qp_shape(problem: &SqpProblem, eval: &WfEval, initial_energy: f64) -> QpShape {
@@ -576,15 +594,7 @@ pub fn run_sqp(
             status = SqpStatus::LineSearchFailed;
             break;
         };
-        let (step_norm, scaled_step) =
-            problem
-                .free
-                .iter()
-                .enumerate()
-                .fold((0.0f64, 0.0f64), |(m, s), (k, &gi)| {
-                    let d = (xn[gi] - x[gi]).abs();
-                    (m.max(d), s.max(d / shape.scale[k]))
-                });
+        let (step_norm, scaled_step) = step_sizes(problem, &shape, &x, &xn);
         let de = eval.energy - en;
         x = xn;
         for (y, zq) in duals.iter_mut().zip(&z) {
