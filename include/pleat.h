@@ -186,6 +186,13 @@
 // projected Newton step on `a ≥ 0` with a sparse Cholesky.
 #define PLEAT_TFW_QP_PROJECTED_NEWTON 1
 
+// `PleatTfwObstacle::kind`: the half-space behind a plane (the surface stays on the side the
+// normal points to).
+#define PLEAT_TFW_OBSTACLE_PLANE 0
+
+// `PleatTfwObstacle::kind`: a solid ball (the surface stays outside).
+#define PLEAT_TFW_OBSTACLE_SPHERE 1
+
 // Doubles per iteration written by `pleat_tfw_result_copy_history`: energy (J), stationarity
 // residual (absolute), step `‖Δx‖∞`, wall seconds since the SQP started.
 #define PLEAT_TFW_HISTORY_COLUMNS 4
@@ -1007,6 +1014,28 @@ typedef struct PleatTfwMaterial {
   double pressure;
 } PleatTfwMaterial;
 
+// A rigid obstacle of the base solve (`pleat_tfw_scene_add_obstacle`; the scene file's
+// `obstacles` entries): every vertex closer than `margin` to its surface pays the one-sided
+// cubic penalty `k Ā_i (margin − d_i)³`. Start from `pleat_tfw_obstacle_default()`.
+typedef struct PleatTfwObstacle {
+  // `sizeof(PleatTfwObstacle)` as the caller knows it (≥ 8).
+  uint32_t struct_size;
+  // `PLEAT_TFW_OBSTACLE_PLANE` or `PLEAT_TFW_OBSTACLE_SPHERE`; default plane.
+  uint32_t kind;
+  // A point of the plane, or the sphere's centre (m); finite; default the origin.
+  double point[3];
+  // The plane's normal, pointing to the allowed side (nonzero, any length; default +z);
+  // ignored for a sphere.
+  double normal[3];
+  // The sphere's radius (m, > 0); ignored for a plane; default 0 (must be set for a sphere).
+  double radius;
+  // Penalty stiffness (J/m⁵, > 0); default 1e9 (`DEFAULT_OBSTACLE_STIFFNESS`: a surface
+  // under a normal load q sinks in about `√(q/3k)`).
+  double stiffness;
+  // Distance from the surface where the penalty starts (m, ≥ 0); default 0.
+  double margin;
+} PleatTfwObstacle;
+
 // Parameters of `pleat_cwf_evaluate`. Get the defaults from
 // `pleat_wrinkle_eval_params_default()` and change what you need; `struct_size` must stay
 // `sizeof(PleatWrinkleEvalParams)` (an older, shorter struct is accepted: missing fields take
@@ -1084,6 +1113,26 @@ typedef struct PleatTfwStats {
   // Wall seconds of the Knöppel phase.
   double seconds_phase;
 } PleatTfwStats;
+
+// A wave count on the evaluated wrinkled surface (`pleat_tfw_result_count_waves`). Set
+// `struct_size = sizeof(PleatTfwWaveCount)` before the call; pleat fills at most that many
+// bytes.
+typedef struct PleatTfwWaveCount {
+  // In: `sizeof(PleatTfwWaveCount)` as the caller knows it (≥ 8). Out: bytes filled.
+  uint32_t struct_size;
+  // 1 when the section was counted as a closed ring (last and first samples compared).
+  uint32_t closed;
+  // Waves: sign changes of `Re z` along the section / 2 (a half-integer on open lines).
+  double waves;
+  // Peak `|Re z|` on the section (m): the wrinkle amplitude there.
+  double peak_amplitude;
+  // Samples (edge crossings) on the section.
+  uint64_t samples;
+  // A point of the section plane (m): the caller's, or the automatic choice.
+  double point[3];
+  // The section plane's normal: the caller's, or the automatic choice.
+  double normal[3];
+} PleatTfwWaveCount;
 
 // Outcome of the Knöppel phase solve of a `PleatCwf` (`pleat_cwf_get_knoppel_report`).
 typedef struct PleatKnoppelReport {
@@ -1940,6 +1989,10 @@ struct PleatTfwParams pleat_tfw_params_default(void);
 // no pressure (the stretched sheet's), with `struct_size` set. Available in every build.
 struct PleatTfwMaterial pleat_tfw_material_default(void);
 
+// The default obstacle: a plane through the origin with normal +z, stiffness 1e9 J/m⁵,
+// margin 0, radius 0, with `struct_size` set. Available in every build.
+struct PleatTfwObstacle pleat_tfw_obstacle_default(void);
+
 // Reads and validates a scene file (JSON; format in README "Tension-field wrinkles").
 //
 // - `path`: NUL-terminated UTF-8 path; non-NULL.
@@ -1993,6 +2046,21 @@ PleatStatus pleat_tfw_scene_from_arrays(const double *rest,
                                         size_t clamped_count,
                                         const double *translation,
                                         struct PleatTfwScene **out);
+
+// Adds a rigid obstacle (plane or sphere) to a scene, kept out of by a penalty in the base
+// solve (the scene file's `obstacles`). The obstacle is validated first; on error the scene
+// is unchanged.
+//
+// - `scene`: non-NULL; not being solved on another thread.
+// - `obstacle`: non-NULL, `struct_size` set (start from `pleat_tfw_obstacle_default()`);
+//   `kind` one of `PLEAT_TFW_OBSTACLE_*`, finite fields, a nonzero plane normal, a sphere
+//   radius > 0, stiffness > 0, margin ≥ 0 (the message names the field, e.g.
+//   `scene: obstacles[0].radius: must be > 0`).
+//
+// # Safety
+// `scene` is NULL or live; `obstacle` is NULL or valid for `obstacle->struct_size` bytes.
+PleatStatus pleat_tfw_scene_add_obstacle(struct PleatTfwScene *scene,
+                                         const struct PleatTfwObstacle *obstacle);
 
 // Destroys a scene. NULL is accepted and ignored.
 //
@@ -2074,6 +2142,29 @@ PleatStatus pleat_tfw_result_evaluate(const struct PleatTfwResult *result,
 // `result` is NULL or live; `out` is NULL or valid for `out->struct_size` bytes.
 PleatStatus pleat_tfw_result_get_stats(const struct PleatTfwResult *result,
                                        struct PleatTfwStats *out);
+
+// Counts the waves of the result's wrinkle field (the library's counter, `tfw::measure`):
+// the field is evaluated with `levels` Loop refinements, and the sign changes of `Re z` where
+// the smooth (unwrinkled) evaluated surface crosses a plane are counted, / 2.
+//
+// - `result`: non-NULL.
+// - `levels`: 0 to 6 (2 or 3 resolve a wave of 3 base edges or more).
+// - `section_point`, `section_normal`: both NULL = automatic (of the three axis planes
+//   through the base's bounding-box centre, the one crossing the most waves; closed when it
+//   surrounds the centre), or both 3 finite doubles (normal nonzero) = that plane.
+// - `section_closed`: 1 = the section is a closed ring around `section_point` (the samples
+//   ordered by angle, last and first compared: cylinders, balloons), 0 = an open line
+//   (ordered along the samples' principal direction); ignored when automatic.
+// - `out`: non-NULL, `out->struct_size = sizeof(PleatTfwWaveCount)` (≥ 8).
+//
+// # Safety
+// Pointers are NULL or valid as described.
+PleatStatus pleat_tfw_result_count_waves(const struct PleatTfwResult *result,
+                                         uint32_t levels,
+                                         const double *section_point,
+                                         const double *section_normal,
+                                         uint32_t section_closed,
+                                         struct PleatTfwWaveCount *out);
 
 // Number of SQP iterations recorded (0 when the SQP did not run, `result` is NULL or the
 // build lacks `tfw`).

@@ -598,6 +598,43 @@ fn bench_tfw_writes_csv_and_svg() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `pleat tfw --qp newton|clarabel` picks the step solver (printed in the summary); an
+/// unknown name exits 2 naming the flag.
+#[cfg(feature = "tfw")]
+#[test]
+fn tfw_qp_flag_picks_the_step_solver() {
+    let dir = std::env::temp_dir().join(format!("pleat-cli-tfw-qp-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("sheet.json");
+    std::fs::write(
+        &scene,
+        pleat::tfw::Scene::stretched_sheet(11, 5, 0.05).to_json_string(),
+    )
+    .unwrap();
+    let out = dir.join("out.obj");
+    for (name, printed) in [("newton", "ProjectedNewton"), ("clarabel", "Clarabel")] {
+        let o = pleat(&[
+            "tfw",
+            path_str(&scene),
+            "-o",
+            path_str(&out),
+            "--levels",
+            "1",
+            "--qp",
+            name,
+            "-q",
+        ]);
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(o.status.success(), "{name}: {text}");
+        assert!(text.contains(&format!("step solver   {printed}")), "{text}");
+        assert!(out.exists());
+    }
+    let o = pleat(&["tfw", path_str(&scene), "-o", path_str(&out), "--qp", "cg"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--qp"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A flat `n × n`-vertex grid on [0,1]² as OBJ in `dir/grid.obj` (vertex `j·n + i` at
 /// `(i, j)/(n − 1)`).
 #[cfg(feature = "wrinkle")]

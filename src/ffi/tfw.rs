@@ -61,6 +61,12 @@ pub const PLEAT_TFW_QP_CLARABEL: u32 = 0;
 /// projected Newton step on `a ≥ 0` with a sparse Cholesky.
 pub const PLEAT_TFW_QP_PROJECTED_NEWTON: u32 = 1;
 
+/// `PleatTfwObstacle::kind`: the half-space behind a plane (the surface stays on the side the
+/// normal points to).
+pub const PLEAT_TFW_OBSTACLE_PLANE: u32 = 0;
+/// `PleatTfwObstacle::kind`: a solid ball (the surface stays outside).
+pub const PLEAT_TFW_OBSTACLE_SPHERE: u32 = 1;
+
 /// Doubles per iteration written by `pleat_tfw_result_copy_history`: energy (J), stationarity
 /// residual (absolute), step `‖Δx‖∞`, wall seconds since the SQP started.
 pub const PLEAT_TFW_HISTORY_COLUMNS: u32 = 4;
@@ -215,7 +221,55 @@ pub struct PleatTfwStats {
     pub seconds_phase: f64,
 }
 
+/// A rigid obstacle of the base solve (`pleat_tfw_scene_add_obstacle`; the scene file's
+/// `obstacles` entries): every vertex closer than `margin` to its surface pays the one-sided
+/// cubic penalty `k Ā_i (margin − d_i)³`. Start from `pleat_tfw_obstacle_default()`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PleatTfwObstacle {
+    /// `sizeof(PleatTfwObstacle)` as the caller knows it (≥ 8).
+    pub struct_size: u32,
+    /// `PLEAT_TFW_OBSTACLE_PLANE` or `PLEAT_TFW_OBSTACLE_SPHERE`; default plane.
+    pub kind: u32,
+    /// A point of the plane, or the sphere's centre (m); finite; default the origin.
+    pub point: [f64; 3],
+    /// The plane's normal, pointing to the allowed side (nonzero, any length; default +z);
+    /// ignored for a sphere.
+    pub normal: [f64; 3],
+    /// The sphere's radius (m, > 0); ignored for a plane; default 0 (must be set for a sphere).
+    pub radius: f64,
+    /// Penalty stiffness (J/m⁵, > 0); default 1e9 (`DEFAULT_OBSTACLE_STIFFNESS`: a surface
+    /// under a normal load q sinks in about `√(q/3k)`).
+    pub stiffness: f64,
+    /// Distance from the surface where the penalty starts (m, ≥ 0); default 0.
+    pub margin: f64,
+}
+
+/// A wave count on the evaluated wrinkled surface (`pleat_tfw_result_count_waves`). Set
+/// `struct_size = sizeof(PleatTfwWaveCount)` before the call; pleat fills at most that many
+/// bytes.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PleatTfwWaveCount {
+    /// In: `sizeof(PleatTfwWaveCount)` as the caller knows it (≥ 8). Out: bytes filled.
+    pub struct_size: u32,
+    /// 1 when the section was counted as a closed ring (last and first samples compared).
+    pub closed: u32,
+    /// Waves: sign changes of `Re z` along the section / 2 (a half-integer on open lines).
+    pub waves: f64,
+    /// Peak `|Re z|` on the section (m): the wrinkle amplitude there.
+    pub peak_amplitude: f64,
+    /// Samples (edge crossings) on the section.
+    pub samples: u64,
+    /// A point of the section plane (m): the caller's, or the automatic choice.
+    pub point: [f64; 3],
+    /// The section plane's normal: the caller's, or the automatic choice.
+    pub normal: [f64; 3],
+}
+
 versioned!(PleatTfwParams, 8, pleat_tfw_params_default);
+versioned!(PleatTfwObstacle, 8, pleat_tfw_obstacle_default);
+versioned!(PleatTfwWaveCount, 8);
 versioned!(PleatTfwMaterial, 16, pleat_tfw_material_default);
 versioned!(PleatTfwStats, 8);
 
@@ -242,6 +296,23 @@ pub extern "C" fn pleat_tfw_material_default() -> PleatTfwMaterial {
         density: 0.0,
         gravity: [0.0; 3],
         pressure: 0.0,
+    }
+}
+
+/// The default obstacle: a plane through the origin with normal +z, stiffness 1e9 J/m⁵,
+/// margin 0, radius 0, with `struct_size` set. Available in every build.
+#[no_mangle]
+pub extern "C" fn pleat_tfw_obstacle_default() -> PleatTfwObstacle {
+    PleatTfwObstacle {
+        struct_size: full_size::<PleatTfwObstacle>(),
+        kind: PLEAT_TFW_OBSTACLE_PLANE,
+        point: [0.0; 3],
+        normal: [0.0, 0.0, 1.0],
+        radius: 0.0,
+        // crate::tfw::DEFAULT_OBSTACLE_STIFFNESS (pinned by a test; the constant exists in
+        // every build of the C ABI).
+        stiffness: 1e9,
+        margin: 0.0,
     }
 }
 
@@ -395,6 +466,26 @@ pub unsafe extern "C" fn pleat_tfw_scene_from_arrays(
     )))
 }
 
+/// Adds a rigid obstacle (plane or sphere) to a scene, kept out of by a penalty in the base
+/// solve (the scene file's `obstacles`). The obstacle is validated first; on error the scene
+/// is unchanged.
+///
+/// - `scene`: non-NULL; not being solved on another thread.
+/// - `obstacle`: non-NULL, `struct_size` set (start from `pleat_tfw_obstacle_default()`);
+///   `kind` one of `PLEAT_TFW_OBSTACLE_*`, finite fields, a nonzero plane normal, a sphere
+///   radius > 0, stiffness > 0, margin ≥ 0 (the message names the field, e.g.
+///   `scene: obstacles[0].radius: must be > 0`).
+///
+/// # Safety
+/// `scene` is NULL or live; `obstacle` is NULL or valid for `obstacle->struct_size` bytes.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_tfw_scene_add_obstacle(
+    scene: *mut PleatTfwScene,
+    obstacle: *const PleatTfwObstacle,
+) -> PleatStatus {
+    tfw_only!([scene, obstacle] guard(|| imp::add_obstacle(scene, obstacle)))
+}
+
 /// Destroys a scene. NULL is accepted and ignored.
 ///
 /// # Safety
@@ -517,6 +608,36 @@ pub unsafe extern "C" fn pleat_tfw_result_get_stats(
     tfw_only!([result, out] guard(|| imp::get_stats(result, out)))
 }
 
+/// Counts the waves of the result's wrinkle field (the library's counter, `tfw::measure`):
+/// the field is evaluated with `levels` Loop refinements, and the sign changes of `Re z` where
+/// the smooth (unwrinkled) evaluated surface crosses a plane are counted, / 2.
+///
+/// - `result`: non-NULL.
+/// - `levels`: 0 to 6 (2 or 3 resolve a wave of 3 base edges or more).
+/// - `section_point`, `section_normal`: both NULL = automatic (of the three axis planes
+///   through the base's bounding-box centre, the one crossing the most waves; closed when it
+///   surrounds the centre), or both 3 finite doubles (normal nonzero) = that plane.
+/// - `section_closed`: 1 = the section is a closed ring around `section_point` (the samples
+///   ordered by angle, last and first compared: cylinders, balloons), 0 = an open line
+///   (ordered along the samples' principal direction); ignored when automatic.
+/// - `out`: non-NULL, `out->struct_size = sizeof(PleatTfwWaveCount)` (≥ 8).
+///
+/// # Safety
+/// Pointers are NULL or valid as described.
+#[no_mangle]
+pub unsafe extern "C" fn pleat_tfw_result_count_waves(
+    result: *const PleatTfwResult,
+    levels: u32,
+    section_point: *const f64,
+    section_normal: *const f64,
+    section_closed: u32,
+    out: *mut PleatTfwWaveCount,
+) -> PleatStatus {
+    tfw_only!([result, levels, section_point, section_normal, section_closed, out]
+        guard(|| imp::count_waves(result, levels, section_point, section_normal,
+                                  section_closed, out)))
+}
+
 /// Number of SQP iterations recorded (0 when the SQP did not run, `result` is NULL or the
 /// build lacks `tfw`).
 ///
@@ -573,11 +694,12 @@ pub(super) mod imp {
     use crate::ffi::common::{c_str_arg, guard_progress};
     use crate::ffi::wrinkle::imp::eval_options;
     use crate::tfw::curvature::CurvatureMethod;
+    use crate::tfw::measure::Section;
     use crate::tfw::wfree::WRule;
     use crate::tfw::QpMethod;
     use crate::tfw::{
-        BaseOptions, BaseStatus, Dirichlet, Material, Motion, Panel, Scene, SqpOptions, SqpStatus,
-        TfwParams, TfwResult, TfwStatus,
+        BaseOptions, BaseStatus, Dirichlet, Material, Motion, Obstacle, ObstacleShape, Panel,
+        Scene, SqpOptions, SqpStatus, TfwParams, TfwResult, TfwStatus,
     };
     use crate::wrinkle::KnoppelOptions;
     use crate::{Error, Result};
@@ -731,6 +853,116 @@ pub(super) mod imp {
         };
         scene.validate()?;
         out.put_boxed(PleatTfwScene { scene });
+        Ok(())
+    }
+
+    /// The Rust obstacle of a C obstacle (validated by `Obstacle`'s scene check).
+    fn obstacle(o: &PleatTfwObstacle) -> Result<Obstacle> {
+        let shape = match o.kind {
+            PLEAT_TFW_OBSTACLE_PLANE => ObstacleShape::Plane {
+                point: o.point,
+                normal: o.normal,
+            },
+            PLEAT_TFW_OBSTACLE_SPHERE => ObstacleShape::Sphere {
+                centre: o.point,
+                radius: o.radius,
+            },
+            k => {
+                return Err(Error::InvalidArgument(format!(
+                    "obstacle->kind is {k}; use PLEAT_TFW_OBSTACLE_PLANE or _SPHERE"
+                )))
+            }
+        };
+        Ok(Obstacle {
+            shape,
+            stiffness: o.stiffness,
+            margin: o.margin,
+        })
+    }
+
+    /// # Safety
+    /// As `pleat_tfw_scene_add_obstacle`.
+    pub(super) unsafe fn add_obstacle(
+        scene: *mut PleatTfwScene,
+        obstacle_p: *const PleatTfwObstacle,
+    ) -> Result<()> {
+        let s = scene
+            .as_mut()
+            .ok_or_else(|| Error::InvalidArgument("scene is NULL".into()))?;
+        crate::ffi::boundary::non_null(obstacle_p, "obstacle")?;
+        let o = obstacle(&read_versioned(obstacle_p, "obstacle")?)?;
+        let mut next = s.scene.clone();
+        next.obstacles.push(o);
+        next.validate()?;
+        s.scene = next;
+        Ok(())
+    }
+
+    /// A caller's 3-vector (finite).
+    ///
+    /// # Safety
+    /// `p` is valid for 3 doubles.
+    unsafe fn vec3(p: *const f64, name: &str) -> Result<[f64; 3]> {
+        let v = doubles(p, 1, 3, name)?;
+        Ok([v[0], v[1], v[2]])
+    }
+
+    /// The caller's section, or `None` for the automatic one.
+    ///
+    /// # Safety
+    /// As `pleat_tfw_result_count_waves`.
+    unsafe fn section(
+        point: *const f64,
+        normal: *const f64,
+        closed: u32,
+    ) -> Result<Option<Section>> {
+        if point.is_null() && normal.is_null() {
+            return Ok(None);
+        }
+        let p = vec3(point, "section_point")?;
+        let n = vec3(normal, "section_normal")?;
+        if n.iter().all(|&c| c == 0.0) {
+            return Err(Error::InvalidArgument(
+                "section_normal is zero; must be nonzero".into(),
+            ));
+        }
+        Ok(Some(if bool_field(closed, "section_closed")? {
+            Section::ring(p, n)
+        } else {
+            Section::line(p, n)
+        }))
+    }
+
+    /// # Safety
+    /// As `pleat_tfw_result_count_waves`.
+    pub(super) unsafe fn count_waves(
+        result: *const PleatTfwResult,
+        levels: u32,
+        point: *const f64,
+        normal: *const f64,
+        closed: u32,
+        out: *mut PleatTfwWaveCount,
+    ) -> Result<()> {
+        let r = result_ref(result)?;
+        check_range(levels, 0, 6, "levels")?;
+        let section = section(point, normal, closed)?;
+        let out = required_versioned_out(out, "out")?;
+        let (s, c) = match section {
+            Some(s) => {
+                let c = crate::tfw::measure::count_waves(&r.cwf, levels as usize, &s)?;
+                (s, c)
+            }
+            None => crate::tfw::measure::count_waves_auto(&r.cwf, levels as usize)?,
+        };
+        out.write(PleatTfwWaveCount {
+            struct_size: 0,
+            closed: u32::from(s.closed),
+            waves: c.waves,
+            peak_amplitude: c.peak,
+            samples: c.samples as u64,
+            point: s.point,
+            normal: s.normal,
+        });
         Ok(())
     }
 
@@ -1145,6 +1377,193 @@ mod tests {
         p.qp = 9;
         let e = read(&p).unwrap_err().to_string();
         assert!(e.contains("params->qp"), "{e}");
+    }
+
+    /// `pleat_tfw_scene_add_obstacle` gives the scene a JSON `obstacles` entry gives, takes
+    /// the defaults for an older (shorter) struct, and rejects bad fields naming them with the
+    /// scene unchanged.
+    #[test]
+    fn obstacles_from_c_match_the_scene_file() {
+        use crate::tfw::{Obstacle, ObstacleShape, DEFAULT_OBSTACLE_STIFFNESS};
+        assert_eq!(
+            pleat_tfw_obstacle_default().stiffness,
+            DEFAULT_OBSTACLE_STIFFNESS
+        );
+        let json =
+            CString::new(crate::tfw::Scene::stretched_sheet(5, 3, 0.05).to_json_string()).unwrap();
+        // SAFETY: valid pointers throughout; the scene is destroyed once.
+        unsafe {
+            let mut scene = null_mut();
+            assert_eq!(
+                pleat_tfw_scene_from_json(json.as_ptr(), &mut scene),
+                PleatStatus::Ok
+            );
+            let mut o = pleat_tfw_obstacle_default();
+            o.kind = PLEAT_TFW_OBSTACLE_SPHERE;
+            o.point = [0.1, 0.0, -0.3];
+            o.radius = 0.25;
+            o.margin = 1e-3;
+            let st = pleat_tfw_scene_add_obstacle(scene, &o);
+            assert_eq!(st, PleatStatus::Ok);
+            let mut old = pleat_tfw_obstacle_default();
+            old.normal = [0.0, 1.0, 0.0];
+            old.stiffness = 5.0;
+            old.struct_size = std::mem::offset_of!(PleatTfwObstacle, stiffness) as u32;
+            assert_eq!(pleat_tfw_scene_add_obstacle(scene, &old), PleatStatus::Ok);
+            let expected = vec![
+                Obstacle {
+                    shape: ObstacleShape::Sphere {
+                        centre: [0.1, 0.0, -0.3],
+                        radius: 0.25,
+                    },
+                    stiffness: DEFAULT_OBSTACLE_STIFFNESS,
+                    margin: 1e-3,
+                },
+                Obstacle {
+                    shape: ObstacleShape::Plane {
+                        point: [0.0; 3],
+                        normal: [0.0, 1.0, 0.0],
+                    },
+                    stiffness: DEFAULT_OBSTACLE_STIFFNESS,
+                    margin: 0.0,
+                },
+            ];
+            assert_eq!((*scene).scene.obstacles, expected);
+            let bad = [
+                (PleatTfwObstacle { kind: 5, ..o }, "obstacle->kind"),
+                (PleatTfwObstacle { radius: 0.0, ..o }, "obstacles[2].radius"),
+                (
+                    PleatTfwObstacle {
+                        point: [f64::NAN, 0.0, 0.0],
+                        ..o
+                    },
+                    "obstacles[2].centre",
+                ),
+                (
+                    PleatTfwObstacle {
+                        kind: PLEAT_TFW_OBSTACLE_PLANE,
+                        normal: [0.0; 3],
+                        ..o
+                    },
+                    "obstacles[2].normal",
+                ),
+                (
+                    PleatTfwObstacle { margin: -1.0, ..o },
+                    "obstacles[2].margin",
+                ),
+                (
+                    PleatTfwObstacle {
+                        stiffness: 0.0,
+                        ..o
+                    },
+                    "obstacles[2].stiffness",
+                ),
+                (
+                    PleatTfwObstacle {
+                        struct_size: 4,
+                        ..o
+                    },
+                    "obstacle",
+                ),
+            ];
+            for (b, field) in bad {
+                let st = pleat_tfw_scene_add_obstacle(scene, &b);
+                assert_eq!(st, PleatStatus::InvalidArgument, "{field}");
+                let msg =
+                    std::ffi::CStr::from_ptr(crate::ffi::pleat_last_error()).to_string_lossy();
+                assert!(msg.contains(field), "{field}: {msg}");
+            }
+            let st = pleat_tfw_scene_add_obstacle(scene, std::ptr::null());
+            assert_eq!(st, PleatStatus::InvalidArgument);
+            let st = pleat_tfw_scene_add_obstacle(null_mut(), &o);
+            assert_eq!(st, PleatStatus::InvalidArgument);
+            assert_eq!((*scene).scene.obstacles, expected);
+            pleat_tfw_scene_destroy(scene);
+        }
+    }
+
+    /// `pleat_tfw_result_count_waves` is the library counter: automatic and given sections
+    /// agree with `tfw::measure` on a solved sheet; bad arguments are named.
+    #[test]
+    fn wave_count_from_c_is_the_library_counter() {
+        let json =
+            CString::new(crate::tfw::Scene::stretched_sheet(13, 6, 0.05).to_json_string()).unwrap();
+        // SAFETY: valid pointers throughout; every handle is destroyed once.
+        unsafe {
+            let mut scene = null_mut();
+            assert_eq!(
+                pleat_tfw_scene_from_json(json.as_ptr(), &mut scene),
+                PleatStatus::Ok
+            );
+            let mut result = null_mut();
+            let st = pleat_tfw_solve(scene, std::ptr::null(), None, null_mut(), &mut result);
+            assert_eq!(st, PleatStatus::Ok);
+            let mut w = PleatTfwWaveCount {
+                struct_size: full_size::<PleatTfwWaveCount>(),
+                ..Default::default()
+            };
+            let st = pleat_tfw_result_count_waves(
+                result,
+                2,
+                std::ptr::null(),
+                std::ptr::null(),
+                0,
+                &mut w,
+            );
+            assert_eq!(st, PleatStatus::Ok);
+            let cwf = &(*result).result.cwf;
+            let (s, c) = crate::tfw::measure::count_waves_auto(cwf, 2).unwrap();
+            assert_eq!(
+                (w.waves, w.peak_amplitude, w.samples),
+                (c.waves, c.peak, c.samples as u64)
+            );
+            assert_eq!(
+                (w.point, w.normal, w.closed),
+                (s.point, s.normal, u32::from(s.closed))
+            );
+            assert!(w.waves >= 1.0 && w.peak_amplitude > 0.0, "{w:?}");
+            let mut g = PleatTfwWaveCount {
+                struct_size: full_size::<PleatTfwWaveCount>(),
+                ..Default::default()
+            };
+            let st = pleat_tfw_result_count_waves(
+                result,
+                2,
+                s.point.as_ptr(),
+                s.normal.as_ptr(),
+                0,
+                &mut g,
+            );
+            assert_eq!(st, PleatStatus::Ok);
+            assert_eq!((g.waves, g.peak_amplitude), (w.waves, w.peak_amplitude));
+            let zero = [0.0; 3];
+            let nan = [f64::NAN, 0.0, 1.0];
+            let cases: [(u32, *const f64, *const f64, u32, &str); 5] = [
+                (7, std::ptr::null(), std::ptr::null(), 0, "levels"),
+                (2, s.point.as_ptr(), std::ptr::null(), 0, "section_normal"),
+                (2, s.point.as_ptr(), zero.as_ptr(), 0, "section_normal"),
+                (2, nan.as_ptr(), s.normal.as_ptr(), 0, "section_point"),
+                (2, s.point.as_ptr(), s.normal.as_ptr(), 2, "section_closed"),
+            ];
+            for (levels, p, n, closed, field) in cases {
+                let st = pleat_tfw_result_count_waves(result, levels, p, n, closed, &mut g);
+                assert_eq!(st, PleatStatus::InvalidArgument, "{field}");
+                let msg =
+                    std::ffi::CStr::from_ptr(crate::ffi::pleat_last_error()).to_string_lossy();
+                assert!(msg.contains(field), "{field}: {msg}");
+            }
+            let st = pleat_tfw_result_count_waves(
+                result,
+                2,
+                std::ptr::null(),
+                std::ptr::null(),
+                0,
+                null_mut(),
+            );
+            assert_eq!(st, PleatStatus::InvalidArgument);
+            pleat_tfw_result_destroy(result);
+            pleat_tfw_scene_destroy(scene);
+        }
     }
 
     /// Same scene and parameters ⇒ the same bytes on 1 and 2 threads (the history's wall

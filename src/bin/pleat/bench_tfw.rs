@@ -141,12 +141,10 @@ pub fn run(args: &TfwBenchArgs) -> ExitCode {
     let mut params = TfwParams::default();
     params.sqp.max_iterations = args.max_iterations;
     params.sqp.snapshot_every = args.wave_every;
-    params.sqp.qp = match args.qp.as_str() {
-        "default" => params.sqp.qp,
-        "clarabel" => QpMethod::Clarabel,
-        "newton" => QpMethod::ProjectedNewton,
-        other => {
-            eprintln!("pleat bench tfw: --qp {other:?}: expected clarabel or newton");
+    params.sqp.qp = match parse_qp(&args.qp, params.sqp.qp) {
+        Ok(q) => q,
+        Err(e) => {
+            eprintln!("pleat bench tfw: {e}");
             return ExitCode::from(EXIT_INPUT);
         }
     };
@@ -245,6 +243,18 @@ fn describe(s: &Section) -> String {
         v(s.normal),
         v(s.point)
     )
+}
+
+/// The step solver named by a `--qp` value (`default` keeps `default`), or the message.
+pub(super) fn parse_qp(name: &str, default: QpMethod) -> Result<QpMethod, String> {
+    match name {
+        "default" => Ok(default),
+        "clarabel" => Ok(QpMethod::Clarabel),
+        "newton" => Ok(QpMethod::ProjectedNewton),
+        other => Err(format!(
+            "--qp {other:?}: expected clarabel, newton or default"
+        )),
+    }
 }
 
 fn write_outputs(dir: &Path, outcomes: &[Outcome], qp: QpMethod) -> std::io::Result<()> {

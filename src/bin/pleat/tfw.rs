@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use pleat::mesh::io::write_mesh;
-use pleat::tfw::{solve, Scene, TfwParams, TfwResult};
+use pleat::tfw::{solve, QpMethod, Scene, TfwParams, TfwResult};
 use pleat::wrinkle::{write_cwf, EvalOptions};
 
 use super::{failure_code, progress_bar, show_progress, EXIT_FAILED, EXIT_INPUT};
@@ -34,6 +34,10 @@ pub struct TfwArgs {
     /// SQP iteration limit.
     #[arg(long, default_value_t = 1000)]
     pub max_iterations: usize,
+    /// The SQP step solver: `clarabel` (QP with the curl constraint), `newton` (projected
+    /// Newton, curl eliminated) or `default` (the library's default).
+    #[arg(long, default_value = "default")]
+    pub qp: String,
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
@@ -54,6 +58,13 @@ pub fn run(args: &TfwArgs) -> ExitCode {
     }
     let mut params = TfwParams::default();
     params.sqp.max_iterations = args.max_iterations;
+    params.sqp.qp = match super::bench_tfw::parse_qp(&args.qp, params.sqp.qp) {
+        Ok(q) => q,
+        Err(e) => {
+            eprintln!("pleat tfw: {e}");
+            return ExitCode::from(EXIT_INPUT);
+        }
+    };
     let bar = progress_bar(args.quiet);
     let result = solve(&scene, &params, &mut |p| show_progress(&bar, p));
     if let Some(b) = &bar {
@@ -66,7 +77,7 @@ pub fn run(args: &TfwArgs) -> ExitCode {
             return ExitCode::from(failure_code(&e));
         }
     };
-    print_summary(&r);
+    print_summary(&r, params.sqp.qp);
     match write_outputs(args, &r) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -91,7 +102,7 @@ fn write_outputs(args: &TfwArgs, r: &TfwResult) -> pleat::Result<()> {
     write_mesh(&args.out, &ev.mesh)
 }
 
-fn print_summary(r: &TfwResult) {
+fn print_summary(r: &TfwResult, qp: QpMethod) {
     println!("status        {:?}: {}", r.status, r.status.describe());
     println!(
         "base          {:?} in {} Newton iterations, {:.3} s",
@@ -105,12 +116,13 @@ fn print_summary(r: &TfwResult) {
     let nw = r.w_faces.iter().filter(|&&w| w).count();
     println!("W faces       {nw} of {}", r.w_faces.len());
     if let Some(s) = &r.sqp {
+        println!("step solver   {qp:?}");
         let last_r = s
             .history
             .last()
             .map_or(s.initial_stationarity, |i| i.stationarity);
         println!(
-            "SQP           {:?} in {} iterations, {:.3} s ({:.3} s in QPs)",
+            "SQP           {:?} in {} iterations, {:.3} s ({:.3} s in steps)",
             s.status,
             s.history.len(),
             r.seconds.sqp,
