@@ -274,6 +274,20 @@ static void tension_field() {
     EXPECT(result.base_mesh().vertex_count() == nv);
     EXPECT(result.cwf().vertex_count() == nv);
     EXPECT(result.evaluate(1).triangle_count() == 4 * st.triangle_count);
+    PleatTfwWaveCount waves = result.count_waves(2);
+    EXPECT(waves.samples > 0 && waves.waves >= 0.0);
+    PleatTfwObstacle plane = pleat_tfw_obstacle_default();
+    plane.point[2] = -0.01;
+    scene.add_obstacle(plane);
+    PleatTfwObstacle ball = pleat_tfw_obstacle_default();
+    ball.kind = PLEAT_TFW_OBSTACLE_SPHERE; // radius left at 0: rejected
+    try {
+        scene.add_obstacle(ball);
+        EXPECT(false);
+    } catch (const pleat::Error &err) {
+        EXPECT(err.status() == PLEAT_STATUS_INVALID_ARGUMENT);
+        std::printf("  ok: sphere without radius -> %s\n", err.what());
+    }
     try {
         scene.solve(params, [](const char *, double) { return false; });
         EXPECT(false);

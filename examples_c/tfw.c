@@ -142,6 +142,35 @@ static void solve_sheet(void) {
     CHECK_STATUS(pleat_tfw_result_evaluate(res, &ep, 2, NULL, NULL, &wrinkled),
                  PLEAT_STATUS_INVALID_ARGUMENT);
 
+    /* the library's wave counter: the automatic section crosses the sheet's 5 periods */
+    {
+        PleatTfwWaveCount w, g;
+        const double zero[3] = {0, 0, 0};
+        memset(&w, 0, sizeof w);
+        w.struct_size = sizeof w;
+        CHECK_STATUS(pleat_tfw_result_count_waves(res, 2, NULL, NULL, 0, &w), PLEAT_STATUS_OK);
+        CHECK(w.struct_size == sizeof w && w.samples > 0);
+        CHECK(w.waves >= 4.0 && w.waves <= 6.0);
+        CHECK(w.peak_amplitude >= 0.28e-3 && w.peak_amplitude <= 0.50e-3);
+        printf("waves %.1f (peak %.3f mm) on the plane through (%.3f, %.3f, %.3f) normal "
+               "(%g, %g, %g)\n",
+               w.waves, w.peak_amplitude * 1e3, w.point[0], w.point[1], w.point[2],
+               w.normal[0], w.normal[1], w.normal[2]);
+        g = w;
+        CHECK_STATUS(pleat_tfw_result_count_waves(res, 2, w.point, w.normal, w.closed, &g),
+                     PLEAT_STATUS_OK);
+        CHECK(g.waves == w.waves);
+        /* misuse: a zero normal, a point without a normal, too many levels, NULL out */
+        CHECK_STATUS(pleat_tfw_result_count_waves(res, 2, w.point, zero, 0, &g),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(pleat_tfw_result_count_waves(res, 2, w.point, NULL, 0, &g),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(pleat_tfw_result_count_waves(res, 9, NULL, NULL, 0, &g),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(pleat_tfw_result_count_waves(res, 2, NULL, NULL, 0, NULL),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+    }
+
     /* misuse of the getters */
     st.struct_size = 4;
     CHECK_STATUS(pleat_tfw_result_get_stats(res, &st), PLEAT_STATUS_INVALID_ARGUMENT);
@@ -205,6 +234,24 @@ static void arrays_scene(void) {
            st.sqp_iterations, st.peak_amplitude * 1e3);
     pleat_tfw_result_destroy(r);
     r = NULL;
+
+    /* an obstacle from C: a plane 5 mm below the sheet; then misuse (no radius, bad kind,
+       NaN point, NULLs), each leaving the scene as it was */
+    {
+        PleatTfwObstacle o = pleat_tfw_obstacle_default();
+        o.point[2] = -5e-3;
+        CHECK_STATUS(pleat_tfw_scene_add_obstacle(s, &o), PLEAT_STATUS_OK);
+        o.kind = PLEAT_TFW_OBSTACLE_SPHERE;
+        CHECK_STATUS(pleat_tfw_scene_add_obstacle(s, &o), PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK(strstr(pleat_last_error(), "radius") != NULL);
+        o.kind = 9;
+        CHECK_STATUS(pleat_tfw_scene_add_obstacle(s, &o), PLEAT_STATUS_INVALID_ARGUMENT);
+        o = pleat_tfw_obstacle_default();
+        o.point[0] = NAN;
+        CHECK_STATUS(pleat_tfw_scene_add_obstacle(s, &o), PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(pleat_tfw_scene_add_obstacle(s, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_STATUS(pleat_tfw_scene_add_obstacle(NULL, &o), PLEAT_STATUS_INVALID_ARGUMENT);
+    }
 
     /* bad parameters */
     p = pleat_tfw_params_default();

@@ -818,6 +818,16 @@ class TfwResult {
                                                relay.user_data(), &m));
         return Mesh(m);
     }
+    /// The library's wave counter on the field evaluated with `levels` refinements: the
+    /// automatic section when `point` and `normal` are null, else the plane through `point`
+    /// with `normal` (a closed ring about `point` when `closed`).
+    PleatTfwWaveCount count_waves(uint32_t levels = 2, const double point[3] = nullptr,
+                                  const double normal[3] = nullptr, bool closed = false) const {
+        PleatTfwWaveCount w{};
+        w.struct_size = sizeof w;
+        check(pleat_tfw_result_count_waves(raw_, levels, point, normal, closed ? 1 : 0, &w));
+        return w;
+    }
     /// SQP history: PLEAT_TFW_HISTORY_COLUMNS (4) doubles per iteration (energy, stationarity
     /// residual, step, wall seconds), flattened.
     std::vector<double> history() const {
@@ -883,6 +893,11 @@ class TfwScene {
             positions.empty() ? nullptr : positions.data(), &material, clamped.data(),
             clamped.size(), translation, &s));
         return TfwScene(s);
+    }
+    /// Adds a plane or sphere obstacle (start from pleat_tfw_obstacle_default()); invalid
+    /// fields throw, naming the field, and leave the scene unchanged.
+    void add_obstacle(const PleatTfwObstacle &obstacle) {
+        check(pleat_tfw_scene_add_obstacle(raw_, &obstacle));
     }
     /// Solves the scene (base surface, wrinkle SQP, phase). `keep_going(stage, fraction)`
     /// returns false to cancel.

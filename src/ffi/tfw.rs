@@ -888,7 +888,7 @@ pub(super) mod imp {
     ) -> Result<()> {
         let s = scene
             .as_mut()
-            .ok_or_else(|| Error::InvalidArgument("scene is NULL".into()))?;
+            .ok_or_else(|| crate::ffi::common::null_arg("scene"))?;
         crate::ffi::boundary::non_null(obstacle_p, "obstacle")?;
         let o = obstacle(&read_versioned(obstacle_p, "obstacle")?)?;
         let mut next = s.scene.clone();

@@ -22,6 +22,7 @@ pub use eigen::{
 };
 pub use krylov::{dot_n, steihaug, steihaug_with_stop, TrustStep};
 pub use sparse::{
-    assemble, entry_index, is_out_of_memory, sym_matvec_lower_into, Cholesky, CholeskyAnalysis,
-    Entry, FactorInfo, LltError, Parallelism, ShiftSchedule, SolveScratch, SparseMatrix,
+    assemble, entry_index, is_out_of_memory, sym_matvec_lower_into, AssemblyPlan, Cholesky,
+    CholeskyAnalysis, Entry, FactorInfo, LltError, Parallelism, ShiftSchedule, SolveScratch,
+    SparseMatrix,
 };

@@ -45,6 +45,51 @@ pub fn assemble(dim: usize, entries: &[Entry], what: &str) -> Result<SparseMatri
         .map_err(|e| Error::Numerical(format!("assembling {what}: {e:?}")))
 }
 
+/// A fixed pattern and the order that sums a list of entries into it (faer's argsort), for
+/// matrices re-assembled many times with the same entries in the same order and only the
+/// values changing (Newton iterations): [`AssemblyPlan::new`] sorts the indices once,
+/// [`AssemblyPlan::assemble`] then fills the values without sorting.
+#[derive(Debug, Clone)]
+pub struct AssemblyPlan {
+    symbolic: faer::sparse::SymbolicSparseColMat<usize>,
+    argsort: faer::sparse::Argsort<usize>,
+    entries: usize,
+}
+
+impl AssemblyPlan {
+    /// The plan of the `dim × dim` matrix with the indices of `entries` (their values are
+    /// ignored). Errors as [`assemble`].
+    pub fn new(dim: usize, entries: &[Entry], what: &str) -> Result<AssemblyPlan> {
+        let idx: Vec<faer::sparse::Pair<usize, usize>> = entries
+            .iter()
+            .map(|e| faer::sparse::Pair::new(e.row, e.col))
+            .collect();
+        let (symbolic, argsort) =
+            faer::sparse::SymbolicSparseColMat::try_new_from_indices(dim, dim, &idx)
+                .map_err(|e| Error::Numerical(format!("assembling {what}: {e:?}")))?;
+        Ok(AssemblyPlan {
+            symbolic,
+            argsort,
+            entries: entries.len(),
+        })
+    }
+
+    /// The matrix whose entry `k` (indices as given to [`AssemblyPlan::new`]) has the value
+    /// `values[k]`, duplicates summed: the matrix [`assemble`] gives for those entries.
+    /// Errors ([`Error::InvalidArgument`]) when the count differs from the plan's.
+    pub fn assemble(&self, values: &[f64]) -> Result<SparseMatrix> {
+        if values.len() != self.entries {
+            return Err(Error::InvalidArgument(format!(
+                "assembly plan of {} entries given {} values",
+                self.entries,
+                values.len()
+            )));
+        }
+        SparseMatrix::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
+            .map_err(|e| Error::Numerical(format!("assembling: {e:?}")))
+    }
+}
+
 /// Index into `a.val()` of the stored entry `(row, col)`, or `None` when it is not in the
 /// pattern.
 pub fn entry_index(a: &SparseMatrix, row: usize, col: usize) -> Option<usize> {
@@ -358,6 +403,30 @@ mod tests {
             }
         }
         assemble(n, &t, "a test matrix").unwrap()
+    }
+
+    /// The plan gives the matrix `assemble` gives (duplicates summed, any order), for new
+    /// values too, and refuses a different count.
+    #[test]
+    fn assembly_plan_matches_assemble() {
+        let mut t = vec![
+            Entry::new(2, 1, 1.0),
+            Entry::new(0, 0, 2.0),
+            Entry::new(2, 1, 0.5),
+            Entry::new(1, 1, 3.0),
+            Entry::new(2, 2, 4.0),
+        ];
+        let plan = AssemblyPlan::new(3, &t, "a test matrix").unwrap();
+        for scale in [1.0, -2.5] {
+            t.iter_mut().for_each(|e| e.val *= scale);
+            let vals: Vec<f64> = t.iter().map(|e| e.val).collect();
+            let a = plan.assemble(&vals).unwrap();
+            let b = assemble(3, &t, "a test matrix").unwrap();
+            assert_eq!(a.symbolic().col_ptr(), b.symbolic().col_ptr());
+            assert_eq!(a.symbolic().row_idx(), b.symbolic().row_idx());
+            assert_eq!(a.val(), b.val());
+        }
+        assert!(plan.assemble(&[1.0]).is_err());
     }
 
     #[test]

@@ -59,6 +59,32 @@ pub fn project_psd<const N: usize>(a: &mut [[f64; N]; N]) {
     }
 }
 
+/// True when the symmetric `N×N` matrix `a` is positive definite: its Cholesky
+/// factorization (lower triangle read) meets only positive, finite pivots.
+#[allow(clippy::needless_range_loop)] // the factor is indexed by row and column
+pub fn is_positive_definite<const N: usize>(a: &[[f64; N]; N]) -> bool {
+    let mut l = [[0.0; N]; N];
+    for j in 0..N {
+        let d = a[j][j] - (0..j).map(|k| l[j][k] * l[j][k]).sum::<f64>();
+        if !(d > 0.0 && d.is_finite()) {
+            return false;
+        }
+        l[j][j] = d.sqrt();
+        for i in j + 1..N {
+            l[i][j] = (a[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>()) / l[j][j];
+        }
+    }
+    true
+}
+
+/// [`project_psd`], except that a positive definite `a` (its own projection) is left as it
+/// is: one small Cholesky instead of the Jacobi sweeps, and no rounding from `V Λ Vᵀ`.
+pub fn project_psd_unless_definite<const N: usize>(a: &mut [[f64; N]; N]) {
+    if !is_positive_definite(a) {
+        project_psd(a);
+    }
+}
+
 /// `a − b` on `[f64; 3]` (the storage form of the TFW code).
 #[inline]
 pub(super) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -101,6 +127,15 @@ mod tests {
                 assert!((a[i][j] - b[i][j]).abs() < 1e-12);
             }
         }
+        assert!(is_positive_definite(&b));
+        let mut d = b;
+        project_psd_unless_definite(&mut d);
+        assert_eq!(d, b);
+        assert!(!is_positive_definite(&[[1.0, 2.0], [2.0, 1.0]]));
+        assert!(!is_positive_definite(&[[1.0, 0.0], [0.0, 0.0]]));
+        let mut e = [[1.0, 2.0], [2.0, 1.0]];
+        project_psd_unless_definite(&mut e);
+        assert!(e.iter().flatten().all(|x| (x - 1.5).abs() < 1e-12), "{e:?}");
         // eigenvalues 3 and -1 (eigvecs (1,1)/√2, (1,-1)/√2): projection = 1.5 [[1,1],[1,1]]
         let mut c = [[1.0, 2.0], [2.0, 1.0]];
         project_psd(&mut c);

@@ -31,7 +31,7 @@
 //! [`crate::tfw::sqp`].
 
 use crate::report::{Progress, ProgressFn};
-use crate::solve::{assemble, CholeskyAnalysis, Entry, Parallelism};
+use crate::solve::{AssemblyPlan, CholeskyAnalysis, Entry, Parallelism};
 use crate::tfw::energy::{HessianMode, WfEval, WfTerms};
 use crate::tfw::sqp::{
     feasible_start, qp_shape, step_sizes, FeasibleStart, SqpIteration, SqpOptions, SqpProblem,
@@ -441,6 +441,7 @@ fn run(
         snapshots.push((0, x.clone()));
     }
     let mut state = NewtonState {
+        plan: None,
         analysis: None,
         shift: options.initial_shift,
     };
@@ -540,8 +541,11 @@ fn run(
     })
 }
 
-/// What the Newton steps carry over: the symbolic analysis and the relative shift σ.
+/// What the Newton steps carry over: the assembly plan and the symbolic analysis of the
+/// reduced matrix (its entries keep one pattern and order: held unknowns enter as zeros), and
+/// the relative shift σ.
 struct NewtonState {
+    plan: Option<AssemblyPlan>,
     analysis: Option<CholeskyAnalysis>,
     shift: f64,
 }
@@ -558,7 +562,11 @@ fn newton_direction(
     weights: &[f64],
     state: &mut NewtonState,
 ) -> Result<Option<(Vec<f64>, u32)>> {
-    let NewtonState { analysis, shift } = state;
+    let NewtonState {
+        plan,
+        analysis,
+        shift,
+    } = state;
     let ny = basis.ny;
     let (mut entries, mean) = reduced_hessian(problem, basis, &eval.hessian, held);
     // the shift σ Bᵀ W B (W = the first iteration's diagonal of H: the clarabel QP's σ I in
@@ -582,13 +590,18 @@ fn newton_direction(
         .zip(held)
         .map(|(&gi, &h)| if h { 0.0 } else { -gi })
         .collect();
+    if plan.is_none() {
+        *plan = Some(AssemblyPlan::new(ny, &entries, "tfw projected Newton")?);
+    }
+    let plan = plan.as_ref().expect("made above");
+    let mut values: Vec<f64> = entries.iter().map(|e| e.val).collect();
     let mut attempts = 0;
     loop {
         attempts += 1;
-        for (en, &b) in entries[first_shift..].iter_mut().zip(&shift_base) {
-            en.val = *shift * b;
+        for (v, &b) in values[first_shift..].iter_mut().zip(&shift_base) {
+            *v = *shift * b;
         }
-        let h = assemble(ny, &entries, "tfw projected Newton")?;
+        let h = plan.assemble(&values)?;
         if analysis.is_none() {
             *analysis = Some(CholeskyAnalysis::new(&h)?);
         }

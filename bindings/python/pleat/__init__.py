@@ -1403,8 +1403,18 @@ _TfwStats = _struct("PleatTfwStats",
                             "curl_residual", "peak_amplitude", "base_relative_gradient",
                             "seconds_base", "seconds_init", "seconds_sqp", "seconds_qp",
                             "seconds_phase"))
+_TfwObstacle = _struct("PleatTfwObstacle", _u32s("struct_size", "kind")
+                       + [("point", _c.c_double * 3), ("normal", _c.c_double * 3)]
+                       + _f64s("radius", "stiffness", "margin"))
+_TfwWaveCount = _struct("PleatTfwWaveCount", _u32s("struct_size", "closed")
+                        + _f64s("waves", "peak_amplitude") + _u64s("samples")
+                        + [("point", _c.c_double * 3), ("normal", _c.c_double * 3)])
 for _name, _res, _args in [
     ("pleat_tfw_params_default", _TfwParams, ()),
+    ("pleat_tfw_obstacle_default", _TfwObstacle, ()),
+    ("pleat_tfw_scene_add_obstacle", _st, (_P, _c.POINTER(_TfwObstacle))),
+    ("pleat_tfw_result_count_waves", _st, (_P, _u32, _D, _D, _u32,
+                                           _c.POINTER(_TfwWaveCount))),
     ("pleat_tfw_material_default", _TfwMaterial, ()),
     ("pleat_tfw_scene_read_file", _st, (_c.c_char_p, _PP)),
     ("pleat_tfw_scene_from_json", _st, (_c.c_char_p, _PP)),
@@ -1423,7 +1433,8 @@ for _name, _res, _args in [
 ]:
     _sig(_name, _res, *_args)
 for _fn, _cls in [("pleat_tfw_params_default", _TfwParams),
-                  ("pleat_tfw_material_default", _TfwMaterial)]:
+                  ("pleat_tfw_material_default", _TfwMaterial),
+                  ("pleat_tfw_obstacle_default", _TfwObstacle)]:
     if getattr(_lib, _fn)().struct_size != _c.sizeof(_cls):
         raise ImportError(f"{_path}: {_cls.__name__} is {getattr(_lib, _fn)().struct_size} bytes "
                           f"in the library, {_c.sizeof(_cls)} in this module")
@@ -1461,7 +1472,8 @@ def _tfw_params(w_rule="text", curvature="quadric", qp=None, **kw):
 class TfwScene(_Handle):
     """A validated tension-field wrinkle scene (panels, material, loads, Dirichlet
     conditions; README "Tension-field wrinkles"). Needs the ``tfw`` capability (else
-    PleatError UNSUPPORTED). Immutable; ``solve()`` gives a TfwResult."""
+    PleatError UNSUPPORTED). ``add_obstacle()`` adds a plane or sphere; ``solve()`` gives a
+    TfwResult."""
 
     _destroy = "pleat_tfw_scene_destroy"
 
@@ -1512,6 +1524,25 @@ class TfwScene(_Handle):
             None if tr is None else _ptr(tr, _c.c_double), _c.byref(h)))
         return cls(h)
 
+    def add_obstacle(self, kind, point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0), radius=0.0,
+                     stiffness=None, margin=0.0):
+        """Adds a rigid obstacle kept out by a penalty in the base solve: ``kind`` "plane"
+        (``point``, ``normal`` pointing to the allowed side) or "sphere" (centre ``point``,
+        ``radius``); ``stiffness`` J/m^5 (None = the library's 1e9), ``margin`` m. Invalid
+        values raise PleatError naming the field; the scene is then unchanged."""
+        kinds = {"plane": 0, "sphere": 1}
+        if kind not in kinds:
+            raise PleatError(1, f"obstacle kind {kind!r}; known: {sorted(kinds)}")
+        o = _lib.pleat_tfw_obstacle_default()
+        o.kind = kinds[kind]
+        o.point[:] = [float(x) for x in point]
+        o.normal[:] = [float(x) for x in normal]
+        o.radius = float(radius)
+        if stiffness is not None:
+            o.stiffness = float(stiffness)
+        o.margin = float(margin)
+        _check(_lib.pleat_tfw_scene_add_obstacle(self._h, _c.byref(o)))
+
     def solve(self, progress=None, **params):
         """Solves the scene (base surface, wrinkle SQP, phase); keywords are PleatTfwParams
         fields (e.g. ``sqp_max_iterations=50``, ``w_rule="reference"``,
@@ -1560,6 +1591,25 @@ class TfwResult(_Handle):
                                             relay.fn, None, _c.byref(h))
         relay.finish(st)
         return Mesh(h)
+
+    def count_waves(self, levels=2, point=None, normal=None, closed=False):
+        """The library's wave counter on the evaluated field: sign changes of Re z / 2 where
+        the smooth surface crosses the plane through ``point`` with ``normal`` (a closed ring
+        about ``point`` when ``closed``), or, with both None, the axis plane through the
+        bounding-box centre crossing the most waves. A dict: waves, peak_amplitude (m),
+        samples, closed, point, normal."""
+        if (point is None) != (normal is None):
+            raise PleatError(1, "count_waves: give both point and normal, or neither")
+        w = _TfwWaveCount()
+        w.struct_size = _c.sizeof(w)
+        p = None if point is None else _doubles(point, 3, "point")
+        n = None if normal is None else _doubles(normal, 3, "normal")
+        _check(_lib.pleat_tfw_result_count_waves(
+            self._h, int(levels), None if p is None else _ptr(p, _c.c_double),
+            None if n is None else _ptr(n, _c.c_double), 1 if closed else 0, _c.byref(w)))
+        d = _as_dict(w)
+        d["closed"] = bool(d["closed"])
+        return d
 
     def history(self):
         """SQP history, a (k, 4) array: energy (J), stationarity residual, step, wall

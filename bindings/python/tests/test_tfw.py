@@ -98,3 +98,37 @@ def test_both_step_solvers():
     with pytest.raises(pleat.PleatError) as e:
         scene.solve(qp="simplex")
     assert "qp" in str(e.value)
+
+
+def test_count_waves(solved):
+    """``count_waves`` (pleat_tfw_result_count_waves): the automatic section crosses the
+    sheet's waves; the same plane given explicitly gives the same count; bad input raises."""
+    w = solved.count_waves(levels=2)
+    assert w["waves"] >= 1 and 0 < w["peak_amplitude"] < 5e-3 and w["samples"] > 0
+    again = solved.count_waves(levels=2, point=w["point"], normal=w["normal"],
+                               closed=w["closed"])
+    assert again["waves"] == w["waves"] and again["peak_amplitude"] == w["peak_amplitude"]
+    with pytest.raises(pleat.PleatError) as e:
+        solved.count_waves(levels=9)
+    assert "levels" in str(e.value)
+    with pytest.raises(pleat.PleatError) as e:
+        solved.count_waves(point=(0, 0, 0), normal=(0, 0, 0))
+    assert "section_normal" in str(e.value)
+
+
+def test_obstacles():
+    """``add_obstacle`` (pleat_tfw_scene_add_obstacle): a plane just below the sheet keeps the
+    base above it; bad obstacles raise naming the field and leave the scene as it was."""
+    uv, tris, pos, clamped = sheet_arrays()
+    scene = pleat.TfwScene.from_arrays(uv, tris, pos, clamped, thickness=1e-4, density=1000,
+                                       gravity=(0, 0, -9.81))
+    with pytest.raises(pleat.PleatError) as e:
+        scene.add_obstacle("sphere", point=(0, 0, -1), radius=0)
+    assert "radius" in str(e.value)
+    with pytest.raises(pleat.PleatError) as e:
+        scene.add_obstacle("cone")
+    assert "cone" in str(e.value)
+    scene.add_obstacle("plane", point=(0, 0, -1e-3), normal=(0, 0, 1))
+    r = scene.solve(sqp_max_iterations=5)
+    z = r.base_mesh().positions()[:, 2]
+    assert z.min() > -1e-3 - 1e-4
