@@ -28,7 +28,9 @@
 //! - [`energy`]: the wrinkle energy `E^wf` (2.20–2.27, 3-point rule of A.7) on vertex
 //!   amplitudes and the edge one-form, with its exact gradient and sparse Hessian.
 //! - [`sqp`]: the wrinkle SQP of A.6.3 (clarabel QP per iteration, `a ≥ 0`, `curl ω = 0` off W,
-//!   convexified Hessian, Armijo line search, termination tests, per-iteration history).
+//!   convexified Hessian, Armijo line search, termination tests, per-iteration history);
+//!   [`pnewton`]: the same SQP with the curl eliminated, projected Newton steps
+//!   ([`QpMethod::ProjectedNewton`]).
 //! - [`pipeline`]: [`solve`] — scene → base → W, init → SQP → [`crate::wrinkle::Cwf`] (Knöppel
 //!   phase), with a report; the wrinkled mesh comes from [`crate::wrinkle::Cwf::evaluate`]
 //!   with [`crate::wrinkle::EvalOptions::in_plane_v2`] (the v2 term of eq. 2.19).
