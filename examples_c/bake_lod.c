@@ -4,6 +4,7 @@
  * progress callback, and check that misuse gives an error status.
  */
 #include <math.h>
+#include <stddef.h>
 #include "test_util.h"
 
 #define SLICES 32
@@ -139,10 +140,20 @@ static void check_bake(const PleatBake *bake, const PleatMesh *lod) {
     CHECK(st.flags & PLEAT_BAKE_TEXTURED);
     CHECK(st.texture_size == 64 && st.charts > 0 && st.texels_covered > 0);
     CHECK(st.vertex_count == nv && st.triangle_count == nt);
+    CHECK(st.atlas_padding > 0 && st.seam_clean_mip >= 0);
     printf("bake: %zu vertices, %zu triangles, %u charts, %llu texels covered, error mean %.2f "
-           "/255, %.3f s\n",
+           "/255, %.3f s, padding %u texels, seams clean to mip %d\n",
            nv, nt, st.charts, (unsigned long long)st.texels_covered, st.appearance_error_mean,
-           st.seconds_total);
+           st.seconds_total, st.atlas_padding, st.seam_clean_mip);
+    {
+        /* An older, shorter PleatBakeStats (before atlas_padding) is still accepted and
+         * filled only up to its size. */
+        PleatBakeStats old;
+        memset(&old, 0xAB, sizeof old);
+        old.struct_size = (uint32_t)offsetof(PleatBakeStats, atlas_padding);
+        CHECK_STATUS(pleat_bake_get_stats(bake, &old), PLEAT_STATUS_OK);
+        CHECK(old.charts == st.charts && old.atlas_padding == 0xABABABABu);
+    }
     free(uv);
     free(tg);
     free(pos);

@@ -515,6 +515,14 @@ typedef struct PleatBakeStats {
   double appearance_error_p95;
   // Maximum of the same error.
   double appearance_error_max;
+  // Gutter between charts in texels as used: the requested padding, or less when the
+  // charts could not be packed with it (then seams hold to a shallower mip); 0 for vertex
+  // colours. Appended 2026-11-27 (older, shorter structs are still accepted).
+  uint32_t atlas_padding;
+  // The deepest mip level (up to the texel rule's, 2 by default) whose bilinear reads stay
+  // inside each chart's own texels by construction; −1 for vertex colours or when even
+  // mip 0 mixes charts. Appended 2026-11-27.
+  int32_t seam_clean_mip;
 } PleatBakeStats;
 
 // Parameters of `pleat_cwf_design`. Get the defaults from `pleat_cwf_design_params_default()`;

@@ -1257,6 +1257,26 @@ fn obj_mtl_bakes_through_the_cli_and_matches_the_field() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// `pleat lod in.obj --bake -o 'out_{np}.glb'` writes one GLB per level (issue 11: "or one
+/// file per level"), each a one-level chain.
+#[test]
+fn cli_bake_writes_one_file_per_level_with_a_placeholder() {
+    let dir = scratch("objcli_per_level");
+    let obj = write_sphere_obj(&dir);
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pleat"))
+        .args(["lod", obj.to_str().unwrap(), "--screen-size", "25,50"])
+        .args(["--bake", "-q", "-o"])
+        .arg(dir.join("lod_{np}.glb"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for n in [25, 50] {
+        check_output(&std::fs::read(dir.join(format!("lod_{n}.glb"))).unwrap(), 1);
+    }
+    assert!(!dir.join("lod_{np}.glb").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// A one-triangle OBJ using material `mat` of `mtl` (written when `Some`), with or without
 /// `vt`. Returns the OBJ path.
 fn triangle_obj(dir: &Path, mtl: Option<&str>, mat: &str, with_vt: bool) -> PathBuf {

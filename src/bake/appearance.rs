@@ -1252,6 +1252,19 @@ pub fn linear_to_srgb(c: f64) -> f64 {
     }
 }
 
+/// `Err` naming the problem when a `w × h` image is empty or over [`MAX_TEXTURE_TEXELS`].
+fn check_image_size(w: u32, h: u32) -> std::result::Result<(), String> {
+    if w == 0 || h == 0 {
+        return Err("image has zero size".into());
+    }
+    if u64::from(w) * u64::from(h) > MAX_TEXTURE_TEXELS {
+        return Err(format!(
+            "image of {w}×{h} texels exceeds the budget of {MAX_TEXTURE_TEXELS} texels"
+        ));
+    }
+    Ok(())
+}
+
 /// Decodes a PNG or JPEG into `(width, height, linear RGBA texels)`; `srgb` decodes the colour
 /// channels' sRGB transfer (alpha is always linear).
 pub(super) fn decode_image(
@@ -1265,6 +1278,12 @@ pub(super) fn decode_image(
             "image format {format:?} is not supported (PNG or JPEG)"
         ));
     }
+    // The header's size first, so an over-budget or empty image is named as such rather
+    // than by the decoder's allocation limit (which stays as a backstop).
+    let header = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
+    if let Ok((w, h)) = header.into_dimensions() {
+        check_image_size(w, h)?;
+    }
     let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
     let mut limits = image::Limits::default();
     limits.max_alloc = Some(MAX_TEXTURE_TEXELS * 8);
@@ -1273,14 +1292,7 @@ pub(super) fn decode_image(
         .decode()
         .map_err(|e| format!("image cannot be decoded: {e}"))?;
     let (w, h) = (img.width(), img.height());
-    if w == 0 || h == 0 {
-        return Err("image has zero size".into());
-    }
-    if u64::from(w) * u64::from(h) > MAX_TEXTURE_TEXELS {
-        return Err(format!(
-            "image of {w}×{h} texels exceeds the budget of {MAX_TEXTURE_TEXELS} texels"
-        ));
-    }
+    check_image_size(w, h)?;
     let lut = texel_lut(srgb);
     let rgba = img.to_rgba8();
     let texels = rgba

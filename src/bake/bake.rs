@@ -219,6 +219,8 @@ fn evaluate_into(app: &Appearance, level: &mut BakedLevel) {
     let finite = |x: f64| x.is_finite().then_some(x);
     level.report.appearance_psnr_db = finite(e.appearance_psnr_db);
     level.report.appearance_psnr_reference_db = finite(e.reference_psnr_db);
+    level.report.appearance_psnr_pooled_db = finite(e.appearance_pooled_psnr_db);
+    level.report.appearance_psnr_reference_pooled_db = finite(e.reference_pooled_psnr_db);
     level.report.normal_map_gain_db = e.normal_map_gain_db.and_then(finite);
     level.report.evaluate_seconds = t.elapsed().as_secs_f64();
 }
@@ -665,11 +667,7 @@ fn bake_textured(
         .iter()
         .map(|&v| lod.positions()[v as usize])
         .collect();
-    let normals: Vec<[f64; 3]> = atlas
-        .xref
-        .iter()
-        .map(|&v| lod_normals[v as usize])
-        .collect();
+    let normals = atlas_normals(&atlas, &positions, &lod_normals);
 
     steps.check("bake: tangents", 0.1)?;
     let t = Instant::now();
@@ -747,6 +745,11 @@ fn bake_textured(
     };
     report.sample_seconds = t.elapsed().as_secs_f64();
 
+    if is_flat_normal_map(&nrm, &cov) {
+        // The LOD's own normals already are the input's shading normals: the map would only
+        // add its 8-bit rounding (see `is_flat_normal_map`).
+        nrm = Vec::new();
+    }
     steps.check("bake: dilation", 0.9)?;
     let t = Instant::now();
     let chart = triangle_charts(&atlas);
@@ -821,6 +824,72 @@ fn bake_textured(
         material,
         report,
     })
+}
+
+/// Covered texels a normal map may hold away from the neutral normal and still count as flat
+/// ([`is_flat_normal_map`]): one in a thousand.
+const FLAT_MAP_OUTLIERS: f64 = 1e-3;
+
+/// True when a baked tangent-space normal map (`nrm`, RGBA8, empty when not baked) holds the
+/// neutral normal `(0, 0, 1)` up to 8-bit rounding (x, y bytes 127 or 128, z byte ≥ 254) at
+/// all but [`FLAT_MAP_OUTLIERS`] of its covered texels: the LOD's interpolated normals already
+/// are the input's shading normals (a LOD lying on a flat input), so the map could only add
+/// its rounding (byte 128 decodes to 0.0039, not 0) and is not written. Measured on the Khronos
+/// texture-coordinate test's fitted LOD: of 584 000 covered texels all but about a hundred are
+/// neutral (the rest tilt by up to 7°, at sliver triangles); shaded PSNR 100 dB (the cap: no
+/// pixel differs from the input's render) without the map, 63.6 dB with it.
+fn is_flat_normal_map(nrm: &[u8], cov: &Coverage) -> bool {
+    if nrm.is_empty() {
+        return false;
+    }
+    let (mut covered, mut tilted) = (0u64, 0u64);
+    for (_, px) in cov
+        .tri
+        .iter()
+        .zip(nrm.chunks_exact(4))
+        .filter(|(&t, _)| t != u32::MAX)
+    {
+        covered += 1;
+        let neutral = (127..=128).contains(&px[0]) && (127..=128).contains(&px[1]) && px[2] >= 254;
+        tilted += u64::from(!neutral);
+    }
+    covered > 0 && tilted as f64 <= FLAT_MAP_OUTLIERS * covered as f64
+}
+
+/// Unit normal of every atlas vertex: the LOD's smooth vertex normal, except where it points
+/// away from the vertex's own chart (`n_v · c_a ≤ 0`, `c_a` the area-weighted normal of the
+/// atlas triangles at atlas vertex `a`, which all lie in one chart), where `c_a` is used.
+///
+/// That happens on folds: a LOD whose two sides touch (the input-plane fit projects both sides
+/// of a sheet thinner than `2d` onto the sheet's plane, e.g. the Khronos texture-coordinate
+/// test's quads) shares vertices between faces of opposite orientation, so the smooth normal
+/// is that of whichever side has more area and the other side's interpolated normal turns
+/// through zero, wrecking its tangent frame and normal map. A chart is flattened without
+/// folding, so its faces around a vertex face one way and the chart normal is the side's own.
+/// Elsewhere the smooth normal is kept. Measured on the shared assets' n_p = 200 LODs: 0–5
+/// atlas vertices switch on the closed ones, 747 of 2806 on the open teapot, 57 of 119 on the
+/// texture-coordinate test (whose shaded PSNR without a map rose from 17.8 to 100 dB).
+fn atlas_normals(atlas: &Atlas, positions: &[[f64; 3]], lod_normals: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    let mut chart = vec![Vec3::ZERO; atlas.xref.len()];
+    for tri in &atlas.triangles {
+        let [a, b, c] = tri.map(|v| Vec3::from(positions[v as usize]));
+        let n = (b - a).cross(c - a);
+        for &v in tri {
+            chart[v as usize] += n;
+        }
+    }
+    atlas
+        .xref
+        .iter()
+        .zip(chart)
+        .map(|(&v, c)| {
+            let smooth = lod_normals[v as usize];
+            match normalized(c) {
+                Some(c) if Vec3::from(smooth).dot(c) <= 0.0 => c.to_array(),
+                _ => smooth,
+            }
+        })
+        .collect()
 }
 
 /// The rows of an optional image (empty image: `n` empty rows).
@@ -1371,5 +1440,67 @@ mod vertex_color_tests {
             new < 0.8 * old,
             "least squares {new} vs vertex sampling {old}"
         );
+    }
+
+    /// A fold: two coincident triangles of opposite orientation sharing their LOD vertices
+    /// (a sheet whose two sides the fit projected onto one plane), each its own chart. The
+    /// smooth vertex normal is zero there; each atlas vertex gets its own side's normal.
+    #[test]
+    fn folded_sides_get_their_own_normals() {
+        let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let lod = TriMesh::new(p.to_vec(), vec![[0, 1, 2], [0, 2, 1]]).unwrap();
+        let atlas = Atlas {
+            size: 16,
+            xref: vec![0, 1, 2, 0, 2, 1],
+            uv: vec![
+                [1.0, 1.0],
+                [7.0, 1.0],
+                [1.0, 7.0],
+                [9.0, 9.0],
+                [15.0, 9.0],
+                [9.0, 15.0],
+            ],
+            triangles: vec![[0, 1, 2], [3, 4, 5]],
+            chart_count: 2,
+            overlapping_texels: 0,
+            padding: 1,
+        };
+        let positions: Vec<[f64; 3]> = atlas.xref.iter().map(|&v| p[v as usize]).collect();
+        let smooth = vertex_normals(&lod);
+        let n = atlas_normals(&atlas, &positions, &smooth);
+        for (a, want) in [
+            (0, 1.0),
+            (1, 1.0),
+            (2, 1.0),
+            (3, -1.0),
+            (4, -1.0),
+            (5, -1.0),
+        ] {
+            assert_eq!(n[a], [0.0, 0.0, want], "atlas vertex {a}");
+        }
+        // Where the smooth normal agrees with the chart, it is kept as is.
+        let tilted = vec![[0.6, 0.0, 0.8]; 3];
+        let one = Atlas {
+            xref: vec![0, 1, 2],
+            triangles: vec![[0, 1, 2]],
+            ..atlas
+        };
+        assert_eq!(atlas_normals(&one, &p, &tilted), tilted);
+    }
+
+    #[test]
+    fn a_neutral_normal_map_is_flat() {
+        let cov = Coverage {
+            size: 2,
+            tri: vec![0, 0, 0, u32::MAX],
+            bary: vec![[1.0, 0.0, 0.0]; 4],
+        };
+        let neutral = [128, 127, 255, 255, 127, 128, 255, 255, 128, 128, 254, 255];
+        let mut img = neutral.to_vec();
+        img.extend([255, 0, 0, 255]); // an uncovered texel does not count
+        assert!(is_flat_normal_map(&img, &cov));
+        img[0] = 140; // one of three covered texels tilted
+        assert!(!is_flat_normal_map(&img, &cov));
+        assert!(!is_flat_normal_map(&[], &cov));
     }
 }

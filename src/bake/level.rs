@@ -58,6 +58,13 @@ pub struct BakeReport {
     /// input at the closest input point (a perfect bake's score; the bake loses
     /// `appearance_psnr_reference_db − appearance_psnr_db`).
     pub appearance_psnr_reference_db: Option<f64>,
+    /// With [`BakeParams::evaluate`]: the unlit PSNR pooled over all views (one mean squared
+    /// error over every pixel both renders cover), which a view sharing only a few pixels (a
+    /// flat asset seen edge-on) cannot dominate as it can the mean over views.
+    pub appearance_psnr_pooled_db: Option<f64>,
+    /// With [`BakeParams::evaluate`]: the closest-point reference's pooled PSNR (the bake
+    /// loses `appearance_psnr_reference_pooled_db − appearance_psnr_pooled_db` over all pixels).
+    pub appearance_psnr_reference_pooled_db: Option<f64>,
     /// With [`BakeParams::evaluate`] and a baked normal map: shaded PSNR with the normal map
     /// minus shaded PSNR without it, dB (> 0: the map brings the level closer to the input).
     pub normal_map_gain_db: Option<f64>,

@@ -484,6 +484,13 @@ impl Surface for ReferenceSurface<'_> {
 /// PSNR in dB of `b` against `a` over the pixels both cover (peak 1, mean squared error over
 /// R, G, B); `None` when they share no pixel; capped at 100 dB for identical images.
 pub fn psnr_db(a: &Frame, b: &Frame) -> Option<f64> {
+    let (sum, count) = squared_error(a, b);
+    psnr_of(sum, count)
+}
+
+/// Sum of squared differences over R, G, B of the pixels both frames cover, and the number of
+/// values summed (3 per pixel).
+pub fn squared_error(a: &Frame, b: &Frame) -> (f64, usize) {
     let (mut sum, mut count) = (0.0, 0usize);
     for (x, y) in a.rgb.iter().zip(&b.rgb) {
         if let (Some(x), Some(y)) = (x, y) {
@@ -491,6 +498,12 @@ pub fn psnr_db(a: &Frame, b: &Frame) -> Option<f64> {
             count += 3;
         }
     }
+    (sum, count)
+}
+
+/// PSNR (peak 1, capped at 100 dB) of `sum` squared errors over `count` values; `None` for no
+/// values.
+fn psnr_of(sum: f64, count: usize) -> Option<f64> {
     if count == 0 {
         return None;
     }
@@ -558,6 +571,12 @@ pub struct Evaluation {
     pub normal_map_gain_db: Option<f64>,
     /// Mean silhouette agreement ([`coverage_iou`]).
     pub coverage_iou: f64,
+    /// Unlit PSNR of the baked level over the pixels both renders cover in all views pooled
+    /// (one mean squared error over every such pixel), dB: unlike the mean over views, a view
+    /// that shares only a few pixels (a flat asset seen edge-on) weighs only those pixels.
+    pub appearance_pooled_psnr_db: f64,
+    /// The same pooled PSNR for the closest-point reference, dB (NaN when not asked).
+    pub reference_pooled_psnr_db: f64,
 }
 
 /// Renders `app` and its baked level `level` from [`EvalParams::views`] views (see the [module
@@ -576,7 +595,7 @@ pub fn evaluate(app: &Appearance, level: &BakedLevel, params: &EvalParams) -> Ev
         normal_map: false,
     };
     let has_map = level.material.normal.is_some() && level.tangents.is_some();
-    let per_view: Vec<[Option<f64>; 5]> = cams
+    let per_view: Vec<([Option<f64>; 5], [(f64, usize); 2])> = cams
         .par_iter()
         .map(|v| {
             let gi = rasterize(v, input.positions(), input.triangles());
@@ -590,20 +609,28 @@ pub fn evaluate(app: &Appearance, level: &BakedLevel, params: &EvalParams) -> Ev
             } else {
                 psnr_db(&in_shaded, &lod_shaded)
             };
-            let refr = reference
-                .as_ref()
-                .and_then(|r| psnr_db(&in_unlit, &shade(&gl, v, r, Mode::Unlit)));
-            [
-                psnr_db(&in_unlit, &lod_unlit),
-                refr,
+            let ref_err = reference.as_ref().map_or((0.0, 0), |r| {
+                squared_error(&in_unlit, &shade(&gl, v, r, Mode::Unlit))
+            });
+            let lod_err = squared_error(&in_unlit, &lod_unlit);
+            let per_view = [
+                psnr_of(lod_err.0, lod_err.1),
+                psnr_of(ref_err.0, ref_err.1),
                 psnr_db(&in_shaded, &lod_shaded),
                 plain,
                 Some(coverage_iou(&in_unlit, &lod_unlit)),
-            ]
+            ];
+            (per_view, [lod_err, ref_err])
         })
         .collect();
+    let pooled = |k: usize| {
+        let (sum, count) = per_view
+            .iter()
+            .fold((0.0, 0), |(s, c), (_, e)| (s + e[k].0, c + e[k].1));
+        psnr_of(sum, count).unwrap_or(f64::NAN)
+    };
     let mean = |k: usize| {
-        let v: Vec<f64> = per_view.iter().filter_map(|r| r[k]).collect();
+        let v: Vec<f64> = per_view.iter().filter_map(|r| r.0[k]).collect();
         if v.is_empty() {
             f64::NAN
         } else {
@@ -620,6 +647,8 @@ pub fn evaluate(app: &Appearance, level: &BakedLevel, params: &EvalParams) -> Ev
         shaded_psnr_without_map_db: plain,
         normal_map_gain_db: has_map.then_some(shaded - plain),
         coverage_iou: mean(4),
+        appearance_pooled_psnr_db: pooled(0),
+        reference_pooled_psnr_db: pooled(1),
     }
 }
 

@@ -231,6 +231,14 @@ pub struct PleatBakeStats {
     pub appearance_error_p95: f64,
     /// Maximum of the same error.
     pub appearance_error_max: f64,
+    /// Gutter between charts in texels as used: the requested padding, or less when the
+    /// charts could not be packed with it (then seams hold to a shallower mip); 0 for vertex
+    /// colours. Appended 2026-11-27 (older, shorter structs are still accepted).
+    pub atlas_padding: u32,
+    /// The deepest mip level (up to the texel rule's, 2 by default) whose bilinear reads stay
+    /// inside each chart's own texels by construction; −1 for vertex colours or when even
+    /// mip 0 mixes charts. Appended 2026-11-27.
+    pub seam_clean_mip: i32,
 }
 
 /// A baked LOD (opaque): the mesh with atlas UVs, normals, tangents and the baked images, or
@@ -808,6 +816,10 @@ pub(super) mod imp {
             appearance_error_mean: r.appearance_error_mean,
             appearance_error_p95: r.appearance_error_p95,
             appearance_error_max: r.appearance_error_max,
+            atlas_padding: r.atlas_padding,
+            seam_clean_mip: r
+                .seam_clean_mip
+                .map_or(-1, |m| i32::try_from(m).unwrap_or(i32::MAX)),
         }
     }
 

@@ -1074,7 +1074,8 @@ _BakeStats = _struct("PleatBakeStats", _u32s("struct_size", "flags", "texture_si
                      + _f64s("seconds_total", "seconds_atlas", "seconds_tangents",
                              "seconds_rasterise", "seconds_sample", "seconds_dilate",
                              "seconds_measure", "fallback_fraction", "appearance_error_mean",
-                             "appearance_error_p95", "appearance_error_max"))
+                             "appearance_error_p95", "appearance_error_max")
+                     + _u32s("atlas_padding") + [("seam_clean_mip", _c.c_int32)])
 _B = _c.POINTER(_c.c_uint8)
 for _name, _res, _args in [
     ("pleat_provenance_params_default", _ProvParams, ()),
@@ -1190,7 +1191,8 @@ def _image(img, srgb, keep):
 class Bake(_Handle):
     """A LOD with the input's appearance baked on (``bake``): mesh arrays with the atlas UVs
     (the atlas splits vertices at chart seams), MikkTSpace tangents and RGBA8 images, or vertex
-    colours when the input had no image. ``stats`` is PleatBakeStats as a dict. Immutable."""
+    colours when the input had no image. ``stats`` is PleatBakeStats as a dict (``atlas_padding``
+    in texels, ``seam_clean_mip`` the deepest clean mip or None). Immutable."""
 
     _destroy = "pleat_bake_free"
 
@@ -1378,7 +1380,10 @@ def bake(lod, input, uvs=None, base_color=None, *, uv_layout="vertex", normals=N
                                        None, _c.byref(out), _c.byref(stats))
     relay.finish(st)
     del keep
-    return Bake(out, _as_dict(stats))
+    d = _as_dict(stats)
+    if d["seam_clean_mip"] < 0:
+        d["seam_clean_mip"] = None  # vertex colours, or even mip 0 mixes charts
+    return Bake(out, d)
 
 
 # --- tension-field wrinkles (capability "tfw") ----------------------------------------------

@@ -10,14 +10,18 @@ use pleat::bake::{
     VertexColors,
 };
 
-use super::{failure_code, progress_bar, show_progress, BakeArgs, EXIT_FAILED, EXIT_INPUT};
+use super::{
+    failure_code, output_path, progress_bar, show_progress, BakeArgs, EXIT_FAILED, EXIT_INPUT,
+    SIZE_PLACEHOLDERS,
+};
 
 /// Options of the textured bake (flattened into `lod`'s options).
 #[derive(clap::Args)]
 pub struct TextureArgs {
     /// Bake the input's materials (glTF: base colour, metallic-roughness, occlusion, emissive,
     /// normal map; OBJ + MTL: Kd, map_Kd; vertex colours when untextured) onto every level and
-    /// write ONE .glb holding the chain (MSFT_lod); the output needs no {np} placeholder.
+    /// write ONE .glb holding the chain (MSFT_lod); with an {np} placeholder in the output, one
+    /// .glb per level instead.
     #[arg(long)]
     pub bake: bool,
     /// Side of the baked square textures in texels [default: 2 texels per screen pixel at the
@@ -103,20 +107,37 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
     };
     let levels = &chain.levels;
     let refs: Vec<&BakedLevel> = levels.iter().map(|l| &l.baked).collect();
-    let written = chain_glb_with_progress(&refs, &mut prog);
+    // `-o OUT.glb`: one file holding the chain; `-o 'OUT_{np}.glb'`: one file per level.
+    let per_level = SIZE_PLACEHOLDERS
+        .iter()
+        .any(|p| output.to_string_lossy().contains(p));
+    let files: Vec<(std::path::PathBuf, Vec<&BakedLevel>)> = if per_level {
+        refs.iter()
+            .map(|&l| (output_path(output, l.screen_size), vec![l]))
+            .collect()
+    } else {
+        vec![(output.to_path_buf(), refs)]
+    };
+    let mut png_seconds = 0.0;
+    for (path, file_levels) in &files {
+        let (bytes, png) = match chain_glb_with_progress(file_levels, &mut prog) {
+            Ok(b) => b,
+            Err(e) => {
+                if let Some(b) = &bar {
+                    b.finish_and_clear();
+                }
+                eprintln!("pleat {cmd}: {e}");
+                return ExitCode::from(failure_code(&e));
+            }
+        };
+        png_seconds += png;
+        if let Err(e) = std::fs::write(path, bytes) {
+            eprintln!("pleat {cmd}: cannot write '{}': {e}", path.display());
+            return ExitCode::from(EXIT_FAILED);
+        }
+    }
     if let Some(b) = &bar {
         b.finish_and_clear();
-    }
-    let (bytes, png_seconds) = match written {
-        Ok(b) => b,
-        Err(e) => {
-            eprintln!("pleat {cmd}: {e}");
-            return ExitCode::from(failure_code(&e));
-        }
-    };
-    if let Err(e) = std::fs::write(output, bytes) {
-        eprintln!("pleat {cmd}: cannot write '{}': {e}", output.display());
-        return ExitCode::from(EXIT_FAILED);
     }
     if !args.quiet {
         for l in levels {
@@ -167,11 +188,12 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
                 );
             }
         }
+        let names: Vec<String> = files.iter().map(|(p, _)| p.display().to_string()).collect();
         println!(
             "geometry {:.2} s, bake {:.2} s, png {png_seconds:.2} s; wrote {}",
             chain.geometry_seconds,
             chain.bake_seconds,
-            output.display()
+            names.join(", ")
         );
     }
     ExitCode::SUCCESS
