@@ -29,7 +29,9 @@
 //!
 //! [`FIT_SWEEPS`] sweeps of {placement, flips}, then one last placement. Every operation passes
 //! the guard, so the mesh stays watertight, manifold, self-intersection-free and of the same
-//! topology. The pipeline skips the fit for cages (a cage must stay outside the input) and
+//! topology, and the coverage check (`coverage.rs`): no line-search trial or flip may leave an
+//! input sample farther from the LOD than `max(`[`COVERAGE_FLOOR`]`·d, its distance before the
+//! fit)`, so the fit cannot pull the surface off a rim or a thin part of the input. The pipeline skips the fit for cages (a cage must stay outside the input) and
 //! reverts it when the measured Hausdorff distance grew (`pipeline.rs`).
 //!
 //! Deterministic for any thread count: closest points and flip decisions are computed in
