@@ -417,6 +417,47 @@ fn output_does_not_depend_on_thread_count() {
     }
 }
 
+/// Issue 12 part 1: on an open input (a tray: a box without its top, walls of zero thickness)
+/// the fit's placements and flips could pull the LOD off the input's rims (the corpus' teapot
+/// and beetle were reverted for that). Every fit operation now keeps each input sample within
+/// `max(d, its distance before the fit)` of the LOD (`lowpoly/coverage.rs`), so the fit is kept
+/// and its input-to-output side stays within the loop's (or d).
+#[test]
+fn input_plane_fit_keeps_an_open_tray_covered() {
+    let b = shapes::box_grid(1.0, 0.6, 0.3, 12);
+    let top = 0.3 - 1e-9;
+    let tris: Vec<[u32; 3]> = b
+        .triangles()
+        .iter()
+        .copied()
+        .filter(|t| !t.iter().all(|&v| b.positions()[v as usize][2] >= top))
+        .collect();
+    let m = TriMesh::new(b.positions().to_vec(), tris).unwrap();
+    let np = 40.0;
+    let (fit, sf) = bake(&m, &params(np), false).unwrap();
+    let without = LodParams {
+        fit_to_input: false,
+        ..params(np)
+    };
+    let (raw, sr) = bake(&m, &without, false).unwrap();
+    assert_valid(&fit, &sf, "tray, fitted");
+    assert_valid(&raw, &sr, "tray, not fitted");
+    eprintln!(
+        "tray n_p = 40: in->out {:.5} -> {:.5} l, out->in {:.5} -> {:.5} l, moves {}, flips {}, \
+         refused {}",
+        sr.hausdorff_in_to_out_rel,
+        sf.hausdorff_in_to_out_rel,
+        sr.hausdorff_out_to_in_rel,
+        sf.hausdorff_out_to_in_rel,
+        sf.fit_moves,
+        sf.fit_flips,
+        sf.fit_uncovering_refused
+    );
+    assert!(sf.fit_moves > 0 && !sf.fit_reverted, "{sf:?}");
+    let allowed = sr.hausdorff_in_to_out_rel.max(1.0 / np) + pleat::lowpoly::FIT_HAUSDORFF_SLACK;
+    assert!(sf.hausdorff_in_to_out_rel <= allowed, "{sf:?}");
+}
+
 /// The public corpus (`../shared/meshes` or `$PLEAT_MESHES`), inputs of at most 200k
 /// triangles, sorted by name.
 fn corpus_meshes() -> Vec<std::path::PathBuf> {

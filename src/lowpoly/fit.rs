@@ -29,7 +29,9 @@
 //!
 //! [`FIT_SWEEPS`] sweeps of {placement, flips}, then one last placement. Every operation passes
 //! the guard, so the mesh stays watertight, manifold, self-intersection-free and of the same
-//! topology. The pipeline skips the fit for cages (a cage must stay outside the input) and
+//! topology, and the coverage check (`coverage.rs`): no line-search trial or flip may leave an
+//! input sample farther from the LOD than `max(`[`COVERAGE_FLOOR`]`·d, its distance before the
+//! fit)`, so the fit cannot pull the surface off a rim or a thin part of the input. The pipeline skips the fit for cages (a cage must stay outside the input) and
 //! reverts it when the measured Hausdorff distance grew (`pipeline.rs`).
 //!
 //! Deterministic for any thread count: closest points and flip decisions are computed in
@@ -39,7 +41,8 @@
 use rayon::prelude::*;
 
 use super::align::capped_step;
-use super::flow::{local_update, record, MoveReport};
+use super::coverage::Coverage;
+use super::flow::{local_update_if, record, MoveReport};
 use super::guard::{Guard, InputModel};
 use crate::geom::{normalized, tri_normal, Vec3};
 use crate::mesh::halfedge::{EdgeId, FaceId, VertexId};
@@ -59,6 +62,10 @@ pub const MAX_STEP: f64 = 3.0;
 /// the planes of a thin spike or a sheet's rim meet far beyond the input, the QEM optimum
 /// extrapolates, and the Hausdorff distance would grow there.
 pub const DRIFT_CAP: f64 = 1.0;
+
+/// The coverage floor, in `d`: no fit operation leaves an input sample farther from the LOD
+/// than `max(COVERAGE_FLOOR · d, its distance before the fit)` (`coverage.rs`).
+pub const COVERAGE_FLOOR: f64 = 1.0;
 
 /// Tikhonov weight `μ / tr A` of the placement (keeps unconstrained directions in place).
 pub const REGULARIZATION: f64 = 1e-2;
@@ -108,6 +115,9 @@ pub(crate) struct FitReport {
     pub flips: u64,
     /// Total length of the applied moves (model units).
     pub motion: f64,
+    /// Moves (line-search trials) and flips refused because they would uncover input
+    /// (`coverage.rs`).
+    pub uncovering_refused: u64,
 }
 
 /// The input's triangles as unit normals and a point on their plane (`None` when degenerate).
@@ -159,6 +169,7 @@ pub(crate) fn fit_to_input(
     keep_going: &mut dyn FnMut(f64) -> bool,
 ) -> Result<FitReport> {
     let planes = InputPlanes::new(g.input(), SAMPLE_RADIUS * d, DRIFT_CAP * d);
+    let mut cov = Coverage::new(g.input(), g.mesh(), d, COVERAGE_FLOOR * d);
     let mut rep = FitReport::default();
     let steps = 2 * FIT_SWEEPS + 1;
     for step in 0..steps {
@@ -166,13 +177,14 @@ pub(crate) fn fit_to_input(
             return Err(Error::Cancelled);
         }
         if step % 2 == 0 {
-            let mr = place_vertices(g, &planes, MAX_STEP * d);
+            let mr = place_vertices(g, &planes, &mut cov, MAX_STEP * d);
             rep.moves += mr.moved;
             rep.motion += mr.total_motion;
         } else {
-            rep.flips += flip_sweep(g, &planes);
+            rep.flips += flip_sweep(g, &planes, &mut cov);
         }
     }
+    rep.uncovering_refused = cov.refused;
     Ok(rep)
 }
 
@@ -211,7 +223,12 @@ impl Quadric {
 
 /// One placement sweep: quadrics from the current mesh, then every vertex in id order toward
 /// its minimiser (step capped at `max_step`) through the guarded line search.
-fn place_vertices(g: &mut Guard<'_>, planes: &InputPlanes<'_>, max_step: f64) -> MoveReport {
+fn place_vertices(
+    g: &mut Guard<'_>,
+    planes: &InputPlanes<'_>,
+    cov: &mut Coverage,
+    max_step: f64,
+) -> MoveReport {
     let m = g.mesh();
     let faces: Vec<FaceId> = m.faces().collect();
     let hits: Vec<[Option<(Vec3, Vec3)>; 10]> = faces
@@ -255,7 +272,11 @@ fn place_vertices(g: &mut Guard<'_>, planes: &InputPlanes<'_>, max_step: f64) ->
         } else {
             None
         };
-        let moved = capped.map_or(0.0, |step| local_update(g, v, step));
+        let moved = capped.map_or(0.0, |step| {
+            let relying = cov.relying_on_ring(g.mesh(), v);
+            let mut keeps = |g: &Guard<'_>, v, q| cov.keeps_move(&relying, g.mesh(), v, q);
+            local_update_if(g, v, step, &mut keeps)
+        });
         record(&mut rep, moved);
     }
     rep
@@ -287,7 +308,7 @@ struct FlipPlan {
 
 /// One flip sweep: decisions on the unchanged mesh in parallel, then the flips in edge order
 /// through the guard (skipping edges whose quad an earlier flip changed). Returns the flips.
-fn flip_sweep(g: &mut Guard<'_>, planes: &InputPlanes<'_>) -> u64 {
+fn flip_sweep(g: &mut Guard<'_>, planes: &InputPlanes<'_>, cov: &mut Coverage) -> u64 {
     let shared: &Guard<'_> = g;
     let edges: Vec<EdgeId> = shared.mesh().edges().collect();
     let plans: Vec<FlipPlan> = edges
@@ -298,6 +319,11 @@ fn flip_sweep(g: &mut Guard<'_>, planes: &InputPlanes<'_>) -> u64 {
     for plan in plans {
         let m = g.mesh();
         if quad_of(g, plan.edge) != Some(plan.quad) {
+            continue;
+        }
+        let [a, b, c, d] = plan.quad.map(|v| Vec3::from(m.position(v)));
+        let relying = cov.relying_on(&[[a, b, c], [b, a, d]]);
+        if !cov.keeps(&relying, &[[c, d, b], [d, c, a]]) {
             continue;
         }
         let h = m.edge_halfedge(plan.edge);

@@ -38,11 +38,22 @@ pub(crate) struct MoveReport {
 /// Alg. 4: tries `v + 0.95 α d` for `α = 1, 1/2, …` and applies the first the guard accepts.
 /// Returns the applied displacement length (0 when none was accepted).
 pub(crate) fn local_update(g: &mut Guard<'_>, v: VertexId, d: Vec3) -> f64 {
+    local_update_if(g, v, d, &mut |_, _, _| true)
+}
+
+/// [`local_update`] with an extra acceptance test: a trial position `q` of `v` is offered to
+/// the guard only when `accept(guard, v, q)` holds (the input-plane fit's coverage check).
+pub(crate) fn local_update_if(
+    g: &mut Guard<'_>,
+    v: VertexId,
+    d: Vec3,
+    accept: &mut dyn FnMut(&Guard<'_>, VertexId, Vec3) -> bool,
+) -> f64 {
     let p = Vec3::from(g.mesh().position(v));
     let mut alpha = 1.0;
     for _ in 0..=MAX_HALVINGS {
         let step = d * (SAFETY_FACTOR * alpha);
-        if g.try_move(v, (p + step).to_array()).is_ok() {
+        if accept(g, v, p + step) && g.try_move(v, (p + step).to_array()).is_ok() {
             return step.length();
         }
         alpha *= 0.5;

@@ -19,6 +19,7 @@
 //! `crate::report`, `crate::error`.
 
 mod align;
+mod coverage;
 pub(crate) mod distance;
 mod extract;
 pub(crate) mod features;

@@ -684,6 +684,7 @@ impl LoopStats {
         s.fit_moves = self.fit.moves;
         s.fit_flips = self.fit.flips;
         s.fit_motion = self.fit.motion;
+        s.fit_uncovering_refused = self.fit.uncovering_refused;
         s.fit_reverted = self.fit_reverted;
         s.fit_sides_rel = self.fit_sides;
     }

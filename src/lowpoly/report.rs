@@ -191,6 +191,9 @@ pub struct LodReport {
     pub fit_flips: u64,
     /// Total vertex motion of the fit (model units).
     pub fit_motion: f64,
+    /// Fit operations (line-search trials and flips) refused because they would have left an
+    /// input sample farther from the LOD than its budget (`lowpoly/coverage.rs`).
+    pub fit_uncovering_refused: u64,
     /// The fit was reverted because the Hausdorff distance grew (the output is the loop's).
     pub fit_reverted: bool,
     /// The fitted LOD's one-sided Hausdorff distances over `l`, `[in→out, out→in]`, whether
@@ -273,6 +276,7 @@ impl LodReport {
         e.count_entry("fit_moves", self.fit_moves);
         e.count_entry("fit_flips", self.fit_flips);
         e.metric_entry("fit_motion", self.fit_motion);
+        e.count_entry("fit_uncovering_refused", self.fit_uncovering_refused);
         e.count_entry("fit_reverted", self.fit_reverted as u64);
         if let Some([i, o]) = self.fit_sides_rel {
             e.metric_entry("fit_in_to_out_rel", i);

@@ -164,6 +164,37 @@ fn one_sided_with(
     Some(m)
 }
 
+/// The samples of the triangle soup `(pos, tris)` in this module's sampling (module docs) at
+/// `spacing`: its referenced vertices in id order, then the interior grid of every nonzero-area
+/// triangle in triangle order (at most `max_k` subdivisions per edge). Deterministic.
+pub(crate) fn surface_samples(
+    pos: &[[f64; 3]],
+    tris: &[[u32; 3]],
+    spacing: f64,
+    max_k: usize,
+) -> Vec<Vec3> {
+    let mut used = vec![false; pos.len()];
+    for t in tris {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let mut out: Vec<Vec3> = (0..pos.len())
+        .filter(|&v| used[v])
+        .map(|v| Vec3::from(pos[v]))
+        .collect();
+    for t in tris {
+        let corners = t.map(|v| pos[v as usize]);
+        if is_collinear(corners[0], corners[1], corners[2]) {
+            continue;
+        }
+        let tri = corners.map(Vec3::from);
+        let k = resolution(&tri, spacing, max_k);
+        for_each_interior_sample(&tri, k, |p| out.push(p));
+    }
+    out
+}
+
 /// Max distance to `to` over the interior samples of face `t` of `from_pos`.
 fn face_max(t: &[u32; 3], from_pos: &[[f64; 3]], to: &Surface<'_>, spacing: f64) -> f64 {
     let corners = t.map(|v| from_pos[v as usize]);

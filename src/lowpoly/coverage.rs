@@ -1,0 +1,178 @@
+//! The input-plane fit's coverage check (issue 12 part 1): no fit operation may uncover input.
+//!
+//! The fit (`fit.rs`) pulls the LOD onto the input's planes, which lowers the output→input
+//! distance; on open or thin inputs (a sheet's rim, a beetle's leg) the QEM placement or a flip
+//! can also pull the surface *off* part of the input, and the input→output side of the
+//! Hausdorff distance grows (measured on the corpus: 0.0117 → 0.0317 l on the beetle at
+//! n_p = 200). This module keeps it:
+//!
+//! - The input is sampled as the Hausdorff measurement samples it (`verify::hausdorff`, its
+//!   referenced vertices plus a barycentric grid at [`SPACING`]` · d`).
+//! - Each sample `s` gets a **budget** `b_s = max(dist(s, LOD before the fit), floor)` with
+//!   `floor = d`: input already farther than `d` from the loop's LOD (hidden input, rims
+//!   the offset rounded) may not get farther, input within `d` may end up to `d` away.
+//! - Invariant: every sample is within its budget of the LOD. A vertex move or a flip replaces
+//!   a patch of faces (the one-ring, the flip's two faces); a sample within its budget of the
+//!   *old* patch may rely on it, so it must be within its budget of the *new* patch, or the
+//!   operation is refused. Samples farther than their budget from the old patch are covered by
+//!   faces the operation does not touch. This is conservative (a sample covered both by the
+//!   patch and by another face is still required to stay covered by the patch).
+//!
+//! Then, over the samples, `in→out(fitted) ≤ max(in→out(loop), d)`. Candidate samples come from
+//! a box tree over the samples' budget boxes `s ± b_s`, queried with the old patch's box.
+//! Deterministic: the check is a pure predicate of the mesh and the candidate positions.
+
+use rayon::prelude::*;
+
+use crate::geom::Vec3;
+use crate::mesh::halfedge::{HalfEdgeMesh, VertexId};
+use crate::spatial::closest::point_triangle_distance;
+use crate::spatial::{BoxTree, TriangleBvh};
+use crate::verify::hausdorff::surface_samples;
+
+use super::guard::InputModel;
+
+/// Spacing of the input samples, in `d` (the Hausdorff measurement's is `l / 400`, `d / 2` at
+/// n_p = 200).
+pub const SPACING: f64 = 0.5;
+
+/// Cap on the per-edge subdivisions of one input triangle's samples.
+const MAX_SUBDIVISIONS: usize = 32;
+
+/// The input samples, their budgets and the box tree over `s ± b_s` (module docs).
+pub(crate) struct Coverage {
+    points: Vec<Vec3>,
+    budget: Vec<f64>,
+    tree: BoxTree,
+    /// Operations refused because they would uncover a sample.
+    pub refused: u64,
+}
+
+impl Coverage {
+    /// Samples `input` at [`SPACING`]` · d` and sets each sample's budget from its distance to
+    /// `lod` (the LOD before the fit), at least `floor`.
+    pub fn new(input: &InputModel, lod: &HalfEdgeMesh, d: f64, floor: f64) -> Coverage {
+        let points = surface_samples(&input.positions, &input.tris, SPACING * d, MAX_SUBDIVISIONS);
+        let tm = lod.to_trimesh();
+        let bvh = TriangleBvh::new(tm.positions(), tm.triangles());
+        let budget: Vec<f64> = points
+            .par_iter()
+            .map(|p| {
+                bvh.closest_point(tm.positions(), tm.triangles(), p.to_array(), f64::INFINITY)
+                    .map_or(f64::INFINITY, |c| c.distance)
+                    .max(floor)
+            })
+            .collect();
+        let tree = BoxTree::new(points.iter().zip(&budget).map(|(&p, &b)| {
+            let r = Vec3::new(b, b, b);
+            (p - r, p + r)
+        }));
+        Coverage {
+            points,
+            budget,
+            tree,
+            refused: 0,
+        }
+    }
+
+    /// The samples that may rely on the faces `old` (within their budget of them): the only
+    /// ones a replacement of `old` must keep covered (module docs).
+    pub fn relying_on(&self, old: &[[Vec3; 3]]) -> Vec<u32> {
+        let Some((lo, hi)) = corners_box(old) else {
+            return Vec::new();
+        };
+        let mut cand = self.tree.overlapping(lo, hi);
+        cand.sort_unstable();
+        cand.into_par_iter()
+            .filter(|&s| within(self.points[s as usize], old, self.budget[s as usize]))
+            .collect()
+    }
+
+    /// Whether the faces `new` keep every sample of `relying` (from [`Coverage::relying_on`])
+    /// within its budget; counts a refusal.
+    pub fn keeps(&mut self, relying: &[u32], new: &[[Vec3; 3]]) -> bool {
+        let ok = relying
+            .par_iter()
+            .all(|&s| within(self.points[s as usize], new, self.budget[s as usize]));
+        if !ok {
+            self.refused += 1;
+        }
+        ok
+    }
+
+    /// [`Coverage::relying_on`] the one-ring of `v`.
+    pub fn relying_on_ring(&self, m: &HalfEdgeMesh, v: VertexId) -> Vec<u32> {
+        let old: Vec<[Vec3; 3]> = m
+            .vertex_faces(v)
+            .map(|f| m.face_positions(f).map(Vec3::from))
+            .collect();
+        self.relying_on(&old)
+    }
+
+    /// [`Coverage::keeps`] for moving `v` of `m` to `q` (its one-ring after the move).
+    pub fn keeps_move(&mut self, relying: &[u32], m: &HalfEdgeMesh, v: VertexId, q: Vec3) -> bool {
+        let new: Vec<[Vec3; 3]> = m
+            .vertex_faces(v)
+            .map(|f| {
+                let vs = m.face_vertices(f);
+                let mut t = m.face_positions(f).map(Vec3::from);
+                for k in 0..3 {
+                    if vs[k] == v {
+                        t[k] = q;
+                    }
+                }
+                t
+            })
+            .collect();
+        self.keeps(relying, &new)
+    }
+}
+
+/// Whether `p` is within `b` of one of `tris`.
+fn within(p: Vec3, tris: &[[Vec3; 3]], b: f64) -> bool {
+    tris.iter().any(|t| point_triangle_distance(p, t) <= b)
+}
+
+/// The bounding box of the corners of `tris` (`None` when empty).
+fn corners_box(tris: &[[Vec3; 3]]) -> Option<(Vec3, Vec3)> {
+    let mut it = tris.iter().flatten();
+    let first = *it.next()?;
+    Some(it.fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: f64, y: f64, z: f64) -> Vec3 {
+        Vec3::new(x, y, z)
+    }
+
+    fn coverage(points: Vec<Vec3>, budget: Vec<f64>) -> Coverage {
+        let tree = BoxTree::new(points.iter().zip(&budget).map(|(&p, &b)| {
+            let r = v(b, b, b);
+            (p - r, p + r)
+        }));
+        Coverage {
+            points,
+            budget,
+            tree,
+            refused: 0,
+        }
+    }
+
+    /// A sample at the origin with budget 1 under a triangle at height 0.5: lifting the
+    /// triangle to 0.9 keeps it, to 1.5 uncovers it; a sample the old patch did not cover
+    /// (farther than its budget) does not constrain the patch.
+    #[test]
+    fn a_patch_may_not_move_off_a_sample_it_covers() {
+        let tri = |z: f64| [v(-1.0, -1.0, z), v(2.0, -1.0, z), v(-1.0, 2.0, z)];
+        let mut c = coverage(vec![v(0.0, 0.0, 0.0)], vec![1.0]);
+        let relying = c.relying_on(&[tri(0.5)]);
+        assert_eq!(relying, vec![0]);
+        assert!(c.keeps(&relying, &[tri(0.9)]));
+        assert!(!c.keeps(&relying, &[tri(1.5)]));
+        assert_eq!(c.refused, 1);
+        assert!(c.relying_on(&[tri(1.2)]).is_empty());
+    }
+}
