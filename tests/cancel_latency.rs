@@ -285,6 +285,34 @@ mod lod {
         });
     }
 
+    /// The setup of a LOD (the guard's input model: the face BVH of 10⁶ tiny components and
+    /// their degeneracy flags) up to its first progress call after the setup, where the run
+    /// stops (the bake itself is measured above on a corpus mesh).
+    #[test]
+    #[ignore = "measurement: seconds per run"]
+    fn lod_setup_cancellation_latency() {
+        let m = super::shapes::tiny_components(100);
+        header();
+        let p = LodParams {
+            screen_size: 16.0,
+            ..LodParams::default()
+        };
+        measure("LOD setup (10⁶ tiny components, n_p 16)", &mut |cb| {
+            let mut past_setup = false;
+            let r = generate(&m, &p, &mut |q: Progress<'_>| {
+                if q.stage != "setup" {
+                    past_setup = true;
+                    return false;
+                }
+                cb(q)
+            });
+            match r {
+                Err(Error::Cancelled) if past_setup => Ok(()),
+                other => other.map(drop),
+            }
+        });
+    }
+
     #[cfg(feature = "cage")]
     #[test]
     #[ignore = "measurement: seconds per run"]

@@ -23,6 +23,57 @@ use faer::{Conj, Mat, MatMut, Par, Side};
 
 use crate::{Error, Result};
 
+/// Factor entries from which a numeric factorization is run by [`run_stoppable`] on a helper
+/// thread (issue 15). Measured 2026-11-27 on the wrinkle design's systems: a factor of 2²¹
+/// entries takes about 0.1 CPU s, so the factorizations left on the calling thread stay far
+/// below the 0.5 s cancellation bound, and small ones pay no thread start.
+pub const STOPPABLE_FACTOR_LEN: usize = 1 << 21;
+
+/// How often [`run_stoppable`] asks its `tick` while the work runs.
+const STOPPABLE_POLL: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// Runs `work` and returns its value, with a cancellation point every 0.1 s while it runs
+/// (issue 15: one sparse Cholesky factorization has no cancellation point inside, 1.1 CPU s on
+/// a 213k-face wrinkle base). When `heavy`, `work` runs on a helper thread, inside a rayon pool
+/// of as many threads as the caller's (so faer's `Par::rayon(0)` there is the caller's
+/// parallelism and the result is bit for bit the one of a call on this thread), while this
+/// thread calls `tick()` every [`STOPPABLE_POLL`]; its first error is returned at once, and the
+/// helper then finishes `work` and drops its value (nothing is returned or kept: the thread
+/// owns everything `work` captured). Otherwise `work` runs right here, without a `tick`.
+/// A panic in `work` is re-raised on this thread.
+pub fn run_stoppable<T: Send + 'static>(
+    heavy: bool,
+    work: impl FnOnce() -> T + Send + 'static,
+    tick: &mut dyn FnMut() -> Result<()>,
+) -> Result<T> {
+    if !heavy {
+        return Ok(work());
+    }
+    let threads = rayon::current_num_threads();
+    let (tx, rx) = std::sync::mpsc::channel::<std::thread::Result<T>>();
+    std::thread::Builder::new()
+        .name("pleat-factor".into())
+        .spawn(move || {
+            let run = || match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+                Ok(pool) => pool.install(work),
+                Err(_) => work(),
+            };
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(run));
+            let _ = tx.send(r); // no receiver after a cancel: the value is dropped here
+        })
+        .map_err(|e| Error::Internal(format!("cannot start a factorization thread: {e}")))?;
+    loop {
+        match rx.recv_timeout(STOPPABLE_POLL) {
+            Ok(Ok(v)) => return Ok(v),
+            Ok(Err(panic)) => std::panic::resume_unwind(panic),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => tick()?,
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(Error::Internal("the factorization thread vanished".into()))
+            }
+        }
+    }
+}
+
 /// Why a numeric factorization failed (faer's error: a non-positive pivot, or out of memory).
 pub use faer::sparse::linalg::LltError;
 
@@ -171,6 +222,19 @@ impl CholeskyAnalysis {
     /// Number of rows (= columns) of the analysed pattern.
     pub fn dim(&self) -> usize {
         self.symbolic.nrows()
+    }
+
+    /// Stored entries of the Cholesky factor `L` of this pattern (the size of every numeric
+    /// factorization: its cost grows with it).
+    pub fn factor_len(&self) -> usize {
+        self.symbolic.len_val()
+    }
+
+    /// True when a numeric factorization of this pattern is long enough to run on a helper
+    /// thread with cancellation polling ([`run_stoppable`]): at least
+    /// [`STOPPABLE_FACTOR_LEN`] factor entries.
+    pub fn is_heavy(&self) -> bool {
+        self.factor_len() >= STOPPABLE_FACTOR_LEN
     }
 
     /// Numeric factorization of `a`, which must have the analysed pattern. Fails when `a` is

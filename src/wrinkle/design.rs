@@ -26,7 +26,9 @@ use super::cwf::Cwf;
 use super::interpolate::checkpoint;
 use super::knoppel::{cotan_weights, cotan_weights_raw, KnoppelOptions, KnoppelReport};
 use super::region::{grow_mask, Adjacency};
-use super::spd::{push_hermitian, push_outer_lower, solve_spd, solve_spd_many};
+use super::spd::{
+    push_hermitian, push_outer_lower, solve_spd, solve_spd_many_with_tick, solve_spd_with_tick,
+};
 use super::topology::Topology;
 use crate::geom::Vec3;
 use crate::mesh::TriMesh;
@@ -378,10 +380,17 @@ fn vector_heat(
         ind[j] = 1.0;
     }
     tick(0.1)?;
-    let (xs, heat_residual) = solve_spd(2 * nv, &tc, &y, "the vector heat system")?;
+    let (xs, heat_residual) =
+        solve_spd_with_tick(2 * nv, &tc, &y, "the vector heat system", &mut || tick(0.2))?;
     tick(0.3)?;
     // both scalar solves on one factorization
-    let mut scalar = solve_spd_many(nv, &tr, &[&y_abs, &ind], "the scalar heat system")?;
+    let mut scalar = solve_spd_many_with_tick(
+        nv,
+        &tr,
+        &[&y_abs, &ind],
+        "the scalar heat system",
+        &mut || tick(0.3),
+    )?;
     let (delta, _) = scalar.pop().expect("two solves");
     let (m, _) = scalar.pop().expect("two solves");
     let v = (0..nv)

@@ -43,8 +43,8 @@ use super::topology::{Topology, NONE};
 use crate::geom::Vec3;
 use crate::report::ProgressFn;
 use crate::solve::{
-    assemble, CholeskyAnalysis, Entry, InverseIterationParams, Parallelism, ShiftSchedule,
-    ShiftedProblem,
+    assemble, run_stoppable, CholeskyAnalysis, Entry, InverseIterationParams, Parallelism,
+    ShiftSchedule, ShiftedProblem,
 };
 use crate::{Error, Result};
 
@@ -793,11 +793,18 @@ fn solve_phase(
         growth: 100.0,
         max_attempts: 5,
     };
-    let llt = an
-        .factor_with_growing_shift(&a, &mass2, schedule, Parallelism::Global)
-        .map_err(|_| {
-            Error::Numerical("the phase pencil (eq. 3.28) is not positive definite".into())
-        })?;
+    // a large factorization runs with `tick` every 0.1 s (issue 15; the same factor)
+    if an.is_heavy() {
+        tick()?;
+    }
+    let (a, mass2) = (std::sync::Arc::new(a), std::sync::Arc::new(mass2));
+    let (a2, m2) = (a.clone(), mass2.clone());
+    let llt = run_stoppable(
+        an.is_heavy(),
+        move || an.factor_with_growing_shift(&a2, &m2, schedule, Parallelism::Global),
+        tick,
+    )?
+    .map_err(|_| Error::Numerical("the phase pencil (eq. 3.28) is not positive definite".into()))?;
     let problem = ShiftedProblem {
         shifted: &llt,
         apply_a: |u: &[f64]| matvec_full(&a, u),
