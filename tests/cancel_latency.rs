@@ -512,13 +512,22 @@ mod wrinkle {
         Some(h.mesh(levels))
     }
 
-    /// Base of the design and edit measurements: 13 334 faces × 4 = 53 336 (Loop 2: 213 344).
+    /// Base of the design and edit measurements: 13 334 faces × 4 = 53 336 (Loop 2: 213 344,
+    /// with `PLEAT_LATENCY_LOOP=2`).
     const LARGE: (&str, usize) = ("clean_cheburashka.obj", 1);
+
+    /// The Loop levels of the design and edit base: `PLEAT_LATENCY_LOOP`, default `LARGE.1`.
+    fn large_levels() -> usize {
+        std::env::var("PLEAT_LATENCY_LOOP")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(LARGE.1)
+    }
 
     #[test]
     #[ignore = "measurement: seconds per run"]
     fn wrinkle_design_cancellation_latency() {
-        let Some(m) = subdivided(LARGE.0, LARGE.1) else {
+        let Some(m) = subdivided(LARGE.0, large_levels()) else {
             return;
         };
         header();
@@ -528,7 +537,7 @@ mod wrinkle {
             &format!(
                 "wrinkle design ({} Loop {}, {} faces, 8 sources of 40 rings)",
                 LARGE.0,
-                LARGE.1,
+                large_levels(),
                 m.triangle_count()
             ),
             &mut |cb| design_with_progress(m.clone(), &sources, &opts, cb).map(drop),
@@ -538,7 +547,7 @@ mod wrinkle {
     #[test]
     #[ignore = "measurement: seconds per run"]
     fn wrinkle_edit_cancellation_latency() {
-        let Some(m) = subdivided(LARGE.0, LARGE.1) else {
+        let Some(m) = subdivided(LARGE.0, large_levels()) else {
             return;
         };
         header();
@@ -551,7 +560,7 @@ mod wrinkle {
             &format!(
                 "wrinkle edit ({} Loop {}, {} faces, 2 regions of 30 rings)",
                 LARGE.0,
-                LARGE.1,
+                large_levels(),
                 m.triangle_count()
             ),
             &mut |cb| edit_with_progress(&cwf, &regions, &opts, cb).map(drop),
@@ -563,7 +572,8 @@ mod wrinkle {
         measure(
             &format!(
                 "wrinkle edit ({} Loop {}, every face: Knöppel)",
-                LARGE.0, LARGE.1
+                LARGE.0,
+                large_levels()
             ),
             &mut |cb| edit_with_progress(&cwf, &global, &opts, cb).map(drop),
         );

@@ -136,6 +136,7 @@ fn unwrap_shared<T: Clone>(a: std::sync::Arc<Vec<T>>) -> Vec<T> {
 
 impl InputModel {
     /// Builds the model; `with_points` adds the vertex index needed by cage mode.
+    #[cfg(test)]
     pub fn new(mesh: &crate::mesh::TriMesh, with_points: bool) -> InputModel {
         Self::new_with_stop(mesh, with_points, &mut || true).expect("never stopped")
     }
@@ -153,9 +154,19 @@ impl InputModel {
         with_points: bool,
         keep_going: &mut dyn FnMut() -> bool,
     ) -> Option<InputModel> {
+        Self::build(mesh, with_points, keep_going, HELPER_THREAD_FACES)
+    }
+
+    /// [`new_with_stop`](Self::new_with_stop) with the helper thread from `helper_from` faces.
+    fn build(
+        mesh: &crate::mesh::TriMesh,
+        with_points: bool,
+        keep_going: &mut dyn FnMut() -> bool,
+        helper_from: usize,
+    ) -> Option<InputModel> {
         let positions = std::sync::Arc::new(mesh.positions().to_vec());
         let tris = std::sync::Arc::new(mesh.triangles().to_vec());
-        let (bvh, degenerate, points) = if tris.len() < HELPER_THREAD_FACES {
+        let (bvh, degenerate, points) = if tris.len() < helper_from {
             let (bvh, points) = build_input_trees(&positions, &tris, with_points);
             (bvh, degeneracy_flags(&positions, &tris), points)
         } else {
@@ -1001,6 +1012,40 @@ pub(crate) mod tests {
         let mut t = a.triangles().to_vec();
         t.extend(b.triangles().iter().map(|f| f.map(|v| v + 8)));
         TriMesh::new(p, t).unwrap()
+    }
+
+    #[test]
+    fn the_input_model_is_the_same_when_built_on_the_helper_thread() {
+        let m = two_cubes();
+        for with_points in [false, true] {
+            let here = InputModel::new(&m, with_points);
+            let mut polls = 0;
+            let there = InputModel::build(
+                &m,
+                with_points,
+                &mut || {
+                    polls += 1;
+                    true
+                },
+                0,
+            )
+            .expect("not cancelled");
+            assert_eq!(
+                (&here.positions, &here.tris),
+                (&there.positions, &there.tris)
+            );
+            assert_eq!(here.degenerate, there.degenerate);
+            assert_eq!(here.diag.to_bits(), there.diag.to_bits());
+            assert_eq!(here.bvh.leaf_ids(), there.bvh.leaf_ids());
+            for t in 0..m.triangle_count() as u32 {
+                assert_eq!(here.bvh.triangle_box(t), there.bvh.triangle_box(t));
+            }
+            for p in [[0.5, 0.5, 1.5], [1.5, 2.5, 0.2], [-1.0, 4.0, 2.0]] {
+                assert_eq!(here.closest(p), there.closest(p));
+            }
+            let pts = |x: &InputModel| x.points.as_ref().map(|(p, b)| (p.clone(), b.leaf_ids()));
+            assert_eq!(pts(&here), pts(&there));
+        }
     }
 
     #[test]

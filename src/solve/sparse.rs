@@ -24,10 +24,11 @@ use faer::{Conj, Mat, MatMut, Par, Side};
 use crate::{Error, Result};
 
 /// Factor entries from which a numeric factorization is run by [`run_stoppable`] on a helper
-/// thread (issue 15). Measured 2026-11-27 on the wrinkle design's systems: a factor of 2²¹
-/// entries takes about 0.1 CPU s, so the factorizations left on the calling thread stay far
-/// below the 0.5 s cancellation bound, and small ones pay no thread start.
-pub const STOPPABLE_FACTOR_LEN: usize = 1 << 21;
+/// thread (issue 15). Measured 2026-11-27 on the wrinkle design's systems: Knöppel's factor on
+/// a 53k-face base has 4.4·10⁶ entries and takes 0.19 CPU s, so one of 2¹⁹ entries takes a few
+/// hundredths of a second: the factorizations left on the calling thread stay far below the
+/// 0.5 s cancellation bound, and small ones pay no thread start.
+pub const STOPPABLE_FACTOR_LEN: usize = 1 << 19;
 
 /// How often [`run_stoppable`] asks its `tick` while the work runs.
 const STOPPABLE_POLL: std::time::Duration = std::time::Duration::from_millis(100);
@@ -422,6 +423,78 @@ mod tests {
             }
         }
         assemble(n, &t, "a test matrix").unwrap()
+    }
+
+    /// The 5-point Laplacian of an `n × n` grid plus the identity (SPD), full storage.
+    fn grid_laplacian(n: usize) -> SparseMatrix {
+        let id = |i: usize, j: usize| i * n + j;
+        let mut t = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                t.push(Entry::new(id(i, j), id(i, j), 5.0));
+                for (di, dj) in [(1, 0), (0, 1)] {
+                    if i + di < n && j + dj < n {
+                        t.push(Entry::new(id(i + di, j + dj), id(i, j), -1.0));
+                        t.push(Entry::new(id(i, j), id(i + di, j + dj), -1.0));
+                    }
+                }
+            }
+        }
+        assemble(n * n, &t, "a test matrix").unwrap()
+    }
+
+    #[test]
+    fn a_factorization_on_the_helper_thread_is_bitwise_the_same() {
+        let a = grid_laplacian(60);
+        let an = CholeskyAnalysis::new(&a).unwrap();
+        let b: Vec<f64> = (0..a.ncols()).map(|i| (i as f64 * 0.37).sin()).collect();
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let here = pool.install(|| an.factor(&a, Parallelism::Global).unwrap().solve(&b));
+            let there = pool.install(|| {
+                let (an, a) = (an.clone(), a.clone());
+                let work = move || an.factor(&a, Parallelism::Global).unwrap();
+                run_stoppable(true, work, &mut || Ok(())).unwrap().solve(&b)
+            });
+            let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&here), bits(&there), "{threads} threads");
+        }
+    }
+
+    #[test]
+    fn stoppable_work_answers_a_cancel_while_it_runs() {
+        // The work waits until released after the return: a cancel must not wait for it.
+        let (release, wait) = std::sync::mpsc::channel::<()>();
+        let (done_tx, done) = std::sync::mpsc::channel::<()>();
+        let work = move || {
+            let _ = wait.recv();
+            let _ = done_tx.send(());
+            7
+        };
+        let mut ticks = 0;
+        let r = run_stoppable(true, work, &mut || {
+            ticks += 1;
+            if ticks < 3 {
+                Ok(())
+            } else {
+                Err(Error::Cancelled)
+            }
+        });
+        assert!(matches!(r, Err(Error::Cancelled)), "{r:?}");
+        assert_eq!(ticks, 3);
+        release.send(()).unwrap();
+        done.recv().unwrap(); // the helper finished on its own
+                              // light work runs here, without a tick
+        let r = run_stoppable(false, || 5, &mut || panic!("no tick for light work"));
+        assert_eq!(r.unwrap(), 5);
+        // a panic of the work reaches the caller
+        let p = std::panic::catch_unwind(|| {
+            run_stoppable(true, || -> u32 { panic!("boom") }, &mut || Ok(()))
+        });
+        assert!(p.is_err());
     }
 
     #[test]
