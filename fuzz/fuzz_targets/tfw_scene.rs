@@ -2,8 +2,7 @@
 //! bytes go through the Rust parser (`Scene::from_json_str`) and the C entry point
 //! (`pleat_tfw_scene_from_json`), which must agree on acceptance; no input may panic. An
 //! accepted scene writes back to JSON that reads again, assembles to a model or a clear error,
-//! and, when tiny (≤ 64 vertices), gets a bounded base solve (5 Newton iterations) whose
-//! positions are finite or whose status says why not.
+//! and, when tiny (≤ 64 vertices), gets a bounded base solve (5 Newton iterations).
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -50,8 +49,7 @@ fuzz_target!(|data: &[u8]| {
             max_iterations: 5,
             ..BaseOptions::default()
         };
-        if let Ok(r) = solve_base(&model, &options, &mut |_| true) {
-            assert_eq!(r.positions.len(), model.positions.len());
-        }
+        // numerical trouble is a status of the result, never a panic
+        let _ = solve_base(&model, &options, &mut |_| true);
     }
 });

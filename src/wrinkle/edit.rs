@@ -787,7 +787,8 @@ fn solve_phase(
             .fold(0.0, f64::max)
             .max(1e-300)
     };
-    let an = CholeskyAnalysis::new(&a)?;
+    let a = std::sync::Arc::new(a);
+    let an = CholeskyAnalysis::new_stoppable(&a, tick)?;
     let schedule = ShiftSchedule {
         initial: 1e-9 * scale,
         growth: 100.0,
@@ -797,7 +798,7 @@ fn solve_phase(
     if an.is_heavy() {
         tick()?;
     }
-    let (a, mass2) = (std::sync::Arc::new(a), std::sync::Arc::new(mass2));
+    let mass2 = std::sync::Arc::new(mass2);
     let (a2, m2) = (a.clone(), mass2.clone());
     let llt = run_stoppable(
         an.is_heavy(),

@@ -235,7 +235,8 @@ fn factor_shifted(
         growth: 100.0,
         max_attempts: 5,
     };
-    let an = CholeskyAnalysis::new(&a)?;
+    let a = std::sync::Arc::new(a);
+    let an = CholeskyAnalysis::new_stoppable(&a, tick)?;
     if an.is_heavy() {
         tick()?;
     }

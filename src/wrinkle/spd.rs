@@ -68,7 +68,7 @@ pub(crate) fn solve_spd_many_with_tick(
         return Ok(rhs.iter().map(|_| (Vec::new(), 0.0)).collect());
     }
     let a = std::sync::Arc::new(assemble(dim, entries, what)?);
-    let an = CholeskyAnalysis::new(&a)?;
+    let an = CholeskyAnalysis::new_stoppable(&a, tick)?;
     let heavy = an.is_heavy();
     if heavy {
         tick()?;
