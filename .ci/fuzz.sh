@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs every fuzz target (fuzz/, cargo-fuzz + libFuzzer, AddressSanitizer) for a short bounded
-# time from the committed seeds. Total time ≈ 10 targets × PLEAT_FUZZ_SECONDS (default 15 s)
+# time from the committed seeds. Total time ≈ 11 targets × PLEAT_FUZZ_SECONDS (default 15 s)
 # plus the build (a full nightly ASan build from a cold cache: ~10 min on 2 cores, so not yet
 # part of .ci/run's budget; see README "Security and robustness").
 #

@@ -94,6 +94,53 @@ static void progress_and_cancel(const PleatMesh *m, const PleatCwf *a,
     free(x0), free(x1), free(labels);
 }
 
+/* Misuse of the _with_progress calls themselves (issue 15): NULL base, field, sources,
+ * regions or out, counts beyond the address space, a bad region struct size and a source
+ * vertex out of range answer PLEAT_STATUS_INVALID_ARGUMENT with a message naming the
+ * argument, before any progress call, and write nothing. */
+static void progress_misuse(const PleatMesh *m, const PleatCwf *a, const PleatCwfRegionEdit *r,
+                            const PleatWrinkleSource *src, size_t nv, size_t nt) {
+    Calls c = {0, 0, "design"};
+    PleatCwf *out = NULL;
+    PleatWrinkleSource far = *src;
+    PleatCwfRegionEdit bad = *r;
+    uint8_t *labels = (uint8_t *)malloc(nt);
+    far.vertex = (uint32_t)nv;
+    bad.struct_size = 1;
+    memset(labels, 0xEE, nt);
+#define MISUSE(call, what)                                                               \
+    do {                                                                                 \
+        CHECK_STATUS(call, PLEAT_STATUS_INVALID_ARGUMENT);                               \
+        CHECK(strstr(pleat_last_error(), what) != NULL);                                 \
+        CHECK(out == NULL && c.calls == 0);                                              \
+    } while (0)
+    MISUSE(pleat_cwf_design_with_progress(NULL, src, 1, NULL, NULL, count_calls, &c, &out),
+           "base");
+    MISUSE(pleat_cwf_design_with_progress(m, NULL, 1, NULL, NULL, count_calls, &c, &out),
+           "sources");
+    MISUSE(pleat_cwf_design_with_progress(m, src, SIZE_MAX, NULL, NULL, count_calls, &c, &out),
+           "sources");
+    MISUSE(pleat_cwf_design_with_progress(m, &far, 1, NULL, NULL, count_calls, &c, &out),
+           "vertex");
+    CHECK_STATUS(pleat_cwf_design_with_progress(m, src, 1, NULL, NULL, count_calls, &c, NULL),
+                 PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK(strstr(pleat_last_error(), "out") != NULL && c.calls == 0);
+    c.stage = "edit";
+    MISUSE(pleat_cwf_edit_with_progress(NULL, r, 1, NULL, count_calls, &c, &out, labels), "cwf");
+    MISUSE(pleat_cwf_edit_with_progress(a, NULL, 1, NULL, count_calls, &c, &out, labels),
+           "regions");
+    MISUSE(pleat_cwf_edit_with_progress(a, r, SIZE_MAX, NULL, count_calls, &c, &out, labels),
+           "regions");
+    MISUSE(pleat_cwf_edit_with_progress(a, &bad, 1, NULL, count_calls, &c, &out, labels),
+           "struct_size");
+    CHECK_STATUS(pleat_cwf_edit_with_progress(a, r, 1, NULL, count_calls, &c, NULL, labels),
+                 PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK(strstr(pleat_last_error(), "out") != NULL && c.calls == 0);
+    CHECK(labels[0] == 0xEE && labels[nt - 1] == 0xEE);
+#undef MISUSE
+    free(labels);
+}
+
 static void edits(void) {
     const double k[3] = {4 * 2 * M_PI, 0, 0};
     PleatMesh *m = make_grid(N);
@@ -180,6 +227,7 @@ static void edits(void) {
     /* with progress callbacks, cancelled */
     r.rotate_radians = M_PI / 2;
     progress_and_cancel(m, a, &r, &src, d, b, nv, nt);
+    progress_misuse(m, a, &r, &src, nv, nt);
 
     /* misuse: a status and a message, nothing written */
     {

@@ -6,7 +6,7 @@ small files derived from the shared corpus (../shared/meshes, or $PLEAT_MESHES):
 vertices and the faces among them. Deterministic; rerun after changing a target's input
 layout:  python3 fuzz/gen_seeds.py
 """
-import base64, json, os, struct, sys
+import base64, json, math, os, struct, sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = os.path.join(HERE, "seeds")
@@ -252,6 +252,43 @@ def main():
     put("lod_bake", "cage", bytes([1, 4, 4]) + bytes(range(7, 130)))
     put("wrinkle_eval", "octa_levels", bytes([0]) + bytes([3]) * 60)
     put("wrinkle_eval", "octa_knoppel", bytes([8]) + bytes(range(2, 70)))
+
+    # TFW scene JSON: the small shipped examples (shrunk meshes, so an input meshes in
+    # milliseconds), the others' features on tiny panels, and an explicit-array scene
+    ex = os.path.join(HERE, "..", "examples", "tfw")
+    for name in ["sheared_rectangle.json", "twisted_cylinder.json"]:
+        path = os.path.join(ex, name)
+        if os.path.exists(path):
+            doc = json.load(open(path))
+            for panel in doc["panels"]:
+                panel["target_vertices"] = 24
+            put("tfw_scene", name, json.dumps(doc, separators=(",", ":")))
+    disk = [[round(0.1 * math.cos(2 * math.pi * k / 12), 6), round(0.1 * math.sin(2 * math.pi * k / 12), 6)]
+            for k in range(12)]
+    balloon = {"name": "disk balloon", "material": {"young": 1e6, "poisson": 0.4, "thickness": 1e-4},
+               "loads": {"pressure": 100}, "panels": [
+                   {"polygon": disk, "target_vertices": 16, "seed": 2, "lens": 0.01},
+                   {"polygon": disk, "target_vertices": 16, "seed": 2, "lens": -0.01}],
+               "dirichlet": [{"panel": 0, "rest_box": [[-0.2, -0.2], [0.2, -0.09]]}]}
+    put("tfw_scene", "disk_balloon_tiny.json", json.dumps(balloon, separators=(",", ":")))
+    holed = {"material": {"young": 1e6, "poisson": 0.3, "thickness": 1e-3, "density": 10},
+             "loads": {"gravity": [0, 0, -9.81]},
+             "panels": [{"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]],
+                         "holes": [[[0.4, 0.4], [0.6, 0.4], [0.6, 0.6], [0.4, 0.6]]],
+                         "target_vertices": 20}],
+             "obstacles": [{"type": "sphere", "centre": [0.5, 0.5, -0.3], "radius": 0.2},
+                           {"type": "plane", "point": [0, 0, -1], "normal": [0, 0, 1],
+                            "stiffness": 1e9, "margin": 0}],
+             "dirichlet": [{"panel": 0, "rest_box": [[0, 0], [0, 1]]}]}
+    put("tfw_scene", "holed_obstacles.json", json.dumps(holed, separators=(",", ":")))
+    sheet = {"name": "two triangles", "material": {"young": 1e6, "poisson": 0.3, "thickness": 1e-3},
+             "seam_tolerance": 1e-6,
+             "panels": [{"rest": [[0, 0], [1, 0], [1, 1], [0, 1]], "triangles": [[0, 1, 2], [0, 2, 3]],
+                         "positions": [[0, 0, 0], [1.1, 0, 0], [1.1, 1, 0], [0, 1, 0]]}],
+             "dirichlet": [{"panel": 0, "vertices": [0, 3]},
+                           {"panel": 0, "vertices": [1, 2], "translation": [0.05, 0, 0]}]}
+    put("tfw_scene", "explicit_sheet.json", json.dumps(sheet, separators=(",", ":")))
+    put("tfw_scene", "bad_key.json", '{"material":{"yung":1},"panels":[]}')
 
 
 main()

@@ -285,6 +285,34 @@ mod lod {
         });
     }
 
+    /// The setup of a LOD (the guard's input model: the face BVH of 10⁶ tiny components and
+    /// their degeneracy flags) up to its first progress call after the setup, where the run
+    /// stops (the bake itself is measured above on a corpus mesh).
+    #[test]
+    #[ignore = "measurement: seconds per run"]
+    fn lod_setup_cancellation_latency() {
+        let m = super::shapes::tiny_components(100);
+        header();
+        let p = LodParams {
+            screen_size: 16.0,
+            ..LodParams::default()
+        };
+        measure("LOD setup (10⁶ tiny components, n_p 16)", &mut |cb| {
+            let mut past_setup = false;
+            let r = generate(&m, &p, &mut |q: Progress<'_>| {
+                if q.stage != "setup" {
+                    past_setup = true;
+                    return false;
+                }
+                cb(q)
+            });
+            match r {
+                Err(Error::Cancelled) if past_setup => Ok(()),
+                other => other.map(drop),
+            }
+        });
+    }
+
     #[cfg(feature = "cage")]
     #[test]
     #[ignore = "measurement: seconds per run"]
@@ -484,13 +512,22 @@ mod wrinkle {
         Some(h.mesh(levels))
     }
 
-    /// Base of the design and edit measurements: 13 334 faces × 4 = 53 336 (Loop 2: 213 344).
+    /// Base of the design and edit measurements: 13 334 faces × 4 = 53 336 (Loop 2: 213 344,
+    /// with `PLEAT_LATENCY_LOOP=2`).
     const LARGE: (&str, usize) = ("clean_cheburashka.obj", 1);
+
+    /// The Loop levels of the design and edit base: `PLEAT_LATENCY_LOOP`, default `LARGE.1`.
+    fn large_levels() -> usize {
+        std::env::var("PLEAT_LATENCY_LOOP")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(LARGE.1)
+    }
 
     #[test]
     #[ignore = "measurement: seconds per run"]
     fn wrinkle_design_cancellation_latency() {
-        let Some(m) = subdivided(LARGE.0, LARGE.1) else {
+        let Some(m) = subdivided(LARGE.0, large_levels()) else {
             return;
         };
         header();
@@ -500,7 +537,7 @@ mod wrinkle {
             &format!(
                 "wrinkle design ({} Loop {}, {} faces, 8 sources of 40 rings)",
                 LARGE.0,
-                LARGE.1,
+                large_levels(),
                 m.triangle_count()
             ),
             &mut |cb| design_with_progress(m.clone(), &sources, &opts, cb).map(drop),
@@ -510,7 +547,7 @@ mod wrinkle {
     #[test]
     #[ignore = "measurement: seconds per run"]
     fn wrinkle_edit_cancellation_latency() {
-        let Some(m) = subdivided(LARGE.0, LARGE.1) else {
+        let Some(m) = subdivided(LARGE.0, large_levels()) else {
             return;
         };
         header();
@@ -523,7 +560,7 @@ mod wrinkle {
             &format!(
                 "wrinkle edit ({} Loop {}, {} faces, 2 regions of 30 rings)",
                 LARGE.0,
-                LARGE.1,
+                large_levels(),
                 m.triangle_count()
             ),
             &mut |cb| edit_with_progress(&cwf, &regions, &opts, cb).map(drop),
@@ -535,7 +572,8 @@ mod wrinkle {
         measure(
             &format!(
                 "wrinkle edit ({} Loop {}, every face: Knöppel)",
-                LARGE.0, LARGE.1
+                LARGE.0,
+                large_levels()
             ),
             &mut |cb| edit_with_progress(&cwf, &global, &opts, cb).map(drop),
         );

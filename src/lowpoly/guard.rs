@@ -66,41 +66,129 @@ pub(crate) struct InputModel {
     pub diag: f64,
 }
 
-impl InputModel {
-    /// Builds the model; `with_points` adds the vertex index needed by cage mode.
-    pub fn new(mesh: &crate::mesh::TriMesh, with_points: bool) -> InputModel {
-        let positions = mesh.positions().to_vec();
-        let tris = mesh.triangles().to_vec();
-        let bvh = TriangleBvh::new(&positions, &tris);
-        let degenerate = tris
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|v| positions[v as usize]);
-                sp::is_collinear(a, b, c)
-            })
+/// Input faces from which [`InputModel::new_with_stop`] builds its trees on a helper thread
+/// (below, on the calling thread: no extra thread for the small inputs of most calls).
+const HELPER_THREAD_FACES: usize = 1 << 17;
+
+/// How often [`InputModel::new_with_stop`] asks whether to go on while its helper thread builds
+/// the trees (issue 15: a cancel is answered within 0.5 s).
+const TREE_POLL: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// The trees of an [`InputModel`]: the face BVH and the optional vertex index.
+type InputTrees = (TriangleBvh, Option<(Vec<[u32; 3]>, TriangleBvh)>);
+
+/// The face BVH of `tris` and, with `with_points`, the vertex index of cage mode (the referenced
+/// vertices as point "triangles" `[v, v, v]` and their BVH).
+fn build_input_trees(positions: &[[f64; 3]], tris: &[[u32; 3]], with_points: bool) -> InputTrees {
+    let bvh = TriangleBvh::new(positions, tris);
+    let points = with_points.then(|| {
+        let mut used = vec![false; positions.len()];
+        for t in tris {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        let pts: Vec<[u32; 3]> = (0..positions.len() as u32)
+            .filter(|&v| used[v as usize])
+            .map(|v| [v, v, v])
             .collect();
-        let points = with_points.then(|| {
-            let mut used = vec![false; positions.len()];
-            for t in &tris {
-                for &v in t {
-                    used[v as usize] = true;
+        let bvh = TriangleBvh::new(positions, &pts);
+        (pts, bvh)
+    });
+    (bvh, points)
+}
+
+/// Per triangle: exactly degenerate (collinear corners).
+fn degeneracy_flags(positions: &[[f64; 3]], tris: &[[u32; 3]]) -> Vec<bool> {
+    tris.iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| positions[v as usize]);
+            sp::is_collinear(a, b, c)
+        })
+        .collect()
+}
+
+/// The trees from the helper thread, asking `keep_going()` every [`TREE_POLL`] meanwhile;
+/// `None` when it answers `false`.
+fn wait_for_trees(
+    rx: &std::sync::mpsc::Receiver<InputTrees>,
+    keep_going: &mut dyn FnMut() -> bool,
+) -> Option<InputTrees> {
+    loop {
+        match rx.recv_timeout(TREE_POLL) {
+            Ok(trees) => return Some(trees),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                if !keep_going() {
+                    return None;
                 }
             }
-            let pts: Vec<[u32; 3]> = (0..positions.len() as u32)
-                .filter(|&v| used[v as usize])
-                .map(|v| [v, v, v])
-                .collect();
-            let bvh = TriangleBvh::new(&positions, &pts);
-            (pts, bvh)
-        });
-        InputModel {
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                panic!("the input model's tree builder panicked")
+            }
+        }
+    }
+}
+
+/// The buffer behind `a` (a copy if another owner is still alive).
+fn unwrap_shared<T: Clone>(a: std::sync::Arc<Vec<T>>) -> Vec<T> {
+    std::sync::Arc::try_unwrap(a).unwrap_or_else(|a| (*a).clone())
+}
+
+impl InputModel {
+    /// Builds the model; `with_points` adds the vertex index needed by cage mode.
+    #[cfg(test)]
+    pub fn new(mesh: &crate::mesh::TriMesh, with_points: bool) -> InputModel {
+        Self::new_with_stop(mesh, with_points, &mut || true).expect("never stopped")
+    }
+
+    /// As [`new`](Self::new), with `keep_going()` asked on the calling thread while the trees
+    /// are built; `None` as soon as it answers `false` (issue 15: the face BVH of parry is one
+    /// sequential build, 1.4 s at 10⁶ faces on a loaded machine, which has no cancellation point
+    /// inside). From [`HELPER_THREAD_FACES`] input faces on, the trees are built on a helper
+    /// thread while this thread computes the degeneracy flags and then asks `keep_going` every
+    /// [`TREE_POLL`]; on a cancel it returns at once and the helper finishes its build and drops
+    /// it (its result has no receiver; nothing is kept). The trees are the same sequential
+    /// builds on either thread, so the model does not depend on the path taken.
+    pub fn new_with_stop(
+        mesh: &crate::mesh::TriMesh,
+        with_points: bool,
+        keep_going: &mut dyn FnMut() -> bool,
+    ) -> Option<InputModel> {
+        Self::build(mesh, with_points, keep_going, HELPER_THREAD_FACES)
+    }
+
+    /// [`new_with_stop`](Self::new_with_stop) with the helper thread from `helper_from` faces.
+    fn build(
+        mesh: &crate::mesh::TriMesh,
+        with_points: bool,
+        keep_going: &mut dyn FnMut() -> bool,
+        helper_from: usize,
+    ) -> Option<InputModel> {
+        let positions = std::sync::Arc::new(mesh.positions().to_vec());
+        let tris = std::sync::Arc::new(mesh.triangles().to_vec());
+        let (bvh, degenerate, points) = if tris.len() < helper_from {
+            let (bvh, points) = build_input_trees(&positions, &tris, with_points);
+            (bvh, degeneracy_flags(&positions, &tris), points)
+        } else {
+            let (tx, rx) = std::sync::mpsc::channel::<InputTrees>();
+            let (p, t) = (positions.clone(), tris.clone());
+            std::thread::spawn(move || {
+                let trees = build_input_trees(&p, &t, with_points);
+                drop((p, t)); // before the send: the caller then owns the buffers alone
+                let _ = tx.send(trees); // no receiver after a cancel: dropped here
+            });
+            let degenerate = degeneracy_flags(&positions, &tris);
+            let (bvh, points) = wait_for_trees(&rx, keep_going)?;
+            (bvh, degenerate, points)
+        };
+        Some(InputModel {
             diag: mesh.bbox_diagonal(),
-            positions,
-            tris,
+            positions: unwrap_shared(positions),
+            tris: unwrap_shared(tris),
             bvh,
             degenerate,
             points,
-        }
+        })
     }
 
     /// Closest input point to `p` and its distance.
@@ -924,6 +1012,40 @@ pub(crate) mod tests {
         let mut t = a.triangles().to_vec();
         t.extend(b.triangles().iter().map(|f| f.map(|v| v + 8)));
         TriMesh::new(p, t).unwrap()
+    }
+
+    #[test]
+    fn the_input_model_is_the_same_when_built_on_the_helper_thread() {
+        let m = two_cubes();
+        for with_points in [false, true] {
+            let here = InputModel::new(&m, with_points);
+            let mut polls = 0;
+            let there = InputModel::build(
+                &m,
+                with_points,
+                &mut || {
+                    polls += 1;
+                    true
+                },
+                0,
+            )
+            .expect("not cancelled");
+            assert_eq!(
+                (&here.positions, &here.tris),
+                (&there.positions, &there.tris)
+            );
+            assert_eq!(here.degenerate, there.degenerate);
+            assert_eq!(here.diag.to_bits(), there.diag.to_bits());
+            assert_eq!(here.bvh.leaf_ids(), there.bvh.leaf_ids());
+            for t in 0..m.triangle_count() as u32 {
+                assert_eq!(here.bvh.triangle_box(t), there.bvh.triangle_box(t));
+            }
+            for p in [[0.5, 0.5, 1.5], [1.5, 2.5, 0.2], [-1.0, 4.0, 2.0]] {
+                assert_eq!(here.closest(p), there.closest(p));
+            }
+            let pts = |x: &InputModel| x.points.as_ref().map(|(p, b)| (p.clone(), b.leaf_ids()));
+            assert_eq!(pts(&here), pts(&there));
+        }
     }
 
     #[test]

@@ -319,7 +319,9 @@ pub(crate) fn run(
     let mut rep = Reporter::new(progress);
     // cancellation points between the setup's trees (each about 1 s on a 10⁶-face input)
     rep.check("setup", 0.0)?;
-    let model = InputModel::new(input, mode == Mode::Cage);
+    let model =
+        InputModel::new_with_stop(input, mode == Mode::Cage, &mut || rep.report("setup", 0.0))
+            .ok_or(Error::Cancelled)?;
     rep.check("setup", 0.0)?;
     let level = Level::new(&model, input, mode);
     bake_level(&level, params, None, &mut rep, (0.0, 1.0))
@@ -351,7 +353,9 @@ pub(crate) fn run_chain(
     let mut rep = Reporter::new(progress);
     // cancellation points between the setup's trees (each about 1 s on a 10⁶-face input)
     rep.check("setup", 0.0)?;
-    let model = InputModel::new(input, mode == Mode::Cage);
+    let model =
+        InputModel::new_with_stop(input, mode == Mode::Cage, &mut || rep.report("setup", 0.0))
+            .ok_or(Error::Cancelled)?;
     rep.check("setup", 0.0)?;
     let level = Level::new(&model, input, mode);
     let mut out: Vec<Option<(TriMesh, LodReport)>> = vec![None; screen_sizes.len()];

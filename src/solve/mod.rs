@@ -10,7 +10,7 @@
 //!
 //! Built with the features that need faer (currently `wrinkle`).
 //!
-//! May import: `faer`, `crate::error` (the crate's `Error`/`Result`). Nothing else of the crate.
+//! May import: `faer`, `rayon` (a helper thread's pool, [`run_stoppable`]), `crate::error` (the crate's `Error`/`Result`). Nothing else of the crate.
 
 pub mod eigen;
 pub mod krylov;
@@ -22,7 +22,7 @@ pub use eigen::{
 };
 pub use krylov::{dot_n, steihaug, steihaug_with_stop, TrustStep};
 pub use sparse::{
-    assemble, entry_index, is_out_of_memory, sym_matvec_lower_into, AssemblyPlan, Cholesky,
-    CholeskyAnalysis, Entry, FactorInfo, LltError, Parallelism, ShiftSchedule, SolveScratch,
-    SparseMatrix,
+    assemble, entry_index, is_out_of_memory, run_stoppable, sym_matvec_lower_into, AssemblyPlan,
+    Cholesky, CholeskyAnalysis, Entry, FactorInfo, LltError, Parallelism, ShiftSchedule,
+    SolveScratch, SparseMatrix, STOPPABLE_FACTOR_LEN,
 };

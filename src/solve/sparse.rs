@@ -23,6 +23,64 @@ use faer::{Conj, Mat, MatMut, Par, Side};
 
 use crate::{Error, Result};
 
+/// Factor entries from which a numeric factorization is run by [`run_stoppable`] on a helper
+/// thread (issue 15). Measured 2026-11-27 on the wrinkle design's systems: Knöppel's factor on
+/// a 53k-face base has 4.4·10⁶ entries and takes 0.19 CPU s, so one of 2¹⁹ entries takes a few
+/// hundredths of a second: the factorizations left on the calling thread stay far below the
+/// 0.5 s cancellation bound, and small ones pay no thread start.
+pub const STOPPABLE_FACTOR_LEN: usize = 1 << 19;
+
+/// Stored matrix entries from which [`CholeskyAnalysis::new_stoppable`] runs the analysis (the
+/// fill-reducing ordering) on a helper thread: measured 2026-11-27, the analyses of the
+/// wrinkle design's systems on a 213k-face base took 0.17–0.56 CPU s (matrices of 0.7–1.7·10⁶
+/// entries), those of a 53k-face base a few hundredths.
+pub const STOPPABLE_MATRIX_NNZ: usize = 1 << 19;
+
+/// How often [`run_stoppable`] asks its `tick` while the work runs.
+const STOPPABLE_POLL: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// Runs `work` and returns its value, with a cancellation point every 0.1 s while it runs
+/// (issue 15: one sparse Cholesky factorization has no cancellation point inside, 1.1 CPU s on
+/// a 213k-face wrinkle base). When `heavy`, `work` runs on a helper thread, inside a rayon pool
+/// of as many threads as the caller's (so faer's `Par::rayon(0)` there is the caller's
+/// parallelism and the result is bit for bit the one of a call on this thread), while this
+/// thread calls `tick()` every 0.1 s; its first error is returned at once, and the
+/// helper then finishes `work` and drops its value (nothing is returned or kept: the thread
+/// owns everything `work` captured). Otherwise `work` runs right here, without a `tick`.
+/// A panic in `work` is re-raised on this thread.
+pub fn run_stoppable<T: Send + 'static>(
+    heavy: bool,
+    work: impl FnOnce() -> T + Send + 'static,
+    tick: &mut dyn FnMut() -> Result<()>,
+) -> Result<T> {
+    if !heavy {
+        return Ok(work());
+    }
+    let threads = rayon::current_num_threads();
+    let (tx, rx) = std::sync::mpsc::channel::<std::thread::Result<T>>();
+    std::thread::Builder::new()
+        .name("pleat-factor".into())
+        .spawn(move || {
+            let run = || match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+                Ok(pool) => pool.install(work),
+                Err(_) => work(),
+            };
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(run));
+            let _ = tx.send(r); // no receiver after a cancel: the value is dropped here
+        })
+        .map_err(|e| Error::Internal(format!("cannot start a factorization thread: {e}")))?;
+    loop {
+        match rx.recv_timeout(STOPPABLE_POLL) {
+            Ok(Ok(v)) => return Ok(v),
+            Ok(Err(panic)) => std::panic::resume_unwind(panic),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => tick()?,
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(Error::Internal("the factorization thread vanished".into()))
+            }
+        }
+    }
+}
+
 /// Why a numeric factorization failed (faer's error: a non-positive pivot, or out of memory).
 pub use faer::sparse::linalg::LltError;
 
@@ -213,9 +271,33 @@ impl CholeskyAnalysis {
         })
     }
 
+    /// [`new`](Self::new) with `tick` as a cancellation point every 0.1 s ([`run_stoppable`])
+    /// when `a` has at least [`STOPPABLE_MATRIX_NNZ`] stored entries; the same analysis.
+    pub fn new_stoppable(
+        a: &Arc<SparseMatrix>,
+        tick: &mut dyn FnMut() -> Result<()>,
+    ) -> Result<CholeskyAnalysis> {
+        let shared = a.clone();
+        let heavy = a.val().len() >= STOPPABLE_MATRIX_NNZ;
+        run_stoppable(heavy, move || CholeskyAnalysis::new(&shared), tick)?
+    }
+
     /// Number of rows (= columns) of the analysed pattern.
     pub fn dim(&self) -> usize {
         self.symbolic.nrows()
+    }
+
+    /// Stored entries of the Cholesky factor `L` of this pattern (the size of every numeric
+    /// factorization: its cost grows with it).
+    pub fn factor_len(&self) -> usize {
+        self.symbolic.len_val()
+    }
+
+    /// True when a numeric factorization of this pattern is long enough to run on a helper
+    /// thread with cancellation polling ([`run_stoppable`]): at least
+    /// [`STOPPABLE_FACTOR_LEN`] factor entries.
+    pub fn is_heavy(&self) -> bool {
+        self.factor_len() >= STOPPABLE_FACTOR_LEN
     }
 
     /// Numeric factorization of `a`, which must have the analysed pattern. Fails when `a` is
@@ -427,6 +509,78 @@ mod tests {
             assert_eq!(a.val(), b.val());
         }
         assert!(plan.assemble(&[1.0]).is_err());
+    }
+
+    /// The 5-point Laplacian of an `n × n` grid plus the identity (SPD), full storage.
+    fn grid_laplacian(n: usize) -> SparseMatrix {
+        let id = |i: usize, j: usize| i * n + j;
+        let mut t = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                t.push(Entry::new(id(i, j), id(i, j), 5.0));
+                for (di, dj) in [(1, 0), (0, 1)] {
+                    if i + di < n && j + dj < n {
+                        t.push(Entry::new(id(i + di, j + dj), id(i, j), -1.0));
+                        t.push(Entry::new(id(i, j), id(i + di, j + dj), -1.0));
+                    }
+                }
+            }
+        }
+        assemble(n * n, &t, "a test matrix").unwrap()
+    }
+
+    #[test]
+    fn a_factorization_on_the_helper_thread_is_bitwise_the_same() {
+        let a = grid_laplacian(60);
+        let an = CholeskyAnalysis::new(&a).unwrap();
+        let b: Vec<f64> = (0..a.ncols()).map(|i| (i as f64 * 0.37).sin()).collect();
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let here = pool.install(|| an.factor(&a, Parallelism::Global).unwrap().solve(&b));
+            let there = pool.install(|| {
+                let (an, a) = (an.clone(), a.clone());
+                let work = move || an.factor(&a, Parallelism::Global).unwrap();
+                run_stoppable(true, work, &mut || Ok(())).unwrap().solve(&b)
+            });
+            let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&here), bits(&there), "{threads} threads");
+        }
+    }
+
+    #[test]
+    fn stoppable_work_answers_a_cancel_while_it_runs() {
+        // The work waits until released after the return: a cancel must not wait for it.
+        let (release, wait) = std::sync::mpsc::channel::<()>();
+        let (done_tx, done) = std::sync::mpsc::channel::<()>();
+        let work = move || {
+            let _ = wait.recv();
+            let _ = done_tx.send(());
+            7
+        };
+        let mut ticks = 0;
+        let r = run_stoppable(true, work, &mut || {
+            ticks += 1;
+            if ticks < 3 {
+                Ok(())
+            } else {
+                Err(Error::Cancelled)
+            }
+        });
+        assert!(matches!(r, Err(Error::Cancelled)), "{r:?}");
+        assert_eq!(ticks, 3);
+        release.send(()).unwrap();
+        done.recv().unwrap(); // the helper finished on its own
+                              // light work runs here, without a tick
+        let r = run_stoppable(false, || 5, &mut || panic!("no tick for light work"));
+        assert_eq!(r.unwrap(), 5);
+        // a panic of the work reaches the caller
+        let p = std::panic::catch_unwind(|| {
+            run_stoppable(true, || -> u32 { panic!("boom") }, &mut || Ok(()))
+        });
+        assert!(p.is_err());
     }
 
     #[test]

@@ -26,7 +26,7 @@ use super::cwf::Cwf;
 use super::interpolate::checkpoint;
 use super::knoppel::{cotan_weights, cotan_weights_raw, KnoppelOptions, KnoppelReport};
 use super::region::{grow_mask, Adjacency};
-use super::spd::{push_hermitian, push_outer_lower, solve_spd, solve_spd_many};
+use super::spd::{push_hermitian, push_outer_lower, solve_spd_many_with_tick, solve_spd_with_tick};
 use super::topology::Topology;
 use crate::geom::Vec3;
 use crate::mesh::TriMesh;
@@ -178,8 +178,18 @@ pub fn design_with_progress(
     tick(0.5)?;
     let t1 = Instant::now();
     // (4) amplitude
-    let (amp, amplitude_residual, clamped) =
-        design_amplitude(&topo, x, sources, &in_i, &in_v, &in_f, &omega, h, opts)?;
+    let (amp, amplitude_residual, clamped) = design_amplitude(
+        &topo,
+        x,
+        sources,
+        &in_i,
+        &in_v,
+        &in_f,
+        &omega,
+        h,
+        opts,
+        &mut || tick(0.5),
+    )?;
     tick(0.6)?;
     let t2 = Instant::now();
     // (5) phase
@@ -378,10 +388,17 @@ fn vector_heat(
         ind[j] = 1.0;
     }
     tick(0.1)?;
-    let (xs, heat_residual) = solve_spd(2 * nv, &tc, &y, "the vector heat system")?;
+    let (xs, heat_residual) =
+        solve_spd_with_tick(2 * nv, &tc, &y, "the vector heat system", &mut || tick(0.2))?;
     tick(0.3)?;
     // both scalar solves on one factorization
-    let mut scalar = solve_spd_many(nv, &tr, &[&y_abs, &ind], "the scalar heat system")?;
+    let mut scalar = solve_spd_many_with_tick(
+        nv,
+        &tr,
+        &[&y_abs, &ind],
+        "the scalar heat system",
+        &mut || tick(0.3),
+    )?;
     let (delta, _) = scalar.pop().expect("two solves");
     let (m, _) = scalar.pop().expect("two solves");
     let v = (0..nv)
@@ -399,7 +416,8 @@ fn vector_heat(
     Ok((v, heat_residual))
 }
 
-/// Eq. 3.25 (step 4): the amplitude, its solve's residual and the number clamped.
+/// Eq. 3.25 (step 4): the amplitude, its solve's residual and the number clamped. `tick` is a
+/// cancellation point every 0.1 s of a large factorization (issue 15; the same result).
 #[allow(clippy::too_many_arguments)]
 fn design_amplitude(
     topo: &Topology,
@@ -411,6 +429,7 @@ fn design_amplitude(
     omega: &[f64],
     h: f64,
     opts: &DesignOptions,
+    tick: &mut dyn FnMut() -> Result<()>,
 ) -> Result<(Vec<f64>, f64, usize)> {
     let nv = topo.n_vertices;
     let mut fixed = vec![None; nv]; // Some(value) for constrained vertices
@@ -487,7 +506,8 @@ fn design_amplitude(
             rhs[i] -= gi * h_const;
         }
     }
-    let (sol, residual) = solve_spd(n, &t, &rhs, "the design amplitude system (eq. 3.25)")?;
+    let what = "the design amplitude system (eq. 3.25)";
+    let (sol, residual) = solve_spd_with_tick(n, &t, &rhs, what, tick)?;
     let mut clamped = 0;
     let amp = (0..nv)
         .map(|j| match fixed[j] {

@@ -38,13 +38,13 @@ use super::knoppel::{
 };
 use super::omega_path::{corner_vector, face_unit_normal};
 use super::region::{classify, Adjacency, FaceClass, Labels};
-use super::spd::{matvec_full, push_hermitian, push_outer_lower, solve_spd};
+use super::spd::{matvec_full, push_hermitian, push_outer_lower, solve_spd, solve_spd_with_tick};
 use super::topology::{Topology, NONE};
 use crate::geom::Vec3;
 use crate::report::ProgressFn;
 use crate::solve::{
-    assemble, CholeskyAnalysis, Entry, InverseIterationParams, Parallelism, ShiftSchedule,
-    ShiftedProblem,
+    assemble, run_stoppable, CholeskyAnalysis, Entry, InverseIterationParams, Parallelism,
+    ShiftSchedule, ShiftedProblem,
 };
 use crate::{Error, Result};
 
@@ -364,7 +364,7 @@ fn edit_with_rings(
             compat_rms(&out, &labels, &[FaceClass::Edit]),
             compat_rms(&out, &labels, &[FaceClass::Interface]),
         ],
-        compat_floor: compat_floor(topo, out.omega(), &labels)?,
+        compat_floor: compat_floor(topo, out.omega(), &labels, &mut || tick(0.95))?,
         seconds: [
             (t1 - t0).as_secs_f64(),
             (t2 - t1).as_secs_f64(),
@@ -787,17 +787,25 @@ fn solve_phase(
             .fold(0.0, f64::max)
             .max(1e-300)
     };
-    let an = CholeskyAnalysis::new(&a)?;
+    let a = std::sync::Arc::new(a);
+    let an = CholeskyAnalysis::new_stoppable(&a, tick)?;
     let schedule = ShiftSchedule {
         initial: 1e-9 * scale,
         growth: 100.0,
         max_attempts: 5,
     };
-    let llt = an
-        .factor_with_growing_shift(&a, &mass2, schedule, Parallelism::Global)
-        .map_err(|_| {
-            Error::Numerical("the phase pencil (eq. 3.28) is not positive definite".into())
-        })?;
+    // a large factorization runs with `tick` every 0.1 s (issue 15; the same factor)
+    if an.is_heavy() {
+        tick()?;
+    }
+    let mass2 = std::sync::Arc::new(mass2);
+    let (a2, m2) = (a.clone(), mass2.clone());
+    let llt = run_stoppable(
+        an.is_heavy(),
+        move || an.factor_with_growing_shift(&a2, &m2, schedule, Parallelism::Global),
+        tick,
+    )?
+    .map_err(|_| Error::Numerical("the phase pencil (eq. 3.28) is not positive definite".into()))?;
     let problem = ShiftedProblem {
         shifted: &llt,
         apply_a: |u: &[f64]| matvec_full(&a, u),
@@ -927,8 +935,14 @@ fn compat_rms(cwf: &Cwf, labels: &Labels, which: &[FaceClass]) -> f64 {
 
 /// [`EditReport::compat_floor`]: `min ‖δ‖²` over non-fixed edges subject to `D δ = D ω` on the
 /// non-fixed faces (`D` the face curl, fixed edges held at 0), by the normal equations
-/// `D Dᵀ y = D ω`, `δ = Dᵀ y`; returns `‖δ‖ / √(non-fixed edges)`.
-fn compat_floor(topo: &Topology, omega: &[f64], labels: &Labels) -> Result<f64> {
+/// `D Dᵀ y = D ω`, `δ = Dᵀ y`; returns `‖δ‖ / √(non-fixed edges)`. `tick` is a cancellation
+/// point every 0.1 s of a large factorization (issue 15: 0.8 CPU s on a 213k-face global edit).
+fn compat_floor(
+    topo: &Topology,
+    omega: &[f64],
+    labels: &Labels,
+    tick: &mut dyn FnMut() -> Result<()>,
+) -> Result<f64> {
     let (row, n_rows) = index_of_not(&labels.face, FaceClass::Fixed);
     let n_edges = labels
         .edge
@@ -969,7 +983,7 @@ fn compat_floor(topo: &Topology, omega: &[f64], labels: &Labels) -> Result<f64> 
         .filter(|&f| row[f] != u32::MAX)
         .map(|f| curl[f])
         .collect();
-    let (y, _) = solve_spd(n_rows, &t, &rhs, "the compatibility floor")?;
+    let (y, _) = solve_spd_with_tick(n_rows, &t, &rhs, "the compatibility floor", tick)?;
     let norm2: f64 = cols
         .iter()
         .map(|c| c.iter().map(|&(r, s)| s * y[r]).sum::<f64>().powi(2))

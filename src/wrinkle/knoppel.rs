@@ -30,8 +30,8 @@ use super::topology::Topology;
 use crate::geom::Vec3;
 use crate::report::{StageTimes, StatEntries};
 use crate::solve::{
-    assemble, inverse_iteration_with_stop, Cholesky, CholeskyAnalysis, Entry, InverseIterationInfo,
-    InverseIterationParams, Parallelism, ShiftSchedule, ShiftedProblem,
+    assemble, inverse_iteration_with_stop, run_stoppable, Cholesky, CholeskyAnalysis, Entry,
+    InverseIterationInfo, InverseIterationParams, Parallelism, ShiftSchedule, ShiftedProblem,
 };
 use crate::{Error, Result};
 
@@ -128,7 +128,7 @@ pub(crate) fn knoppel_phase_with_tick(
     let mass = floored(&vertex_area);
     // the real form: both reals of vertex j carry its mass and its component
     let mass2: Vec<f64> = (0..2 * n).map(|i| mass[i / 2]).collect();
-    let llt = factor_shifted(topo, &w, omega, &mass2, opts.shift)?;
+    let llt = factor_shifted(topo, &w, omega, &mass2, opts.shift, tick)?;
     tick()?;
     let sigma = llt.info().shift;
     let (comp, n_comp) = components(topo);
@@ -206,13 +206,16 @@ fn connection_laplacian_apply(topo: &Topology, w: &[f64], omega: &[f64], u: &[f6
 
 /// Assembles `L_ω` (real form) and factors `L_ω + σM` with
 /// `σ = shift · max_j(L_jj / M_j)`, multiplying σ by 100 (up to 4 times) while it is not
-/// numerically positive definite. `mass2` is `M`'s diagonal in the real form.
+/// numerically positive definite. `mass2` is `M`'s diagonal in the real form. A large
+/// factorization runs with `tick` as a cancellation point every 0.1 s
+/// ([`run_stoppable`]); the factor is the same.
 fn factor_shifted(
     topo: &Topology,
     w: &[f64],
     omega: &[f64],
     mass2: &[f64],
     shift: f64,
+    tick: &mut dyn FnMut() -> Result<()>,
 ) -> Result<Cholesky> {
     let n = topo.n_vertices;
     let mass: Vec<f64> = mass2.iter().step_by(2).copied().collect();
@@ -232,15 +235,24 @@ fn factor_shifted(
         growth: 100.0,
         max_attempts: 5,
     };
-    CholeskyAnalysis::new(&a)?
-        .factor_with_growing_shift(&a, mass2, schedule, Parallelism::Global)
-        .map_err(|_| {
-            Error::Numerical(
-                "the shifted connection Laplacian is not positive definite (is the mesh \
+    let a = std::sync::Arc::new(a);
+    let an = CholeskyAnalysis::new_stoppable(&a, tick)?;
+    if an.is_heavy() {
+        tick()?;
+    }
+    let mass2 = mass2.to_vec();
+    run_stoppable(
+        an.is_heavy(),
+        move || an.factor_with_growing_shift(&a, &mass2, schedule, Parallelism::Global),
+        tick,
+    )?
+    .map_err(|_| {
+        Error::Numerical(
+            "the shifted connection Laplacian is not positive definite (is the mesh \
                  degenerate?)"
-                    .into(),
-            )
-        })
+                .into(),
+        )
+    })
 }
 
 /// Off-diagonal 2×2 blocks: `H_lk = −w e^{iω_kl}`, `H_kl = −w e^{−iω_kl}`.

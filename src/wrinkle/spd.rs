@@ -5,14 +5,31 @@
 
 use super::complex::Complex;
 use crate::solve::{
-    assemble, sym_matvec_lower_into, CholeskyAnalysis, Entry, Parallelism, ShiftSchedule,
-    SparseMatrix,
+    assemble, run_stoppable, sym_matvec_lower_into, Cholesky, CholeskyAnalysis, Entry, LltError,
+    Parallelism, ShiftSchedule, SparseMatrix,
 };
 use crate::{Error, Result};
 
 /// Solves `N x = b` for a symmetric positive (semi-)definite `N` given by its lower-triangle
 /// `entries` (duplicates summed). A numerically singular `N` gets the smallest diagonal shift
 /// `σ = 1e-12·max N_ii · 100^k` that factors. Returns `x` and the relative residual
+/// The factorization of `a`, or of `a + σI` with the smallest `σ = 1e-12·max a_ii · 100^k`
+/// (k < 6) that factors when `a` is numerically singular.
+fn factor_or_shift(
+    an: &CholeskyAnalysis,
+    a: &SparseMatrix,
+) -> std::result::Result<Cholesky, LltError> {
+    an.factor(a, Parallelism::Global).or_else(|_| {
+        let max_diag = diagonal(a).into_iter().fold(0.0, f64::max).max(1e-300);
+        let schedule = ShiftSchedule {
+            initial: 1e-12 * max_diag,
+            growth: 100.0,
+            max_attempts: 6,
+        };
+        an.factor_with_growing_shift(a, &vec![1.0; a.ncols()], schedule, Parallelism::Global)
+    })
+}
+
 /// `‖N x − b‖ / ‖b‖` (0 when `b = 0`). `what` names the system in errors.
 pub(crate) fn solve_spd(
     dim: usize,
@@ -20,40 +37,48 @@ pub(crate) fn solve_spd(
     rhs: &[f64],
     what: &str,
 ) -> Result<(Vec<f64>, f64)> {
-    let mut x = solve_spd_many(dim, entries, &[rhs], what)?;
+    solve_spd_with_tick(dim, entries, rhs, what, &mut || Ok(()))
+}
+
+/// [`solve_spd`] with `tick` as a cancellation point (its error returned as is) every 0.1 s
+/// of a large factorization (issue 15, [`run_stoppable`]); the same result.
+pub(crate) fn solve_spd_with_tick(
+    dim: usize,
+    entries: &[Entry],
+    rhs: &[f64],
+    what: &str,
+    tick: &mut dyn FnMut() -> Result<()>,
+) -> Result<(Vec<f64>, f64)> {
+    let mut x = solve_spd_many_with_tick(dim, entries, &[rhs], what, tick)?;
     Ok(x.pop().expect("one right-hand side"))
 }
 
 /// [`solve_spd`] for several right-hand sides on one factorization (each result as
-/// [`solve_spd`] would give it, bit for bit).
-pub(crate) fn solve_spd_many(
+/// [`solve_spd`] would give it, bit for bit), with `tick` as a cancellation point (its error
+/// returned as is) after the analysis and every 0.1 s of a large factorization (issue 15,
+/// [`run_stoppable`]); the same results.
+pub(crate) fn solve_spd_many_with_tick(
     dim: usize,
     entries: &[Entry],
     rhs: &[&[f64]],
     what: &str,
+    tick: &mut dyn FnMut() -> Result<()>,
 ) -> Result<Vec<(Vec<f64>, f64)>> {
     if dim == 0 {
         return Ok(rhs.iter().map(|_| (Vec::new(), 0.0)).collect());
     }
-    let a = assemble(dim, entries, what)?;
-    let an = CholeskyAnalysis::new(&a)?;
-    let llt = match an.factor(&a, Parallelism::Global) {
-        Ok(l) => l,
-        Err(_) => {
-            let max_diag = diagonal(&a).into_iter().fold(0.0, f64::max).max(1e-300);
-            let schedule = ShiftSchedule {
-                initial: 1e-12 * max_diag,
-                growth: 100.0,
-                max_attempts: 6,
-            };
-            an.factor_with_growing_shift(&a, &vec![1.0; dim], schedule, Parallelism::Global)
-                .map_err(|_| {
-                    Error::Numerical(format!(
-                        "{what} is not positive definite (degenerate mesh?)"
-                    ))
-                })?
-        }
-    };
+    let a = std::sync::Arc::new(assemble(dim, entries, what)?);
+    let an = CholeskyAnalysis::new_stoppable(&a, tick)?;
+    let heavy = an.is_heavy();
+    if heavy {
+        tick()?;
+    }
+    let shared = a.clone();
+    let llt = run_stoppable(heavy, move || factor_or_shift(&an, &shared), tick)?.map_err(|_| {
+        Error::Numerical(format!(
+            "{what} is not positive definite (degenerate mesh?)"
+        ))
+    })?;
     rhs.iter()
         .map(|b| {
             let x = llt.solve(b);
