@@ -579,6 +579,11 @@ pub struct Evaluation {
     pub reference_pooled_psnr_db: f64,
 }
 
+/// One view's scores: the five per-view PSNR/IoU figures of [`evaluate`] (unlit, reference,
+/// shaded with and without the map, coverage IoU) and the (squared error, pixels) sums of the
+/// unlit bake and the reference, pooled over views afterwards.
+type ViewScores = ([Option<f64>; 5], [(f64, usize); 2]);
+
 /// Renders `app` and its baked level `level` from [`EvalParams::views`] views (see the [module
 /// docs](self)) and compares them.
 pub fn evaluate(app: &Appearance, level: &BakedLevel, params: &EvalParams) -> Evaluation {
@@ -595,7 +600,7 @@ pub fn evaluate(app: &Appearance, level: &BakedLevel, params: &EvalParams) -> Ev
         normal_map: false,
     };
     let has_map = level.material.normal.is_some() && level.tangents.is_some();
-    let per_view: Vec<([Option<f64>; 5], [(f64, usize); 2])> = cams
+    let per_view: Vec<ViewScores> = cams
         .par_iter()
         .map(|v| {
             let gi = rasterize(v, input.positions(), input.triangles());
