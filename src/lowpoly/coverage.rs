@@ -63,6 +63,11 @@ impl Coverage {
                     .max(floor)
             })
             .collect();
+        Coverage::from_samples(points, budget)
+    }
+
+    /// The coverage of `points` with their `budget`s: the box tree over `s ± b_s`, no refusals.
+    fn from_samples(points: Vec<Vec3>, budget: Vec<f64>) -> Coverage {
         let tree = BoxTree::new(points.iter().zip(&budget).map(|(&p, &b)| {
             let r = Vec3::new(b, b, b);
             (p - r, p + r)
@@ -149,16 +154,7 @@ mod tests {
     }
 
     fn coverage(points: Vec<Vec3>, budget: Vec<f64>) -> Coverage {
-        let tree = BoxTree::new(points.iter().zip(&budget).map(|(&p, &b)| {
-            let r = v(b, b, b);
-            (p - r, p + r)
-        }));
-        Coverage {
-            points,
-            budget,
-            tree,
-            refused: 0,
-        }
+        Coverage::from_samples(points, budget)
     }
 
     /// A sample at the origin with budget 1 under a triangle at height 0.5: lifting the
