@@ -458,6 +458,86 @@ fn input_plane_fit_keeps_an_open_tray_covered() {
     assert!(sf.hausdorff_in_to_out_rel <= allowed, "{sf:?}");
 }
 
+/// Brute-force smallest distance between two faces of `m` sharing no vertex (exact test for
+/// contact, then the closed-form distance of disjoint triangles; every pair, no pruning).
+fn min_non_adjacent_gap(m: &TriMesh) -> f64 {
+    use pleat::geom::Vec3;
+    use pleat::spatial::closest::disjoint_triangle_distance;
+    let t = m.triangles();
+    let mut best = f64::INFINITY;
+    for i in 0..t.len() {
+        for j in i + 1..t.len() {
+            if t[i].iter().any(|v| t[j].contains(v)) {
+                continue;
+            }
+            let (a, b) = (m.triangle_positions(i), m.triangle_positions(j));
+            if pleat::spatial::triangles_intersect(&a, &b) {
+                return 0.0;
+            }
+            let d = disjoint_triangle_distance(&a.map(Vec3::from), &b.map(Vec3::from), 0.0);
+            best = best.min(d);
+        }
+    }
+    best
+}
+
+/// A square `[0,1]²` grid of `n × n` quads at height `z`, facing `+z` or (`up` false) `−z`.
+fn square_sheet(n: u32, z: f64, up: bool) -> TriMesh {
+    let id = |i: u32, j: u32| j * (n + 1) + i;
+    let pos = (0..=n)
+        .flat_map(|j| {
+            (0..=n).map(move |i| [f64::from(i) / f64::from(n), f64::from(j) / f64::from(n), z])
+        })
+        .collect();
+    let mut tris = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if up {
+                tris.extend([[a, b, c], [a, c, d]]);
+            } else {
+                tris.extend([[a, c, b], [a, d, c]]);
+            }
+        }
+    }
+    TriMesh::new(pos, tris).unwrap()
+}
+
+/// Issue 11/12: a double-sided sheet thinner than `2d` (two parallel quads `0.2 d` apart, one
+/// facing up, one down) is not fitted into a LOD folded onto itself: the input-plane fit keeps
+/// every pair of faces sharing no vertex at least `FIT_SELF_CLEARANCE · d` apart, or no closer
+/// than the loop left them (the fit's guarantee), and the LOD stays valid (independent
+/// verification and `meshcheck`).
+#[test]
+fn input_plane_fit_keeps_a_thin_sheet_apart() {
+    let np = 40.0;
+    let gap = 0.2 * 2f64.sqrt() / np;
+    let m = union(&square_sheet(6, 0.0, false), &square_sheet(6, gap, true));
+    let (fit, sf) = bake(&m, &params(np), false).unwrap();
+    let without = LodParams {
+        fit_to_input: false,
+        ..params(np)
+    };
+    let (raw, sr) = bake(&m, &without, false).unwrap();
+    assert_valid(&fit, &sf, "thin sheet, fitted");
+    assert_valid(&raw, &sr, "thin sheet, not fitted");
+    let c = pleat::lowpoly::FIT_SELF_CLEARANCE * sf.d;
+    let (g_fit, g_raw) = (min_non_adjacent_gap(&fit), min_non_adjacent_gap(&raw));
+    eprintln!(
+        "thin sheet n_p = 40: d {:.5}, self-clearance {c:.5}; smallest gap between faces sharing \
+         no vertex: loop {g_raw:.3e}, fitted {g_fit:.3e}; faces {}; moves {}, reverted {}",
+        sf.d,
+        fit.triangle_count(),
+        sf.fit_moves,
+        sf.fit_reverted
+    );
+    assert!(sf.fit_moves > 0, "{sf:?}");
+    assert!(
+        g_fit >= c.min(g_raw),
+        "fitted gap {g_fit} < min({c}, {g_raw})"
+    );
+}
+
 /// The public corpus (`../shared/meshes` or `$PLEAT_MESHES`), inputs of at most 200k
 /// triangles, sorted by name.
 fn corpus_meshes() -> Vec<std::path::PathBuf> {

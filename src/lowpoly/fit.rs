@@ -29,7 +29,11 @@
 //!
 //! [`FIT_SWEEPS`] sweeps of {placement, flips}, then one last placement. Every operation passes
 //! the guard, so the mesh stays watertight, manifold, self-intersection-free and of the same
-//! topology, and the coverage check (`coverage.rs`): no line-search trial or flip may leave an
+//! topology; the guard also keeps the LOD's sheets [`SELF_CLEARANCE`]`·d` apart (its check 6:
+//! no operation brings a face within that distance of a face sharing no vertex with it, or
+//! closer than it was), so the two sides of an input sheet thinner than `2d`, which both
+//! project onto the sheet's plane, stop that far apart instead of collapsing onto each other;
+//! and the coverage check (`coverage.rs`): no line-search trial or flip may leave an
 //! input sample farther from the LOD than `max(`[`COVERAGE_FLOOR`]`·d, its distance before the
 //! fit)`, so the fit cannot pull the surface off a rim or a thin part of the input. The pipeline skips the fit for cages (a cage must stay outside the input) and
 //! reverts it when the measured Hausdorff distance grew (`pipeline.rs`).
@@ -66,6 +70,13 @@ pub const DRIFT_CAP: f64 = 1.0;
 /// The coverage floor, in `d`: no fit operation leaves an input sample farther from the LOD
 /// than `max(COVERAGE_FLOOR · d, its distance before the fit)` (`coverage.rs`).
 pub const COVERAGE_FLOOR: f64 = 1.0;
+
+/// The self-clearance of the fit, in `d`: no fit operation brings a LOD face closer than
+/// `SELF_CLEARANCE · d` to a face sharing no vertex with it, or closer than it already was
+/// (the guard's check 6). Without it, both sides of a double-sided sheet fit onto the same
+/// plane and the LOD folds onto itself, 10⁻⁶ apart (README, "The texture-coordinate test after
+/// the fit").
+pub const SELF_CLEARANCE: f64 = 0.25;
 
 /// Tikhonov weight `μ / tr A` of the placement (keeps unconstrained directions in place).
 pub const REGULARIZATION: f64 = 1e-2;
@@ -164,6 +175,18 @@ fn at(t: &[Vec3; 3], b: [f64; 3]) -> Vec3 {
 /// Runs the fit on the guard's mesh (a LOD: never call it in cage mode). `keep_going` is
 /// polled with the fraction done; `false` cancels.
 pub(crate) fn fit_to_input(
+    g: &mut Guard<'_>,
+    d: f64,
+    keep_going: &mut dyn FnMut(f64) -> bool,
+) -> Result<FitReport> {
+    g.set_self_clearance(SELF_CLEARANCE * d);
+    let r = fit_sweeps(g, d, keep_going);
+    g.set_self_clearance(0.0);
+    r
+}
+
+/// The sweeps of [`fit_to_input`] (module docs).
+fn fit_sweeps(
     g: &mut Guard<'_>,
     d: f64,
     keep_going: &mut dyn FnMut(f64) -> bool,

@@ -36,6 +36,12 @@
 //!    `c` of each face) is at least `c`, or — where the start surface already was closer — at
 //!    least the distance of the patch `M_e` replaces: no operation brings a cage face closer to
 //!    the input than `c`, and none makes an existing shortfall worse.
+//! 6. **Sheets kept apart** (LOD mode with a self-clearance `s > 0`, set by the input-plane fit,
+//!    `fit.rs`) — the exact distance (`disjoint_triangle_distance`, as in check 5) between every
+//!    face of `M_e` and every LOD face sharing no vertex with it is at least `s`, or at least
+//!    what it was for the patch `M_e` replaces: no operation brings two sheets of the surface
+//!    that are not neighbours within `s` of each other (a thin sheet's two sides projected onto
+//!    one plane, intersection-free only in floating point), and none makes a shortfall worse.
 
 use super::report::GuardCounts;
 use crate::geom::{bbox_of, normalized, tri_normal, Vec3};
@@ -240,6 +246,9 @@ pub(crate) enum Reject {
     /// Cage mode with a clearance: a modified face would come closer to the input than the
     /// clearance (and closer than the faces it replaces).
     Clearance,
+    /// LOD mode with a self-clearance: a modified face would come closer than it to a face
+    /// sharing no vertex with it (and closer than the faces it replaces).
+    SelfClearance,
 }
 
 /// The corners of face `f` as raw vertex indices (the BVH's triangle boundary).
@@ -267,8 +276,10 @@ pub(crate) struct GuardScratch {
     excluded: Vec<FaceId>,
     /// Vertices of `M_e` (after the operation).
     verts: Vec<VertexId>,
-    /// Geometry that `M_e` replaced (cage mode only).
+    /// Geometry that `M_e` replaced (cage mode and with a self-clearance only).
     old_patch: Vec<[[f64; 3]; 3]>,
+    /// Vertex ids of `old_patch`'s faces (same order).
+    old_ids: Vec<[VertexId; 3]>,
     normals: Vec<Vec3>,
     cand: Vec<FaceId>,
 }
@@ -285,6 +296,9 @@ pub(crate) struct Guard<'a> {
     /// Cage mode: the smallest distance to the input a modified face may have (model units;
     /// 0 = only "no contact").
     clearance: f64,
+    /// LOD mode: the smallest distance a modified face may have to a face sharing no vertex
+    /// with it (check 6; model units; 0 = off).
+    self_clearance: f64,
     exact_only: bool,
     cone_cos: f64,
     scratch: GuardScratch,
@@ -315,6 +329,7 @@ impl<'a> Guard<'a> {
             input,
             cage,
             clearance: 0.0,
+            self_clearance: 0.0,
             exact_only: false,
             cone_cos: CONE_HALF_ANGLE.cos(),
             scratch: GuardScratch::default(),
@@ -333,6 +348,30 @@ impl<'a> Guard<'a> {
     /// docs); 0, the initial value, only forbids contact.
     pub fn set_clearance(&mut self, c: f64) {
         self.clearance = c;
+    }
+
+    /// Sets the self-clearance `s` (model units, `≥ 0`) kept by moves, flips and collapses
+    /// outside cage mode (check 6 of the module docs); 0, the initial value, turns it off.
+    pub fn set_self_clearance(&mut self, s: f64) {
+        self.self_clearance = s;
+    }
+
+    /// Whether checks need the geometry an operation replaces (checks 4–6).
+    fn keeps_old_patch(&self) -> bool {
+        self.cage || self.self_clearance > 0.0
+    }
+
+    /// Records the faces `faces` as the patch an operation replaces (when a check needs it).
+    fn save_old_patch(&self, faces: impl Iterator<Item = FaceId>, s: &mut GuardScratch) {
+        s.old_patch.clear();
+        s.old_ids.clear();
+        if self.keeps_old_patch() {
+            let m = &self.mesh;
+            for f in faces {
+                s.old_patch.push(m.face_positions(f));
+                s.old_ids.push(m.face_vertices(f));
+            }
+        }
     }
 
     /// The clearance kept in cage mode (0 outside cage mode or when none was set).
@@ -359,12 +398,7 @@ impl<'a> Guard<'a> {
         self.flush_bvh();
         let old_p = self.mesh.position(v);
         let mut s = std::mem::take(&mut self.scratch);
-        s.old_patch.clear();
-        if self.cage {
-            let m = &self.mesh;
-            s.old_patch
-                .extend(m.vertex_faces(v).map(|f| m.face_positions(f)));
-        }
+        self.save_old_patch(self.mesh.vertex_faces(v), &mut s);
         if self.mesh.set_position(v, p).is_err() {
             self.scratch = s;
             return Err(Reject::Degenerate);
@@ -514,16 +548,8 @@ impl<'a> Guard<'a> {
             return Err(Reject::Topology);
         }
         let mut s = std::mem::take(&mut self.scratch);
-        s.old_patch.clear();
-        if self.cage {
-            let m = &self.mesh;
-            s.old_patch.extend(
-                [m.face(h), m.face(h.twin())]
-                    .into_iter()
-                    .flatten()
-                    .map(|f| m.face_positions(f)),
-            );
-        }
+        let m = &self.mesh;
+        self.save_old_patch([m.face(h), m.face(h.twin())].into_iter().flatten(), &mut s);
         let rec = self.mesh.flip_edge(h).expect("a flip that passed can_flip");
         self.fill_patch(rec.faces.into_iter(), &mut s);
         let mut st = GuardCounts::default();
@@ -604,6 +630,7 @@ impl<'a> Guard<'a> {
         s.m_1.clear();
         s.verts.clear();
         s.old_patch.clear();
+        s.old_ids.clear();
         s.excluded.clear();
         // M_e: the faces around a and b except the edge's own (the link condition makes those
         // the only faces with both endpoints).
@@ -613,8 +640,9 @@ impl<'a> Guard<'a> {
         ) {
             let fv = m.face_vertices(f);
             s.excluded.push(f);
-            if self.cage {
+            if self.keeps_old_patch() {
                 s.old_patch.push(fv.map(|u| m.position(u)));
+                s.old_ids.push(fv);
             }
             if dying.contains(&Some(f)) {
                 continue;
@@ -663,6 +691,7 @@ impl<'a> Guard<'a> {
             Err(Reject::TouchesInput) => st.rejected_touch += 1,
             Err(Reject::Uncovers) => st.rejected_uncover += 1,
             Err(Reject::Clearance) => st.rejected_clearance += 1,
+            Err(Reject::SelfClearance) => st.rejected_self_clearance += 1,
         }
         r
     }
@@ -680,6 +709,9 @@ impl<'a> Guard<'a> {
         }
         check_within_m1(s, cone_ok, st)?;
         self.check_against_rest(s, st)?;
+        if !self.cage && self.self_clearance > 0.0 {
+            self.check_self_clearance(s, st)?;
+        }
         if self.cage {
             if self.clearance > 0.0 {
                 self.check_clearance(s, st)?;
@@ -768,6 +800,51 @@ impl<'a> Guard<'a> {
             Ok(())
         } else {
             Err(Reject::Clearance)
+        }
+    }
+
+    /// Check 6 (LOD mode with self-clearance `s`): the faces of `M_e` are at least `s` from
+    /// every face sharing no vertex with them — the rest of `M_1` and the faces of `M_r` the
+    /// BVH finds within `s` of the old or new patch — or no closer than the patch they replace.
+    /// Runs after checks 2–3, so the new patch meets none of those faces.
+    fn check_self_clearance(&self, s: &GuardScratch, st: &mut GuardCounts) -> Result<(), Reject> {
+        let c = self.self_clearance;
+        let new: Vec<LodFace> = s.m_1[..s.n_e]
+            .iter()
+            .map(|f| (f.v, f.t.map(Vec3::from)))
+            .collect();
+        let old: Vec<LodFace> = s
+            .old_ids
+            .iter()
+            .zip(&s.old_patch)
+            .map(|(&v, t)| (v, t.map(Vec3::from)))
+            .collect();
+        let (lo, hi) = bbox(
+            s.m_1[..s.n_e]
+                .iter()
+                .flat_map(|f| f.t)
+                .chain(s.old_patch.iter().flatten().copied()),
+        );
+        let pad = Vec3::splat(c);
+        let mut others: Vec<LodFace> = s.m_1[s.n_e..]
+            .iter()
+            .map(|f| (f.v, f.t.map(Vec3::from)))
+            .collect();
+        others.extend(
+            self.bvh
+                .query_box((lo - pad).to_array(), (hi + pad).to_array())
+                .map(FaceId::new)
+                .filter(|&g| s.excluded.binary_search(&g).is_err() && self.mesh.is_face_live(g))
+                .map(|g| {
+                    let v = self.tris[g].map(VertexId::new);
+                    (v, v.map(|u| Vec3::from(self.mesh.position(u))))
+                }),
+        );
+        let new_gap = self_gap(&new, &others, c, st);
+        if new_gap >= c || new_gap >= self_gap(&old, &others, c, st) {
+            Ok(())
+        } else {
+            Err(Reject::SelfClearance)
         }
     }
 
@@ -884,6 +961,31 @@ fn patch_gap(
         }
     }
     Some(best)
+}
+
+/// A LOD face for check 6: vertex ids and corners.
+type LodFace = ([VertexId; 3], [Vec3; 3]);
+
+/// The smallest distance, capped at `cap`, between a face of `patch` and a face of `others`
+/// sharing no vertex with it (exact triangle–triangle distances; the pairs must not
+/// intersect, which checks 2–3 established for a new patch and the mesh's validity for an old
+/// one).
+fn self_gap(patch: &[LodFace], others: &[LodFace], cap: f64, st: &mut GuardCounts) -> f64 {
+    let mut best = cap;
+    for (pv, pt) in patch {
+        let pbox = bbox_of(pt.iter().copied());
+        for (ov, ot) in others {
+            if pv.iter().any(|v| ov.contains(v)) {
+                continue;
+            }
+            if box_gap(pbox, bbox_of(ot.iter().copied())) >= best {
+                continue;
+            }
+            st.exact_tests += 1;
+            best = best.min(disjoint_triangle_distance(pt, ot, 0.0));
+        }
+    }
+    best
 }
 
 /// Euclidean distance between two axis-aligned boxes (0 when they overlap): a lower bound of
@@ -1185,5 +1287,32 @@ pub(crate) mod tests {
             Err(Reject::Clearance)
         );
         assert_eq!(g.stats.rejected_clearance, 1);
+    }
+
+    /// Check 6: moving the unit cube's corner `(1, 1, 1)` down to `z = 0.2` brings face
+    /// `[4, 5, 7]` within 0.2 of bottom face `[0, 2, 3]` (at corner 3, below the moved
+    /// vertex), which shares no vertex with it: refused with a self-clearance of 0.3,
+    /// accepted with 0.1 or without one; from there, with 0.3, a move that shrinks the shortfall
+    /// (up to 0.25) is accepted and one that deepens it (down to 0.1) refused.
+    #[test]
+    fn self_clearance_keeps_sheets_apart() {
+        let m = cube(1.0, 0.0);
+        let input = InputModel::new(&m, false);
+        let low = [1.0, 1.0, 0.2];
+        for (c, ok) in [(0.0, true), (0.1, true), (0.3, false)] {
+            let mut g = guard_for(&m, &input, false);
+            g.set_self_clearance(c);
+            let r = g.try_move(VertexId::new(7), low);
+            assert_eq!(r.is_ok(), ok, "self-clearance {c}: {r:?}");
+            assert_eq!(g.stats.rejected_self_clearance, u64::from(!ok));
+        }
+        let mut g = guard_for(&m, &input, false);
+        assert!(g.try_move(VertexId::new(7), low).is_ok());
+        g.set_self_clearance(0.3);
+        assert!(g.try_move(VertexId::new(7), [1.0, 1.0, 0.25]).is_ok());
+        assert_eq!(
+            g.try_move(VertexId::new(7), [1.0, 1.0, 0.1]),
+            Err(Reject::SelfClearance)
+        );
     }
 }

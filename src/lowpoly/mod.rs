@@ -36,6 +36,7 @@ mod pipeline;
 mod report;
 mod simplify;
 
+pub use fit::SELF_CLEARANCE as FIT_SELF_CLEARANCE;
 pub use guard::CONE_HALF_ANGLE;
 pub use offset::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};
 pub use pipeline::{

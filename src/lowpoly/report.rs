@@ -101,6 +101,9 @@ pub struct GuardCounts {
     /// Rejected (cage with clearance): a face would come closer to the input than the
     /// clearance.
     pub rejected_clearance: u64,
+    /// Rejected (LOD with a self-clearance, the input-plane fit): a face would come closer to
+    /// a face sharing no vertex with it than the self-clearance.
+    pub rejected_self_clearance: u64,
     /// Patches whose normal cone allowed skipping the shared-vertex pairs.
     pub cone_fast_path: u64,
     /// Exact triangle–triangle tests run.
@@ -118,6 +121,7 @@ impl GuardCounts {
         self.rejected_touch += o.rejected_touch;
         self.rejected_uncover += o.rejected_uncover;
         self.rejected_clearance += o.rejected_clearance;
+        self.rejected_self_clearance += o.rejected_self_clearance;
         self.cone_fast_path += o.cone_fast_path;
         self.exact_tests += o.exact_tests;
     }
@@ -266,6 +270,7 @@ impl LodReport {
         if self.clearance.is_some() {
             e.count_entry("guard_rejected_clearance", g.rejected_clearance);
         }
+        e.count_entry("guard_rejected_self_clearance", g.rejected_self_clearance);
         e.count_entry("guard_cone_fast_path", g.cone_fast_path);
         e.count_entry("guard_exact_tests", g.exact_tests);
         e.count_entry("target_met", self.target_met as u64);
