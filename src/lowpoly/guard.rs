@@ -38,7 +38,8 @@
 //!    the input than `c`, and none makes an existing shortfall worse.
 //! 6. **Sheets kept apart** (LOD mode with a self-clearance `s > 0`, set by the input-plane fit,
 //!    `fit.rs`) — the exact distance (`disjoint_triangle_distance`, as in check 5) between every
-//!    face of `M_e` and every LOD face sharing no vertex with it is at least `s`, or at least
+//!    face of `M_e` and every LOD face sharing no vertex with it whose normal points more than
+//!    90° away from its own (two sides of a sheet) is at least `s`, or at least
 //!    what it was for the patch `M_e` replaces: no operation brings two sheets of the surface
 //!    that are not neighbours within `s` of each other (a thin sheet's two sides projected onto
 //!    one plane, intersection-free only in floating point), and none makes a shortfall worse.
@@ -804,7 +805,7 @@ impl<'a> Guard<'a> {
     }
 
     /// Check 6 (LOD mode with self-clearance `s`): the faces of `M_e` are at least `s` from
-    /// every face sharing no vertex with them — the rest of `M_1` and the faces of `M_r` the
+    /// every [`opposed`] face sharing no vertex with them — the rest of `M_1` and the faces of `M_r` the
     /// BVH finds within `s` of the old or new patch — or no closer than the patch they replace.
     /// Runs after checks 2–3, so the new patch meets none of those faces.
     fn check_self_clearance(&self, s: &GuardScratch, st: &mut GuardCounts) -> Result<(), Reject> {
@@ -963,11 +964,18 @@ fn patch_gap(
     Some(best)
 }
 
+/// Whether two faces' normals point more than 90° apart (`n_a · n_b < 0`): the two sides of a
+/// sheet or of a crevice, which check 6 keeps apart; faces across a crease of 90° or more,
+/// or on one side of a surface (a flat patch's slivers), are neighbours it leaves alone.
+fn opposed(a: &[Vec3; 3], b: &[Vec3; 3]) -> bool {
+    tri_normal(a[0], a[1], a[2]).dot(tri_normal(b[0], b[1], b[2])) < 0.0
+}
+
 /// A LOD face for check 6: vertex ids and corners.
 type LodFace = ([VertexId; 3], [Vec3; 3]);
 
-/// The smallest distance, capped at `cap`, between a face of `patch` and a face of `others`
-/// sharing no vertex with it (exact triangle–triangle distances; the pairs must not
+/// The smallest distance, capped at `cap`, between a face of `patch` and an [`opposed`] face
+/// of `others` sharing no vertex with it (exact triangle–triangle distances; the pairs must not
 /// intersect, which checks 2–3 established for a new patch and the mesh's validity for an old
 /// one).
 fn self_gap(patch: &[LodFace], others: &[LodFace], cap: f64, st: &mut GuardCounts) -> f64 {
@@ -975,7 +983,7 @@ fn self_gap(patch: &[LodFace], others: &[LodFace], cap: f64, st: &mut GuardCount
     for (pv, pt) in patch {
         let pbox = bbox_of(pt.iter().copied());
         for (ov, ot) in others {
-            if pv.iter().any(|v| ov.contains(v)) {
+            if pv.iter().any(|v| ov.contains(v)) || !opposed(pt, ot) {
                 continue;
             }
             if box_gap(pbox, bbox_of(ot.iter().copied())) >= best {
