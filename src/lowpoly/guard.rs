@@ -247,8 +247,8 @@ pub(crate) enum Reject {
     /// Cage mode with a clearance: a modified face would come closer to the input than the
     /// clearance (and closer than the faces it replaces).
     Clearance,
-    /// LOD mode with a self-clearance: a modified face would come closer than it to a face
-    /// sharing no vertex with it (and closer than the faces it replaces).
+    /// LOD mode with a self-clearance: a modified face would come closer than it to an opposed
+    /// face sharing no vertex with it (and closer than the faces it replaces).
     SelfClearance,
 }
 
@@ -351,8 +351,10 @@ impl<'a> Guard<'a> {
         self.clearance = c;
     }
 
-    /// Sets the self-clearance `s` (model units, `≥ 0`) kept by moves, flips and collapses
-    /// outside cage mode (check 6 of the module docs); 0, the initial value, turns it off.
+    /// Sets the self-clearance `s` (model units, `≥ 0`) kept outside cage mode by every
+    /// operation checked alone — moves, flips, `try_collapse` (check 6 of the module docs; the
+    /// simplification's batched collapses are not re-checked against each other for it, so only
+    /// the fit sets it); 0, the initial value, turns it off.
     pub fn set_self_clearance(&mut self, s: f64) {
         self.self_clearance = s;
     }
