@@ -39,7 +39,8 @@ mod simplify;
 pub use guard::CONE_HALF_ANGLE;
 pub use offset::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};
 pub use pipeline::{
-    generate, generate_chain, Clearance, LodParams, DEFAULT_CLEARANCE_FRACTION, FIT_HAUSDORFF_SLACK,
+    generate, generate_chain, Clearance, LodParams, DEFAULT_CLEARANCE_FRACTION,
+    FIT_HAUSDORFF_SLACK, LOD_VOXEL_SCALES,
 };
 #[cfg(feature = "cage")]
 pub(crate) use pipeline::{run, run_chain, Mode};
