@@ -155,6 +155,31 @@ const MAX_LOD_VOXEL_SCALE: f64 = LOD_VOXEL_SCALES[LOD_VOXEL_SCALES.len() - 1];
 /// 1010 B per estimated face; dirty_ogre at n_p = 200, 380 B. The former 400 B let the beetle
 /// at n_p = 1000 through an estimate of 2.2 GiB to a 5.9 GiB peak. 1100 B bounds both.
 const BYTES_PER_WORK_FACE: f64 = 1100.0;
+/// Peak bytes per input sample of the input-plane fit's coverage check (`coverage.rs`: the
+/// input sampled at `SPACING · d`, a budget and a box per sample, the tree over them), which
+/// grows like `n_p²` and does not depend on the offset voxel. Measured 2026-11-27:
+/// dirty_synth_flipped_s1 at n_p = 1000 (4.09 M samples) peaks at 1920 MiB in the fit where the
+/// loop before it peaked at 900 MiB: 487 B per sample over the input term.
+const BYTES_PER_FIT_SAMPLE: f64 = 500.0;
+/// Per-edge sample cap of the coverage check (`coverage::MAX_SUBDIVISIONS`).
+const FIT_MAX_SUBDIVISIONS: f64 = 32.0;
+
+/// Upper bound on the fit's coverage samples of `input` at offset distance `d`: the referenced
+/// vertices plus, per triangle, the `(k + 1)(k + 2)/2` barycentric points of resolution
+/// `k = ⌈longest edge / (SPACING · d)⌉ ≤ 32` (`verify::hausdorff::surface_samples`).
+fn fit_samples(input: &TriMesh, d: f64) -> f64 {
+    let spacing = super::coverage::SPACING * d;
+    let per_triangle: f64 = (0..input.triangle_count())
+        .map(|t| {
+            let [a, b, c] = input.triangle_positions(t).map(crate::geom::Vec3::from);
+            let e = a.distance(b).max(b.distance(c)).max(c.distance(a));
+            let k = (e / spacing).ceil().clamp(1.0, FIT_MAX_SUBDIVISIONS);
+            (k + 1.0) * (k + 2.0) / 2.0
+        })
+        .sum();
+    input.vertex_count() as f64 + per_triangle
+}
+
 /// Approximate bytes per input face (copy, BVH, flags, reader buffers). Measured 2026-11-27 as
 /// the peak RSS of `pleat lod --screen-size 8` (an offset surface of a few hundred faces) less
 /// the 8 MB of a tiny input, per input face: 700 B (cad_thingi10k_908460, 36k faces), 680 B
@@ -242,10 +267,11 @@ impl LodParams {
             .find(|&s| self.memory_estimate(input, s) <= budget)
     }
 
-    /// Estimated peak bytes: the input structures plus the offset surface, whose face count is
-    /// about `2 · area / h²` with voxel edge `h = voxel_scale · d/√3` (area of a thin part's
-    /// offset ≤ twice the input's, plus a sphere of radius `d` per component, bounded by the
-    /// box).
+    /// Estimated peak bytes: the input structures plus the larger of the loop's term — the
+    /// offset surface, whose face count is about `2 · area / h²` with voxel edge
+    /// `h = voxel_scale · d/√3` (area of a thin part's offset ≤ twice the input's, plus a
+    /// sphere of radius `d` per component, bounded by the box), at [`BYTES_PER_WORK_FACE`] —
+    /// and, with `fit_to_input`, the fit's coverage samples at [`BYTES_PER_FIT_SAMPLE`].
     fn memory_estimate(&self, input: &TriMesh, voxel_scale: f64) -> f64 {
         let l = input.bbox_diagonal();
         let d = l / self.screen_size;
@@ -255,7 +281,14 @@ impl LodParams {
         let ext: Vec<f64> = (0..3).map(|k| hi[k] - lo[k] + 2.0 * d).collect();
         let box_area = 2.0 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[0] * ext[2]);
         let faces = 2.0 * area.min(8.0 * box_area) / (h * h);
-        faces * BYTES_PER_WORK_FACE + input.triangle_count() as f64 * BYTES_PER_INPUT_FACE
+        let fit = if self.fit_to_input {
+            fit_samples(input, d) * BYTES_PER_FIT_SAMPLE
+        } else {
+            0.0
+        };
+        // the loop's peak and the fit's come one after the other (the fit's LOD is small)
+        (faces * BYTES_PER_WORK_FACE).max(fit)
+            + input.triangle_count() as f64 * BYTES_PER_INPUT_FACE
     }
 }
 
@@ -928,8 +961,20 @@ mod tests {
         let base = LodParams {
             screen_size: 10.0,
             max_rounds: 2,
+            fit_to_input: false,
             ..LodParams::default()
         };
+        // the fit's coverage samples are counted whatever the voxel
+        let fit = LodParams {
+            fit_to_input: true,
+            ..base.clone()
+        };
+        let samples = fit_samples(&m, m.bbox_diagonal() / 10.0);
+        assert!(samples >= 12.0 * 3.0 + 8.0);
+        for &s in &LOD_VOXEL_SCALES {
+            assert!(fit.memory_estimate(&m, s) >= samples * BYTES_PER_FIT_SAMPLE);
+            assert!(fit.memory_estimate(&m, s) >= base.memory_estimate(&m, s));
+        }
         // the estimate falls with the voxel scale (faces ∝ 1/scale²)
         for w in LOD_VOXEL_SCALES.windows(2) {
             assert!(base.memory_estimate(&m, w[1]) < base.memory_estimate(&m, w[0]));
