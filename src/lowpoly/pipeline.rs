@@ -93,7 +93,10 @@ pub struct LodParams {
     /// Minimum feature-curve length `l0` in edges (offset stage).
     pub l0: u32,
     /// Upper bound on the memory of the bake in bytes; estimated before the expensive work
-    /// starts, exceeding it fails with `Error::LimitExceeded`.
+    /// starts. A LOD whose estimate exceeds it at the default offset voxel takes the finest
+    /// coarser voxel of [`LOD_VOXEL_SCALES`] that fits (reported as
+    /// [`LodReport::offset_voxel_scale`]); beyond the coarsest (cages: beyond the default) it
+    /// fails with `Error::LimitExceeded` before any large allocation.
     pub memory_budget_bytes: u64,
     /// Run the feature-alignment step (Alg. 6). Default true.
     pub align: bool,
