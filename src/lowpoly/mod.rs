@@ -40,7 +40,8 @@ pub use fit::SELF_CLEARANCE as FIT_SELF_CLEARANCE;
 pub use guard::CONE_HALF_ANGLE;
 pub use offset::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};
 pub use pipeline::{
-    generate, generate_chain, Clearance, LodParams, DEFAULT_CLEARANCE_FRACTION, FIT_HAUSDORFF_SLACK,
+    generate, generate_chain, Clearance, LodParams, DEFAULT_CLEARANCE_FRACTION,
+    FIT_HAUSDORFF_SLACK, LOD_VOXEL_SCALES,
 };
 #[cfg(feature = "cage")]
 pub(crate) use pipeline::{run, run_chain, Mode};

@@ -93,7 +93,10 @@ pub struct LodParams {
     /// Minimum feature-curve length `l0` in edges (offset stage).
     pub l0: u32,
     /// Upper bound on the memory of the bake in bytes; estimated before the expensive work
-    /// starts, exceeding it fails with `Error::LimitExceeded`.
+    /// starts. A LOD whose estimate exceeds it at the default offset voxel takes the finest
+    /// coarser voxel of [`LOD_VOXEL_SCALES`] that fits (reported as
+    /// [`LodReport::offset_voxel_scale`]); beyond the coarsest (cages: beyond the default) it
+    /// fails with `Error::LimitExceeded` before any large allocation.
     pub memory_budget_bytes: u64,
     /// Run the feature-alignment step (Alg. 6). Default true.
     pub align: bool,
@@ -135,8 +138,51 @@ impl Default for LodParams {
     }
 }
 
-/// Approximate bytes per working-mesh face (half-edge records, BVH node, caches).
-const BYTES_PER_WORK_FACE: f64 = 400.0;
+/// Voxel scales (multiples of the offset stage's voxel edge `d/√3`, `OffsetParams::voxel_scale`)
+/// a LOD's offset surface may use, finest first: the finest whose memory estimate fits
+/// `memory_budget_bytes` is taken (issue 12 part 4), so every bake that fits at the default
+/// voxel is unchanged, and large screen sizes (n_p = 1000) trade offset resolution for memory
+/// (offset faces ∝ 1/scale²) instead of being refused. Cages keep scale 1: their offset must
+/// enclose the input without contact, and its vertices are only within `[d − h, d + h]` of the
+/// input. The largest scale, 2, still has a grid point within `√3·h/2 = d` of every input
+/// point, the limit below which no thin part is missed (dissertation Fig. 4.4; `OffsetParams`).
+pub const LOD_VOXEL_SCALES: [f64; 5] = [1.0, 1.25, 1.5, 1.75, 2.0];
+const MAX_LOD_VOXEL_SCALE: f64 = LOD_VOXEL_SCALES[LOD_VOXEL_SCALES.len() - 1];
+
+/// Peak bytes per *estimated* offset face ([`LodParams::memory_estimate`]'s face count): the
+/// first simplification pass holds the half-edge mesh, the guard's BVH and caches, the pass's
+/// per-edge targets, quadrics and queue, plus the offset surface kept for an exact rerun.
+/// Measured 2026-11-27 (issue 12 part 4): dirty_beetle at n_p = 1000 peaks at 6.38 GB (VmHWM)
+/// with 8.72 M offset faces (730 B per real face) where the estimate counted 6.3 M faces
+/// (thin legs: the offset of a thin part has far more area than twice the part's), i.e.
+/// 1010 B per estimated face; dirty_ogre at n_p = 200, 380 B. The former 400 B let the beetle
+/// at n_p = 1000 through an estimate of 2.2 GiB to a 5.9 GiB peak. 1100 B bounds both.
+const BYTES_PER_WORK_FACE: f64 = 1100.0;
+/// Peak bytes per input sample of the input-plane fit's coverage check (`coverage.rs`: the
+/// input sampled at `SPACING · d`, a budget and a box per sample, the tree over them), which
+/// grows like `n_p²` and does not depend on the offset voxel. Measured 2026-11-27:
+/// dirty_synth_flipped_s1 at n_p = 1000 (4.09 M samples) peaks at 1920 MiB in the fit where the
+/// loop before it peaked at 900 MiB: 487 B per sample over the input term.
+const BYTES_PER_FIT_SAMPLE: f64 = 500.0;
+/// Per-edge sample cap of the coverage check (`coverage::MAX_SUBDIVISIONS`).
+const FIT_MAX_SUBDIVISIONS: f64 = 32.0;
+
+/// Upper bound on the fit's coverage samples of `input` at offset distance `d`: the referenced
+/// vertices plus, per triangle, the `(k + 1)(k + 2)/2` barycentric points of resolution
+/// `k = ⌈longest edge / (SPACING · d)⌉ ≤ 32` (`verify::hausdorff::surface_samples`).
+fn fit_samples(input: &TriMesh, d: f64) -> f64 {
+    let spacing = super::coverage::SPACING * d;
+    let per_triangle: f64 = (0..input.triangle_count())
+        .map(|t| {
+            let [a, b, c] = input.triangle_positions(t).map(crate::geom::Vec3::from);
+            let e = a.distance(b).max(b.distance(c)).max(c.distance(a));
+            let k = (e / spacing).ceil().clamp(1.0, FIT_MAX_SUBDIVISIONS);
+            (k + 1.0) * (k + 2.0) / 2.0
+        })
+        .sum();
+    input.vertex_count() as f64 + per_triangle
+}
+
 /// Approximate bytes per input face (copy, BVH, flags, reader buffers). Measured 2026-11-27 as
 /// the peak RSS of `pleat lod --screen-size 8` (an offset surface of a few hundred faces) less
 /// the 8 MB of a tiny input, per input face: 700 B (cad_thingi10k_908460, 36k faces), 680 B
@@ -196,32 +242,56 @@ impl LodParams {
                 self.clearance
             ));
         }
-        let est = self.memory_estimate(input);
-        if est > self.memory_budget_bytes as f64 {
+        if self.offset_voxel_scale(input, Mode::Lod).is_none() {
+            let est = self.memory_estimate(input, MAX_LOD_VOXEL_SCALE);
             return Err(Error::LimitExceeded(format!(
-                "the bake needs about {:.0} MiB at screen size {} but the memory budget is \
-                 {:.0} MiB",
+                "the bake needs about {:.0} MiB at screen size {} (offset voxel {}× the default) \
+                 but the memory budget is {:.0} MiB",
                 est / (1u64 << 20) as f64,
                 self.screen_size,
+                MAX_LOD_VOXEL_SCALE,
                 self.memory_budget_bytes as f64 / (1u64 << 20) as f64
             )));
         }
         Ok(())
     }
 
-    /// Estimated peak bytes: the input structures plus the offset surface, whose face count is
-    /// about `2 · area / h²` with voxel edge `h = d/√3` (area of a thin part's offset ≤ twice
-    /// the input's, plus a sphere of radius `d` per component, bounded by the box).
-    fn memory_estimate(&self, input: &TriMesh) -> f64 {
+    /// The finest voxel scale of [`LOD_VOXEL_SCALES`] (cages: only 1) whose
+    /// [`memory_estimate`](Self::memory_estimate) fits the budget, or `None`.
+    fn offset_voxel_scale(&self, input: &TriMesh, mode: Mode) -> Option<f64> {
+        let scales: &[f64] = match mode {
+            Mode::Lod => &LOD_VOXEL_SCALES,
+            Mode::Cage => &LOD_VOXEL_SCALES[..1],
+        };
+        let budget = self.memory_budget_bytes as f64;
+        scales
+            .iter()
+            .copied()
+            .find(|&s| self.memory_estimate(input, s) <= budget)
+    }
+
+    /// Estimated peak bytes: the input structures plus the larger of the loop's term — the
+    /// offset surface, whose face count is about `2 · area / h²` with voxel edge
+    /// `h = voxel_scale · d/√3` (area of a thin part's offset ≤ twice the input's, plus a
+    /// sphere of radius `d` per component, bounded by the box), at [`BYTES_PER_WORK_FACE`] —
+    /// and, with `fit_to_input`, the fit's coverage samples at [`BYTES_PER_FIT_SAMPLE`].
+    fn memory_estimate(&self, input: &TriMesh, voxel_scale: f64) -> f64 {
         let l = input.bbox_diagonal();
         let d = l / self.screen_size;
-        let h = d / 3f64.sqrt();
+        let h = voxel_scale * d / 3f64.sqrt();
         let area = 2.0 * input.surface_area() + 4.0 * std::f64::consts::PI * d * d;
         let (lo, hi) = input.bbox();
         let ext: Vec<f64> = (0..3).map(|k| hi[k] - lo[k] + 2.0 * d).collect();
         let box_area = 2.0 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[0] * ext[2]);
         let faces = 2.0 * area.min(8.0 * box_area) / (h * h);
-        faces * BYTES_PER_WORK_FACE + input.triangle_count() as f64 * BYTES_PER_INPUT_FACE
+        let fit = if self.fit_to_input {
+            fit_samples(input, d) * BYTES_PER_FIT_SAMPLE
+        } else {
+            0.0
+        };
+        // the loop's peak and the fit's come one after the other (the fit's LOD is small)
+        (faces * BYTES_PER_WORK_FACE).max(fit)
+            + input.triangle_count() as f64 * BYTES_PER_INPUT_FACE
     }
 }
 
@@ -316,6 +386,7 @@ pub(crate) fn run(
     progress: &mut ProgressFn<'_>,
 ) -> Result<(TriMesh, LodReport)> {
     params.validate(input)?;
+    check_mode_budget(params, input, mode)?;
     let mut rep = Reporter::new(progress);
     // cancellation points between the setup's trees (each about 1 s on a 10⁶-face input)
     rep.check("setup", 0.0)?;
@@ -346,6 +417,7 @@ pub(crate) fn run_chain(
             ..params.clone()
         };
         p.validate(input)?;
+        check_mode_budget(&p, input, mode)?;
         level_params.push(p);
     }
     let mut order: Vec<usize> = (0..screen_sizes.len()).collect();
@@ -378,6 +450,20 @@ pub(crate) fn run_chain(
         .into_iter()
         .map(|x| x.expect("every level baked"))
         .collect())
+}
+
+/// Refuses, before any allocation, a bake whose memory estimate fits no voxel scale allowed in
+/// `mode` ([`LodParams::validate`] checks the LOD scales; cages allow only scale 1).
+fn check_mode_budget(p: &LodParams, input: &TriMesh, mode: Mode) -> Result<()> {
+    if p.offset_voxel_scale(input, mode).is_some() {
+        return Ok(());
+    }
+    Err(Error::LimitExceeded(format!(
+        "the bake needs about {:.0} MiB at screen size {} but the memory budget is {:.0} MiB",
+        p.memory_estimate(input, 1.0) / (1u64 << 20) as f64,
+        p.screen_size,
+        p.memory_budget_bytes as f64 / (1u64 << 20) as f64
+    )))
 }
 
 /// Whether a cage baked with `p` keeps a positive clearance (its sign does not depend on `d`).
@@ -428,8 +514,12 @@ fn bake_level(
     let (start, slack) = match finer {
         Some(m) => (m.clone(), d),
         None => {
-            let (m, dev) = initial_surface(level, params, d, rep)?;
+            let scale = params
+                .offset_voxel_scale(level.input, mode)
+                .ok_or_else(|| Error::LimitExceeded("over the memory budget".into()))?;
+            let (m, dev) = initial_surface(level, params, d, scale, rep)?;
             stats.offset_max_deviation_over_d = dev;
+            stats.offset_voxel_scale = (scale != 1.0).then_some(scale);
             (m, 0.0)
         }
     };
@@ -792,16 +882,19 @@ fn optimize(
 
 /// The start surface `M_d`: the offset surface of stage 1 (§4.3.1) at distance `d`, which is
 /// watertight, manifold and intersection-free, and encloses the input at distance about `d`,
-/// with its largest vertex deviation over `d`. In cage mode the enclosure and the absence of
+/// with its largest vertex deviation over `d`, on a voxel `voxel_scale` times the default
+/// ([`LOD_VOXEL_SCALES`]). In cage mode the enclosure and the absence of
 /// contact are checked here, since the guard only keeps them.
 fn initial_surface(
     level: &Level<'_>,
     params: &LodParams,
     d: f64,
+    voxel_scale: f64,
     rep: &mut Reporter<'_, '_>,
 ) -> Result<(TriMesh, Option<f64>)> {
     let op = OffsetParams {
         distance: OffsetDistance::Absolute(d),
+        voxel_scale,
         theta0_deg: params.theta0_deg,
         l0: params.l0,
         memory_budget_bytes: params.memory_budget_bytes,
@@ -838,4 +931,80 @@ fn initial_surface(
     }
     let deviation = ostats.verification.map(|v| v.max_deviation_over_d);
     Ok((mesh, deviation))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube() -> TriMesh {
+        let v = (0..8)
+            .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+            .collect();
+        let t = vec![
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        TriMesh::new(v, t).unwrap()
+    }
+
+    #[test]
+    fn a_budget_between_voxel_scales_coarsens_the_lod_and_refuses_the_cage() {
+        let m = cube();
+        let base = LodParams {
+            screen_size: 10.0,
+            max_rounds: 2,
+            fit_to_input: false,
+            ..LodParams::default()
+        };
+        // the fit's coverage samples are counted whatever the voxel
+        let fit = LodParams {
+            fit_to_input: true,
+            ..base.clone()
+        };
+        let samples = fit_samples(&m, m.bbox_diagonal() / 10.0);
+        assert!(samples >= 12.0 * 3.0 + 8.0);
+        for &s in &LOD_VOXEL_SCALES {
+            assert!(fit.memory_estimate(&m, s) >= samples * BYTES_PER_FIT_SAMPLE);
+            assert!(fit.memory_estimate(&m, s) >= base.memory_estimate(&m, s));
+        }
+        // the estimate falls with the voxel scale (faces ∝ 1/scale²)
+        for w in LOD_VOXEL_SCALES.windows(2) {
+            assert!(base.memory_estimate(&m, w[1]) < base.memory_estimate(&m, w[0]));
+        }
+        let p = LodParams {
+            memory_budget_bytes: base.memory_estimate(&m, 1.5).ceil() as u64,
+            ..base.clone()
+        };
+        assert_eq!(p.offset_voxel_scale(&m, Mode::Lod), Some(1.5));
+        assert_eq!(p.offset_voxel_scale(&m, Mode::Cage), None);
+        let (lod, rep) = run(&m, &p, Mode::Lod, &mut |_| true).unwrap();
+        assert_eq!(rep.offset_voxel_scale, Some(1.5));
+        assert!(rep.verified.all_hold(), "{:?}", rep.verified);
+        assert!(lod.triangle_count() >= 4);
+        // cages keep the default voxel: refused before any work
+        assert!(matches!(
+            run(&m, &p, Mode::Cage, &mut |_| true),
+            Err(Error::LimitExceeded(_))
+        ));
+        // below the coarsest scale's estimate: refused by validate
+        let tight = LodParams {
+            memory_budget_bytes: base.memory_estimate(&m, 2.0) as u64 - 1,
+            ..base.clone()
+        };
+        assert!(matches!(tight.validate(&m), Err(Error::LimitExceeded(_))));
+        // the default budget keeps the default voxel
+        let (_, rep) = run(&m, &base, Mode::Lod, &mut |_| true).unwrap();
+        assert_eq!(rep.offset_voxel_scale, None);
+    }
 }

@@ -167,6 +167,9 @@ pub struct LodReport {
     /// Largest distance of an offset-surface vertex from the `d`-iso-surface, over `d`
     /// (dimensionless); `None` in a chain level started from the finer level.
     pub offset_max_deviation_over_d: Option<f64>,
+    /// The offset stage's voxel edge over its default `d/√3` when the memory budget made the
+    /// LOD fall back to a coarser one (`lowpoly::LOD_VOXEL_SCALES`); `None` at the default.
+    pub offset_voxel_scale: Option<f64>,
     /// Faces of the start surface (offset surface, or the finer level in a chain).
     pub faces_offset: u64,
     /// Rounds of Alg. 3 run.
@@ -245,6 +248,9 @@ impl LodReport {
         e.metric_entry("d", self.d);
         if let Some(dev) = self.offset_max_deviation_over_d {
             e.metric_entry("offset_max_deviation_over_d", dev);
+        }
+        if let Some(s) = self.offset_voxel_scale {
+            e.metric_entry("offset_voxel_scale", s);
         }
         e.count_entry("faces_offset", self.faces_offset);
         e.metric_entry("simplify_first_pass_s", self.simplify_first_pass_seconds);
