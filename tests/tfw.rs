@@ -2308,7 +2308,8 @@ mod scene_speed {
         ]
     }
 
-    /// `(iterations, SQP seconds)` until stable (module docs), and the final waves and peak.
+    /// `(iterations, SQP seconds)` until stable (module docs), and the final waves and peak;
+    /// prints from which iteration on each criterion holds alone.
     fn stable_point(
         r: &TfwResult,
         params: &TfwParams,
@@ -2330,8 +2331,16 @@ mod scene_speed {
                 s.history[k - 1].energy
             }
         };
-        // walk back from the end over the checked snapshots while the answer equals the final
-        let mut stable = n;
+        let seconds_at = |k: usize| {
+            if k == 0 {
+                0.0
+            } else {
+                s.history[k - 1].seconds
+            }
+        };
+        // from which checked iteration on each criterion holds (walking back from the end)
+        let (mut kw, mut kp1, mut kp5, mut ke) = (n, n, n, n);
+        let (mut w_ok, mut p1_ok, mut p5_ok, mut e_ok) = (true, true, true, true);
         for (k, x) in s.snapshots.iter().rev() {
             if *k == n || k % every != 0 {
                 continue;
@@ -2345,20 +2354,35 @@ mod scene_speed {
             )
             .unwrap();
             let waves = count_waves(&cwf, levels, section).unwrap().waves;
-            let same = waves == final_waves
-                && (peak(a) - final_peak).abs() <= 1e-2 * final_peak
-                && (energy_at(*k) - final_e).abs() <= 1e-3 * final_e.abs();
-            if !same {
+            let dp = (peak(a) - final_peak).abs();
+            w_ok &= waves == final_waves;
+            p1_ok &= dp <= 1e-2 * final_peak;
+            p5_ok &= dp <= 5e-2 * final_peak;
+            e_ok &= (energy_at(*k) - final_e).abs() <= 1e-3 * final_e.abs();
+            for (ok, kk) in [
+                (w_ok, &mut kw),
+                (p1_ok, &mut kp1),
+                (p5_ok, &mut kp5),
+                (e_ok, &mut ke),
+            ] {
+                if ok {
+                    *kk = *k;
+                }
+            }
+            if !(w_ok || p1_ok || p5_ok || e_ok) {
                 break;
             }
-            stable = *k;
         }
-        let seconds = if stable == 0 {
-            0.0
-        } else {
-            s.history[stable - 1].seconds
-        };
-        (stable, seconds, final_waves, final_peak)
+        eprintln!(
+            "  from: waves {kw} it / {:.2} s, peak ±1 % {kp1} it / {:.2} s, peak ±5 % {kp5} it / \
+             {:.2} s, E ±1e-3 {ke} it / {:.2} s",
+            seconds_at(kw),
+            seconds_at(kp1),
+            seconds_at(kp5),
+            seconds_at(ke)
+        );
+        let stable = kw.max(kp1).max(ke);
+        (stable, seconds_at(stable), final_waves, final_peak)
     }
 
     fn run(case: &Case, qp: QpMethod, every: usize) {
