@@ -382,7 +382,7 @@ pub(super) fn defaults_without_tfw() -> PleatTfwParams {
         out_of_scope_slack_fraction: 0.5,
         curvature: PLEAT_TFW_CURVATURE_QUADRIC_FIT,
         reserved2: 0,
-        qp: PLEAT_TFW_QP_CLARABEL,
+        qp: PLEAT_TFW_QP_PROJECTED_NEWTON,
         reserved3: 0,
     }
 }
