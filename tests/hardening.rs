@@ -562,3 +562,53 @@ fn tfw_scene_fuzz_seeds_pass_the_targets_checks() {
         seeds.len()
     );
 }
+
+/// A pile of `n` near-copies of one triangle, each corner moved by up to ±1e-9 (a fixed
+/// pseudo-random jitter): every pair has touching boxes and is decided by the exact test.
+fn jittered_pile(n: u32) -> TriMesh {
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    let mut jitter = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % 2001) as f64 * 1e-12 - 1e-9
+    };
+    let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let p: Vec<[f64; 3]> = (0..n)
+        .flat_map(|_| corners)
+        .map(|c: [f64; 3]| c.map(|x| x + jitter()))
+        .collect();
+    let t = (0..n).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+    TriMesh::new(p, t).unwrap()
+}
+
+/// README "Not guaranteed": the self-intersection pass tests a pile of near-duplicate faces pair
+/// by pair. Measures, for a 20k-face jittered pile, the full report's time and the latency of a
+/// cancel requested 0.2 s into it (from the first `false` to the return).
+#[test]
+#[ignore = "measurement: cargo test --release --test hardening jittered -- --ignored --nocapture"]
+fn jittered_pile_report_time_and_cancel_latency() {
+    let m = jittered_pile(20_000);
+    let options = ReportOptions::default();
+    let t0 = Instant::now();
+    let mut calls = 0;
+    let full = MeshReport::compute_with_progress(&m, &options, &mut |_| {
+        calls += 1;
+        true
+    })
+    .expect("not cancelled");
+    println!(
+        "  20k jittered pile: report {:.2} s, {calls} progress calls, {:?} intersecting pairs",
+        t0.elapsed().as_secs_f64(),
+        full.n_self_intersecting_pairs
+    );
+    // the request is at 0.2 s; the callback sees it at its next call
+    let request = Duration::from_millis(200);
+    let t0 = Instant::now();
+    let r = MeshReport::compute_with_progress(&m, &options, &mut |_| t0.elapsed() < request);
+    let latency = t0.elapsed().saturating_sub(request).as_secs_f64();
+    println!(
+        "  cancel requested at 0.2 s: returned {latency:.2} s later (cancelled: {})",
+        r.is_none()
+    );
+}

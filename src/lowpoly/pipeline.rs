@@ -248,9 +248,11 @@ const MAX_COORDINATE_PER_VOXEL: f64 = 1_099_511_627_776.0;
 /// [`MIN_INPUT_EXTENT`] is `InvalidMesh`. A zero extent is left to the caller's "nothing to
 /// approximate". The message says which bound and how to get within it.
 fn check_coordinate_range(input: &TriMesh, screen_size: f64) -> Result<()> {
+    // Coordinates are finite (a `TriMesh` invariant) and the screen size finite and > 0
+    // (checked first), so `magnitude` is finite and `reach` at most +∞, never NaN.
     let (lo, hi) = input.bbox();
     let magnitude = lo.iter().chain(&hi).fold(0.0f64, |m, c| m.max(c.abs()));
-    if !(magnitude <= MAX_WORK_COORDINATE) {
+    if magnitude > MAX_WORK_COORDINATE {
         return Err(Error::LimitExceeded(format!(
             "the input's coordinates reach {magnitude:e}, beyond the supported ±{:.1e} (2^128): \
              the bake's exact predicates and estimates would overflow; scale the input down",
@@ -267,7 +269,7 @@ fn check_coordinate_range(input: &TriMesh, screen_size: f64) -> Result<()> {
     }
     let d = input.bbox_diagonal() / screen_size;
     let reach = magnitude + 2.0 * d;
-    if extent > 0.0 && !(reach <= MAX_WORK_COORDINATE) {
+    if extent > 0.0 && reach > MAX_WORK_COORDINATE {
         return Err(Error::LimitExceeded(format!(
             "the offset distance d = l / n_p = {d:.3e} takes the offset box to ±{reach:.3e}, \
              beyond the supported ±{:.1e} (2^128); raise the screen size or scale the input down",
