@@ -13,9 +13,9 @@
 //! panics still show), or long: it catches regressions on and near the seeds, the nightly
 //! campaign (`bash .ci/fuzz.sh`) finds new bugs.
 //!
-//! A finding panics with the target, the input's number and its bytes written to
-//! `target/fuzz-smoke/<target>-<n>.bin` (replay: copy it to `fuzz/regressions/` as
-//! `<target>-<what>.bin`). `PLEAT_FUZZ_SMOKE_SCALE=k` runs k times the executions (longer local
+//! A finding fails the target's test, naming the input (`seed-…`, `regression-…`,
+//! `mutant-<n>`) and writing its bytes to `target/tmp/fuzz-smoke/<target>-<input>.bin` (keep it
+//! as `fuzz/regressions/<target>-<what>.bin`, which `tests/hardening.rs` replays too). `PLEAT_FUZZ_SMOKE_SCALE=k` runs k times the executions (longer local
 //! runs; the inputs of the default run are a prefix of the longer one's).
 #![cfg(all(
     feature = "lod",
@@ -197,7 +197,7 @@ fn run_one(name: &str, target: fuzz::Target, label: &str, data: &[u8]) -> bool {
         Err(_) => {
             let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fuzz-smoke");
             std::fs::create_dir_all(&dir).expect("a directory for the finding");
-            let path = dir.join(format!("{name}-{label}.bin"));
+            let path = dir.join(format!("{name}-{}.bin", label.trim_end_matches(".bin")));
             std::fs::write(&path, data).expect("the finding written");
             panic!(
                 "fuzz target {name} failed on {label} ({} bytes, saved as {})",
