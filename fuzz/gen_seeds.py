@@ -252,6 +252,15 @@ def main():
     put("lod_bake", "cage", bytes([1, 4, 4]) + bytes(range(7, 130)))
     put("wrinkle_eval", "octa_levels", bytes([0]) + bytes([3]) * 60)
     put("wrinkle_eval", "octa_knoppel", bytes([8]) + bytes(range(2, 70)))
+    # inputs whose evaluation succeeds (the two above are refused by pleat_cwf_evaluate's
+    # parameter checks), so blind mutation (tests/fuzz_smoke.rs) starts next to the deep paths:
+    # per value `small()` reads a selector byte (< 250: a small value) and an i8 / 16
+    omega = [0, 8, 0, 248] * 6  # 12 edges: ±0.5
+    amp = [0, 16] * 6  # 6 vertices: 1/8
+    zeta = [0, 16, 0, 0] * 6  # z̃ = (1, 0)
+    tail = [2, 63, 0, 0, 1]  # levels 2, every field, fixed boundary, no angle, cap 2^14
+    put("wrinkle_eval", "octa_eval_ok", bytes([0] + omega + amp + zeta + tail))
+    put("wrinkle_eval", "octa_knoppel_eval_ok", bytes([8] + omega + amp + zeta + tail))  # z̃ read, not passed
 
     # TFW scene JSON: the small shipped examples (shrunk meshes, so an input meshes in
     # milliseconds), the others' features on tiny panels, and an explicit-array scene

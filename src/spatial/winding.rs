@@ -17,6 +17,13 @@
 //!   at worst near the surface (tested), far below the 0.5 inside/outside threshold.
 //!
 //! Queries on the surface itself are singular; their value is unspecified (finite).
+//!
+//! Scale: winding numbers do not change when the surface and the query are scaled together, so
+//! [`FastWindingNumber`] scales both by a power of two that brings the mesh's largest extent
+//! to about 1 (multiplying by a power of two is exact, so the values are those of the unscaled
+//! evaluation wherever it did not overflow, up to the last bit of `atan2`). Its second moments grow as the fourth power of the extent and its far field
+//! divides by `|y|⁷`, so without the scaling a mesh of extent ~10⁴⁴ or more gave `∞ / ∞ = NaN`
+//! (found by fuzzing, issue 15: a cage of extent 10⁵⁵ "did not enclose" its input).
 
 use rayon::prelude::*;
 
@@ -62,10 +69,13 @@ pub fn solid_angle(t: [[f64; 3]; 3], p: [f64; 3]) -> f64 {
 /// many times (`&self` queries are thread-safe).
 #[derive(Debug, Clone)]
 pub struct FastWindingNumber {
+    /// The mesh's positions times `scale`.
     positions: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
     nodes: Vec<Node>,
     beta: f64,
+    /// The power of two applied to positions and queries ([`extent_scale`]).
+    scale: f64,
 }
 
 /// Leaves hold at most this many triangles unless [`FastWindingNumber::with_options`] says.
@@ -134,7 +144,12 @@ impl FastWindingNumber {
     /// cost of more exact triangle evaluations per query near the surface.
     pub fn with_options(mesh: &TriMesh, beta: f64, leaf_size: usize) -> Self {
         let leaf_size = leaf_size.max(1);
-        let positions = mesh.positions().to_vec();
+        let scale = extent_scale(mesh.positions());
+        let positions: Vec<[f64; 3]> = mesh
+            .positions()
+            .iter()
+            .map(|p| p.map(|c| c * scale))
+            .collect();
         let triangles = mesh.triangles();
         let centroids: Vec<[f64; 3]> = triangles
             .par_iter()
@@ -155,11 +170,17 @@ impl FastWindingNumber {
             triangles,
             nodes,
             beta,
+            scale,
         }
     }
 
-    /// The approximate winding number at `p`.
+    /// The approximate winding number at `p` (0 for a point so far from the mesh, relative to
+    /// its extent, that its scaled coordinates overflow: it sees no solid angle).
     pub fn winding_number(&self, p: [f64; 3]) -> f64 {
+        let p = p.map(|c| c * self.scale);
+        if !p.iter().all(|c| c.is_finite()) {
+            return 0.0;
+        }
         self.eval(0, p) / (4.0 * std::f64::consts::PI)
     }
 
@@ -186,6 +207,26 @@ impl FastWindingNumber {
             }
         }
     }
+}
+
+/// The power of two `2^−e` that brings the largest bounding-box side of `positions` into
+/// `[1, 2)` (`e` clamped to ±1022 so the factor stays a normal number; 1 for an empty or
+/// non-finite box). Multiplying by it is exact unless a result underflows.
+fn extent_scale(positions: &[[f64; 3]]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    if !(extent.is_finite() && extent > 0.0) {
+        return 1.0;
+    }
+    let e = (extent.log2().floor() as i32).clamp(-1022, 1022);
+    2f64.powi(-e)
 }
 
 /// Far field to second order (three terms, as Barill et al. 2018 §3.2):
@@ -555,5 +596,40 @@ mod tests {
         for (e, a) in exact.iter().zip(&one) {
             assert!((e - a).abs() < 5e-3, "{e} vs {a}");
         }
+    }
+
+    /// Scaling the torus and the queries together by 2^k gives the same winding numbers, for
+    /// extents from 2^-120 to 2^180 (before the extent scaling, the far field's `y³ S / |y|⁷`
+    /// was `∞ / ∞ = NaN` from extents of about 10^44 on: issue 15's cage at 10^55).
+    #[test]
+    fn fast_winding_numbers_do_not_depend_on_scale() {
+        let t = torus(96, 48);
+        let points: Vec<[f64; 3]> = (0..40)
+            .map(|i| [-3.0 + 0.15 * i as f64, 0.2, 0.03 * (i % 5) as f64])
+            .collect();
+        let base = FastWindingNumber::new(&t).winding_numbers(&points);
+        for k in [-120, -40, 40, 120, 180] {
+            let s = 2f64.powi(k);
+            let (p, tris) = t.clone().into_parts();
+            let scaled = TriMesh::new(p.iter().map(|v| v.map(|c| c * s)).collect(), tris).unwrap();
+            let q: Vec<[f64; 3]> = points.iter().map(|v| v.map(|c| c * s)).collect();
+            let w = FastWindingNumber::new(&scaled).winding_numbers(&q);
+            for (a, b) in base.iter().zip(&w) {
+                assert!((a - b).abs() < 1e-12, "2^{k}: {a} vs {b}");
+            }
+        }
+        // a query overflowing the scaled frame sees nothing
+        let huge = TriMesh::new(
+            t.positions()
+                .iter()
+                .map(|v| v.map(|c| c * 1e-300))
+                .collect(),
+            t.triangles().to_vec(),
+        )
+        .unwrap();
+        assert_eq!(
+            FastWindingNumber::new(&huge).winding_number([1e300, 0.0, 0.0]),
+            0.0
+        );
     }
 }
