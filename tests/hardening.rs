@@ -351,6 +351,7 @@ mod lod_limits {
     /// front as beyond ±2^128, as is an input whose voxels are below its coordinates'
     /// precision. Inside the range, scales from 10⁻³⁰ to 10³⁰ and a tetrahedron 10¹⁰ from the
     /// origin bake to a cage and a LOD.
+    #[cfg(feature = "cage")]
     #[test]
     fn extreme_dynamic_range_is_refused_or_baked_never_an_internal_error() {
         let soup = TriMesh::new(

@@ -184,7 +184,7 @@ impl Cwf {
         }
         let out = stats
             .stages
-            .time(EvalStage::Displace, || finish(level, faces, opts));
+            .time(EvalStage::Displace, || finish(level, faces, opts))?;
         if !progress(Progress {
             stage: "displace",
             fraction: 1.0,
@@ -310,8 +310,10 @@ fn empty_topology() -> Topology {
     Topology::empty()
 }
 
-/// Normals, displacement and the optional outputs.
-fn finish(level: Level<'_>, faces: Vec<[u32; 3]>, opts: &EvalOptions) -> Evaluated {
+/// Normals, displacement and the optional outputs; `Numerical` when a displaced position is not
+/// finite (finite but huge amplitudes, scales or coordinates overflow `f64` in the upsampling
+/// or the displacement: found by fuzzing `wrinkle_eval`, issue 15).
+fn finish(level: Level<'_>, faces: Vec<[u32; 3]>, opts: &EvalOptions) -> crate::Result<Evaluated> {
     let normals = vertex_normals(&level.x, &faces);
     let s = opts.displacement_scale;
     let displaced: Vec<[f64; 3]> = level
@@ -330,7 +332,17 @@ fn finish(level: Level<'_>, faces: Vec<[u32; 3]>, opts: &EvalOptions) -> Evaluat
         .want_phase
         .then(|| level.z.par_iter().map(|z| z.arg()).collect());
     let has_omega = opts.want_omega && level.omega.len() == level.topo.n_edges();
-    Evaluated {
+    if let Some(v) = displaced
+        .iter()
+        .position(|p| p.iter().any(|c| !c.is_finite()))
+    {
+        return Err(crate::Error::Numerical(format!(
+            "the evaluated surface is not finite at vertex {v}: the amplitudes, the displacement \
+             scale or the coordinates are too large for f64 once upsampled and displaced; scale \
+             them down"
+        )));
+    }
+    Ok(Evaluated {
         mesh: TriMesh::new(displaced, faces).expect("refined meshes are valid"),
         amplitude: opts.want_amplitude.then_some(level.amplitude),
         phase,
@@ -338,7 +350,7 @@ fn finish(level: Level<'_>, faces: Vec<[u32; 3]>, opts: &EvalOptions) -> Evaluat
         smooth_positions: opts.want_z.then(|| level.x.clone()),
         z: opts.want_z.then_some(level.z),
         omega: has_omega.then_some(level.omega),
-    }
+    })
 }
 
 /// Adds the in-plane term of [`EvalOptions::in_plane_v2`] to `displaced`.
