@@ -944,6 +944,13 @@ typedef struct PleatMeshReport {
   double bbox_min[3];
   // Bounding-box maximum corner.
   double bbox_max[3];
+  // 1 when `self_intersecting_pair_count` is a lower bound, not the exact count: counting
+  // stops once 2²² exact tests have found an intersection (a pile of near-copies of one
+  // triangle; stacked exact copies are counted per group without using it up).
+  // `self_intersection_free` is exact (0) then. Appended 2026-11-27 (issue 15).
+  uint32_t self_intersecting_pair_count_is_lower_bound;
+  // Padding; written as 0.
+  uint32_t reserved;
 } PleatMeshReport;
 
 // Parameters of `pleat_tfw_solve`. Get the defaults from `pleat_tfw_params_default()`;

@@ -173,16 +173,12 @@ fn mutant(seeds: &[Vec<u8>], rng: &mut Rng) -> Vec<u8> {
 
 /// The files of `dir` whose names pass `keep`, sorted by name, with their bytes.
 fn files(dir: &Path, keep: impl Fn(&str) -> bool) -> Vec<(PathBuf, Vec<u8>)> {
-    let Ok(entries) = std::fs::read_dir(dir) else {
+    let Ok(paths) = fuzz::sorted_files(dir) else {
         return Vec::new();
     };
-    let mut paths: Vec<PathBuf> = entries
-        .map(|e| e.expect("a directory entry").path())
-        .filter(|p| p.is_file() && keep(&p.file_name().unwrap().to_string_lossy()))
-        .collect();
-    paths.sort();
     paths
         .into_iter()
+        .filter(|p| keep(&p.file_name().unwrap().to_string_lossy()))
         .map(|p| {
             let bytes = std::fs::read(&p).expect("readable input");
             (p, bytes)

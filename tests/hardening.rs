@@ -13,7 +13,7 @@ use pleat::Error;
 
 #[path = "common/shapes.rs"]
 mod shapes;
-use shapes::tiny_components;
+use shapes::{jittered_pile, tiny_components};
 
 /// Runs `f`, asserting it returns within `secs` seconds.
 fn within<T>(secs: u64, what: &str, f: impl FnOnce() -> T) -> T {
@@ -427,9 +427,8 @@ mod lod_limits {
 #[allow(dead_code)]
 mod fuzz;
 
-/// Every input in fuzz/regressions/ (`<target>-<what>.bin`) replayed through its target's
-/// checks: no panic, no `PLEAT_STATUS_INTERNAL`, the target's invariants. A file still named
-/// `-open` is a finding not fixed yet and fails here until it is.
+/// The committed fuzz inputs (regressions, seeds) through [`fuzz`]'s targets, which need
+/// every feature they use.
 #[cfg(all(
     feature = "lod",
     feature = "cage",
@@ -437,26 +436,50 @@ mod fuzz;
     feature = "io-gltf",
     feature = "tfw"
 ))]
-#[test]
-fn fuzz_regressions_pass_their_targets_checks() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions");
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .expect("fuzz/regressions/")
-        .map(|e| e.expect("an entry").path())
-        .collect();
-    files.sort();
-    assert!(
-        !files.is_empty(),
-        "no regression inputs in {}",
-        dir.display()
-    );
-    for path in &files {
-        let name = path.file_name().unwrap().to_string_lossy();
-        let (target, run) = fuzz::target_of_regression(&name)
-            .unwrap_or_else(|| panic!("{name}: not named <target>-<what>"));
-        let data = std::fs::read(path).expect("readable");
-        let accepted = within(60, &name, || run(&data));
-        println!("  {name}: target {target}, accepted: {accepted}");
+mod fuzz_inputs {
+    use super::{fuzz, within};
+
+    /// Every input in fuzz/regressions/ (`<target>-<what>.bin`) replayed through its target's
+    /// checks: no panic, no `PLEAT_STATUS_INTERNAL`, the target's invariants. A file still named
+    /// `-open` is a finding not fixed yet and fails here until it is.
+    #[test]
+    fn fuzz_regressions_pass_their_targets_checks() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions");
+        let files = fuzz::sorted_files(&dir).expect("fuzz/regressions/");
+        assert!(
+            !files.is_empty(),
+            "no regression inputs in {}",
+            dir.display()
+        );
+        for path in &files {
+            let name = path.file_name().unwrap().to_string_lossy();
+            let (target, run) = fuzz::target_of_regression(&name)
+                .unwrap_or_else(|| panic!("{name}: not named <target>-<what>"));
+            let data = std::fs::read(path).expect("readable");
+            let accepted = within(60, &name, || run(&data));
+            println!("  {name}: target {target}, accepted: {accepted}");
+        }
+    }
+
+    /// The `tfw_scene` fuzz target's checks (`fuzz::tfw_scene`, fuzz/src/lib.rs) on its committed
+    /// seeds: the Rust parser and `pleat_tfw_scene_from_json` agree on acceptance, no panic
+    /// reaches the C boundary, an accepted scene's JSON reads again, and a tiny accepted scene
+    /// assembles and gets a bounded base solve without a panic; at least 4 of the seeds are
+    /// accepted, so the target starts past the parser.
+    #[test]
+    fn tfw_scene_fuzz_seeds_pass_the_targets_checks() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/tfw_scene");
+        let seeds = fuzz::sorted_files(&dir).expect("the committed seeds");
+        assert!(seeds.len() >= 5, "{} seeds", seeds.len());
+        let accepted = seeds
+            .iter()
+            .filter(|path| fuzz::tfw_scene(&std::fs::read(path).expect("a readable seed")))
+            .count();
+        assert!(
+            accepted >= 4,
+            "{accepted} of {} seeds accepted",
+            seeds.len()
+        );
     }
 }
 
@@ -532,57 +555,6 @@ fn a_million_coincident_vertices_are_reported_and_baked() {
     lod_limits::bake_or_limit(&m, "10^6 coincident vertices");
 }
 
-/// The `tfw_scene` fuzz target's checks (`fuzz::tfw_scene`, fuzz/src/lib.rs) on its committed
-/// seeds: the Rust parser and `pleat_tfw_scene_from_json` agree on acceptance, no panic
-/// reaches the C boundary, an accepted scene's JSON reads again, and a tiny accepted scene
-/// assembles and gets a bounded base solve without a panic; at least 4 of the seeds are
-/// accepted, so the target starts past the parser.
-#[cfg(all(
-    feature = "lod",
-    feature = "cage",
-    feature = "wrinkle",
-    feature = "io-gltf",
-    feature = "tfw"
-))]
-#[test]
-fn tfw_scene_fuzz_seeds_pass_the_targets_checks() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/tfw_scene");
-    let mut seeds: Vec<_> = std::fs::read_dir(&dir)
-        .expect("the committed seeds")
-        .map(|e| e.expect("a seed").path())
-        .collect();
-    seeds.sort();
-    assert!(seeds.len() >= 5, "{} seeds", seeds.len());
-    let accepted = seeds
-        .iter()
-        .filter(|path| fuzz::tfw_scene(&std::fs::read(path).expect("a readable seed")))
-        .count();
-    assert!(
-        accepted >= 4,
-        "{accepted} of {} seeds accepted",
-        seeds.len()
-    );
-}
-
-/// A pile of `n` near-copies of one triangle, each corner moved by up to ±1e-9 (a fixed
-/// pseudo-random jitter): every pair has touching boxes and is decided by the exact test.
-fn jittered_pile(n: u32) -> TriMesh {
-    let mut state = 0x2545_F491_4F6C_DD1Du64;
-    let mut jitter = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state % 2001) as f64 * 1e-12 - 1e-9
-    };
-    let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-    let p: Vec<[f64; 3]> = (0..n)
-        .flat_map(|_| corners)
-        .map(|c: [f64; 3]| c.map(|x| x + jitter()))
-        .collect();
-    let t = (0..n).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
-    TriMesh::new(p, t).unwrap()
-}
-
 /// README "Not guaranteed": the self-intersection pass tests a pile of near-duplicate faces pair
 /// by pair. Measures, for a 20k-face jittered pile, the full report's time and the latency of a
 /// cancel requested 0.2 s into it (from the first `false` to the return).
@@ -599,10 +571,13 @@ fn jittered_pile_report_time_and_cancel_latency() {
     })
     .expect("not cancelled");
     println!(
-        "  20k jittered pile: report {:.2} s, {calls} progress calls, {:?} intersecting pairs",
+        "  20k jittered pile: report {:.2} s, {calls} progress calls, {:?} intersecting pairs \
+         (lower bound: {:?})",
         t0.elapsed().as_secs_f64(),
-        full.n_self_intersecting_pairs
+        full.n_self_intersecting_pairs,
+        full.n_self_intersecting_pairs_is_lower_bound
     );
+    assert_eq!(full.self_intersection_free, Some(false));
     // the request is at 0.2 s; the callback sees it at its next call
     let request = Duration::from_millis(200);
     let t0 = Instant::now();

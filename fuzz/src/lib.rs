@@ -51,6 +51,20 @@ pub fn target_of_regression(file_name: &str) -> Option<(&'static str, Target)> {
     TARGETS.iter().find(|(n, _)| *n == prefix).copied()
 }
 
+/// The regular files of `dir`, sorted by path (the seed and regression directories, read in
+/// a fixed order by `tests/hardening.rs` and `tests/fuzz_smoke.rs`).
+pub fn sorted_files(dir: &std::path::Path) -> std::io::Result<Vec<std::path::PathBuf>> {
+    let mut paths = Vec::new();
+    for entry in std::fs::read_dir(dir)? {
+        let path = entry?.path();
+        if path.is_file() {
+            paths.push(path);
+        }
+    }
+    paths.sort();
+    Ok(paths)
+}
+
 /// Reads little-endian numbers from the fuzz input; past the end it yields zeros, so every
 /// input, however short, drives the target to the end.
 pub struct Bytes<'a> {

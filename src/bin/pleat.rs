@@ -729,8 +729,13 @@ fn print_report(path: &std::path::Path, r: &MeshReport) {
     }
     match (r.self_intersection_free, r.n_self_intersecting_pairs) {
         (Some(free), Some(n)) => println!(
-            "  self-intersections  {} ({n} intersecting pairs)",
-            if free { "none" } else { "yes" }
+            "  self-intersections  {} ({}{n} intersecting pairs)",
+            if free { "none" } else { "yes" },
+            if r.n_self_intersecting_pairs_is_lower_bound == Some(true) {
+                "at least "
+            } else {
+                ""
+            }
         ),
         _ => println!("  self-intersections  not checked"),
     }

@@ -75,6 +75,13 @@ pub struct PleatMeshReport {
     pub bbox_min: [f64; 3],
     /// Bounding-box maximum corner.
     pub bbox_max: [f64; 3],
+    /// 1 when `self_intersecting_pair_count` is a lower bound, not the exact count: counting
+    /// stops once 2²² exact tests have found an intersection (a pile of near-copies of one
+    /// triangle; stacked exact copies are counted per group without using it up).
+    /// `self_intersection_free` is exact (0) then. Appended 2026-11-27 (issue 15).
+    pub self_intersecting_pair_count_is_lower_bound: u32,
+    /// Padding; written as 0.
+    pub reserved: u32,
 }
 
 fn to_c(r: &MeshReport) -> PleatMeshReport {
@@ -107,6 +114,10 @@ fn to_c(r: &MeshReport) -> PleatMeshReport {
         bbox_diagonal: r.bbox_diagonal,
         bbox_min: r.bbox_min,
         bbox_max: r.bbox_max,
+        self_intersecting_pair_count_is_lower_bound: r
+            .n_self_intersecting_pairs_is_lower_bound
+            .unwrap_or(false) as u32,
+        reserved: 0,
     }
 }
 

@@ -27,7 +27,7 @@
 //! cost one test, not `k(k−1)/2`. The listing functions return every pair, so their output (and
 //! time) stays quadratic in the copies.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
@@ -111,11 +111,25 @@ pub(crate) fn find_self_intersections_welded(
 /// [`find_self_intersections_welded`] without the list of pairs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub(crate) struct SelfIntersectionCounts {
-    /// Intersecting pairs of non-degenerate faces (`pairs.len()` of the listing pass).
+    /// Intersecting pairs of non-degenerate faces (`pairs.len()` of the listing pass); a lower
+    /// bound when [`pairs_is_lower_bound`](Self::pairs_is_lower_bound).
     pub pairs: u64,
+    /// True when counting stopped at the cap on exact tests that found an intersection
+    /// ([`MAX_COUNTED_HITS`]): `pairs` is then a lower bound (at least that many pairs
+    /// intersect), never an overestimate. `pairs > 0` then, so "no intersecting pair" stays
+    /// exact.
+    pub pairs_is_lower_bound: bool,
     /// Degenerate faces (`degenerate.len()` of the listing pass).
     pub degenerate: usize,
 }
+
+/// Exact tests that found an intersection after which [`count_self_intersections_welded`]
+/// stops counting (issue 15): a pile of near-copies of one face (20 000 copies with corners
+/// jittered by ±10⁻⁹: 1.5·10⁸ intersecting pairs, one exact test each, 63 CPU s) is then
+/// answered with a lower bound in about a second; the largest corpus count is 342 834
+/// (large_cycloidal_mid16), 12 times below the cap. Pairs of stacked exact copies are counted
+/// per group (no test each) and do not use up the cap.
+pub(crate) const MAX_COUNTED_HITS: u64 = 1 << 22;
 
 /// The counts of [`find_self_intersections_welded`], in time linear in the number of stacked
 /// copies of a face rather than quadratic (issue 15): the non-degenerate faces are grouped by
@@ -125,14 +139,20 @@ pub(crate) struct SelfIntersectionCounts {
 /// and only one representative per group enters the broad phase, a hit between the groups of
 /// sizes `k` and `m` counting `k·m` pairs. Faces of one group have the same corners and share
 /// the same vertices with any other face, so every one of those pairs gets the representatives'
-/// answer: the counts equal the listing pass's exactly.
+/// answer: the counts equal the listing pass's exactly, unless more than `max_hits` exact tests
+/// of the broad phase find an intersection: counting then stops after the first query face (in
+/// the chunks' fixed order) at which the tests that found one reach `max_hits`, and the count
+/// is a lower bound ([`SelfIntersectionCounts::pairs_is_lower_bound`]; the same for any number
+/// of threads).
 ///
 /// `keep_going(fraction)` is called on the calling thread after the grouping, after the trees
-/// and after each batch of chunk pairs of the traversal; `None` as soon as it returns `false`.
+/// and after each round of the traversal (about [`CANDIDATES_PER_ROUND`] candidate pairs, so
+/// also inside one pile of overlapping faces); `None` as soon as it returns `false`.
 pub(crate) fn count_self_intersections_welded(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
     weld: &ExactWeld,
+    max_hits: u64,
     keep_going: &mut dyn FnMut(f64) -> bool,
 ) -> Option<(SelfIntersectionCounts, SelfIntersectionTimes)> {
     let t0 = std::time::Instant::now();
@@ -157,6 +177,8 @@ pub(crate) fn count_self_intersections_welded(
     let across = chunks.weighted_count_where(
         |f, g| narrow.intersect(f, g),
         |f, g| u64::from(groups.size[f as usize]) * u64::from(groups.size[g as usize]),
+        max_hits,
+        CANDIDATES_PER_ROUND,
         &mut |f| keep_going(0.2 + 0.8 * f),
     )?;
     let times = SelfIntersectionTimes {
@@ -165,7 +187,8 @@ pub(crate) fn count_self_intersections_welded(
         pairs_and_tests: t0.elapsed().as_secs_f64(),
     };
     let counts = SelfIntersectionCounts {
-        pairs: inside + across,
+        pairs: inside + across.total,
+        pairs_is_lower_bound: across.capped,
         degenerate: degenerate.len(),
     };
     Some((counts, times))
@@ -310,14 +333,61 @@ const CHUNK_FACES: usize = 1 << 15;
 /// of 32k faces are about 0.14 CPU s (0.52 CPU s for the 31 trees of 10⁶ faces, 2026-11-27).
 const TREES_PER_BATCH: usize = 8;
 
+/// Candidate pairs (touching boxes, each query's tree visit counted as one more) per round of a
+/// large chunk pair in [`ChunkedBvh::weighted_count_where`] (and estimated per thread in a
+/// batch of small ones), between two cancellation points: about 0.18 CPU s when every
+/// candidate needs the full exact test (350 ns each on a pile of near-copies).
+const CANDIDATES_PER_ROUND: u64 = 1 << 19;
+
 /// Spatially coherent chunks of faces with one BVH each (parallel build and traversal).
-struct ChunkedBvh {
+struct ChunkedBvh<'a> {
     trees: Vec<TriangleBvh>,
+    /// The faces in Morton order; chunk `i` is `order[i * size..]`, `size` faces at most.
+    order: Vec<u32>,
+    size: usize,
+    positions: &'a [[f64; 3]],
+    welded: &'a [[u32; 3]],
 }
 
-impl ChunkedBvh {
+/// The result of [`ChunkedBvh::weighted_count_where`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct CappedCount {
+    /// The weighted sum over the pairs counted.
+    total: u64,
+    /// True when counting stopped at the cap before the last query face.
+    capped: bool,
+}
+
+/// A chunk pair of [`ChunkedBvh::weighted_count_where`]: query chunk `i`, tree `j` (`i ≤ j`),
+/// and its estimated candidate pairs.
+#[derive(Debug, Clone, Copy)]
+struct PairTask {
+    i: usize,
+    j: usize,
+    estimate: u64,
+}
+
+/// Faces of a chunk whose box queries estimate a chunk pair's candidates
+/// ([`ChunkedBvh::pair_tasks`]).
+const ESTIMATE_SAMPLES: usize = 64;
+
+/// One thread's share of a round of [`ChunkedBvh::weighted_count_where`].
+#[derive(Default)]
+struct RoundPart {
+    total: u64,
+    hits: u64,
+    /// `(query position, weighted sum, hits)` of its query faces with a hit.
+    per_face: Vec<(usize, u64, u64)>,
+}
+
+impl<'a> ChunkedBvh<'a> {
     /// About `faces.len() / chunk_faces` chunks (at least 1, at most 64).
-    fn new(positions: &[[f64; 3]], welded: &[[u32; 3]], faces: &[u32], chunk_faces: usize) -> Self {
+    fn new(
+        positions: &'a [[f64; 3]],
+        welded: &'a [[u32; 3]],
+        faces: &[u32],
+        chunk_faces: usize,
+    ) -> Self {
         Self::new_with_stop(positions, welded, faces, chunk_faces, &mut |_| true)
             .expect("never stopped")
     }
@@ -328,8 +398,8 @@ impl ChunkedBvh {
     /// of one piece of 0.5 CPU s at 10⁶ faces); `None` as soon as it returns `false`. The trees
     /// are those of one parallel build: each chunk's tree depends on its faces only.
     fn new_with_stop(
-        positions: &[[f64; 3]],
-        welded: &[[u32; 3]],
+        positions: &'a [[f64; 3]],
+        welded: &'a [[u32; 3]],
         faces: &[u32],
         chunk_faces: usize,
         keep_going: &mut dyn FnMut(f64) -> bool,
@@ -352,7 +422,13 @@ impl ChunkedBvh {
                 return None;
             }
         }
-        Some(ChunkedBvh { trees })
+        Some(ChunkedBvh {
+            trees,
+            order,
+            size,
+            positions,
+            welded,
+        })
     }
 
     /// The pairs `(f, g)`, `f < g`, of faces with touching boxes that pass `test`, sorted. Each
@@ -377,39 +453,222 @@ impl ChunkedBvh {
     }
 
     /// `Σ weight(f, g)` over the pairs `(f, g)`, `f < g`, of faces with touching boxes that
-    /// pass `test` (each visited once, as in [`pairs_where`](Self::pairs_where)). Chunk pairs
-    /// are processed in parallel in batches, with `keep_going(fraction)` on the calling thread
-    /// after each batch; `None` as soon as it returns `false`. An integer sum: the same
-    /// whatever the number of threads.
+    /// pass `test` (each counted once, as in [`pairs_where`](Self::pairs_where)), chunk pair
+    /// by chunk pair in a fixed order ([`pair_tasks`](Self::pair_tasks)), with
+    /// `keep_going(fraction)` on the calling thread between pieces of about
+    /// `round_candidates` candidate pairs per thread; `None` as soon as it returns `false`.
+    /// A chunk pair estimated at most `2 · round_candidates` candidates is traversed as one piece
+    /// (tree against tree, consecutive such pairs in parallel); a larger one (a pile of
+    /// overlapping faces: issue 15) by one box query per face of its first chunk, in rounds
+    /// of about `round_candidates` candidates ([`count_round`](Self::count_round)).
+    ///
+    /// Counting stops at the first chunk pair (or, inside a large one, query face) in that
+    /// order at which the tests passed reach `max_hits`; the total then covers what came
+    /// before it and it (`capped` when more remains). Every piece's contribution is an
+    /// integer that does not depend on who computes it, so the result is the same whatever
+    /// the number of threads.
     fn weighted_count_where(
         &self,
         test: impl Fn(u32, u32) -> bool + Sync,
         weight: impl Fn(u32, u32) -> u64 + Sync,
+        max_hits: u64,
+        round_candidates: u64,
         keep_going: &mut dyn FnMut(f64) -> bool,
-    ) -> Option<u64> {
-        let n = self.trees.len();
-        let tasks: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
-        let mut total = 0u64;
-        let mut done = 0;
-        for batch in tasks.chunks(n.max(1)) {
-            total += batch
+    ) -> Option<CappedCount> {
+        let max_hits = max_hits.max(1);
+        let tasks = self.pair_tasks();
+        let light = |t: &PairTask| t.estimate <= 2 * round_candidates;
+        let budget = round_candidates * rayon::current_num_threads() as u64;
+        let (mut total, mut hits, mut k) = (0u64, 0u64, 0usize);
+        while k < tasks.len() {
+            if !light(&tasks[k]) {
+                let t = tasks[k];
+                let len = self.chunk(t.i).len();
+                let mut start = 0;
+                while start < len {
+                    let (end, parts) = self.count_round(t, start, round_candidates, &test, &weight);
+                    let round_hits: u64 = parts.iter().map(|p| p.hits).sum();
+                    if hits + round_hits >= max_hits {
+                        // Resolved at the first query face in order that reaches the cap.
+                        let mut per_face: Vec<(usize, u64, u64)> =
+                            parts.into_iter().flat_map(|p| p.per_face).collect();
+                        per_face.sort_unstable();
+                        for (q, w, h) in per_face {
+                            total += w;
+                            hits += h;
+                            if hits >= max_hits {
+                                let capped = q + 1 < len || k + 1 < tasks.len();
+                                return Some(CappedCount { total, capped });
+                            }
+                        }
+                        unreachable!("the round's hits reach the cap");
+                    }
+                    total += parts.iter().map(|p| p.total).sum::<u64>();
+                    hits += round_hits;
+                    start = end;
+                    let done = (k as f64 + start as f64 / len as f64) / tasks.len() as f64;
+                    if !keep_going(done) {
+                        return None;
+                    }
+                }
+                k += 1;
+                continue;
+            }
+            let mut end = k + 1;
+            let mut sum = tasks[k].estimate;
+            while end < tasks.len() && light(&tasks[end]) && sum + tasks[end].estimate <= budget {
+                sum += tasks[end].estimate;
+                end += 1;
+            }
+            let per_task: Vec<(u64, u64)> = tasks[k..end]
                 .par_iter()
-                .map(|&(i, j)| {
-                    let mut sum = 0u64;
-                    self.for_each_pair(i, j, |f, g| {
+                .map(|t| {
+                    let (mut w, mut h) = (0u64, 0u64);
+                    self.for_each_pair(t.i, t.j, |f, g| {
                         if test(f, g) {
-                            sum += weight(f, g);
+                            w += weight(f, g);
+                            h += 1;
                         }
                     });
-                    sum
+                    (w, h)
                 })
-                .sum::<u64>();
-            done += batch.len();
-            if !keep_going(done as f64 / tasks.len() as f64) {
+                .collect();
+            for (idx, (w, h)) in per_task.into_iter().enumerate() {
+                total += w;
+                hits += h;
+                if hits >= max_hits {
+                    let capped = k + idx + 1 < tasks.len();
+                    return Some(CappedCount { total, capped });
+                }
+            }
+            k = end;
+            if !keep_going(k as f64 / tasks.len() as f64) {
                 return None;
             }
         }
-        Some(total)
+        Some(CappedCount {
+            total,
+            capped: false,
+        })
+    }
+
+    /// The faces of chunk `i` (Morton order).
+    fn chunk(&self, i: usize) -> &[u32] {
+        let lo = (i * self.size).min(self.order.len());
+        &self.order[lo..(lo + self.size).min(self.order.len())]
+    }
+
+    /// The chunk pairs `(i, j)`, `i ≤ j`, whose bounds touch, in order, each with an estimate
+    /// of its candidate pairs: the mean number of faces of tree `j` whose boxes touch one of
+    /// [`ESTIMATE_SAMPLES`] evenly spaced faces of chunk `i`, times the faces of chunk `i`
+    /// (pairs inside one chunk counted from both sides). Deterministic; a group of heavy
+    /// faces that no sample meets is smaller than `1 / ESTIMATE_SAMPLES` of the chunk.
+    fn pair_tasks(&self) -> Vec<PairTask> {
+        let later = self.touching_later_chunks();
+        let pairs: Vec<(usize, usize)> = (0..self.trees.len())
+            .flat_map(|i| {
+                std::iter::once(i)
+                    .chain(later[i].iter().copied())
+                    .map(move |j| (i, j))
+            })
+            .collect();
+        pairs
+            .into_par_iter()
+            .map(|(i, j)| {
+                let faces = self.chunk(i);
+                let samples = faces.len().clamp(1, ESTIMATE_SAMPLES);
+                let seen: u64 = (0..samples)
+                    .map(|s| {
+                        let (lo, hi) = self.face_box(faces[s * faces.len() / samples]);
+                        self.trees[j].query_box(lo, hi).count() as u64
+                    })
+                    .sum();
+                let estimate = (seen * faces.len() as u64).div_ceil(samples as u64);
+                PairTask { i, j, estimate }
+            })
+            .collect()
+    }
+
+    /// The box of face `f`'s welded corners.
+    fn face_box(&self, f: u32) -> ([f64; 3], [f64; 3]) {
+        corners_box(&self.welded[f as usize].map(|v| self.positions[v as usize]))
+    }
+
+    /// One round of a large chunk pair `t` of [`weighted_count_where`](Self::weighted_count_where):
+    /// the faces of chunk `t.i` from position `start`, claimed in order by the pool's threads
+    /// until about `round_candidates` candidates are spent, each queried against tree `t.j`;
+    /// the end of the claimed positions and each thread's share.
+    fn count_round(
+        &self,
+        t: PairTask,
+        start: usize,
+        round_candidates: u64,
+        test: &(impl Fn(u32, u32) -> bool + Sync),
+        weight: &(impl Fn(u32, u32) -> u64 + Sync),
+    ) -> (usize, Vec<RoundPart>) {
+        let faces = self.chunk(t.i);
+        let next = AtomicUsize::new(start);
+        let spent = AtomicU64::new(0);
+        let parts: Vec<RoundPart> = (0..rayon::current_num_threads())
+            .into_par_iter()
+            .map(|_| {
+                let mut part = RoundPart::default();
+                while spent.load(Ordering::Relaxed) < round_candidates {
+                    let q = next.fetch_add(1, Ordering::Relaxed);
+                    if q >= faces.len() {
+                        break;
+                    }
+                    let (sum, h, candidates) = self.count_face(faces[q], t, test, weight);
+                    spent.fetch_add(candidates, Ordering::Relaxed);
+                    if h > 0 {
+                        part.per_face.push((q, sum, h));
+                        part.total += sum;
+                        part.hits += h;
+                    }
+                }
+                part
+            })
+            .collect();
+        (next.load(Ordering::Relaxed).min(faces.len()), parts)
+    }
+
+    /// For face `f` of chunk `t.i`: `(Σ weight, tests passed, candidates visited + 1)` over
+    /// its partners with touching boxes in tree `t.j` (only `g > f` when `t.j == t.i`).
+    fn count_face(
+        &self,
+        f: u32,
+        t: PairTask,
+        test: &impl Fn(u32, u32) -> bool,
+        weight: &impl Fn(u32, u32) -> u64,
+    ) -> (u64, u64, u64) {
+        let (lo, hi) = self.face_box(f);
+        let (mut sum, mut hits, mut candidates) = (0u64, 0u64, 1u64);
+        for g in self.trees[t.j].query_box(lo, hi) {
+            if t.j == t.i && g <= f {
+                continue;
+            }
+            candidates += 1;
+            let (a, b) = (f.min(g), f.max(g));
+            if test(a, b) {
+                sum += weight(a, b);
+                hits += 1;
+            }
+        }
+        (sum, hits, candidates)
+    }
+
+    /// Per chunk `i`: the chunks `j > i` whose bounds touch its bounds.
+    fn touching_later_chunks(&self) -> Vec<Vec<usize>> {
+        let bounds: Vec<_> = self.trees.iter().map(TriangleBvh::bounds).collect();
+        let touch = |i: usize, j: usize| match (bounds[i], bounds[j]) {
+            (Some((alo, ahi)), Some((blo, bhi))) => {
+                (0..3).all(|k| alo[k] <= bhi[k] && blo[k] <= ahi[k])
+            }
+            _ => false,
+        };
+        (0..self.trees.len())
+            .map(|i| (i + 1..self.trees.len()).filter(|&j| touch(i, j)).collect())
+            .collect()
     }
 
     /// Whether some pair of faces with touching boxes passes `test`. Chunk pairs are processed
@@ -555,15 +814,128 @@ mod tests {
                 "chunk size {chunk_faces}"
             );
             let mut calls = 0;
+            let weight = |f: u32, g: u32| u64::from(f + g);
             let count =
-                chunked.weighted_count_where(|_, _| true, |f, g| u64::from(f + g), &mut |_| {
+                chunked.weighted_count_where(|_, _| true, weight, u64::MAX, 1 << 10, &mut |_| {
                     calls += 1;
                     true
                 });
             let want: u64 = single.iter().map(|&(f, g)| u64::from(f + g)).sum();
-            assert_eq!(count, Some(want), "chunk size {chunk_faces}");
-            assert!(calls >= chunked.trees.len().div_ceil(2));
+            let exact = CappedCount {
+                total: want,
+                capped: false,
+            };
+            assert_eq!(count, Some(exact), "chunk size {chunk_faces}");
+            assert!(calls >= 1);
         }
+    }
+
+    /// `n` copies of one triangle, each corner moved independently by up to ±10⁻⁹: a pile of
+    /// near-copies (no two faces share a vertex), one chunk, most pairs intersecting.
+    fn jittered_pile(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut jitter = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % 2001) as f64 * 1e-12 - 1e-9
+        };
+        let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let p = (0..n)
+            .flat_map(|_| corners)
+            .map(|c: [f64; 3]| c.map(|x| x + jitter()))
+            .collect();
+        let t = (0..n).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        (p, t)
+    }
+
+    #[test]
+    fn a_pile_is_counted_in_rounds_and_capped_the_same_way_for_any_thread_count() {
+        let (p, t) = jittered_pile(300);
+        let listed = find_self_intersections_in(&p, &t).pairs.len() as u64;
+        assert!(listed > 20_000, "{listed}");
+        let faces: Vec<u32> = (0..t.len() as u32).collect();
+        let narrow = Narrow {
+            positions: &p,
+            welded: &t,
+        };
+        let count = |max_hits: u64, round: u64, threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let chunks = ChunkedBvh::new(&p, &t, &faces, CHUNK_FACES);
+                let mut calls = 0;
+                let c = chunks.weighted_count_where(
+                    |f, g| narrow.intersect(f, g),
+                    |_, _| 1,
+                    max_hits,
+                    round,
+                    &mut |_| {
+                        calls += 1;
+                        true
+                    },
+                );
+                (c.expect("not cancelled"), calls)
+            })
+        };
+        let exact = CappedCount {
+            total: listed,
+            capped: false,
+        };
+        // rounds of 64 and 4096: the chunk pair is large (estimated 9·10⁴ candidates), counted
+        // face by face and capped at the first face reaching 5000 hits; rounds of 2¹⁹: one
+        // small piece, counted whole (the cap is reached at its end: exact)
+        let (capped, _) = count(5000, 64, 1);
+        assert!(capped.capped && (5000..listed).contains(&capped.total));
+        for threads in [1, 3] {
+            for round in [64, 4096, 1 << 19] {
+                let (c, calls) = count(u64::MAX, round, threads);
+                assert_eq!(c, exact, "{threads} threads, rounds of {round}");
+                if round == 64 {
+                    // one chunk, yet many cancellation points
+                    assert!(calls > 50, "{calls}");
+                }
+                let want = if round < 1 << 19 { capped } else { exact };
+                assert_eq!(count(5000, round, threads).0, want);
+                assert_eq!(count(listed, round, threads).0.total, listed);
+            }
+        }
+        // a cancel inside the chunk's pairs is answered at the next round
+        let chunks = ChunkedBvh::new(&p, &t, &faces, CHUNK_FACES);
+        let mut calls = 0;
+        let stopped = chunks.weighted_count_where(
+            |f, g| narrow.intersect(f, g),
+            |_, _| 1,
+            u64::MAX,
+            64,
+            &mut |_| {
+                calls += 1;
+                calls < 3
+            },
+        );
+        assert_eq!((stopped, calls), (None, 3));
+        // through the counting pass: the exact count, or a lower bound at the cap
+        let weld = ExactWeld::compute(&p);
+        let run = |max_hits| {
+            count_self_intersections_welded(&p, &t, &weld, max_hits, &mut |_| true)
+                .unwrap()
+                .0
+        };
+        let full = run(u64::MAX);
+        assert_eq!((full.pairs, full.pairs_is_lower_bound), (listed, false));
+        assert_eq!(run(5000), full, "one small piece, counted whole");
+        // a pile estimated beyond 2²⁰ candidates is counted face by face and stops at the cap
+        let (p, t) = jittered_pile(1500);
+        let weld = ExactWeld::compute(&p);
+        let low = count_self_intersections_welded(&p, &t, &weld, 5000, &mut |_| true)
+            .unwrap()
+            .0;
+        assert!(
+            low.pairs_is_lower_bound && (5000..7000).contains(&low.pairs),
+            "{low:?}"
+        );
     }
 
     #[test]

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use crate::mesh::{ExactWeld, TriMesh};
 use crate::report::{Stage, StageTimes};
 use crate::spatial::is_collinear;
-use crate::spatial::self_intersect::count_self_intersections_welded;
+use crate::spatial::self_intersect::{count_self_intersections_welded, MAX_COUNTED_HITS};
 
 /// What [`MeshReport::compute_with`] computes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -156,6 +156,16 @@ pub struct MeshReport {
     /// cost does not grow with the square of the copies (250 000 copies of a tetrahedron:
     /// 124 999 500 000 pairs, counted in about a second).
     pub n_self_intersecting_pairs: Option<usize>,
+    /// True when [`Self::n_self_intersecting_pairs`] is a lower bound rather than the exact
+    /// count: the pass stops counting once 2²² exact tests have found an intersection (issue
+    /// 15: a pile of 20 000 near-copies of one face has 1.5·10⁸ intersecting pairs, each
+    /// needing its own test; stacked exact copies are counted per group and do not use the
+    /// cap). The count is then at least that large and [`Self::self_intersection_free`] is
+    /// still exact (`false`). Deterministic: the same for any number of threads. `None` when
+    /// the pass was skipped. In [`Self::to_json`] only when `true`
+    /// (`n_self_intersecting_pairs_is_lower_bound`, after `self_intersection_free`), so the line
+    /// stays meshcheck's whenever the count is exact.
+    pub n_self_intersecting_pairs_is_lower_bound: Option<bool>,
     /// Degenerate triangles after exact welding (equal to [`Self::n_degenerate_faces`], since
     /// welding moves no point); `None` when the pass was skipped (`n_degenerate_faces_welded`).
     pub n_degenerate_faces_welded: Option<usize>,
@@ -232,9 +242,9 @@ impl MeshReport {
 
     /// The report with the given options and a progress callback (a cancellation point),
     /// called on the calling thread with the fraction done after each phase and, in the
-    /// self-intersection pass, after each batch of chunk pairs (at most 10⁶ faces' worth of
-    /// work between two calls; issue 15); `None` as soon as it returns `false`. When not
-    /// cancelled, the same report as [`Self::compute_with`].
+    /// self-intersection pass, after each batch of chunk trees and of about 2¹⁹ candidate
+    /// pairs per thread, also inside one pile of overlapping faces (issue 15); `None` as soon
+    /// as it returns `false`. When not cancelled, the same report as [`Self::compute_with`].
     pub fn compute_with_progress(
         mesh: &TriMesh,
         options: &ReportOptions,
@@ -283,10 +293,13 @@ impl MeshReport {
         let n_duplicate_faces = stats.time(S::DuplicateFaces, || count_duplicate_faces(tris));
         phase_done(keep_going, topo, 7)?;
         let si = if options.self_intersections {
-            let (si, t) =
-                count_self_intersections_welded(positions, mesh.triangles(), &weld, &mut |f| {
-                    keep_going(topo + (1.0 - topo) * f)
-                })?;
+            let (si, t) = count_self_intersections_welded(
+                positions,
+                mesh.triangles(),
+                &weld,
+                MAX_COUNTED_HITS,
+                &mut |f| keep_going(topo + (1.0 - topo) * f),
+            )?;
             stats.push(S::SiPrepare, t.prepare);
             stats.push(S::SiBvh, t.bvh);
             stats.push(S::SiPairsAndTests, t.pairs_and_tests);
@@ -347,6 +360,7 @@ impl MeshReport {
             bbox_max: faces.bbox_max,
             bbox_diagonal,
             n_self_intersecting_pairs: si.map(|s| usize::try_from(s.pairs).unwrap_or(usize::MAX)),
+            n_self_intersecting_pairs_is_lower_bound: si.map(|s| s.pairs_is_lower_bound),
             n_degenerate_faces_welded: si.map(|s| s.degenerate),
             self_intersection_free: si.map(|s| s.pairs == 0 && s.degenerate == 0),
         })
@@ -414,6 +428,9 @@ impl MeshReport {
             opt_to_json(self.n_degenerate_faces_welded),
         );
         j.opt_bool("self_intersection_free", self.self_intersection_free);
+        if self.n_self_intersecting_pairs_is_lower_bound == Some(true) {
+            j.opt_bool("n_self_intersecting_pairs_is_lower_bound", Some(true));
+        }
         j.finish()
     }
 }
@@ -1027,6 +1044,7 @@ mod tests {
                 );
                 assert_eq!(r.n_degenerate_faces_welded, Some(listed.degenerate.len()));
                 assert_eq!(r.self_intersection_free, Some(listed.is_free()), "{seed}");
+                assert_eq!(r.n_self_intersecting_pairs_is_lower_bound, Some(false));
                 let mut calls = 0;
                 let with = MeshReport::compute_with_progress(&m, &options, &mut |_| {
                     calls += 1;

@@ -164,3 +164,22 @@ pub fn tiny_components(n: u32) -> TriMesh {
     }
     TriMesh::new(p, t).unwrap()
 }
+
+/// A pile of `n` near-copies of one triangle, each corner moved by up to ±1e-9 (a fixed
+/// pseudo-random jitter): every pair has touching boxes and is decided by the exact test.
+pub fn jittered_pile(n: u32) -> TriMesh {
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    let mut jitter = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % 2001) as f64 * 1e-12 - 1e-9
+    };
+    let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let p: Vec<[f64; 3]> = (0..n)
+        .flat_map(|_| corners)
+        .map(|c: [f64; 3]| c.map(|x| x + jitter()))
+        .collect();
+    let t = (0..n).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+    TriMesh::new(p, t).unwrap()
+}

@@ -164,7 +164,8 @@ _Report = _struct("PleatMeshReport", _u32s("struct_size", "is_closed")
                           "consistently_oriented", "self_intersections_checked",
                           "self_intersection_free")
                   + _f64s("surface_area", "signed_volume", "bbox_diagonal")
-                  + [("bbox_min", _c.c_double * 3), ("bbox_max", _c.c_double * 3)])
+                  + [("bbox_min", _c.c_double * 3), ("bbox_max", _c.c_double * 3)]
+                  + _u32s("self_intersecting_pair_count_is_lower_bound", "reserved"))
 _EvalParams = _struct("PleatWrinkleEvalParams", _u32s("struct_size", "levels", "flags", "boundary")
                       + _f64s("corner_angle", "displacement_scale")
                       + _u64s("max_output_triangles"))
@@ -481,7 +482,8 @@ _LOD_KEYS = ("max_rounds", "target_faces", "flow_ratio", "epsilon", "theta0_deg"
 _LOD_STATS_FLAGS = ("watertight", "manifold", "self_intersection_free", "encloses_input",
                     "exact_rerun", "target_met")
 _REPORT_FLAGS = ("is_closed", "is_edge_manifold", "is_manifold", "is_watertight",
-                 "consistently_oriented", "self_intersections_checked", "self_intersection_free")
+                 "consistently_oriented", "self_intersections_checked", "self_intersection_free",
+                 "self_intersecting_pair_count_is_lower_bound")
 
 
 def _lod_params(screen_size, align=True, measure_floor=False, fit=True, **kw):
@@ -609,7 +611,7 @@ class Mesh(_Handle):
             st = _lib.pleat_mesh_check_with_progress(self._h, flags, relay.fn, None,
                                                      _c.byref(r))
             relay.finish(st)
-        return _as_dict(r, flags=_REPORT_FLAGS)
+        return _as_dict(r, skip=("struct_size", "reserved"), flags=_REPORT_FLAGS)
 
     def _bake(self, fn, screen_size, progress, kw):
         p = _lod_params(screen_size, **kw)

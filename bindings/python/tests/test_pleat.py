@@ -104,6 +104,7 @@ def test_check_report(tet):
     r = soup.check()
     assert r["component_count"] == 2 and r["self_intersections_checked"]
     assert r["self_intersecting_pair_count"] > 0 and not r["self_intersection_free"]
+    assert r["self_intersecting_pair_count_is_lower_bound"] is False and "reserved" not in r
     r = soup.check(self_intersections=False)
     assert not r["self_intersections_checked"] and r["self_intersecting_pair_count"] == 0
     open_grid = pleat.Mesh.from_arrays(*grid_arrays(4))
