@@ -26,6 +26,13 @@
 //! (the same welded vertex set) first and traverse one face per group, so `k` copies of a face
 //! cost one test, not `k(k−1)/2`. The listing functions return every pair, so their output (and
 //! time) stays quadratic in the copies.
+//!
+//! Piles of near-copies (issue 15): faces that overlap without being exact copies need one
+//! exact test per pair (330 ns each on a jittered pile, against 19 ns of traversal). The
+//! counting pass therefore estimates each chunk pair's candidates from 64 sampled faces,
+//! counts a large chunk pair face by face in rounds of about 2¹⁹ candidates with a progress
+//! call after each, and stops counting once 2²² tests have found an intersection, reporting
+//! the count as a lower bound (deterministic: cut at a fixed position of a fixed order).
 
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 
