@@ -1055,6 +1055,7 @@ pub(super) mod imp {
                 )?,
                 load_steps: p.base_load_steps as usize,
                 bending_scale: tolerance(p.bending_scale, "params->bending_scale")?,
+                ..BaseOptions::default()
             },
             w_rule,
             initial_amplitude: (a > 0.0).then_some(a),
