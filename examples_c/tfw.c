@@ -160,6 +160,15 @@ static void solve_sheet(void) {
         CHECK_STATUS(pleat_tfw_result_count_waves(res, 2, w.point, w.normal, w.closed, &g),
                      PLEAT_STATUS_OK);
         CHECK(g.waves == w.waves);
+        /* min_radius (appended 2026-11-27): samples nearer the section point are dropped */
+        g.min_radius = 0.02;
+        CHECK_STATUS(pleat_tfw_result_count_waves(res, 2, w.point, w.normal, w.closed, &g),
+                     PLEAT_STATUS_OK);
+        CHECK(g.min_radius == 0.02 && g.samples > 0 && g.samples < w.samples);
+        g.min_radius = -1.0;
+        CHECK_STATUS(pleat_tfw_result_count_waves(res, 2, w.point, w.normal, w.closed, &g),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        g.min_radius = 0.0;
         /* misuse: a zero normal, a point without a normal, too many levels, NULL out */
         CHECK_STATUS(pleat_tfw_result_count_waves(res, 2, w.point, zero, 0, &g),
                      PLEAT_STATUS_INVALID_ARGUMENT);

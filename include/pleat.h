@@ -1147,6 +1147,11 @@ typedef struct PleatTfwWaveCount {
   double point[3];
   // The section plane's normal: the caller's, or the automatic choice.
   double normal[3];
+  // In (appended 2026-11-27; read only when `struct_size` covers it, else 0): samples
+  // closer than this (m, finite, ≥ 0) to the line through the section point along the
+  // normal are dropped — e.g. `0.5 ×` the outer radius keeps a balloon's outer half of its
+  // equator; 0 keeps all. Out: the value used.
+  double min_radius;
 } PleatTfwWaveCount;
 
 // Outcome of the Knöppel phase solve of a `PleatCwf` (`pleat_cwf_get_knoppel_report`).
@@ -2170,7 +2175,9 @@ PleatStatus pleat_tfw_result_get_stats(const struct PleatTfwResult *result,
 // - `section_closed`: 1 = the section is a closed ring around `section_point` (the samples
 //   ordered by angle, last and first compared: cylinders, balloons), 0 = an open line
 //   (ordered along the samples' principal direction); ignored when automatic.
-// - `out`: non-NULL, `out->struct_size = sizeof(PleatTfwWaveCount)` (≥ 8).
+// - `out`: non-NULL, `out->struct_size = sizeof(PleatTfwWaveCount)` (≥ 8); with the full
+//   size, `out->min_radius` (finite, ≥ 0) is read first: samples closer than it to the line
+//   through the section point along the normal are dropped (automatic sections too).
 //
 // # Safety
 // Pointers are NULL or valid as described.

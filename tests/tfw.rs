@@ -2397,11 +2397,12 @@ mod scene_speed {
         if std::env::var("PLEAT_TFW_BASE_HISTORY").is_ok() {
             for (k, h) in b.history.iter().enumerate() {
                 eprintln!(
-                    "  base {k:3} E {:.15e} |g| {:.3e} t {} shift {:.2e} {}{:.3} s",
+                    "  base {k:3} E {:.15e} |g| {:.3e} t {} shift {:.2e} cg {} {}{:.3} s",
                     h.energy,
                     h.gradient_norm,
                     h.step,
                     h.shift,
+                    h.times.cg_iterations,
                     if h.gradient_step {
                         "gradient step "
                     } else {
@@ -2412,6 +2413,25 @@ mod scene_speed {
             }
         }
         let per_it = r.seconds.base / b.history.len().max(1) as f64;
+        {
+            let k = b.history.len().max(1) as f64;
+            let sum = |f: &dyn Fn(&pleat::tfw::NewtonTimes) -> f64| {
+                b.history.iter().map(|h| f(&h.times)).sum::<f64>() / k
+            };
+            eprintln!(
+                "  base per iteration: evaluate {:.1} ms, assemble {:.1} ms, factor {:.1} ms \
+                 ({:.2} attempts), solve {:.1} ms ({:.1} CG it), line search {:.1} ms ({:.2} \
+                 evaluations)",
+                1e3 * sum(&|t| t.evaluate),
+                1e3 * sum(&|t| t.assemble),
+                1e3 * sum(&|t| t.factor),
+                sum(&|t| t.factor_attempts as f64),
+                1e3 * sum(&|t| t.solve),
+                sum(&|t| t.cg_iterations as f64),
+                1e3 * sum(&|t| t.line_search),
+                sum(&|t| t.line_search_evaluations as f64),
+            );
+        }
         let tail: Vec<String> = b
             .history
             .iter()

@@ -820,11 +820,14 @@ class TfwResult {
     }
     /// The library's wave counter on the field evaluated with `levels` refinements: the
     /// automatic section when `point` and `normal` are null, else the plane through `point`
-    /// with `normal` (a closed ring about `point` when `closed`).
+    /// with `normal` (a closed ring about `point` when `closed`); samples closer than
+    /// `min_radius` (m) to the line through the point along the normal are dropped.
     PleatTfwWaveCount count_waves(uint32_t levels = 2, const double point[3] = nullptr,
-                                  const double normal[3] = nullptr, bool closed = false) const {
+                                  const double normal[3] = nullptr, bool closed = false,
+                                  double min_radius = 0.0) const {
         PleatTfwWaveCount w{};
         w.struct_size = sizeof w;
+        w.min_radius = min_radius;
         check(pleat_tfw_result_count_waves(raw_, levels, point, normal, closed ? 1 : 0, &w));
         return w;
     }

@@ -265,6 +265,11 @@ pub struct PleatTfwWaveCount {
     pub point: [f64; 3],
     /// The section plane's normal: the caller's, or the automatic choice.
     pub normal: [f64; 3],
+    /// In (appended 2026-11-27; read only when `struct_size` covers it, else 0): samples
+    /// closer than this (m, finite, ≥ 0) to the line through the section point along the
+    /// normal are dropped — e.g. `0.5 ×` the outer radius keeps a balloon's outer half of its
+    /// equator; 0 keeps all. Out: the value used.
+    pub min_radius: f64,
 }
 
 versioned!(PleatTfwParams, 8, pleat_tfw_params_default);
@@ -620,7 +625,9 @@ pub unsafe extern "C" fn pleat_tfw_result_get_stats(
 /// - `section_closed`: 1 = the section is a closed ring around `section_point` (the samples
 ///   ordered by angle, last and first compared: cylinders, balloons), 0 = an open line
 ///   (ordered along the samples' principal direction); ignored when automatic.
-/// - `out`: non-NULL, `out->struct_size = sizeof(PleatTfwWaveCount)` (≥ 8).
+/// - `out`: non-NULL, `out->struct_size = sizeof(PleatTfwWaveCount)` (≥ 8); with the full
+///   size, `out->min_radius` (finite, ≥ 0) is read first: samples closer than it to the line
+///   through the section point along the normal are dropped (automatic sections too).
 ///
 /// # Safety
 /// Pointers are NULL or valid as described.
@@ -946,13 +953,24 @@ pub(super) mod imp {
         let r = result_ref(result)?;
         check_range(levels, 0, 6, "levels")?;
         let section = section(point, normal, closed)?;
+        let min_radius = wave_count_min_radius(out)?;
         let out = required_versioned_out(out, "out")?;
+        let count = |s: &Section| crate::tfw::measure::count_waves(&r.cwf, levels as usize, s);
         let (s, c) = match section {
-            Some(s) => {
-                let c = crate::tfw::measure::count_waves(&r.cwf, levels as usize, &s)?;
+            Some(mut s) => {
+                s.min_radius = min_radius;
+                let c = count(&s)?;
                 (s, c)
             }
-            None => crate::tfw::measure::count_waves_auto(&r.cwf, levels as usize)?,
+            None => {
+                let (mut s, c) = crate::tfw::measure::count_waves_auto(&r.cwf, levels as usize)?;
+                if min_radius > 0.0 {
+                    s.min_radius = min_radius;
+                    (s, count(&s)?)
+                } else {
+                    (s, c)
+                }
+            }
         };
         out.write(PleatTfwWaveCount {
             struct_size: 0,
@@ -962,8 +980,33 @@ pub(super) mod imp {
             samples: c.samples as u64,
             point: s.point,
             normal: s.normal,
+            min_radius: s.min_radius,
         });
         Ok(())
+    }
+
+    /// `out->min_radius` when the caller's `struct_size` covers it (validated: finite,
+    /// ≥ 0), else 0. `out` NULL or too small is left to `required_versioned_out`.
+    ///
+    /// # Safety
+    /// `out` is NULL or valid for `out->struct_size` bytes.
+    unsafe fn wave_count_min_radius(out: *const PleatTfwWaveCount) -> Result<f64> {
+        if out.is_null() {
+            return Ok(0.0);
+        }
+        let size = std::ptr::read_unaligned(out as *const u32) as usize;
+        let end = std::mem::offset_of!(PleatTfwWaveCount, min_radius) + 8;
+        if size < end {
+            return Ok(0.0);
+        }
+        let v = std::ptr::read_unaligned(std::ptr::addr_of!((*out).min_radius));
+        check_f64(
+            v,
+            v.is_finite() && v >= 0.0,
+            "out->min_radius",
+            "finite and ≥ 0",
+        )?;
+        Ok(v)
     }
 
     /// A non-negative finite tolerance field.
@@ -1055,6 +1098,7 @@ pub(super) mod imp {
                 )?,
                 load_steps: p.base_load_steps as usize,
                 bending_scale: tolerance(p.bending_scale, "params->bending_scale")?,
+                ..BaseOptions::default()
             },
             w_rule,
             initial_amplitude: (a > 0.0).then_some(a),
@@ -1536,6 +1580,60 @@ mod tests {
             );
             assert_eq!(st, PleatStatus::Ok);
             assert_eq!((g.waves, g.peak_amplitude), (w.waves, w.peak_amplitude));
+            // min_radius (appended): the library counter with that section; an older struct
+            // size is not read (0); a bad value is named
+            let mut m = PleatTfwWaveCount {
+                struct_size: full_size::<PleatTfwWaveCount>(),
+                min_radius: 0.02,
+                ..Default::default()
+            };
+            let st = pleat_tfw_result_count_waves(
+                result,
+                2,
+                s.point.as_ptr(),
+                s.normal.as_ptr(),
+                0,
+                &mut m,
+            );
+            assert_eq!(st, PleatStatus::Ok);
+            let cut = crate::tfw::measure::Section {
+                min_radius: 0.02,
+                ..s
+            };
+            let c2 = crate::tfw::measure::count_waves(cwf, 2, &cut).unwrap();
+            assert_eq!(
+                (m.waves, m.samples, m.min_radius),
+                (c2.waves, c2.samples as u64, 0.02)
+            );
+            assert!(m.samples < w.samples, "{m:?} vs {w:?}");
+            let mut old = PleatTfwWaveCount {
+                struct_size: std::mem::offset_of!(PleatTfwWaveCount, min_radius) as u32,
+                min_radius: -1.0,
+                ..Default::default()
+            };
+            let st = pleat_tfw_result_count_waves(
+                result,
+                2,
+                std::ptr::null(),
+                std::ptr::null(),
+                0,
+                &mut old,
+            );
+            assert_eq!(st, PleatStatus::Ok);
+            assert_eq!((old.waves, old.samples), (w.waves, w.samples));
+            assert_eq!(old.min_radius, -1.0, "beyond struct_size: not written");
+            m.min_radius = f64::NAN;
+            let st = pleat_tfw_result_count_waves(
+                result,
+                2,
+                std::ptr::null(),
+                std::ptr::null(),
+                0,
+                &mut m,
+            );
+            assert_eq!(st, PleatStatus::InvalidArgument);
+            let msg = std::ffi::CStr::from_ptr(crate::ffi::pleat_last_error()).to_string_lossy();
+            assert!(msg.contains("out->min_radius"), "{msg}");
             let zero = [0.0; 3];
             let nan = [f64::NAN, 0.0, 1.0];
             let cases: [(u32, *const f64, *const f64, u32, &str); 5] = [

@@ -84,7 +84,7 @@ pub mod wfree;
 
 pub use base::{
     solve_base, BaseEval, BaseOptions, BaseProblem, BaseResult, BaseStatus, NewtonIteration,
-    StrainSummary, TermEnergies, Terms,
+    NewtonTimes, StrainSummary, TermEnergies, Terms,
 };
 pub use material::{Branch, Lame};
 pub use pipeline::{solve, TfwParams, TfwResult, TfwSeconds, TfwStatus};

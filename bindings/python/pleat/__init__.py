@@ -1415,7 +1415,8 @@ _TfwObstacle = _struct("PleatTfwObstacle", _u32s("struct_size", "kind")
                        + _f64s("radius", "stiffness", "margin"))
 _TfwWaveCount = _struct("PleatTfwWaveCount", _u32s("struct_size", "closed")
                         + _f64s("waves", "peak_amplitude") + _u64s("samples")
-                        + [("point", _c.c_double * 3), ("normal", _c.c_double * 3)])
+                        + [("point", _c.c_double * 3), ("normal", _c.c_double * 3)]
+                        + _f64s("min_radius"))
 for _name, _res, _args in [
     ("pleat_tfw_params_default", _TfwParams, ()),
     ("pleat_tfw_obstacle_default", _TfwObstacle, ()),
@@ -1599,16 +1600,19 @@ class TfwResult(_Handle):
         relay.finish(st)
         return Mesh(h)
 
-    def count_waves(self, levels=2, point=None, normal=None, closed=False):
+    def count_waves(self, levels=2, point=None, normal=None, closed=False, min_radius=0.0):
         """The library's wave counter on the evaluated field: sign changes of Re z / 2 where
         the smooth surface crosses the plane through ``point`` with ``normal`` (a closed ring
         about ``point`` when ``closed``), or, with both None, the axis plane through the
-        bounding-box centre crossing the most waves. A dict: waves, peak_amplitude (m),
-        samples, closed, point, normal."""
+        bounding-box centre crossing the most waves. Samples closer than ``min_radius`` (m)
+        to the line through the point along the normal are dropped (a balloon's outer half:
+        half its outer radius). A dict: waves, peak_amplitude (m), samples, closed, point,
+        normal, min_radius."""
         if (point is None) != (normal is None):
             raise PleatError(1, "count_waves: give both point and normal, or neither")
         w = _TfwWaveCount()
         w.struct_size = _c.sizeof(w)
+        w.min_radius = float(min_radius)
         p = None if point is None else _doubles(point, 3, "point")
         n = None if normal is None else _doubles(normal, 3, "normal")
         _check(_lib.pleat_tfw_result_count_waves(

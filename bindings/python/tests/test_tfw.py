@@ -108,6 +108,12 @@ def test_count_waves(solved):
     again = solved.count_waves(levels=2, point=w["point"], normal=w["normal"],
                                closed=w["closed"])
     assert again["waves"] == w["waves"] and again["peak_amplitude"] == w["peak_amplitude"]
+    cut = solved.count_waves(levels=2, point=w["point"], normal=w["normal"],
+                             closed=w["closed"], min_radius=0.02)
+    assert cut["min_radius"] == 0.02 and 0 < cut["samples"] < w["samples"]
+    with pytest.raises(pleat.PleatError) as e:
+        solved.count_waves(min_radius=-1.0)
+    assert "min_radius" in str(e.value)
     with pytest.raises(pleat.PleatError) as e:
         solved.count_waves(levels=9)
     assert "levels" in str(e.value)
