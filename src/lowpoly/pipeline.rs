@@ -93,10 +93,10 @@ pub struct LodParams {
     /// Minimum feature-curve length `l0` in edges (offset stage).
     pub l0: u32,
     /// Upper bound on the memory of the bake in bytes; estimated before the expensive work
-    /// starts. A LOD takes the finest voxel of [`LOD_VOXEL_SCALES`], from the one its screen
-    /// size starts from on ([`LOD_VOXEL_SCALE`]), whose estimate fits (reported as [`LodReport::offset_voxel_scale`]); beyond the coarsest
-    /// (cages: beyond scale 1) it fails with `Error::LimitExceeded` before any large
-    /// allocation.
+    /// starts. A LOD takes the finest voxel of [`LOD_VOXEL_SCALES`] whose estimate fits, from
+    /// the one its screen size starts from on (see [`LOD_VOXEL_SCALE`]; reported as
+    /// [`LodReport::offset_voxel_scale`]); beyond the coarsest (cages: beyond scale 1) it fails
+    /// with `Error::LimitExceeded` before any large allocation.
     pub memory_budget_bytes: u64,
     /// Run the feature-alignment step (Alg. 6). Default true.
     pub align: bool,
@@ -139,7 +139,8 @@ impl Default for LodParams {
 }
 
 /// Voxel scales (multiples of the offset stage's voxel edge `d/√3`, `OffsetParams::voxel_scale`)
-/// a LOD's offset surface may use, finest first: from [`LOD_VOXEL_SCALE`] on, the finest whose
+/// a LOD's offset surface may use, finest first: from the scale its screen size starts from
+/// (1, or [`LOD_VOXEL_SCALE`] from [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] on), the finest whose
 /// memory estimate fits `memory_budget_bytes` is taken (issue 12 part 4), so large screen
 /// sizes trade offset resolution for memory (offset faces ∝ 1/scale²) instead of being
 /// refused. Cages keep scale 1: their offset must enclose the input without contact, and its
@@ -1010,10 +1011,10 @@ fn initial_surface(
         l0: params.l0,
         memory_budget_bytes: params.memory_budget_bytes,
         // A LOD's own output is verified independently at the end (`verify_level`), and the
-        // guard only keeps what the start surface has: verifying the dense intermediate
-        // surface too cost ≈ 10% of a LOD bake (issue 12 part 2). A cage keeps it: its start
-        // surface is checked for enclosure below, and the offset's report is what says it
-        // is a valid start.
+        // guard only keeps what the start surface has (a bad start ends in `Internal` there):
+        // verifying the dense intermediate surface too cost ≈ 5% of a LOD bake's CPU at scale
+        // 2, with the same output bytes (issue 12 part 2, README "A coarser first stage").
+        // Cages keep it, with the enclosure check below.
         verify: level.mode == Mode::Cage,
         ..OffsetParams::default()
     };
