@@ -165,10 +165,14 @@ pub struct LodReport {
     /// Offset distance `d = l / n_p` (model units).
     pub d: f64,
     /// Largest distance of an offset-surface vertex from the `d`-iso-surface, over `d`
-    /// (dimensionless); `None` in a chain level started from the finer level.
+    /// (dimensionless), measured by the offset stage's verification, which only cages run
+    /// (a LOD's output is verified at the end instead); `None` for LODs and in a chain level
+    /// started from the finer level.
     pub offset_max_deviation_over_d: Option<f64>,
-    /// The offset stage's voxel edge over its default `d/√3` when the memory budget made the
-    /// LOD fall back to a coarser one (`lowpoly::LOD_VOXEL_SCALES`); `None` at the default.
+    /// The offset stage's voxel edge over the offset's default `d/√3` when not 1: for a LOD at
+    /// `n_p ≥ lowpoly::LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`, `lowpoly::LOD_VOXEL_SCALE` (2), or a
+    /// coarser scale of `lowpoly::LOD_VOXEL_SCALES` when the memory budget needs one; `None` for cages (always 1) and in a chain level started
+    /// from the finer level.
     pub offset_voxel_scale: Option<f64>,
     /// Faces of the start surface (offset surface, or the finer level in a chain).
     pub faces_offset: u64,
