@@ -81,24 +81,36 @@ impl Coverage {
     }
 
     /// The samples that may rely on the faces `old` (within their budget of them): the only
-    /// ones a replacement of `old` must keep covered (module docs).
-    pub fn relying_on(&self, old: &[[Vec3; 3]]) -> Vec<u32> {
+    /// ones a replacement of `old` must keep covered (module docs). Each comes with the index
+    /// of an `old` face within its budget, which [`Coverage::keeps`] tries first.
+    pub fn relying_on(&self, old: &[[Vec3; 3]]) -> Vec<Relying> {
         let Some((lo, hi)) = corners_box(old) else {
             return Vec::new();
         };
         let mut cand = self.tree.overlapping(lo, hi);
         cand.sort_unstable();
+        let patch = Patch::new(old);
         cand.into_par_iter()
-            .filter(|&s| within(self.points[s as usize], old, self.budget[s as usize]))
+            .filter_map(|s| {
+                let (p, b) = (self.points[s as usize], self.budget[s as usize]);
+                patch.face_within(p, b, 0).map(|k| Relying {
+                    sample: s,
+                    face: k as u32,
+                })
+            })
             .collect()
     }
 
     /// Whether the faces `new` keep every sample of `relying` (from [`Coverage::relying_on`])
     /// within its budget; counts a refusal.
-    pub fn keeps(&mut self, relying: &[u32], new: &[[Vec3; 3]]) -> bool {
-        let ok = relying
-            .par_iter()
-            .all(|&s| within(self.points[s as usize], new, self.budget[s as usize]));
+    pub fn keeps(&mut self, relying: &[Relying], new: &[[Vec3; 3]]) -> bool {
+        let patch = Patch::new(new);
+        let ok = relying.par_iter().all(|r| {
+            let s = r.sample as usize;
+            patch
+                .face_within(self.points[s], self.budget[s], r.face as usize)
+                .is_some()
+        });
         if !ok {
             self.refused += 1;
         }
@@ -106,7 +118,7 @@ impl Coverage {
     }
 
     /// [`Coverage::relying_on`] the one-ring of `v`.
-    pub fn relying_on_ring(&self, m: &HalfEdgeMesh, v: VertexId) -> Vec<u32> {
+    pub fn relying_on_ring(&self, m: &HalfEdgeMesh, v: VertexId) -> Vec<Relying> {
         let old: Vec<[Vec3; 3]> = m
             .vertex_faces(v)
             .map(|f| m.face_positions(f).map(Vec3::from))
@@ -115,7 +127,13 @@ impl Coverage {
     }
 
     /// [`Coverage::keeps`] for moving `v` of `m` to `q` (its one-ring after the move).
-    pub fn keeps_move(&mut self, relying: &[u32], m: &HalfEdgeMesh, v: VertexId, q: Vec3) -> bool {
+    pub fn keeps_move(
+        &mut self,
+        relying: &[Relying],
+        m: &HalfEdgeMesh,
+        v: VertexId,
+        q: Vec3,
+    ) -> bool {
         let new: Vec<[Vec3; 3]> = m
             .vertex_faces(v)
             .map(|f| {
@@ -133,9 +151,63 @@ impl Coverage {
     }
 }
 
-/// Whether `p` is within `b` of one of `tris`.
-fn within(p: Vec3, tris: &[[Vec3; 3]], b: f64) -> bool {
-    tris.iter().any(|t| point_triangle_distance(p, t) <= b)
+/// A sample that relies on a patch ([`Coverage::relying_on`]): the sample's index and the index
+/// of a patch face within its budget (where the replacement patch is checked first: a vertex
+/// move keeps the one-ring's face order).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Relying {
+    /// Index of the sample.
+    pub sample: u32,
+    /// Index of the patch face found within the sample's budget.
+    pub face: u32,
+}
+
+/// A patch of faces with their bounding boxes, for the coverage predicate.
+struct Patch<'a> {
+    tris: &'a [[Vec3; 3]],
+    boxes: Vec<(Vec3, Vec3)>,
+}
+
+impl<'a> Patch<'a> {
+    fn new(tris: &'a [[Vec3; 3]]) -> Self {
+        let boxes = tris
+            .iter()
+            .map(|t| (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2])))
+            .collect();
+        Patch { tris, boxes }
+    }
+
+    /// A face of the patch within `b` of `p` (`point_triangle_distance ≤ b`), trying face
+    /// `first` first, then the others in order; `None` when there is none. The answer to
+    /// "is there one" is the exact predicate's: a face is skipped without its distance only
+    /// when its box is farther than `b` by more than [`box_cull_margin`] — far beyond the
+    /// rounding of either distance — so speed is all the boxes change.
+    fn face_within(&self, p: Vec3, b: f64, first: usize) -> Option<usize> {
+        let margin = box_cull_margin(p, b);
+        let near = |k: usize| {
+            let (lo, hi) = self.boxes[k];
+            box_distance(lo, hi, p) <= b + margin && point_triangle_distance(p, &self.tris[k]) <= b
+        };
+        let n = self.tris.len();
+        if first < n && near(first) {
+            return Some(first);
+        }
+        (0..n).filter(|&k| k != first).find(|&k| near(k))
+    }
+}
+
+/// How much farther than `b` a face's box must be from `p` before the face is skipped unseen:
+/// `10⁻⁹ (b + ‖p‖∞)`, some 10⁶ times the rounding error of the distances involved.
+fn box_cull_margin(p: Vec3, b: f64) -> f64 {
+    1e-9 * (b + p.x.abs().max(p.y.abs()).max(p.z.abs()))
+}
+
+/// Euclidean distance from `p` to the closed box `[lo, hi]` (0 inside).
+fn box_distance(lo: Vec3, hi: Vec3, p: Vec3) -> f64 {
+    let dx = (lo.x - p.x).max(p.x - hi.x).max(0.0);
+    let dy = (lo.y - p.y).max(p.y - hi.y).max(0.0);
+    let dz = (lo.z - p.z).max(p.z - hi.z).max(0.0);
+    (dx * dx + dy * dy + dz * dz).sqrt()
 }
 
 /// The bounding box of the corners of `tris` (`None` when empty).
@@ -165,7 +237,7 @@ mod tests {
         let tri = |z: f64| [v(-1.0, -1.0, z), v(2.0, -1.0, z), v(-1.0, 2.0, z)];
         let mut c = coverage(vec![v(0.0, 0.0, 0.0)], vec![1.0]);
         let relying = c.relying_on(&[tri(0.5)]);
-        assert_eq!(relying, vec![0]);
+        assert_eq!(relying, vec![Relying { sample: 0, face: 0 }]);
         assert!(c.keeps(&relying, &[tri(0.9)]));
         assert!(!c.keeps(&relying, &[tri(1.5)]));
         assert_eq!(c.refused, 1);
