@@ -112,6 +112,28 @@ pub struct LodParams {
     /// offset and re-sharpens rounded creases; reverted when the two-sided Hausdorff distance
     /// would grow by more than [`FIT_HAUSDORFF_SLACK`]` · l`. Default true.
     pub fit_to_input: bool,
+    /// LODs only (cages always start from the offset surface, which encloses the input): the
+    /// surface the loop starts from (issue 12 part 1, see [`LodStart`]). Default
+    /// [`LodStart::Auto`].
+    pub start: LodStart,
+}
+
+/// The surface a LOD's loop starts from (issue 12 part 1; ignored for cages, which must
+/// enclose the input and always start from the offset surface).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LodStart {
+    /// [`Input`](Self::Input) when the input is clean ([`check_clean`]), else
+    /// [`Offset`](Self::Offset). The check costs a topology pass on every input and a
+    /// self-intersection pass only on inputs whose topology is clean.
+    #[default]
+    Auto,
+    /// The offset surface at `d` (§4.3.1), the dissertation's start: works on any soup.
+    Offset,
+    /// The exactly welded input itself, as a chain level starts from a finer level: the
+    /// one-sided distance check of Alg. 5 is relaxed to `slack = d`, so the output stays
+    /// within about `d` of the input. The input must be clean ([`check_clean`]), else
+    /// `InvalidArgument` names the property that fails.
+    Input,
 }
 
 /// The largest growth of the two-sided Hausdorff distance (over `l`) the input-plane fit may
@@ -134,6 +156,7 @@ impl Default for LodParams {
             measure_floor: false,
             clearance: Clearance::default(),
             fit_to_input: true,
+            start: LodStart::Auto,
         }
     }
 }
@@ -407,6 +430,107 @@ fn check_coordinate_range(input: &TriMesh, screen_size: f64) -> Result<()> {
     Ok(())
 }
 
+/// Checks that `input` is *clean* — after exact welding (`ReportOptions::weld`, as
+/// `meshcheck --weld`): watertight, manifold, consistently and outward oriented, without
+/// degenerate faces, self-intersection-free, all by the independent verifier
+/// [`MeshReport`] — and returns the welded input (unreferenced vertices dropped, first-use
+/// order of the representatives) that [`LodStart::Input`] starts from. `Err` names the
+/// first property that fails.
+pub fn check_clean(input: &TriMesh) -> std::result::Result<TriMesh, String> {
+    clean_welded(input, &mut |_| true).expect("never cancelled")
+}
+
+/// [`check_clean`] with a progress callback (a cancellation point; `None` when it returns
+/// `false`). Topology first, the self-intersection pass only when topology is clean, so
+/// that `LodStart::Auto` costs a dirty input only the topology pass.
+fn clean_welded(
+    input: &TriMesh,
+    keep_going: &mut dyn FnMut(f64) -> bool,
+) -> Option<std::result::Result<TriMesh, String>> {
+    let topo = MeshReport::compute_with_progress(
+        input,
+        &ReportOptions {
+            self_intersections: false,
+            weld: true,
+        },
+        &mut |f| keep_going(0.1 * f),
+    )?;
+    let failing = [
+        ("closed (watertight)", topo.is_watertight),
+        ("manifold", topo.is_manifold),
+        ("consistently oriented", topo.consistently_oriented),
+        (
+            "free of degenerate faces",
+            topo.n_degenerate_faces == 0 && topo.n_combinatorially_degenerate_faces == 0,
+        ),
+        (
+            "outward oriented",
+            topo.n_inward_oriented_components == Some(0),
+        ),
+    ]
+    .into_iter()
+    .find(|(_, holds)| !holds);
+    if let Some((name, _)) = failing {
+        return Some(Err(format!("the input is not {name} after exact welding")));
+    }
+    let welded = weld_compact(input);
+    let si = MeshReport::compute_with_progress(&welded, &ReportOptions::default(), &mut |f| {
+        keep_going(0.1 + 0.9 * f)
+    })?;
+    if si.self_intersection_free != Some(true) {
+        return Some(Err(format!(
+            "the input is not self-intersection-free after exact welding ({} intersecting \
+             pairs)",
+            si.n_self_intersecting_pairs.unwrap_or(0)
+        )));
+    }
+    Some(Ok(welded))
+}
+
+/// `input` with exactly coincident vertices merged (`crate::mesh::ExactWeld`) and only the
+/// referenced representatives kept, numbered in order of first use by the triangles.
+fn weld_compact(input: &TriMesh) -> TriMesh {
+    let weld = crate::mesh::ExactWeld::compute(input.positions());
+    let mut new_index = vec![u32::MAX; input.vertex_count()];
+    let mut positions = Vec::new();
+    let triangles: Vec<[u32; 3]> = weld
+        .apply(input.triangles())
+        .into_iter()
+        .map(|t| {
+            t.map(|v| {
+                let slot = &mut new_index[v as usize];
+                if *slot == u32::MAX {
+                    *slot = positions.len() as u32;
+                    positions.push(input.positions()[v as usize]);
+                }
+                *slot
+            })
+        })
+        .collect();
+    TriMesh::new(positions, triangles).expect("a welded copy of a valid mesh is valid")
+}
+
+/// The start of a LOD bake (`None`: the offset surface) by `params.start`, with
+/// `InvalidArgument` for [`LodStart::Input`] on an input that is not clean. Cages: `None`.
+fn choose_start(
+    input: &TriMesh,
+    params: &LodParams,
+    mode: Mode,
+    rep: &mut Reporter<'_, '_>,
+) -> Result<Option<TriMesh>> {
+    if mode == Mode::Cage || params.start == LodStart::Offset {
+        return Ok(None);
+    }
+    let clean = clean_welded(input, &mut |f| rep.report("setup", f)).ok_or(Error::Cancelled)?;
+    match (clean, params.start) {
+        (Ok(m), _) => Ok(Some(m)),
+        (Err(why), LodStart::Input) => Err(Error::InvalidArgument(format!(
+            "start = input needs a clean input: {why}; use start = auto or offset"
+        ))),
+        (Err(_), _) => Ok(None),
+    }
+}
+
 /// Whether the loop builds a LOD or a cage.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Mode {
@@ -506,8 +630,11 @@ pub(crate) fn run(
         InputModel::new_with_stop(input, mode == Mode::Cage, &mut || rep.report("setup", 0.0))
             .ok_or(Error::Cancelled)?;
     rep.check("setup", 0.0)?;
+    let start = choose_start(input, params, mode, &mut rep)?;
     let level = Level::new(&model, input, mode);
-    bake_level(&level, params, None, &mut rep, (0.0, 1.0))
+    let (mesh, mut stats) = bake_level(&level, params, start.as_ref(), &mut rep, (0.0, 1.0))?;
+    stats.started_from_input = start.is_some();
+    Ok((mesh, stats))
 }
 
 /// [`generate_chain`] for either mode.
@@ -543,7 +670,9 @@ pub(crate) fn run_chain(
     rep.check("setup", 0.0)?;
     let level = Level::new(&model, input, mode);
     let mut out: Vec<Option<(TriMesh, LodReport)>> = vec![None; screen_sizes.len()];
-    let mut prev: Option<TriMesh> = None;
+    // the finest level starts from the welded input when it is clean (`LodStart`)
+    let mut prev: Option<TriMesh> = choose_start(input, &level_params[order[0]], mode, &mut rep)?;
+    let from_input = prev.is_some();
     let n = order.len() as f64;
     for (rank, &i) in order.iter().enumerate() {
         let window = (rank as f64 / n, 1.0 / n);
@@ -555,6 +684,7 @@ pub(crate) fn run_chain(
             .filter(|_| !(mode == Mode::Cage && has_clearance(&level_params[i])));
         let (mesh, mut stats) = bake_level(&level, &level_params[i], finer, &mut rep, window)?;
         stats.chain_level = Some(rank as u64);
+        stats.started_from_input = rank == 0 && from_input;
         prev = Some(mesh.clone());
         out[i] = Some((mesh, stats));
     }
