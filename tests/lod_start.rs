@@ -129,6 +129,27 @@ fn auto_on_a_dirty_soup_is_the_offset_start_byte_for_byte() {
     assert_valid(&auto, &sa, "dirty torus auto");
 }
 
+/// A sphere buried in another is clean but not connected: `Auto` takes the offset start,
+/// whose interior removal drops the buried sphere; `Input` keeps it (as asked).
+#[test]
+fn auto_starts_a_clean_input_with_a_buried_component_from_the_offset() {
+    let outer = shapes::icosphere(1.0, 3);
+    let inner = shapes::scaled(&shapes::icosphere(1.0, 2), [0.5; 3]);
+    let mut p = outer.positions().to_vec();
+    let k = p.len() as u32;
+    p.extend_from_slice(inner.positions());
+    let mut t = outer.triangles().to_vec();
+    t.extend(inner.triangles().iter().map(|f| f.map(|i| i + k)));
+    let nested = TriMesh::new(p, t).unwrap();
+    assert!(check_clean(&nested).is_ok());
+    let (_, s) = bake(&nested, &params(50.0, LodStart::Auto)).unwrap();
+    assert!(!s.started_from_input);
+    let (out, s) = bake(&nested, &params(50.0, LodStart::Input)).unwrap();
+    assert!(s.started_from_input);
+    assert_valid(&out, &s, "nested input start");
+    assert_eq!(MeshReport::compute(&out).n_components, 2);
+}
+
 #[test]
 fn input_start_reaches_a_face_target() {
     let m = shapes::icosphere(1.0, 4);

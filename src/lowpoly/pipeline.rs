@@ -118,13 +118,34 @@ pub struct LodParams {
     pub start: LodStart,
 }
 
+/// The largest total genus of a clean input that [`LodStart::Auto`] starts from (see there):
+/// the offset surface closes handles narrower than about `2d`, and on the corpus' genus-23
+/// tray that halves the face count; genus ≤ 4 (fertility, a CAD part, tori) did better from
+/// the input. The threshold between 4 and 23 is not measured more finely.
+pub const AUTO_MAX_GENUS: i64 = 8;
+
 /// The surface a LOD's loop starts from (issue 12 part 1; ignored for cages, which must
 /// enclose the input and always start from the offset surface).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LodStart {
-    /// [`Input`](Self::Input) when the input is clean ([`check_clean`]), else
-    /// [`Offset`](Self::Offset). The check costs a topology pass on every input and a
-    /// self-intersection pass only on inputs whose topology is clean.
+    /// [`Input`](Self::Input) when the input is clean ([`check_clean`]), connected and of
+    /// total genus at most [`AUTO_MAX_GENUS`], else [`Offset`](Self::Offset). Connected,
+    /// because a second component may be buried in the first (invisible, removed by the
+    /// offset stage's interior removal, kept by Input); every clean corpus mesh is connected,
+    /// so clean multi-component inputs are not measured.
+    ///
+    /// Measured 2026-11-27 (README "LOD benchmark", "Clean inputs start from the input") on
+    /// the 11 clean corpus meshes ≤ 40k faces at n_p = 200, Input against Offset: 24% fewer
+    /// faces on average (412 against 545), two-sided Hausdorff 0.99% of l against 1.47%, less
+    /// CPU on 10 of 11 (median 4.8 against 7.3 s), every output CGAL-valid; at pleat's face
+    /// count Input's normal difference is below MeshLab QEM's on 10 of 11 and its PSNR above on
+    /// 10 of 11. The exception is the one high-genus mesh, the tray (genus 23): Input keeps its
+    /// 23 handles where the offset closes most of them, and ends at 2.5× Offset's faces —
+    /// hence the genus limit. On the 600k-face armadillo Input costs 1.6× Offset's CPU (the
+    /// first pass works through the dense input; 750 against 922 faces, Hausdorff 1.04 against
+    /// 1.13% of l). The check costs a topology pass on every input (0.04 s on the 124k-face
+    /// ogre, no measurable change of its bake) and a self-intersection pass only on inputs whose
+    /// topology is clean (≈ 1 s on the 600k-face armadillo, ≈ 3% of its bake).
     #[default]
     Auto,
     /// The offset surface at `d` (§4.3.1), the dissertation's start: works on any soup.
@@ -437,16 +458,28 @@ fn check_coordinate_range(input: &TriMesh, screen_size: f64) -> Result<()> {
 /// order of the representatives) that [`LodStart::Input`] starts from. `Err` names the
 /// first property that fails.
 pub fn check_clean(input: &TriMesh) -> std::result::Result<TriMesh, String> {
-    clean_welded(input, &mut |_| true).expect("never cancelled")
+    clean_welded(input, &mut |_| true)
+        .expect("never cancelled")
+        .map(|c| c.mesh)
 }
 
-/// [`check_clean`] with a progress callback (a cancellation point; `None` when it returns
-/// `false`). Topology first, the self-intersection pass only when topology is clean, so
+/// A clean input ([`check_clean`]) and what [`LodStart::Auto`] decides from.
+struct CleanInput {
+    /// The welded input.
+    mesh: TriMesh,
+    /// Total genus.
+    genus: i64,
+    /// Connected components.
+    components: usize,
+}
+
+/// [`check_clean`] with the input's total genus, and a progress callback (a cancellation
+/// point; `None` when it returns `false`). Topology first, the self-intersection pass only when topology is clean, so
 /// that `LodStart::Auto` costs a dirty input only the topology pass.
 fn clean_welded(
     input: &TriMesh,
     keep_going: &mut dyn FnMut(f64) -> bool,
-) -> Option<std::result::Result<TriMesh, String>> {
+) -> Option<std::result::Result<CleanInput, String>> {
     let topo = MeshReport::compute_with_progress(
         input,
         &ReportOptions {
@@ -484,7 +517,11 @@ fn clean_welded(
             si.n_self_intersecting_pairs.unwrap_or(0)
         )));
     }
-    Some(Ok(welded))
+    Some(Ok(CleanInput {
+        mesh: welded,
+        genus: topo.total_genus.unwrap_or(0),
+        components: topo.n_components,
+    }))
 }
 
 /// `input` with exactly coincident vertices merged (`crate::mesh::ExactWeld`) and only the
@@ -523,7 +560,8 @@ fn choose_start(
     }
     let clean = clean_welded(input, &mut |f| rep.report("setup", f)).ok_or(Error::Cancelled)?;
     match (clean, params.start) {
-        (Ok(m), _) => Ok(Some(m)),
+        (Ok(c), LodStart::Auto) if c.genus > AUTO_MAX_GENUS || c.components > 1 => Ok(None),
+        (Ok(c), _) => Ok(Some(c.mesh)),
         (Err(why), LodStart::Input) => Err(Error::InvalidArgument(format!(
             "start = input needs a clean input: {why}; use start = auto or offset"
         ))),
@@ -1197,6 +1235,8 @@ mod tests {
             screen_size: 10.0,
             max_rounds: 2,
             fit_to_input: false,
+            // the clean cube would start from itself under `Auto`
+            start: LodStart::Offset,
             ..LodParams::default()
         };
         // the fit's coverage samples are counted whatever the voxel
