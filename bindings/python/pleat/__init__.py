@@ -144,7 +144,7 @@ _LodStats = _struct("PleatLodStats", _u32s("struct_size", "rounds")
                             "seconds_align", "seconds_verify", "offset_distance", "hausdorff",
                             "hausdorff_relative")
                     + _u32s("watertight", "manifold", "self_intersection_free", "encloses_input",
-                            "exact_rerun", "target_met", "started_from_input")
+                            "exact_rerun", "target_met")
                     + _f64s("hausdorff_in_to_out_relative", "hausdorff_out_to_in_relative",
                             "hausdorff_floor_relative", "min_clearance",
                             "min_clearance_relative", "clearance_required")
@@ -480,7 +480,7 @@ class _Handle:
 _LOD_KEYS = ("max_rounds", "target_faces", "flow_ratio", "epsilon", "theta0_deg", "l0",
              "memory_budget_bytes")
 _LOD_STATS_FLAGS = ("watertight", "manifold", "self_intersection_free", "encloses_input",
-                    "exact_rerun", "target_met")
+                    "exact_rerun", "target_met", "started_from_input")
 _REPORT_FLAGS = ("is_closed", "is_edge_manifold", "is_manifold", "is_watertight",
                  "consistently_oriented", "self_intersections_checked", "self_intersection_free",
                  "self_intersecting_pair_count_is_lower_bound")
