@@ -618,7 +618,9 @@ impl<'p, 'f> Reporter<'p, 'f> {
 }
 
 /// Bakes one LOD of `input` (any triangle soup) at `params.screen_size`: a watertight,
-/// manifold, self-intersection-free mesh within about `d = l / n_p` of the input (Pro.I–III).
+/// manifold, self-intersection-free mesh within about `d = l / n_p` of the input (Pro.I–III),
+/// starting from the offset surface or, for a clean input, the input itself
+/// ([`LodParams::start`], [`LodReport::started_from_input`]).
 /// `progress` is called on this thread; returning `false` cancels with `Error::Cancelled`.
 ///
 /// [`LodReport`]: stage seconds, counts, the achieved error (`hausdorff_rel` = two-sided
@@ -637,7 +639,8 @@ pub fn generate(
 }
 
 /// Bakes one LOD per screen size (in the given order of `screen_sizes`). The finest level is
-/// baked from the input; each coarser level starts from the next finer result (which already
+/// baked from the input (from its offset surface, or from the welded input itself as
+/// [`LodParams::start`] decides); each coarser level starts from the next finer result (which already
 /// has every Pro.III guarantee, so the guard keeps them), with the one-sided distance check of
 /// Alg. 5 relaxed to `d` of the coarser level — the distance its own offset surface would start
 /// from. `params.screen_size` and `params.target_faces` are ignored (a face target is per
