@@ -65,6 +65,9 @@ static void bake_chain(const PleatMesh *input) {
     for (i = 0; i < 3; i++) stats[i].struct_size = sizeof stats[0];
     params.max_rounds = 8;
     params.flags = PLEAT_LOD_MEASURE_FLOOR;
+    /* The input is clean, so the default (auto) would start the finest level from the input
+       itself, which has no offset floor to measure: start from the offset surface. */
+    params.start = PLEAT_LOD_START_OFFSET;
     CHECK_STATUS(pleat_lod_generate_chain(input, sizes, 3, &params, print_progress, &calls,
                                           levels, stats),
                  PLEAT_STATUS_OK);
@@ -90,6 +93,7 @@ static void bake_chain(const PleatMesh *input) {
                    : stats[i].hausdorff_out_to_in_relative));
         /* The floor is measured on the level baked from the offset surface (the finest, n_p =
            100); coarser levels start from the finer result and report NaN. */
+        CHECK(stats[i].started_from_input == 0);
         if (i == 2) {
             CHECK(stats[i].hausdorff_floor_relative >= 0.0 &&
                   stats[i].hausdorff_floor_relative < 2.0 / sizes[i]);

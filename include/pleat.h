@@ -144,6 +144,15 @@
 // on the input's planes and normal-improving flips after the loop; ignored for cages).
 #define PLEAT_LOD_NO_FIT 8
 
+// `PleatLodParams::start`: the welded input when clean, else the offset surface.
+#define PLEAT_LOD_START_AUTO 0
+
+// `PleatLodParams::start`: the offset surface at d.
+#define PLEAT_LOD_START_OFFSET 1
+
+// `PleatLodParams::start`: the welded input, which must be clean.
+#define PLEAT_LOD_START_INPUT 2
+
 // `pleat_mesh_check` flag: skip the self-intersection test (the most expensive part);
 // `self_intersections_checked` is then 0.
 #define PLEAT_CHECK_SKIP_SELF_INTERSECTIONS 1
@@ -781,6 +790,14 @@ typedef struct PleatLodParams {
   // only "no contact". Appended for issue 12; callers with an older `struct_size` get the
   // default.
   double clearance;
+  // LODs only: the surface the loop starts from: 0 = auto (the welded input when it is
+  // clean — closed, manifold, consistently and outward oriented, no degenerate face,
+  // self-intersection-free — else the offset surface), 1 = the offset surface at d,
+  // 2 = the welded input (`PLEAT_STATUS_INVALID_ARGUMENT` naming the failing property when
+  // it is not clean). Other values are `PLEAT_STATUS_INVALID_ARGUMENT`. Cages always start
+  // from the offset surface. Appended for issue 12; callers with an older `struct_size`
+  // get 0 (auto).
+  uint32_t start;
 } PleatLodParams;
 
 // Statistics of one baked level, filled when a non-NULL pointer is passed. Set `struct_size`
@@ -849,6 +866,9 @@ typedef struct PleatLodStats {
   // Cages: 1 when `min_clearance >= clearance_required`; 0 when the cage could not keep
   // the clearance (it still encloses without contact — see `encloses_input`). LODs: 0.
   uint32_t clearance_kept;
+  // 1 when the level's loop started from the welded input (`PleatLodParams::start`; in a
+  // chain only the finest level can), 0 when from the offset surface or a finer level.
+  uint32_t started_from_input;
 } PleatLodStats;
 
 // Parameters of `pleat_offset_surface`. Get defaults from `pleat_offset_params_default()` and

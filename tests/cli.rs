@@ -771,3 +771,93 @@ fn wrinkle_edit_compat_target_widens_and_interp_no_locality() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--start` (issue 12 part 1): `input` on a clean mesh says so in the summary, on a dirty
+/// soup fails with the property that fails; an unknown value is a usage error.
+#[cfg(feature = "lod")]
+#[test]
+fn lod_start_option() {
+    let dir = std::env::temp_dir().join(format!("pleat-cli-start-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("o.obj");
+    let out_s = out.to_str().unwrap();
+    let dirty = "assets/dirty_two_boxes.obj";
+    let o = pleat(&[
+        "lod",
+        dirty,
+        "--screen-size",
+        "20",
+        "--start",
+        "input",
+        "-o",
+        out_s,
+    ]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("start = input needs a clean input"), "{err}");
+    let o = pleat(&[
+        "lod",
+        dirty,
+        "--screen-size",
+        "20",
+        "--start",
+        "sideways",
+        "-o",
+        out_s,
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = pleat(&[
+        "lod",
+        dirty,
+        "--screen-size",
+        "20",
+        "--rounds",
+        "2",
+        "-o",
+        out_s,
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("started from the input"));
+    let box_ = dir.join("box.obj");
+    let b = pleat::mesh::TriMesh::new(
+        vec![
+            [0., 0., 0.],
+            [1., 0., 0.],
+            [1., 1., 0.],
+            [0., 1., 0.],
+            [0., 0., 1.],
+            [1., 0., 1.],
+            [1., 1., 1.],
+            [0., 1., 1.],
+        ],
+        vec![
+            [0, 2, 1],
+            [0, 3, 2],
+            [4, 5, 6],
+            [4, 6, 7],
+            [0, 1, 5],
+            [0, 5, 4],
+            [1, 2, 6],
+            [1, 6, 5],
+            [2, 3, 7],
+            [2, 7, 6],
+            [3, 0, 4],
+            [3, 4, 7],
+        ],
+    )
+    .unwrap();
+    pleat::mesh::io::write_mesh(&box_, &b).unwrap();
+    let o = pleat(&[
+        "lod",
+        box_.to_str().unwrap(),
+        "--screen-size",
+        "20",
+        "--start",
+        "input",
+        "-o",
+        out_s,
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("started from the input"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -182,6 +182,12 @@ struct BakeArgs {
     /// the default) or a length in model units (`0.002`); below d. `0d` only forbids contact.
     #[arg(long, value_parser = parse_clearance)]
     clearance: Option<pleat::lowpoly::Clearance>,
+    /// LODs: the surface the loop starts from: `input` (the welded input; it must be closed,
+    /// manifold, oriented and intersection-free), `offset` (the offset surface at d, any
+    /// soup) or `auto` (input when it is clean, else offset). Cages always start from the
+    /// offset surface.
+    #[arg(long, value_parser = parse_start, default_value = "auto")]
+    start: pleat::lowpoly::LodStart,
     /// No progress bar and no summary.
     #[arg(short, long)]
     quiet: bool,
@@ -542,6 +548,7 @@ fn lod_params(args: &BakeArgs, sizes: &[f64], faces: Option<usize>) -> LodParams
         align: !args.no_align,
         fit_to_input: !args.no_fit,
         clearance: args.clearance.unwrap_or_default(),
+        start: args.start,
         ..LodParams::default()
     }
 }
@@ -566,6 +573,18 @@ fn bake_levels(
         (true, true) => pleat::cage::generate_chain(mesh, sizes, params, prog),
         #[cfg(not(feature = "cage"))]
         (_, true) => unreachable!("the cage subcommand needs the cage feature"),
+    }
+}
+
+/// `--start`: `auto`, `offset` or `input`.
+#[cfg(feature = "lod")]
+fn parse_start(s: &str) -> Result<pleat::lowpoly::LodStart, String> {
+    use pleat::lowpoly::LodStart;
+    match s {
+        "auto" => Ok(LodStart::Auto),
+        "offset" => Ok(LodStart::Offset),
+        "input" => Ok(LodStart::Input),
+        _ => Err(format!("expected auto, offset or input, got {s}")),
     }
 }
 
@@ -655,6 +674,9 @@ fn print_bake_summary(
             "NO"
         }
     );
+    if s.started_from_input {
+        println!("  started from the input (clean: closed, manifold, intersection-free)");
+    }
     if let Some(c) = &s.clearance {
         println!(
             "  clearance: exact minimum {:.3e} ({:.2} d), required {:.3e} ({:.2} d){}",

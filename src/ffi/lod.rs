@@ -70,7 +70,22 @@ pub struct PleatLodParams {
     /// only "no contact". Appended for issue 12; callers with an older `struct_size` get the
     /// default.
     pub clearance: f64,
+    /// LODs only: the surface the loop starts from: 0 = auto (the welded input when it is
+    /// clean — closed, manifold, consistently and outward oriented, no degenerate face,
+    /// self-intersection-free — else the offset surface), 1 = the offset surface at d,
+    /// 2 = the welded input (`PLEAT_STATUS_INVALID_ARGUMENT` naming the failing property when
+    /// it is not clean). Other values are `PLEAT_STATUS_INVALID_ARGUMENT`. Cages always start
+    /// from the offset surface. Appended for issue 12; callers with an older `struct_size`
+    /// get 0 (auto).
+    pub start: u32,
 }
+
+/// `PleatLodParams::start`: the welded input when clean, else the offset surface.
+pub const PLEAT_LOD_START_AUTO: u32 = 0;
+/// `PleatLodParams::start`: the offset surface at d.
+pub const PLEAT_LOD_START_OFFSET: u32 = 1;
+/// `PleatLodParams::start`: the welded input, which must be clean.
+pub const PLEAT_LOD_START_INPUT: u32 = 2;
 
 /// Statistics of one baked level, filled when a non-NULL pointer is passed. Set `struct_size`
 /// to `sizeof(PleatLodStats)`; pleat fills only that many bytes. Yes/no fields are 0 or 1.
@@ -140,6 +155,9 @@ pub struct PleatLodStats {
     /// Cages: 1 when `min_clearance >= clearance_required`; 0 when the cage could not keep
     /// the clearance (it still encloses without contact — see `encloses_input`). LODs: 0.
     pub clearance_kept: u32,
+    /// 1 when the level's loop started from the welded input (`PleatLodParams::start`; in a
+    /// chain only the finest level can), 0 when from the offset surface or a finer level.
+    pub started_from_input: u32,
 }
 
 /// The defaults, with `struct_size = sizeof(PleatLodParams)`.
@@ -156,7 +174,7 @@ versioned!(PleatLodParams, 16, pleat_lod_params_default);
 versioned!(PleatLodStats, 8);
 
 #[cfg(feature = "lod")]
-use crate::lowpoly::Clearance;
+use crate::lowpoly::{Clearance, LodStart};
 
 #[cfg(feature = "lod")]
 impl From<&crate::lowpoly::LodParams> for PleatLodParams {
@@ -182,6 +200,11 @@ impl From<&crate::lowpoly::LodParams> for PleatLodParams {
             clearance: match p.clearance {
                 Clearance::FractionOfD(c) | Clearance::Absolute(c) => c,
             },
+            start: match p.start {
+                LodStart::Auto => PLEAT_LOD_START_AUTO,
+                LodStart::Offset => PLEAT_LOD_START_OFFSET,
+                LodStart::Input => PLEAT_LOD_START_INPUT,
+            },
         }
     }
 }
@@ -202,6 +225,7 @@ pub(super) fn defaults_without_lod() -> PleatLodParams {
         flags: 0,
         memory_budget_bytes: 2 << 30,
         clearance: 0.1,
+        start: PLEAT_LOD_START_AUTO,
     }
 }
 
@@ -228,7 +252,18 @@ pub(super) mod imp {
                 | PLEAT_LOD_NO_FIT,
             "params->flags",
         )?;
+        let start = match p.start {
+            PLEAT_LOD_START_AUTO => LodStart::Auto,
+            PLEAT_LOD_START_OFFSET => LodStart::Offset,
+            PLEAT_LOD_START_INPUT => LodStart::Input,
+            v => {
+                return Err(Error::InvalidArgument(format!(
+                    "params->start must be 0 (auto), 1 (offset) or 2 (input), got {v}"
+                )))
+            }
+        };
         Ok(LodParams {
+            start,
             screen_size: p.screen_size,
             target_faces: target,
             max_rounds: p.max_rounds,
@@ -308,6 +343,7 @@ pub(super) mod imp {
             min_clearance_relative: s.clearance.map_or(f64::NAN, |c| c.min_rel),
             clearance_required: s.clearance.map_or(f64::NAN, |c| c.required),
             clearance_kept: s.clearance.is_some_and(|c| c.kept) as u32,
+            started_from_input: s.started_from_input as u32,
         }
     }
 }

@@ -40,8 +40,9 @@ pub use fit::SELF_CLEARANCE as FIT_SELF_CLEARANCE;
 pub use guard::CONE_HALF_ANGLE;
 pub use offset::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};
 pub use pipeline::{
-    generate, generate_chain, Clearance, LodParams, DEFAULT_CLEARANCE_FRACTION,
-    FIT_HAUSDORFF_SLACK, LOD_COARSE_VOXEL_MIN_SCREEN_SIZE, LOD_VOXEL_SCALE, LOD_VOXEL_SCALES,
+    check_clean, generate, generate_chain, Clearance, LodParams, LodStart, AUTO_MAX_GENUS,
+    DEFAULT_CLEARANCE_FRACTION, FIT_HAUSDORFF_SLACK, LOD_COARSE_VOXEL_MIN_SCREEN_SIZE,
+    LOD_VOXEL_SCALE, LOD_VOXEL_SCALES,
 };
 #[cfg(feature = "cage")]
 pub(crate) use pipeline::{run, run_chain, Mode};

@@ -174,7 +174,8 @@ pub struct LodReport {
     /// coarser scale of `lowpoly::LOD_VOXEL_SCALES` when the memory budget needs one; `None` for cages (always 1) and in a chain level started
     /// from the finer level.
     pub offset_voxel_scale: Option<f64>,
-    /// Faces of the start surface (offset surface, or the finer level in a chain).
+    /// Faces of the start surface (offset surface, the welded input, or the finer level in a
+    /// chain).
     pub faces_offset: u64,
     /// Rounds of Alg. 3 run.
     pub rounds: u64,
@@ -232,6 +233,9 @@ pub struct LodReport {
     pub vertices: u64,
     /// Rank of this level in a chain, 0 = finest (baked first); `None` outside a chain.
     pub chain_level: Option<u64>,
+    /// The loop started from the welded input (`LodParams::start`, issue 12 part 1) instead of
+    /// the offset surface (in a chain: this level is the finest and started from the input).
+    pub started_from_input: bool,
     /// Guarantees verified afterwards by `crate::verify`: watertight, manifold (and
     /// consistently oriented), self-intersection-free, same topology as the offset surface,
     /// and for cages enclosure without contact.
@@ -257,6 +261,7 @@ impl LodReport {
             e.metric_entry("offset_voxel_scale", s);
         }
         e.count_entry("faces_offset", self.faces_offset);
+        e.count_entry("started_from_input", self.started_from_input as u64);
         e.metric_entry("simplify_first_pass_s", self.simplify_first_pass_seconds);
         e.count_entry("rounds", self.rounds);
         for (i, f) in self.faces_per_round.iter().enumerate() {

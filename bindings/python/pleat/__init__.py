@@ -137,7 +137,7 @@ _PROGRESS_FN = _c.CFUNCTYPE(_c.c_int32, _c.c_void_p, _c.POINTER(_Progress))
 _LodParams = _struct("PleatLodParams", _u32s("struct_size", "max_rounds") + _f64s("screen_size")
                      + _u64s("target_faces") + _f64s("flow_ratio", "epsilon", "theta0_deg")
                      + _u32s("l0", "flags") + _u64s("memory_budget_bytes")
-                     + _f64s("clearance"))
+                     + _f64s("clearance") + _u32s("start"))
 _LodStats = _struct("PleatLodStats", _u32s("struct_size", "rounds")
                     + _u64s("face_count", "vertex_count", "start_face_count", "collapse_count")
                     + _f64s("seconds_total", "seconds_offset", "seconds_simplify", "seconds_flow",
@@ -148,7 +148,7 @@ _LodStats = _struct("PleatLodStats", _u32s("struct_size", "rounds")
                     + _f64s("hausdorff_in_to_out_relative", "hausdorff_out_to_in_relative",
                             "hausdorff_floor_relative", "min_clearance",
                             "min_clearance_relative", "clearance_required")
-                    + _u32s("clearance_kept"))
+                    + _u32s("clearance_kept", "started_from_input"))
 _OffsetParams = _struct("PleatOffsetParams", _u32s("struct_size", "use_absolute_distance")
                         + _f64s("screen_size", "distance", "voxel_scale", "theta0_deg")
                         + _u32s("l0", "features", "remove_interior", "iso_refinement_steps")
@@ -480,19 +480,26 @@ class _Handle:
 _LOD_KEYS = ("max_rounds", "target_faces", "flow_ratio", "epsilon", "theta0_deg", "l0",
              "memory_budget_bytes")
 _LOD_STATS_FLAGS = ("watertight", "manifold", "self_intersection_free", "encloses_input",
-                    "exact_rerun", "target_met")
+                    "exact_rerun", "target_met", "started_from_input")
 _REPORT_FLAGS = ("is_closed", "is_edge_manifold", "is_manifold", "is_watertight",
                  "consistently_oriented", "self_intersections_checked", "self_intersection_free",
                  "self_intersecting_pair_count_is_lower_bound")
 
 
-def _lod_params(screen_size, align=True, measure_floor=False, fit=True, **kw):
+# PleatLodParams::start (PLEAT_LOD_START_*)
+_LOD_STARTS = {"auto": 0, "offset": 1, "input": 2}
+
+
+def _lod_params(screen_size, align=True, measure_floor=False, fit=True, start="auto", **kw):
     """PleatLodParams from the defaults and keyword overrides (names of the C fields)."""
     p = _lib.pleat_lod_params_default()
     unknown = set(kw) - set(_LOD_KEYS)
     if unknown:
         raise TypeError(f"unknown LOD parameter(s) {sorted(unknown)}; known: "
-                        f"{sorted(_LOD_KEYS + ('align', 'measure_floor', 'fit'))}")
+                        f"{sorted(_LOD_KEYS + ('align', 'measure_floor', 'fit', 'start'))}")
+    if start not in _LOD_STARTS:
+        raise ValueError(f"start must be one of {sorted(_LOD_STARTS)}, got {start!r}")
+    p.start = _LOD_STARTS[start]
     if screen_size is not None:
         p.screen_size = float(screen_size)
     for k, v in kw.items():
@@ -628,7 +635,9 @@ class Mesh(_Handle):
         ``max_rounds``, ``flow_ratio``, ``epsilon``, ``theta0_deg``, ``l0``,
         ``memory_budget_bytes`` (C field names and defaults), ``align=False`` to skip the
         feature alignment, ``measure_floor=True`` for ``hausdorff_floor_relative``,
-        ``fit=False`` to skip the final fit to this mesh's planes (PLEAT_LOD_NO_FIT).
+        ``fit=False`` to skip the final fit to this mesh's planes (PLEAT_LOD_NO_FIT),
+        ``start="auto"|"offset"|"input"``: the surface the loop starts from (the welded
+        input when it is clean for ``auto``; ``stats["started_from_input"]``).
         ``progress(stage, fraction)`` is called on this thread; return True to cancel
         (PleatError CANCELLED); an exception it raises comes out of this call."""
         return self._bake(_lib.pleat_lod_generate, screen_size, progress, params)

@@ -33,6 +33,20 @@ def test_lod_of_a_soup_and_parameters():
 
 
 @needs("lod")
+def test_lod_start(cube):
+    assert cube.lod(screen_size=10, start="input").stats["started_from_input"]
+    assert cube.lod(screen_size=10).stats["started_from_input"]  # auto: the cube is clean
+    assert not cube.lod(screen_size=10, start="offset").stats["started_from_input"]
+    soup = pleat.Mesh.from_arrays(*two_boxes())
+    assert not soup.lod(screen_size=10, max_rounds=2).stats["started_from_input"]
+    with pytest.raises(pleat.PleatError) as e:
+        soup.lod(screen_size=10, start="input")
+    assert e.value.status == "INVALID_ARGUMENT"
+    with pytest.raises(ValueError):
+        cube.lod(screen_size=10, start="sideways")
+
+
+@needs("lod")
 def test_lod_chain(cube):
     chain = cube.lod_chain([20, 10])
     assert len(chain) == 2
