@@ -32,7 +32,9 @@
 //! [`crate::tfw::sqp`].
 
 use crate::report::{Progress, ProgressFn};
-use crate::solve::{AssemblyPlan, CholeskyAnalysis, Entry, Parallelism};
+use crate::solve::{
+    dot_n, steihaug, sym_matvec_lower_into, AssemblyPlan, CholeskyAnalysis, Entry, Parallelism,
+};
 use crate::tfw::energy::{HessianMode, WfEval, WfTerms};
 use crate::tfw::sqp::{
     feasible_start, qp_shape, step_sizes, FeasibleStart, SqpIteration, SqpOptions, SqpProblem,
@@ -430,7 +432,19 @@ fn run(
         .map(|d| shape.energy_scale / (d * d))
         .collect();
     let mut x = scatter(&y);
-    let mut eval = e.evaluate(&x, WfTerms::ALL, HessianMode::ProjectedPerFace);
+    let cg = CgRefinement::from_env();
+    let evaluate = |x: &[f64]| -> (WfEval, Option<Vec<(usize, usize, f64)>>) {
+        if cg.iterations > 0 {
+            let (p, h) = e.evaluate_projected_and_exact(x, WfTerms::ALL);
+            (p, Some(h))
+        } else {
+            (
+                e.evaluate(x, WfTerms::ALL, HessianMode::ProjectedPerFace),
+                None,
+            )
+        }
+    };
+    let (mut eval, mut exact) = evaluate(&x);
     let grad_y = |eval: &WfEval| -> Vec<f64> {
         let g_free: Vec<f64> = problem.free.iter().map(|&g| eval.gradient[g]).collect();
         basis.transpose_times(&g_free)
@@ -443,8 +457,10 @@ fn run(
     }
     let mut state = NewtonState {
         plan: None,
+        exact_plan: None,
         analysis: None,
         shift: options.initial_shift,
+        last_full: false,
     };
     let mut history = Vec::new();
     let mut qp_seconds = 0.0;
@@ -464,9 +480,19 @@ fn run(
         let held: Vec<bool> = (0..basis.ny)
             .map(|i| i < na && y[i] <= 0.0 && g[i] > 0.0)
             .collect();
-        let step = newton_direction(problem, &basis, &eval, &g, &held, &weights, &mut state)?;
+        let step = newton_direction(
+            problem,
+            &basis,
+            &eval,
+            exact.as_deref(),
+            &cg,
+            &g,
+            &held,
+            &weights,
+            &mut state,
+        )?;
         qp_seconds += t0.elapsed().as_secs_f64();
-        let Some((d, attempts)) = step else {
+        let Some((d, attempts, cg_iterations)) = step else {
             status = SqpStatus::QpFailed;
             break;
         };
@@ -500,7 +526,7 @@ fn run(
         let de = eval.energy - en;
         y = yn;
         x = xn;
-        eval = e.evaluate(&x, WfTerms::ALL, HessianMode::ProjectedPerFace);
+        (eval, exact) = evaluate(&x);
         g = grad_y(&eval);
         let r = projected_gradient_norm(&g, &y, na);
         history.push(SqpIteration {
@@ -510,6 +536,7 @@ fn run(
             step_length: t,
             shift: state.shift,
             qp_iterations: attempts,
+            cg_iterations: cg_iterations as u32,
             curl_residual: problem.curl_residual(&x),
             seconds: start.elapsed().as_secs_f64(),
         });
@@ -517,6 +544,7 @@ fn run(
             snapshots.push((history.len(), x.clone()));
         }
         state.shift = next_shift(state.shift, t);
+        state.last_full = t >= 1.0;
         if r <= options.stationarity_tolerance * r0 {
             status = SqpStatus::Stationary;
             break;
@@ -557,31 +585,115 @@ fn next_shift(shift: f64, t: f64) -> f64 {
     }
 }
 
+/// The exact-Hessian refinement of the projected Newton step (README "Tension-field wrinkles",
+/// issue 13's slow SQP): Steihaug–Toint CG on the exact reduced Hessian `Bᵀ H B` (held
+/// amplitudes fixed), preconditioned by the factorization of `Bᵀ(H_proj + σW)B`, in the region
+/// `‖s‖_M ≤ radius · ‖s₀‖_M` (s₀ the projected step), stopped at `‖Hs + g‖ ≤ tolerance ‖g‖`.
+/// The analogue of the base solve's CG (`tfw::base`), whose pressure projection made Newton
+/// linear the same way the per-face PSD projection of `E^wf` (S:2302–2307) does here.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CgRefinement {
+    /// CG iterations per step (0 = the projected step alone).
+    pub iterations: usize,
+    /// Trust-region radius relative to the projected step's `M`-norm.
+    pub radius: f64,
+    /// Relative model-gradient tolerance.
+    pub tolerance: f64,
+    /// Refine only after a full step (`t = 1`) of the line search: near the optimum, where
+    /// the spec switches to the true Hessian (A.6.3).
+    pub after_full_step: bool,
+}
+
+impl CgRefinement {
+    /// Off by default (the projected step);
+    /// `PLEAT_TFW_SQP_CG=iterations[,radius[,tolerance[,after_full_step]]]` turns it on for
+    /// measurement (radius 1e3, tolerance 1e-3, every step unless given). An
+    /// experiment's switch until it is a field of [`SqpOptions`] (which needs the C API's
+    /// struct literal to follow).
+    pub fn from_env() -> CgRefinement {
+        let mut c = CgRefinement {
+            iterations: 0,
+            radius: 1e3,
+            tolerance: 1e-3,
+            after_full_step: false,
+        };
+        if let Ok(v) = std::env::var("PLEAT_TFW_SQP_CG") {
+            let f: Vec<f64> = v.split(',').filter_map(|t| t.trim().parse().ok()).collect();
+            if let Some(&n) = f.first() {
+                c.iterations = n.max(0.0) as usize;
+            }
+            if let Some(&r) = f.get(1) {
+                c.radius = r;
+            }
+            if let Some(&t) = f.get(2) {
+                c.tolerance = t;
+            }
+            c.after_full_step = f.get(3).is_some_and(|&g| g > 0.0);
+        }
+        c
+    }
+}
+
+/// Steihaug–Toint CG on `h` (exact reduced Hessian, lower triangle) with the right-hand side
+/// `rhs = −g` (0 on held unknowns) preconditioned by `precond` (`M⁻¹`), region
+/// `cg.radius · ‖d₀‖_M` where `d₀ = M⁻¹ rhs` is the projected step; returns the step and the
+/// CG iterations. Its first CG iterate is `d₀` at its exact-model best length.
+fn refine_by_cg(
+    h: &crate::solve::SparseMatrix,
+    precond: &dyn Fn(&[f64]) -> Vec<f64>,
+    rhs: &[f64],
+    d0: &[f64],
+    cg: &CgRefinement,
+) -> (Vec<f64>, usize) {
+    let g: Vec<f64> = rhs.iter().map(|v| -v).collect();
+    let m_norm0 = dot_n(rhs, d0).max(0.0).sqrt(); // ‖d₀‖_M² = d₀ᵀ M d₀ = −gᵀd₀
+    let hess = |v: &[f64], y: &mut [f64]| sym_matvec_lower_into(h, v, y);
+    let gnorm = dot_n(&g, &g).sqrt();
+    let st = steihaug(
+        &g,
+        &hess,
+        precond,
+        cg.radius * m_norm0,
+        cg.tolerance * gnorm,
+        cg.iterations,
+    );
+    (st.step, st.iterations)
+}
+
 /// What the Newton steps carry over: the assembly plan and the symbolic analysis of the
 /// reduced matrix (its entries keep one pattern and order: held unknowns enter as zeros), and
 /// the relative shift σ.
 struct NewtonState {
     plan: Option<AssemblyPlan>,
+    /// The plan of the exact reduced Hessian (CG refinement only).
+    exact_plan: Option<AssemblyPlan>,
     analysis: Option<CholeskyAnalysis>,
     shift: f64,
+    /// The last accepted step was full (`t = 1`).
+    last_full: bool,
 }
 
 /// The projected Newton direction in `y` (held unknowns: 0) and the factorizations tried, or
 /// `None` when the factorization fails even with a relative shift above 1e4 (doubled per
 /// failure, as the clarabel QP's). The symbolic analysis is made on the first call and reused.
+#[allow(clippy::too_many_arguments)]
 fn newton_direction(
     problem: &SqpProblem,
     basis: &CurlFreeBasis,
     eval: &WfEval,
+    exact: Option<&[(usize, usize, f64)]>,
+    cg: &CgRefinement,
     g: &[f64],
     held: &[bool],
     weights: &[f64],
     state: &mut NewtonState,
-) -> Result<Option<(Vec<f64>, u32)>> {
+) -> Result<Option<(Vec<f64>, u32, usize)>> {
     let NewtonState {
         plan,
+        exact_plan,
         analysis,
         shift,
+        last_full,
     } = state;
     let ny = basis.ny;
     let (mut entries, mean) = reduced_hessian(problem, basis, &eval.hessian, held);
@@ -625,7 +737,22 @@ fn newton_direction(
         if let Ok(chol) = an.factor(&h, Parallelism::Global) {
             let d = chol.solve(&rhs);
             if d.iter().all(|v| v.is_finite()) {
-                return Ok(Some((d, attempts)));
+                let refine = cg.iterations > 0 && (!cg.after_full_step || *last_full);
+                let Some(exact) = exact.filter(|_| refine) else {
+                    return Ok(Some((d, attempts, 0)));
+                };
+                let (mut xe, _) = reduced_hessian(problem, basis, exact, held);
+                xe.extend((0..ny).map(|i| Entry::new(i, i, if held[i] { mean } else { 0.0 })));
+                if exact_plan.is_none() {
+                    *exact_plan = Some(AssemblyPlan::new(ny, &xe, "tfw exact reduced Hessian")?);
+                }
+                let xv: Vec<f64> = xe.iter().map(|e| e.val).collect();
+                let hx = exact_plan.as_ref().expect("made above").assemble(&xv)?;
+                let (s, its) = refine_by_cg(&hx, &|r| chol.solve(r), &rhs, &d, cg);
+                if s.iter().all(|v| v.is_finite()) {
+                    return Ok(Some((s, attempts, its)));
+                }
+                return Ok(Some((d, attempts, its)));
             }
         }
         *shift *= 2.0;

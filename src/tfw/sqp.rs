@@ -156,6 +156,9 @@ pub struct SqpIteration {
     /// Clarabel interior-point iterations of the QP (projected Newton: Cholesky
     /// factorizations tried).
     pub qp_iterations: u32,
+    /// Projected Newton with the exact-Hessian refinement ([`crate::tfw::pnewton`]): the
+    /// Steihaug–Toint CG iterations of the step (0 otherwise).
+    pub cg_iterations: u32,
     /// Max curl residual over the faces outside W after the step.
     pub curl_residual: f64,
     /// Wall time since the SQP started (s).
@@ -611,6 +614,7 @@ pub fn run_sqp(
             step_length: t,
             shift,
             qp_iterations,
+            cg_iterations: 0,
             curl_residual: problem.curl_residual(&x),
             seconds: start.elapsed().as_secs_f64(),
         });
