@@ -2338,6 +2338,8 @@ mod scene_speed {
                 s.history[k - 1].seconds
             }
         };
+        // PLEAT_TFW_WAVE_TRACE: print waves / peak / E at every checked snapshot
+        let trace = std::env::var("PLEAT_TFW_WAVE_TRACE").is_ok();
         // from which checked iteration on each criterion holds (walking back from the end)
         let (mut kw, mut kp1, mut kp5, mut ke) = (n, n, n, n);
         let (mut w_ok, mut p1_ok, mut p5_ok, mut e_ok) = (true, true, true, true);
@@ -2355,6 +2357,13 @@ mod scene_speed {
             .unwrap();
             let waves = count_waves(&cwf, levels, section).unwrap().waves;
             let dp = (peak(a) - final_peak).abs();
+            if trace {
+                eprintln!(
+                    "  trace {k:4}: waves {waves} peak {:.4} mm E {:.10e}",
+                    1e3 * peak(a),
+                    energy_at(*k)
+                );
+            }
             w_ok &= waves == final_waves;
             p1_ok &= dp <= 1e-2 * final_peak;
             p5_ok &= dp <= 5e-2 * final_peak;
@@ -2369,7 +2378,7 @@ mod scene_speed {
                     *kk = *k;
                 }
             }
-            if !(w_ok || p1_ok || p5_ok || e_ok) {
+            if !(w_ok || p1_ok || p5_ok || e_ok || trace) {
                 break;
             }
         }
@@ -2408,7 +2417,7 @@ mod scene_speed {
                 / (k + 1 - lo) as f64;
             eprintln!(
                 "  sqp {:4} E {:.10e} r/r0 {:.2e} rate {:.4} t {} halvings {:.2} shift {:.1e} cg \
-                 {:.1} {:.2} s",
+                 {:.1} held {} {:.2} s",
                 k + 1,
                 h[k].energy,
                 h[k].stationarity / r0,
@@ -2417,6 +2426,7 @@ mod scene_speed {
                 halvings,
                 h[k].shift,
                 cg,
+                h[k].held,
                 h[k].seconds
             );
         }

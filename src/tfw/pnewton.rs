@@ -537,6 +537,7 @@ fn run(
             shift: state.shift,
             qp_iterations: attempts,
             cg_iterations: cg_iterations as u32,
+            held: held.iter().filter(|&&h| h).count() as u32,
             curl_residual: problem.curl_residual(&x),
             seconds: start.elapsed().as_secs_f64(),
         });
