@@ -1072,6 +1072,18 @@ mod wrinkle_energy {
         }
     }
 
+    /// The one-pass evaluation of the exact-Hessian CG refinement (issue 13, branch `tfw13`)
+    /// returns exactly the two evaluations it replaces.
+    #[test]
+    fn projected_and_exact_in_one_pass_equal_the_two_evaluations() {
+        let (e, x) = fixture();
+        let ex = e.evaluate(&x, WfTerms::ALL, HessianMode::Exact);
+        let pr = e.evaluate(&x, WfTerms::ALL, HessianMode::ProjectedPerFace);
+        let (p, h) = e.evaluate_projected_and_exact(&x, WfTerms::ALL);
+        assert_eq!(p, pr);
+        assert_eq!(h, ex.hessian);
+    }
+
     /// The spec's uniform-patch optimum (da = 0): `|ω|* = (48β(α+β)/(α+2β)²)^{1/4}
     /// √(κ(1+λ_t)/h)` and `½[α(λ_t+λ_c+P/2) + 2β(λ_c+P/2)] = −(h²/6)(α+2β)s`, `s = |ω|²`,
     /// `P = a²s`, reproduced by Newton on `(a, w)` with the code's gradient and Hessian.
