@@ -25,6 +25,10 @@
 //! (`next_shift`: grown after short line-search steps) where the clarabel SQP halves it after
 //! every step), and the Armijo line
 //! search runs along the projected arc `max(0, a + t d_a)` with the slope `gᵀ(y(t) − y)`.
+//! Near the optimum (after a full step with σ ≤ 1e-8) the step is refined by Steihaug–Toint CG
+//! on the **exact** `Bᵀ H B` preconditioned by that factorization ([`CgRefinement`],
+//! 2026-11-27): the projected matrix alone made the cylinders converge linearly (r × 0.985–0.994
+//! per full step, 526 iterations; now 77, README "Tension-field wrinkles").
 //! `Bᵀ H B` keeps one sparsity pattern (held entries are stored as zeros), so faer's symbolic
 //! analysis is done once. Every iterate is `x = B y`, curl-free to rounding by construction.
 //! The stationarity residual is the projected gradient in `y` (`∇_y E`, with `min(g, 0)` for
