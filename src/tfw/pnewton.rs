@@ -639,8 +639,9 @@ impl CgRefinement {
     };
 
     /// The default since 2026-11-27 (branch `tfw13`): 50 CG iterations, region 10 ‖s₀‖_M,
-    /// tolerance 1e-3, after full steps with σ ≤ 1e-8 only (README "Tension-field wrinkles": the cylinders'
-    /// SQP from 526 / 487 to 73 / 58 iterations, same or lower final energy).
+    /// tolerance 1e-3, after full steps with σ ≤ 1e-8 only (README "Tension-field wrinkles":
+    /// the cylinders' SQP from 526 / 487 to 77 / 76 iterations, the torus's from 396 to 136,
+    /// the same or a lower final energy on every scene).
     pub const DEFAULT: CgRefinement = CgRefinement {
         iterations: 50,
         radius: 10.0,
