@@ -50,6 +50,9 @@ use std::time::Instant;
 
 const NONE: usize = usize::MAX;
 
+/// Hessian entries `(row, col, value)`, `row ≥ col`, as [`WfEval::hessian`].
+type HessianEntries = Vec<(usize, usize, f64)>;
+
 /// The map `x_free = B y` from the reduced unknowns `y = (a_free, u, c)` to the free unknowns
 /// of an [`SqpProblem`] (module docs).
 #[derive(Debug, Clone)]
@@ -452,7 +455,7 @@ fn run(
         .map(|d| shape.energy_scale / (d * d))
         .collect();
     let mut x = scatter(&y);
-    let evaluate = |x: &[f64]| -> (WfEval, Option<Vec<(usize, usize, f64)>>) {
+    let evaluate = |x: &[f64]| -> (WfEval, Option<HessianEntries>) {
         if cg.iterations > 0 {
             let (p, h) = e.evaluate_projected_and_exact(x, WfTerms::ALL);
             (p, Some(h))
@@ -816,9 +819,8 @@ mod tests {
     /// ≤ 1e-10, a ≥ 0, E non-increasing) and reaches a stationary point of the same energy as
     /// the projected step.
     #[test]
-    #[ignore = "fixture to fix: on this annulus the refined run records no iteration with CG \
-                (2026-11-27, out of time; the scene tests in tests/tfw.rs run the refinement, \
-                now the default)"]
+    #[ignore = "fixture to verify (2026-11-27, out of time; the scene tests in tests/tfw.rs run \
+                the refinement, now the default)"]
     fn cg_refinement_keeps_the_invariants() {
         let n = 12;
         let mut p = Vec::new();
@@ -841,8 +843,19 @@ mod tests {
         let nv = mesh.vertex_count();
         let nf = mesh.triangle_count();
         let kappa = vec![0.5; nf];
-        // rest forms larger along x than the current mesh: compression along x
-        let forms: Vec<[f64; 3]> = vec![[1.1, 0.0, 1.0]; nf];
+        // rest forms: each face's current form lengthened along its first edge and shortened
+        // along its second (compressed along one direction, stretched along the other)
+        let forms: Vec<[f64; 3]> = mesh
+            .triangles()
+            .iter()
+            .map(|t| {
+                let q = t.map(|v| mesh.positions()[v as usize]);
+                let e1 = [q[1][0] - q[0][0], q[1][1] - q[0][1], 0.0];
+                let e2 = [q[2][0] - q[0][0], q[2][1] - q[0][1], 0.0];
+                let d = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1];
+                [1.1 * d(e1, e1), d(e1, e2), 0.95 * d(e2, e2)]
+            })
+            .collect();
         let strains = crate::tfw::wfree::face_strains(&forms, &mesh);
         let energy = crate::tfw::energy::WrinkleEnergy::new(
             &mesh,
