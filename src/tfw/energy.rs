@@ -307,10 +307,42 @@ impl WrinkleEnergy {
                 j
             })
             .collect();
+        self.assemble_jets(&locals)
+    }
+
+    /// [`Self::evaluate`] with [`HessianMode::ProjectedPerFace`] and, from the same face jets,
+    /// the exact Hessian's entries (same order and pattern as [`WfEval::hessian`]): one
+    /// forward-mode pass for both (the exact-Hessian CG of [`crate::tfw::pnewton`]).
+    pub fn evaluate_projected_and_exact(
+        &self,
+        x: &[f64],
+        terms: WfTerms,
+    ) -> (WfEval, Vec<(usize, usize, f64)>) {
+        let exact: Vec<Jet> = self
+            .faces
+            .par_iter()
+            .map(|f| self.face_jet(f, x, terms))
+            .collect();
+        let projected: Vec<Jet> = exact
+            .par_iter()
+            .map(|j| {
+                let mut p = *j;
+                project_psd_unless_definite(&mut p.h);
+                p
+            })
+            .collect();
+        (
+            self.assemble_jets(&projected),
+            self.assemble_jets(&exact).hessian,
+        )
+    }
+
+    /// Sums the face jets in face order into energy, gradient and Hessian entries.
+    fn assemble_jets(&self, locals: &[Jet]) -> WfEval {
         let mut gradient = vec![0.0; self.dimension()];
         let mut hessian = Vec::with_capacity(15 * locals.len());
         let mut energy = 0.0;
-        for (f, j) in self.faces.iter().zip(&locals) {
+        for (f, j) in self.faces.iter().zip(locals) {
             energy += j.v;
             let (idx, sg) = self.local_map(f);
             for i in 0..L {

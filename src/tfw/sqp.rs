@@ -156,6 +156,12 @@ pub struct SqpIteration {
     /// Clarabel interior-point iterations of the QP (projected Newton: Cholesky
     /// factorizations tried).
     pub qp_iterations: u32,
+    /// Projected Newton with the exact-Hessian refinement ([`crate::tfw::pnewton`]): the
+    /// Steihaug–Toint CG iterations of the step (0 otherwise).
+    pub cg_iterations: u32,
+    /// Projected Newton: amplitudes held at 0 in the step (at the bound with a positive
+    /// gradient); 0 for clarabel.
+    pub held: u32,
     /// Max curl residual over the faces outside W after the step.
     pub curl_residual: f64,
     /// Wall time since the SQP started (s).
@@ -611,6 +617,8 @@ pub fn run_sqp(
             step_length: t,
             shift,
             qp_iterations,
+            cg_iterations: 0,
+            held: 0,
             curl_residual: problem.curl_residual(&x),
             seconds: start.elapsed().as_secs_f64(),
         });
