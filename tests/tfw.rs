@@ -2250,7 +2250,7 @@ mod solver_comparison {
 mod scene_speed {
     use super::*;
     use pleat::tfw::measure::{count_waves, Section};
-    use pleat::tfw::{solve, QpMethod, TfwParams, TfwResult};
+    use pleat::tfw::{solve, CgRefinement, QpMethod, TfwParams, TfwResult};
 
     struct Case {
         name: &'static str,
@@ -2444,10 +2444,36 @@ mod scene_speed {
         }
     }
 
+    /// The measurement switch `PLEAT_TFW_SQP_CG=iterations[,radius[,tolerance[,after_full_step[,
+    /// max_shift]]]]` (`0` = the projected step alone; radius 1e3, tolerance 1e-3, every step
+    /// unless given); unset: the library's default [`CgRefinement::DEFAULT`].
+    fn cg_refinement_from_env() -> CgRefinement {
+        let Ok(v) = std::env::var("PLEAT_TFW_SQP_CG") else {
+            return CgRefinement::DEFAULT;
+        };
+        let mut c = CgRefinement::OFF;
+        let f: Vec<f64> = v.split(',').filter_map(|t| t.trim().parse().ok()).collect();
+        if let Some(&n) = f.first() {
+            c.iterations = n.max(0.0) as usize;
+        }
+        if let Some(&r) = f.get(1) {
+            c.radius = r;
+        }
+        if let Some(&t) = f.get(2) {
+            c.tolerance = t;
+        }
+        c.after_full_step = f.get(3).is_some_and(|&g| g > 0.0);
+        if let Some(&m) = f.get(4) {
+            c.max_shift = m;
+        }
+        c
+    }
+
     fn run(case: &Case, qp: QpMethod, every: usize) {
         let mut params = TfwParams::default();
         params.sqp.qp = qp;
         params.sqp.snapshot_every = every;
+        params.sqp.cg_refinement = cg_refinement_from_env();
         if let Ok(n) = std::env::var("PLEAT_TFW_BASE_ITERS") {
             params.base.max_iterations = n.parse().unwrap();
         }

@@ -1118,6 +1118,7 @@ pub(super) mod imp {
                 time_limit_seconds: if t > 0.0 { t } else { f64::INFINITY },
                 qp,
                 snapshot_every: 0,
+                ..SqpOptions::default()
             },
             curvature,
             knoppel: KnoppelOptions::default(),

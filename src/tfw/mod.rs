@@ -88,6 +88,7 @@ pub use base::{
 };
 pub use material::{Branch, Lame};
 pub use pipeline::{solve, TfwParams, TfwResult, TfwSeconds, TfwStatus};
+pub use pnewton::CgRefinement;
 pub use scene::{
     Dirichlet, Material, Model, Motion, Obstacle, ObstacleShape, Panel, Rotation, Scene,
     DEFAULT_OBSTACLE_STIFFNESS,

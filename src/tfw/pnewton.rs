@@ -394,16 +394,15 @@ fn projected_gradient_norm(g: &[f64], y: &[f64], na: usize) -> f64 {
 
 /// Runs the SQP by projected Newton (module docs, [`crate::tfw::QpMethod::ProjectedNewton`]) from `x0 =
 /// [a | ω]` (made feasible first), whatever `options.qp` says; otherwise as
-/// [`crate::tfw::sqp::run_sqp`]. The step is refined on the exact Hessian
-/// ([`CgRefinement::DEFAULT`]; the experiment switch `PLEAT_TFW_SQP_CG` overrides it,
-/// [`CgRefinement::from_env`]).
+/// [`crate::tfw::sqp::run_sqp`]. The step is refined on the exact Hessian as
+/// `options.cg_refinement` says ([`CgRefinement::DEFAULT`] unless set).
 pub fn run_sqp_projected_newton(
     problem: &SqpProblem,
     x0: &[f64],
     options: &SqpOptions,
     progress: &mut ProgressFn<'_>,
 ) -> Result<SqpResult> {
-    run_sqp_projected_newton_with(problem, x0, options, &CgRefinement::from_env(), progress)
+    run_sqp_projected_newton_with(problem, x0, options, &options.cg_refinement, progress)
 }
 
 /// [`run_sqp_projected_newton`] with the step's exact-Hessian refinement given explicitly
@@ -652,34 +651,6 @@ impl CgRefinement {
         after_full_step: true,
         max_shift: 1e-8,
     };
-
-    /// [`Self::DEFAULT`] unless the experiment switch
-    /// `PLEAT_TFW_SQP_CG=iterations[,radius[,tolerance[,after_full_step[,max_shift]]]]` says
-    /// otherwise (`0` = the projected step alone; radius 1e3, tolerance 1e-3, every step unless
-    /// given).
-    /// A switch for measurements until the refinement is a field of [`SqpOptions`] (which
-    /// needs the C API's struct literal in `src/ffi/tfw.rs` to follow).
-    pub fn from_env() -> CgRefinement {
-        let Ok(v) = std::env::var("PLEAT_TFW_SQP_CG") else {
-            return CgRefinement::DEFAULT;
-        };
-        let mut c = CgRefinement::OFF;
-        let f: Vec<f64> = v.split(',').filter_map(|t| t.trim().parse().ok()).collect();
-        if let Some(&n) = f.first() {
-            c.iterations = n.max(0.0) as usize;
-        }
-        if let Some(&r) = f.get(1) {
-            c.radius = r;
-        }
-        if let Some(&t) = f.get(2) {
-            c.tolerance = t;
-        }
-        c.after_full_step = f.get(3).is_some_and(|&g| g > 0.0);
-        if let Some(&m) = f.get(4) {
-            c.max_shift = m;
-        }
-        c
-    }
 }
 
 /// Steihaug–Toint CG on `h` (exact reduced Hessian, lower triangle) with the right-hand side

@@ -33,6 +33,7 @@
 use crate::report::{Progress, ProgressFn};
 use crate::solve::{assemble, CholeskyAnalysis, Entry, Parallelism};
 use crate::tfw::energy::{HessianMode, WfEval, WfTerms, WrinkleEnergy};
+use crate::tfw::pnewton::CgRefinement;
 use crate::{Error, Result};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
@@ -63,6 +64,10 @@ pub struct SqpOptions {
     /// iterations (0 = none; the last iterate is always [`SqpResult::x`]). For wave counts
     /// against time (`pleat bench tfw`); costs one vector per snapshot, no evaluation.
     pub snapshot_every: usize,
+    /// Projected Newton only: the exact-Hessian CG refinement of the step near the optimum
+    /// (default [`CgRefinement::DEFAULT`] since 2026-11-27; [`CgRefinement::OFF`] is the
+    /// projected step alone; README "Tension-field wrinkles").
+    pub cg_refinement: CgRefinement,
 }
 
 /// How [`run_sqp`] computes a step.
@@ -79,7 +84,7 @@ pub enum QpMethod {
 
 impl Default for SqpOptions {
     /// 1000 iterations, r/r₀ 1e-6, ΔE/E 1e-10, step 1e-10, Armijo 0.2, δ₀ 1e-6, no time limit,
-    /// projected Newton, no snapshots.
+    /// projected Newton with the exact-Hessian refinement near the optimum, no snapshots.
     fn default() -> Self {
         SqpOptions {
             max_iterations: 1000,
@@ -91,6 +96,7 @@ impl Default for SqpOptions {
             time_limit_seconds: f64::INFINITY,
             qp: QpMethod::ProjectedNewton,
             snapshot_every: 0,
+            cg_refinement: CgRefinement::DEFAULT,
         }
     }
 }
