@@ -372,6 +372,7 @@ pub fn bake_case(
     target: Option<usize>,
     cage: bool,
     clearance: Option<pleat::lowpoly::Clearance>,
+    voxel_scale: Option<f64>,
     prog: &mut pleat::report::ProgressFn<'_>,
 ) -> (Row, Option<TriMesh>) {
     let mut row = Row {
@@ -386,6 +387,7 @@ pub fn bake_case(
         target_faces: target,
         measure_floor: true,
         clearance: clearance.unwrap_or_default(),
+        offset_voxel_scale: voxel_scale,
         ..Default::default()
     };
     let mut run = timed(|| {

@@ -182,6 +182,11 @@ struct BakeArgs {
     /// the default) or a length in model units (`0.002`); below d. `0d` only forbids contact.
     #[arg(long, value_parser = parse_clearance)]
     clearance: Option<pleat::lowpoly::Clearance>,
+    /// LODs: the offset voxel to start from, a multiple of d/√3 in (0, 2] (`1` = the
+    /// dissertation's voxel) [default: 2 from n_p = 200 on, 1 below]; a coarser one is taken
+    /// when the memory estimate needs it. Ignored for cages.
+    #[arg(long)]
+    voxel_scale: Option<f64>,
     /// No progress bar and no summary.
     #[arg(short, long)]
     quiet: bool,
@@ -542,6 +547,7 @@ fn lod_params(args: &BakeArgs, sizes: &[f64], faces: Option<usize>) -> LodParams
         align: !args.no_align,
         fit_to_input: !args.no_fit,
         clearance: args.clearance.unwrap_or_default(),
+        offset_voxel_scale: args.voxel_scale,
         ..LodParams::default()
     }
 }
