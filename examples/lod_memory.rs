@@ -162,7 +162,20 @@ fn main() {
     };
     PEAK.store(LIVE.load(Ordering::Relaxed), Ordering::Relaxed);
     let result = {
+        let mut tick = Instant::now();
         let mut progress = |p: pleat::Progress<'_>| {
+            // a timeline of the first simplification pass (the peak), every 2 s
+            let first_pass = p.stage == "simplify"
+                && episodes.iter().filter(|e| e.stage == "simplify").count() <= 1;
+            if first_pass && tick.elapsed().as_secs_f64() >= 2.0 {
+                tick = Instant::now();
+                println!(
+                    "  first pass at {:.5}: live {:.1} MiB, peak so far {:.1} MiB",
+                    p.fraction,
+                    mib(LIVE.load(Ordering::Relaxed)),
+                    mib(PEAK.load(Ordering::Relaxed))
+                );
+            }
             if episodes.last().is_none_or(|e| e.stage != p.stage) {
                 close(&mut episodes, &mut t);
                 let live = LIVE.load(Ordering::Relaxed);
