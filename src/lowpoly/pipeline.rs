@@ -179,13 +179,14 @@ pub const LOD_COARSE_VOXEL_MIN_SCREEN_SIZE: f64 = 200.0;
 
 /// Peak bytes per *estimated* offset face ([`LodParams::memory_estimate`]'s face count): the
 /// first simplification pass holds the half-edge mesh, the guard's BVH and caches, the pass's
-/// per-edge targets, quadrics and queue, plus the offset surface kept for an exact rerun.
-/// Measured 2026-11-27 (issue 12 part 4): dirty_beetle at n_p = 1000 peaks at 6.38 GB (VmHWM)
-/// with 8.72 M offset faces (730 B per real face) where the estimate counted 6.3 M faces
-/// (thin legs: the offset of a thin part has far more area than twice the part's), i.e.
-/// 1010 B per estimated face; dirty_ogre at n_p = 200, 380 B. The former 400 B let the beetle
-/// at n_p = 1000 through an estimate of 2.2 GiB to a 5.9 GiB peak. 1100 B bounds both.
-const BYTES_PER_WORK_FACE: f64 = 1100.0;
+/// quadrics and queue, plus the offset surface kept for an exact rerun and round 0's copy.
+/// Measured 2026-11-27 (issue 12 part 4, `examples/lod_memory.rs`): dirty_beetle at n_p = 1000
+/// (scale 2, 2.18 M offset faces where the estimate counts 1.58 M: the offset of a thin leg has
+/// far more area than twice the leg's) peaked at 1592 MiB (VmHWM), 1056 B per estimated face;
+/// with no per-edge target array, the queue filled in chunks and the guard's old BVH freed
+/// before a rebuild, at 1195 MiB (VmHWM; 1190 MiB allocated, in the first pass's first BVH
+/// rebuild), 793 B per estimated face. 900 B bounds it with a 13% margin (formerly 1100 B).
+const BYTES_PER_WORK_FACE: f64 = 900.0;
 /// Peak bytes per input sample of the input-plane fit's coverage check (`coverage.rs`: the
 /// input sampled at `SPACING · d`, a budget and a box per sample, the tree over them), which
 /// grows like `n_p²` and does not depend on the offset voxel. Measured 2026-11-27:
