@@ -221,7 +221,7 @@ fn fit_samples(input: &TriMesh, d: f64) -> f64 {
 const BYTES_PER_INPUT_FACE: f64 = 700.0;
 
 /// The finest voxel scale a bake in `mode` at `screen_size` starts from: for LODs the caller's
-/// `requested` scale ([`LodParams::offset_voxel_scale`]) or else [`LOD_VOXEL_SCALE`] from
+/// `requested` scale (the field `LodParams::offset_voxel_scale`) or else [`LOD_VOXEL_SCALE`] from
 /// [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] on and 1 below; for cages 1.
 fn finest_voxel_scale(mode: Mode, screen_size: f64, requested: Option<f64>) -> f64 {
     let rule = if screen_size >= LOD_COARSE_VOXEL_MIN_SCREEN_SIZE {
@@ -308,8 +308,8 @@ impl LodParams {
         Ok(())
     }
 
-    /// The offset voxel scale a LOD of `input` with these parameters starts from (see
-    /// [`offset_voxel_scale`](Self::offset_voxel_scale) and [`LOD_VOXEL_SCALES`]), or `None`
+    /// The offset voxel scale a LOD of `input` with these parameters starts from (see the
+    /// field `offset_voxel_scale` and [`LOD_VOXEL_SCALES`]), or `None`
     /// when even the coarsest scale's estimate exceeds the budget (then `validate` refuses).
     /// The same choice `generate` makes; for benchmarks and tools.
     pub fn lod_voxel_scale(&self, input: &TriMesh) -> Option<f64> {
