@@ -365,6 +365,8 @@ pub fn read_face_targets(path: &Path) -> Result<HashMap<(String, u64), usize>, S
 
 #[cfg(feature = "lod")]
 /// Bakes one case and checks it; never panics (a panic in the bake becomes the status).
+// The case's parameters, one by one, as `pleat bench lod` takes them from its flags.
+#[allow(clippy::too_many_arguments)]
 pub fn bake_case(
     name: &str,
     mesh: &TriMesh,
@@ -372,6 +374,7 @@ pub fn bake_case(
     target: Option<usize>,
     cage: bool,
     clearance: Option<pleat::lowpoly::Clearance>,
+    voxel_scale: Option<f64>,
     prog: &mut pleat::report::ProgressFn<'_>,
 ) -> (Row, Option<TriMesh>) {
     let mut row = Row {
@@ -386,6 +389,7 @@ pub fn bake_case(
         target_faces: target,
         measure_floor: true,
         clearance: clearance.unwrap_or_default(),
+        offset_voxel_scale: voxel_scale,
         ..Default::default()
     };
     let mut run = timed(|| {

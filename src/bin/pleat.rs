@@ -188,6 +188,11 @@ struct BakeArgs {
     /// offset surface.
     #[arg(long, value_parser = parse_start, default_value = "auto")]
     start: pleat::lowpoly::LodStart,
+    /// LODs: the offset voxel to start from, a multiple of d/√3 in (0, 2] (`1` = the
+    /// dissertation's voxel) [default: 2 from n_p = 200 on, 1 below]; a coarser one is taken
+    /// when the memory estimate needs it. Ignored for cages.
+    #[arg(long)]
+    voxel_scale: Option<f64>,
     /// No progress bar and no summary.
     #[arg(short, long)]
     quiet: bool,
@@ -549,6 +554,7 @@ fn lod_params(args: &BakeArgs, sizes: &[f64], faces: Option<usize>) -> LodParams
         fit_to_input: !args.no_fit,
         clearance: args.clearance.unwrap_or_default(),
         start: args.start,
+        offset_voxel_scale: args.voxel_scale,
         ..LodParams::default()
     }
 }

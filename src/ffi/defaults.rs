@@ -286,3 +286,24 @@ fn wrinkle_interp_params_locality_field() {
     let e = interpolate::imp::options(&bad).unwrap_err().to_string();
     assert!(e.contains("params->locality"), "{e}");
 }
+
+/// `PleatLodParams::offset_voxel_scale` (issue 12 part 4): 0 and older struct sizes are
+/// automatic, (0, 2] is passed on, NaN/negative/> 2 are refused naming the field.
+#[cfg(feature = "lod")]
+#[test]
+fn lod_params_offset_voxel_scale_is_checked() {
+    use super::boundary::read_versioned;
+    let mut c = pleat_lod_params_default();
+    c.offset_voxel_scale = 1.5;
+    assert_eq!(lod::imp::to_rust(&c).unwrap().offset_voxel_scale, Some(1.5));
+    // an older caller (up to `clearance`) gets automatic
+    c.struct_size = std::mem::offset_of!(PleatLodParams, offset_voxel_scale) as u32;
+    // SAFETY: `c` is a full, live struct; pleat reads its first `struct_size` bytes.
+    let old = unsafe { read_versioned(&c, "params") }.unwrap();
+    assert_eq!(lod::imp::to_rust(&old).unwrap().offset_voxel_scale, None);
+    for bad in [f64::NAN, -1.0, 2.5, f64::INFINITY] {
+        c.offset_voxel_scale = bad;
+        let e = lod::imp::to_rust(&c).unwrap_err().to_string();
+        assert!(e.contains("params->offset_voxel_scale"), "{e}");
+    }
+}

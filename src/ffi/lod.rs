@@ -78,6 +78,12 @@ pub struct PleatLodParams {
     /// from the offset surface. Appended for issue 12; callers with an older `struct_size`
     /// get 0 (auto).
     pub start: u32,
+    /// LODs only: the offset voxel the bake starts from, as a multiple of d/√3, in (0, 2];
+    /// 0 (the default) = automatic (2 from n_p = 200 on, 1 below; see README "A coarser first
+    /// stage"). A coarser voxel is still taken when the memory estimate needs it. NaN,
+    /// negative or > 2 is `PLEAT_STATUS_INVALID_ARGUMENT`. Appended for issue 12 part 4;
+    /// callers with an older `struct_size` get automatic.
+    pub offset_voxel_scale: f64,
 }
 
 /// `PleatLodParams::start`: the welded input when clean, else the offset surface.
@@ -205,6 +211,7 @@ impl From<&crate::lowpoly::LodParams> for PleatLodParams {
                 LodStart::Offset => PLEAT_LOD_START_OFFSET,
                 LodStart::Input => PLEAT_LOD_START_INPUT,
             },
+            offset_voxel_scale: p.offset_voxel_scale.unwrap_or(0.0),
         }
     }
 }
@@ -226,6 +233,7 @@ pub(super) fn defaults_without_lod() -> PleatLodParams {
         memory_budget_bytes: 2 << 30,
         clearance: 0.1,
         start: PLEAT_LOD_START_AUTO,
+        offset_voxel_scale: 0.0,
     }
 }
 
@@ -280,7 +288,22 @@ pub(super) mod imp {
             } else {
                 Clearance::FractionOfD(p.clearance)
             },
+            offset_voxel_scale: voxel_scale_to_rust(p.offset_voxel_scale)?,
         })
+    }
+
+    /// `PleatLodParams::offset_voxel_scale`: 0 is automatic (`None`), a value in (0, 2] is
+    /// passed on, anything else (NaN, negative, infinite, > 2) is `InvalidArgument`.
+    fn voxel_scale_to_rust(s: f64) -> Result<Option<f64>> {
+        if s == 0.0 {
+            return Ok(None);
+        }
+        if !(s.is_finite() && s > 0.0 && s <= 2.0) {
+            return Err(Error::InvalidArgument(format!(
+                "params->offset_voxel_scale must be 0 (automatic) or in (0, 2], got {s}"
+            )));
+        }
+        Ok(Some(s))
     }
 
     pub(super) fn bake(

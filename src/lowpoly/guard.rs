@@ -884,6 +884,8 @@ fn rebuild_threshold(mesh: &HalfEdgeMesh) -> usize {
 }
 
 /// Rebuilds the guard's BVH over the live faces (dropping the dead leaves of removed faces).
+/// The old tree is freed first, so the rebuild never holds two trees (issue 12 part 4: on the
+/// first pass over a dense offset surface the old tree still has a leaf per offset face).
 fn rebuild_bvh(
     mesh: &HalfEdgeMesh,
     tris: &FaceData<[u32; 3]>,
@@ -891,6 +893,7 @@ fn rebuild_bvh(
     edits: &mut usize,
 ) {
     let live: Vec<FaceId> = mesh.faces().collect();
+    *bvh = TriangleBvh::default();
     *bvh = TriangleBvh::from_subset(mesh.positions(), tris.as_slice(), FaceId::raw_slice(&live));
     *edits = 0;
 }

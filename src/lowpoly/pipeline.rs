@@ -116,6 +116,15 @@ pub struct LodParams {
     /// surface the loop starts from (issue 12 part 1, see [`LodStart`]). Default
     /// [`LodStart::Auto`].
     pub start: LodStart,
+    /// LODs only (ignored for cages): the offset voxel the bake starts from, as a multiple of
+    /// `d/√3`. `None` (default) follows the rule of [`LOD_VOXEL_SCALE`] (scale 2 from
+    /// [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] on, 1 below); `Some(s)` starts from `s`, finite and
+    /// in `(0, 2]` (else `InvalidArgument`), e.g. `Some(1.0)` for the dissertation's voxel. The
+    /// memory-budget fallback still applies: when `s` does not fit, the finest of
+    /// [`LOD_VOXEL_SCALES`] coarser than `s` that fits is taken. Replaces the former benchmark
+    /// environment variable `PLEAT_LOD_VOXEL_SCALE` (issue 12 part 4), so the output depends on
+    /// the parameters only.
+    pub offset_voxel_scale: Option<f64>,
 }
 
 /// The largest total genus of a clean input that [`LodStart::Auto`] starts from (see there):
@@ -178,6 +187,7 @@ impl Default for LodParams {
             clearance: Clearance::default(),
             fit_to_input: true,
             start: LodStart::Auto,
+            offset_voxel_scale: None,
         }
     }
 }
@@ -211,21 +221,16 @@ pub const LOD_VOXEL_SCALE: f64 = 2.0;
 /// The smallest screen size `n_p` at which a LOD starts from [`LOD_VOXEL_SCALE`] (see there).
 pub const LOD_COARSE_VOXEL_MIN_SCREEN_SIZE: f64 = 200.0;
 
-/// Benchmark switch, not an API: `PLEAT_LOD_VOXEL_SCALE=<s>` makes every LOD start from scale
-/// `s` (clamped to `(0, 2]`; e.g. `1` for the dissertation's voxel) instead of the rule of
-/// [`LOD_VOXEL_SCALE`], so that both can be compared with one binary (`README`, "A coarser
-/// first stage").
-const VOXEL_SCALE_ENV: &str = "PLEAT_LOD_VOXEL_SCALE";
-
 /// Peak bytes per *estimated* offset face ([`LodParams::memory_estimate`]'s face count): the
 /// first simplification pass holds the half-edge mesh, the guard's BVH and caches, the pass's
-/// per-edge targets, quadrics and queue, plus the offset surface kept for an exact rerun.
-/// Measured 2026-11-27 (issue 12 part 4): dirty_beetle at n_p = 1000 peaks at 6.38 GB (VmHWM)
-/// with 8.72 M offset faces (730 B per real face) where the estimate counted 6.3 M faces
-/// (thin legs: the offset of a thin part has far more area than twice the part's), i.e.
-/// 1010 B per estimated face; dirty_ogre at n_p = 200, 380 B. The former 400 B let the beetle
-/// at n_p = 1000 through an estimate of 2.2 GiB to a 5.9 GiB peak. 1100 B bounds both.
-const BYTES_PER_WORK_FACE: f64 = 1100.0;
+/// quadrics and queue, plus the offset surface kept for an exact rerun and round 0's copy.
+/// Measured 2026-11-27 (issue 12 part 4, `examples/lod_memory.rs`): dirty_beetle at n_p = 1000
+/// (scale 2, 2.18 M offset faces where the estimate counts 1.58 M: the offset of a thin leg has
+/// far more area than twice the leg's) peaked at 1592 MiB (VmHWM), 1056 B per estimated face;
+/// with no per-edge target array, the queue filled in chunks and the guard's old BVH freed
+/// before a rebuild, at 1195 MiB (VmHWM; 1190 MiB allocated, in the first pass's first BVH
+/// rebuild), 793 B per estimated face. 900 B bounds it with a 13% margin (formerly 1100 B).
+const BYTES_PER_WORK_FACE: f64 = 900.0;
 /// Peak bytes per input sample of the input-plane fit's coverage check (`coverage.rs`: the
 /// input sampled at `SPACING · d`, a budget and a box per sample, the tree over them), which
 /// grows like `n_p²` and does not depend on the offset voxel. Measured 2026-11-27:
@@ -259,10 +264,10 @@ fn fit_samples(input: &TriMesh, d: f64) -> f64 {
 /// 211 MB (149 MB with the former 200 B).
 const BYTES_PER_INPUT_FACE: f64 = 700.0;
 
-/// The finest voxel scale a bake in `mode` at `screen_size` starts from: for LODs
-/// [`LOD_VOXEL_SCALE`] from [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] on and 1 below (or the
-/// [`VOXEL_SCALE_ENV`] benchmark switch), for cages 1.
-fn finest_voxel_scale(mode: Mode, screen_size: f64) -> f64 {
+/// The finest voxel scale a bake in `mode` at `screen_size` starts from: for LODs the caller's
+/// `requested` scale (the field `LodParams::offset_voxel_scale`) or else [`LOD_VOXEL_SCALE`] from
+/// [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] on and 1 below; for cages 1.
+fn finest_voxel_scale(mode: Mode, screen_size: f64, requested: Option<f64>) -> f64 {
     let rule = if screen_size >= LOD_COARSE_VOXEL_MIN_SCREEN_SIZE {
         LOD_VOXEL_SCALE
     } else {
@@ -270,11 +275,7 @@ fn finest_voxel_scale(mode: Mode, screen_size: f64) -> f64 {
     };
     match mode {
         Mode::Cage => 1.0,
-        Mode::Lod => std::env::var(VOXEL_SCALE_ENV)
-            .ok()
-            .and_then(|v| v.parse::<f64>().ok())
-            .filter(|v| v.is_finite() && *v > 0.0)
-            .map_or(rule, |v| v.min(MAX_LOD_VOXEL_SCALE)),
+        Mode::Lod => requested.unwrap_or(rule),
     }
 }
 
@@ -314,6 +315,13 @@ impl LodParams {
         if self.memory_budget_bytes == 0 {
             return bad("memory budget must be > 0".into());
         }
+        if let Some(v) = self.offset_voxel_scale {
+            if !(v.is_finite() && v > 0.0 && v <= MAX_LOD_VOXEL_SCALE) {
+                return bad(format!(
+                    "offset_voxel_scale must be finite and in (0, {MAX_LOD_VOXEL_SCALE}], got {v}"
+                ));
+            }
+        }
         check_coordinate_range(input, self.screen_size)?;
         let l = input.bbox_diagonal();
         if !(l > 0.0 && l.is_finite()) {
@@ -344,13 +352,29 @@ impl LodParams {
         Ok(())
     }
 
+    /// The offset voxel scale a LOD of `input` with these parameters starts from (see the
+    /// field `offset_voxel_scale` and [`LOD_VOXEL_SCALES`]), or `None`
+    /// when even the coarsest scale's estimate exceeds the budget (then `validate` refuses).
+    /// The same choice `generate` makes; for benchmarks and tools.
+    pub fn lod_voxel_scale(&self, input: &TriMesh) -> Option<f64> {
+        self.offset_voxel_scale(input, Mode::Lod)
+    }
+
+    /// The estimated peak bytes of a LOD bake of `input` at offset voxel `voxel_scale` — the
+    /// figure compared with `memory_budget_bytes` (see the private `memory_estimate`); meant to
+    /// be an upper bound of the measured peak (README, "Large screen sizes").
+    pub fn memory_estimate_bytes(&self, input: &TriMesh, voxel_scale: f64) -> f64 {
+        self.memory_estimate(input, voxel_scale)
+    }
+
     /// The voxel scale a bake in `mode` uses: see [`voxel_scale_from`](Self::voxel_scale_from),
     /// from [`finest_voxel_scale`].
     fn offset_voxel_scale(&self, input: &TriMesh, mode: Mode) -> Option<f64> {
-        self.voxel_scale_from(input, mode, finest_voxel_scale(mode, self.screen_size))
+        let finest = finest_voxel_scale(mode, self.screen_size, self.offset_voxel_scale);
+        self.voxel_scale_from(input, mode, finest)
     }
 
-    /// The finest voxel scale of [`LOD_VOXEL_SCALES`] (cages: only 1) not finer than `finest`
+    /// The first of `finest` and the coarser scales of [`LOD_VOXEL_SCALES`] (cages: only 1)
     /// whose [`memory_estimate`](Self::memory_estimate) fits the budget, or `None`.
     fn voxel_scale_from(&self, input: &TriMesh, mode: Mode, finest: f64) -> Option<f64> {
         let scales: &[f64] = match mode {
@@ -358,10 +382,10 @@ impl LodParams {
             Mode::Cage => &LOD_VOXEL_SCALES[..1],
         };
         let budget = self.memory_budget_bytes as f64;
-        scales
-            .iter()
-            .copied()
-            .filter(|&s| s >= finest)
+        let coarser = scales.iter().copied().filter(|&s| s > finest);
+        std::iter::once(finest)
+            .filter(|&s| mode == Mode::Lod || scales.contains(&s))
+            .chain(coarser)
             .find(|&s| self.memory_estimate(input, s) <= budget)
     }
 
@@ -1293,5 +1317,37 @@ mod tests {
             Some(LOD_VOXEL_SCALE)
         );
         assert_eq!(large.offset_voxel_scale(&m, Mode::Cage), Some(1.0));
+        // a requested scale replaces the rule (here: scale 1 below the threshold; also a scale
+        // off the list), the budget's fallback
+        // to the coarser listed scales still applies, cages ignore it
+        let asked = |s: f64, budget: u64| LodParams {
+            offset_voxel_scale: Some(s),
+            memory_budget_bytes: budget,
+            ..base.clone()
+        };
+        let roomy = 1u64 << 40;
+        assert_eq!(
+            asked(1.0, roomy).offset_voxel_scale(&m, Mode::Lod),
+            Some(1.0)
+        );
+        assert_eq!(
+            asked(1.1, roomy).offset_voxel_scale(&m, Mode::Lod),
+            Some(1.1)
+        );
+        assert_eq!(
+            asked(1.1, p.memory_budget_bytes).offset_voxel_scale(&m, Mode::Lod),
+            Some(1.5)
+        );
+        assert_eq!(
+            asked(1.1, roomy).offset_voxel_scale(&m, Mode::Cage),
+            Some(1.0)
+        );
+        assert!(asked(2.0, roomy).validate(&m).is_ok());
+        for bad in [0.0, -1.0, 2.01, f64::NAN, f64::INFINITY] {
+            match asked(bad, roomy).validate(&m) {
+                Err(Error::InvalidArgument(msg)) => assert!(msg.contains("offset_voxel_scale")),
+                other => panic!("scale {bad}: {other:?}"),
+            }
+        }
     }
 }

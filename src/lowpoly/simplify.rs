@@ -198,7 +198,8 @@ fn collapse_target(q: &Quadric, pa: Vec3, pb: Vec3) -> (Vec3, f64) {
     (x, q.eval(x).max(0.0))
 }
 
-/// A queue entry: cost and edge id (the target position is in `Pass::targets`).
+/// A queue entry: cost and edge id (the target position is recomputed by
+/// `Pass::edge_target`).
 #[derive(Debug, Clone, Copy)]
 struct Entry {
     cost: f64,
@@ -214,6 +215,10 @@ impl Entry {
             .is_lt()
     }
 }
+
+/// Edges per chunk of [`Pass::queue_all_edges`]: large enough to keep both cores busy, small
+/// enough that the chunk's buffers (12 B per edge) stay below a MB.
+const QUEUE_FILL_CHUNK: usize = 1 << 16;
 
 /// Marks an edge that is not in the queue.
 const NOT_QUEUED: u32 = u32::MAX;
@@ -356,7 +361,6 @@ struct Pass<'g, 'a> {
     g: &'g mut Guard<'a>,
     opt: SimplifyOptions,
     quadrics: VertexData<Quadric>,
-    targets: EdgeData<Vec3>,
     /// The queue and the batch formation.
     batcher: Batcher,
     /// Sampled distance to the input per face (NaN mean = not computed yet).
@@ -517,7 +521,6 @@ impl<'g, 'a> Pass<'g, 'a> {
         let quadrics = vertex_quadrics(g);
         let m = g.mesh();
         let mut pass = Pass {
-            targets: EdgeData::filled(m.edge_capacity(), Vec3::ZERO),
             face_dist: FaceData::filled(m.face_capacity(), FaceDist::UNKNOWN),
             vert_dist: VertexData::filled(m.vertex_capacity(), f64::NAN),
             batcher: Batcher {
@@ -539,28 +542,32 @@ impl<'g, 'a> Pass<'g, 'a> {
         pass
     }
 
-    /// Fills the queue with every edge: targets and costs computed in parallel (each depends
-    /// only on its edge), then one bottom-up heap build.
+    /// Fills the queue with every edge: costs computed in parallel (each depends only on its
+    /// edge), then one bottom-up heap build. The edges go through in chunks of
+    /// [`QUEUE_FILL_CHUNK`], so the transient buffers are bounded instead of 36 B per edge of
+    /// the dense offset surface (issue 12 part 4); the entries are the same, in the same order,
+    /// whatever the chunk or thread count.
     fn queue_all_edges(&mut self) {
-        let m = self.g.mesh();
-        let edges: Vec<EdgeId> = m.edges().collect();
-        let quadrics = &self.quadrics;
-        let targets: Vec<(Vec3, f64)> = edges
-            .par_iter()
-            .with_min_len(1024)
-            .map(|&e| {
-                let h = m.edge_halfedge(e);
-                let (a, b) = (m.origin(h), m.target(h));
-                let q = quadrics[a].add(&quadrics[b]);
-                collapse_target(&q, m.position(a).into(), m.position(b).into())
-            })
-            .collect();
-        let mut entries = Vec::with_capacity(edges.len());
-        for (&e, &(target, cost)) in edges.iter().zip(&targets) {
-            self.targets[e] = target;
-            entries.push(Entry { cost, edge: e });
+        let mut entries = Vec::with_capacity(self.g.mesh().edge_count());
+        let mut edges: Vec<EdgeId> = Vec::with_capacity(QUEUE_FILL_CHUNK);
+        let mut all = self.g.mesh().edges().peekable();
+        while all.peek().is_some() {
+            edges.clear();
+            edges.extend(all.by_ref().take(QUEUE_FILL_CHUNK));
+            let this = &*self;
+            let costs: Vec<f64> = edges
+                .par_iter()
+                .with_min_len(1024)
+                .map(|&e| this.edge_target(e).1)
+                .collect();
+            entries.extend(
+                edges
+                    .iter()
+                    .zip(costs)
+                    .map(|(&edge, cost)| Entry { cost, edge }),
+            );
         }
-        self.batcher.heap = Queue::from_entries(m.edge_capacity(), entries);
+        self.batcher.heap = Queue::from_entries(self.g.mesh().edge_capacity(), entries);
     }
 
     fn target_reached(&self) -> bool {
@@ -570,13 +577,21 @@ impl<'g, 'a> Pass<'g, 'a> {
     }
 
     fn push(&mut self, e: EdgeId) {
+        let (_, cost) = self.edge_target(e);
+        self.batcher.heap.push(Entry { cost, edge: e });
+    }
+
+    /// The quadric optimum and cost of collapsing `e` ([`collapse_target`] of its endpoints'
+    /// summed quadrics). Recomputed where needed instead of stored per edge (24 B per edge of
+    /// the dense offset surface; issue 12 part 4): within a pass only a commit changes a
+    /// quadric or a position, and it re-queues every edge at the surviving vertex, so the
+    /// value when an edge is popped is the one its queue cost was computed with.
+    fn edge_target(&self, e: EdgeId) -> (Vec3, f64) {
         let m = self.g.mesh();
         let h = m.edge_halfedge(e);
         let (a, b) = (m.origin(h), m.target(h));
         let q = self.quadrics[a].add(&self.quadrics[b]);
-        let (target, cost) = collapse_target(&q, m.position(a).into(), m.position(b).into());
-        self.targets[e] = target;
-        self.batcher.heap.push(Entry { cost, edge: e });
+        collapse_target(&q, m.position(a).into(), m.position(b).into())
     }
 
     /// The queue loop. Candidates are taken in cost order in **batches** of collapses whose
@@ -690,7 +705,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         };
         let (a, b) = (m.origin(h), m.target(h));
         let (pa, pb) = (Vec3::from(m.position(a)), Vec3::from(m.position(b)));
-        let mut candidates = [self.targets[e]; 4];
+        let mut candidates = [self.edge_target(e).0; 4];
         let mut n = 1;
         for c in [(pa + pb) * 0.5, pa, pb] {
             if !candidates[..n].contains(&c) {

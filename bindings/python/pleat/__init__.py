@@ -137,7 +137,8 @@ _PROGRESS_FN = _c.CFUNCTYPE(_c.c_int32, _c.c_void_p, _c.POINTER(_Progress))
 _LodParams = _struct("PleatLodParams", _u32s("struct_size", "max_rounds") + _f64s("screen_size")
                      + _u64s("target_faces") + _f64s("flow_ratio", "epsilon", "theta0_deg")
                      + _u32s("l0", "flags") + _u64s("memory_budget_bytes")
-                     + _f64s("clearance") + _u32s("start"))
+                     + _f64s("clearance") + _u32s("start")
+                     + _f64s("offset_voxel_scale"))
 _LodStats = _struct("PleatLodStats", _u32s("struct_size", "rounds")
                     + _u64s("face_count", "vertex_count", "start_face_count", "collapse_count")
                     + _f64s("seconds_total", "seconds_offset", "seconds_simplify", "seconds_flow",
@@ -478,7 +479,8 @@ class _Handle:
 # --- meshes, LODs, cages, offsets ----------------------------------------------------------
 
 _LOD_KEYS = ("max_rounds", "target_faces", "flow_ratio", "epsilon", "theta0_deg", "l0",
-             "memory_budget_bytes")
+             "memory_budget_bytes", "offset_voxel_scale")
+_LOD_FLOAT_KEYS = ("flow_ratio", "epsilon", "theta0_deg", "offset_voxel_scale")
 _LOD_STATS_FLAGS = ("watertight", "manifold", "self_intersection_free", "encloses_input",
                     "exact_rerun", "target_met", "started_from_input")
 _REPORT_FLAGS = ("is_closed", "is_edge_manifold", "is_manifold", "is_watertight",
@@ -503,7 +505,7 @@ def _lod_params(screen_size, align=True, measure_floor=False, fit=True, start="a
     if screen_size is not None:
         p.screen_size = float(screen_size)
     for k, v in kw.items():
-        setattr(p, k, float(v) if k in ("flow_ratio", "epsilon", "theta0_deg") else int(v))
+        setattr(p, k, float(v) if k in _LOD_FLOAT_KEYS else int(v))
     p.flags = ((0 if align else _LOD_NO_ALIGN) | (_LOD_MEASURE_FLOOR if measure_floor else 0)
                | (0 if fit else _LOD_NO_FIT))
     return p
@@ -633,11 +635,11 @@ class Mesh(_Handle):
         watertight, manifold, self-intersection-free Mesh within about diag/screen_size of
         this one, with ``stats`` (PleatLodStats as a dict). ``params``: ``target_faces``,
         ``max_rounds``, ``flow_ratio``, ``epsilon``, ``theta0_deg``, ``l0``,
-        ``memory_budget_bytes`` (C field names and defaults), ``align=False`` to skip the
-        feature alignment, ``measure_floor=True`` for ``hausdorff_floor_relative``,
-        ``fit=False`` to skip the final fit to this mesh's planes (PLEAT_LOD_NO_FIT),
-        ``start="auto"|"offset"|"input"``: the surface the loop starts from (the welded
-        input when it is clean for ``auto``; ``stats["started_from_input"]``).
+        ``memory_budget_bytes``, ``offset_voxel_scale`` (C field names and defaults; 0 =
+        automatic), ``align=False`` to skip the feature alignment, ``measure_floor=True`` for
+        ``hausdorff_floor_relative``, ``fit=False`` to skip the final fit to this mesh's planes
+        (PLEAT_LOD_NO_FIT), ``start="auto"|"offset"|"input"``: the surface the loop starts
+        from (the welded input when it is clean for ``auto``; ``stats["started_from_input"]``).
         ``progress(stage, fraction)`` is called on this thread; return True to cancel
         (PleatError CANCELLED); an exception it raises comes out of this call."""
         return self._bake(_lib.pleat_lod_generate, screen_size, progress, params)

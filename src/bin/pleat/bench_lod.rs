@@ -57,6 +57,11 @@ pub struct LodBenchArgs {
     /// units (see `pleat cage --clearance`).
     #[arg(long, value_parser = super::parse_clearance)]
     pub clearance: Option<pleat::lowpoly::Clearance>,
+    /// LODs: the offset voxel to start from, a multiple of d/√3 in (0, 2] (`1` = the
+    /// dissertation's voxel) [default: 2 from n_p = 200 on, 1 below]; see `pleat lod
+    /// --voxel-scale`.
+    #[arg(long)]
+    pub voxel_scale: Option<f64>,
     /// Face target per (mesh, n_p) from a CSV with columns `mesh`, `n_p`, `meshopt_faces`
     /// (the one `cargo bench --bench lod` writes) [default: target/bench/lod_vs_meshopt.csv].
     #[arg(long, num_args = 0..=1, default_missing_value = "target/bench/lod_vs_meshopt.csv")]
@@ -164,6 +169,7 @@ fn sweep(args: &LodBenchArgs) -> Result<(), (u8, String)> {
                 target,
                 args.cage,
                 args.clearance,
+                args.voxel_scale,
                 &mut prog,
             );
             if let (Some(out), true) = (&out, row.ok()) {
