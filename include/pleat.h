@@ -798,6 +798,8 @@ typedef struct PleatLodParams {
   // from the offset surface. Appended for issue 12; callers with an older `struct_size`
   // get 0 (auto).
   uint32_t start;
+  // Reserved, 0 (keeps the struct free of padding).
+  uint32_t reserved;
   // LODs only: the offset voxel the bake starts from, as a multiple of d/√3, in (0, 2];
   // 0 (the default) = automatic (2 from n_p = 200 on, 1 below; see README "A coarser first
   // stage"). A coarser voxel is still taken when the memory estimate needs it. NaN,

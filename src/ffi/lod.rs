@@ -78,6 +78,8 @@ pub struct PleatLodParams {
     /// from the offset surface. Appended for issue 12; callers with an older `struct_size`
     /// get 0 (auto).
     pub start: u32,
+    /// Reserved, 0 (keeps the struct free of padding).
+    pub reserved: u32,
     /// LODs only: the offset voxel the bake starts from, as a multiple of d/√3, in (0, 2];
     /// 0 (the default) = automatic (2 from n_p = 200 on, 1 below; see README "A coarser first
     /// stage"). A coarser voxel is still taken when the memory estimate needs it. NaN,
@@ -211,6 +213,7 @@ impl From<&crate::lowpoly::LodParams> for PleatLodParams {
                 LodStart::Offset => PLEAT_LOD_START_OFFSET,
                 LodStart::Input => PLEAT_LOD_START_INPUT,
             },
+            reserved: 0,
             offset_voxel_scale: p.offset_voxel_scale.unwrap_or(0.0),
         }
     }
@@ -233,6 +236,7 @@ pub(super) fn defaults_without_lod() -> PleatLodParams {
         memory_budget_bytes: 2 << 30,
         clearance: 0.1,
         start: PLEAT_LOD_START_AUTO,
+        reserved: 0,
         offset_voxel_scale: 0.0,
     }
 }
@@ -260,6 +264,12 @@ pub(super) mod imp {
                 | PLEAT_LOD_NO_FIT,
             "params->flags",
         )?;
+        if p.reserved != 0 {
+            return Err(Error::InvalidArgument(format!(
+                "params->reserved must be 0, got {}",
+                p.reserved
+            )));
+        }
         let start = match p.start {
             PLEAT_LOD_START_AUTO => LodStart::Auto,
             PLEAT_LOD_START_OFFSET => LodStart::Offset,
