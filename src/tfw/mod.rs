@@ -88,9 +88,8 @@ pub use base::{
 };
 pub use material::{Branch, Lame};
 pub use pipeline::{solve, TfwParams, TfwResult, TfwSeconds, TfwStatus};
-pub use pnewton::CgRefinement;
 pub use scene::{
     Dirichlet, Material, Model, Motion, Obstacle, ObstacleShape, Panel, Rotation, Scene,
     DEFAULT_OBSTACLE_STIFFNESS,
 };
-pub use sqp::{QpMethod, SqpIteration, SqpOptions, SqpResult, SqpStatus};
+pub use sqp::{CgRefinement, QpMethod, SqpIteration, SqpOptions, SqpResult, SqpStatus};

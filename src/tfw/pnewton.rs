@@ -41,8 +41,8 @@ use crate::solve::{
 };
 use crate::tfw::energy::{HessianMode, WfEval, WfTerms};
 use crate::tfw::sqp::{
-    feasible_start, qp_shape, step_sizes, FeasibleStart, SqpIteration, SqpOptions, SqpProblem,
-    SqpResult, SqpStatus,
+    feasible_start, qp_shape, step_sizes, CgRefinement, FeasibleStart, SqpIteration, SqpOptions,
+    SqpProblem, SqpResult, SqpStatus,
 };
 use crate::{Error, Result};
 use std::collections::VecDeque;
@@ -605,52 +605,6 @@ fn next_shift(shift: f64, t: f64) -> f64 {
     } else {
         (shift * 4.0).min(1e2)
     }
-}
-
-/// The exact-Hessian refinement of the projected Newton step (README "Tension-field wrinkles",
-/// issue 13's slow SQP): Steihaug–Toint CG on the exact reduced Hessian `Bᵀ H B` (held
-/// amplitudes fixed), preconditioned by the factorization of `Bᵀ(H_proj + σW)B`, in the region
-/// `‖s‖_M ≤ radius · ‖s₀‖_M` (s₀ the projected step), stopped at `‖Hs + g‖ ≤ tolerance ‖g‖`.
-/// The analogue of the base solve's CG (`tfw::base`), whose pressure projection made Newton
-/// linear the same way the per-face PSD projection of `E^wf` (S:2302–2307) does here.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CgRefinement {
-    /// CG iterations per step (0 = the projected step alone).
-    pub iterations: usize,
-    /// Trust-region radius relative to the projected step's `M`-norm.
-    pub radius: f64,
-    /// Relative model-gradient tolerance.
-    pub tolerance: f64,
-    /// Refine only after a full step (`t = 1`) of the line search and while the relative
-    /// shift σ is at most [`Self::max_shift`]: near the optimum, where the spec switches to
-    /// the true Hessian (A.6.3). Far from it the exact-Hessian steps took other paths (the
-    /// sheared rectangle: a higher stationary energy, README).
-    pub after_full_step: bool,
-    /// With `after_full_step`: the largest relative shift σ at which to refine.
-    pub max_shift: f64,
-}
-
-impl CgRefinement {
-    /// The projected step alone.
-    pub const OFF: CgRefinement = CgRefinement {
-        iterations: 0,
-        radius: 1e3,
-        tolerance: 1e-3,
-        after_full_step: false,
-        max_shift: f64::INFINITY,
-    };
-
-    /// The default since 2026-11-27 (branch `tfw13`): 50 CG iterations, region 10 ‖s₀‖_M,
-    /// tolerance 1e-3, after full steps with σ ≤ 1e-8 only (README "Tension-field wrinkles":
-    /// the cylinders' SQP from 526 / 487 to 77 / 76 iterations, the torus's from 396 to 136,
-    /// the same or a lower final energy on every scene).
-    pub const DEFAULT: CgRefinement = CgRefinement {
-        iterations: 50,
-        radius: 10.0,
-        tolerance: 1e-3,
-        after_full_step: true,
-        max_shift: 1e-8,
-    };
 }
 
 /// Steihaug–Toint CG on `h` (exact reduced Hessian, lower triangle) with the right-hand side
