@@ -482,7 +482,7 @@ fn check_coordinate_range(input: &TriMesh, screen_size: f64) -> Result<()> {
 /// order of the representatives) that [`LodStart::Input`] starts from. `Err` names the
 /// first property that fails.
 pub fn check_clean(input: &TriMesh) -> std::result::Result<TriMesh, String> {
-    clean_welded(input, &mut |_| true)
+    clean_welded(input, &|_| false, &mut |_| true)
         .expect("never cancelled")
         .map(|c| c.mesh)
 }
@@ -491,17 +491,33 @@ pub fn check_clean(input: &TriMesh) -> std::result::Result<TriMesh, String> {
 struct CleanInput {
     /// The welded input.
     mesh: TriMesh,
+    /// Its genus and components.
+    topology: CleanTopology,
+}
+
+/// The topology of a clean input that [`LodStart::Auto`] decides from.
+struct CleanTopology {
     /// Total genus.
     genus: i64,
     /// Connected components.
     components: usize,
 }
 
+impl CleanTopology {
+    /// Whether [`LodStart::Auto`] starts from the offset surface rather than this input.
+    fn auto_refuses(&self) -> bool {
+        self.genus > AUTO_MAX_GENUS || self.components > 1
+    }
+}
+
 /// [`check_clean`] with the input's total genus, and a progress callback (a cancellation
 /// point; `None` when it returns `false`). Topology first, the self-intersection pass only when topology is clean, so
-/// that `LodStart::Auto` costs a dirty input only the topology pass.
+/// that `LodStart::Auto` costs a dirty input only the topology pass. `skip(&topology)`: the
+/// caller will not use a clean input of this topology (`LodStart::Auto` and too many
+/// components or too high a genus), so `Err` without the self-intersection pass.
 fn clean_welded(
     input: &TriMesh,
+    skip: &dyn Fn(&CleanTopology) -> bool,
     keep_going: &mut dyn FnMut(f64) -> bool,
 ) -> Option<std::result::Result<CleanInput, String>> {
     let topo = MeshReport::compute_with_progress(
@@ -530,6 +546,13 @@ fn clean_welded(
     if let Some((name, _)) = failing {
         return Some(Err(format!("the input is not {name} after exact welding")));
     }
+    let topology = CleanTopology {
+        genus: topo.total_genus.unwrap_or(0),
+        components: topo.n_components,
+    };
+    if skip(&topology) {
+        return Some(Err("the input's topology is not started from".into()));
+    }
     let welded = weld_compact(input);
     let si = MeshReport::compute_with_progress(&welded, &ReportOptions::default(), &mut |f| {
         keep_going(0.1 + 0.9 * f)
@@ -543,8 +566,7 @@ fn clean_welded(
     }
     Some(Ok(CleanInput {
         mesh: welded,
-        genus: topo.total_genus.unwrap_or(0),
-        components: topo.n_components,
+        topology,
     }))
 }
 
@@ -582,9 +604,13 @@ fn choose_start(
     if mode == Mode::Cage || params.start == LodStart::Offset {
         return Ok(None);
     }
-    let clean = clean_welded(input, &mut |f| rep.report("setup", f)).ok_or(Error::Cancelled)?;
+    let auto = params.start == LodStart::Auto;
+    // Auto never starts from an input it refuses by topology: no self-intersection pass then
+    let skip = |t: &CleanTopology| auto && t.auto_refuses();
+    let clean =
+        clean_welded(input, &skip, &mut |f| rep.report("setup", f)).ok_or(Error::Cancelled)?;
     match (clean, params.start) {
-        (Ok(c), LodStart::Auto) if c.genus > AUTO_MAX_GENUS || c.components > 1 => Ok(None),
+        (Ok(c), LodStart::Auto) if c.topology.auto_refuses() => Ok(None),
         (Ok(c), _) => Ok(Some(c.mesh)),
         (Err(why), LodStart::Input) => Err(Error::InvalidArgument(format!(
             "start = input needs a clean input: {why}; use start = auto or offset"
@@ -878,13 +904,19 @@ fn bake_level(
     let measure_s = t0.elapsed().as_secs_f64();
     if let Some(pre) = ls.prefit.take() {
         let t0 = Instant::now();
-        let pre_sides = verify::hausdorff_sides_with_progress(&pre, input, &mut |f| {
-            rep.report("fit", 0.75 + 0.25 * f)
-        })
+        let fitted = hausdorff_of(&sides);
+        let pre_sides = verify::hausdorff_sides_unless(
+            &pre,
+            input,
+            &|x| keeps_fit(fitted, x, l),
+            // the pre-fit maximum is most likely on the side of the fitted one
+            sides.output_to_input >= sides.input_to_output,
+            &mut |f| rep.report("fit", 0.75 + 0.25 * f),
+        )
         .ok_or(Error::Cancelled)?;
         ls.fit_s += t0.elapsed().as_secs_f64();
         ls.fit_sides = Some([sides.input_to_output / l, sides.output_to_input / l]);
-        if hausdorff_of(&sides) > hausdorff_of(&pre_sides) + FIT_HAUSDORFF_SLACK * l {
+        if let Some(pre_sides) = pre_sides.filter(|p| !keeps_fit(fitted, hausdorff_of(p), l)) {
             // The fit's safety revert: the loop's output (guarded like the fit's) instead.
             let t0 = Instant::now();
             mesh = pre;
@@ -948,6 +980,15 @@ fn bake_level(
     stats.vertices = mesh.vertex_count() as u64;
     rep.check("done", 1.0)?;
     Ok((mesh, stats))
+}
+
+/// Whether a pre-fit Hausdorff distance `pre` keeps a fit that measured `fitted` (the fit's
+/// safety revert is `fitted > pre + FIT_HAUSDORFF_SLACK · l`). Monotone in `pre` (rounding of
+/// `pre + slack` is), and the pre-fit distance is a maximum over samples, so one sample `x`
+/// with `keeps_fit(fitted, x, l)` decides it: the pre-fit measure stops there
+/// (`verify::hausdorff_sides_unless`), with the same decision as the full measure.
+fn keeps_fit(fitted: f64, pre: f64, l: f64) -> bool {
+    !(fitted > pre + FIT_HAUSDORFF_SLACK * l)
 }
 
 /// The two-sided distance of measured `sides`.

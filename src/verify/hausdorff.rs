@@ -125,6 +125,31 @@ fn one_sided_with(
     input: &TriMesh,
     keep_going: &mut dyn FnMut(f64) -> bool,
 ) -> Option<f64> {
+    match one_sided_until(from, to, input, &|_| false, keep_going)? {
+        Scan::Max(m) => Some(m),
+        Scan::Reached => unreachable!("nothing reaches a bound that is never reached"),
+    }
+}
+
+/// How a scan of [`one_sided_until`] ended.
+enum Scan {
+    /// Every sample scanned: their maximum distance.
+    Max(f64),
+    /// A sample's distance satisfied the `reach` predicate (the scan stopped there).
+    Reached,
+}
+
+/// [`one_sided_with`] that stops as soon as a sample's distance satisfies `reach` (checked on
+/// each face's maximum and each vertex's distance, so a monotone `reach` is checked on every
+/// sample). Without a stop, the maximum is the same bytes as [`one_sided_with`]'s (the same
+/// samples, the same exact `max`).
+fn one_sided_until(
+    from: &TriMesh,
+    to: &Surface<'_>,
+    input: &TriMesh,
+    reach: &(dyn Fn(f64) -> bool + Sync),
+    keep_going: &mut dyn FnMut(f64) -> bool,
+) -> Option<Scan> {
     let spacing = input.bbox_diagonal() / SAMPLES_PER_DIAGONAL;
     let from_pos = from.positions();
     let from_tris = from.triangles();
@@ -135,14 +160,19 @@ fn one_sided_with(
         }
     }
     let total = (from_pos.len() + 16 * from_tris.len()).max(1) as f64;
+    let checked = |d: f64| if reach(d) { Err(()) } else { Ok(d) };
+    let max_ok = |a: f64, b: f64| Ok(a.max(b));
     let mut done = 0usize;
     let mut m: f64 = 0.0;
     let vertices: Vec<usize> = (0..from_pos.len()).filter(|&v| used[v]).collect();
     for chunk in vertices.chunks(16 * FACES_PER_CHUNK) {
         let vmax = chunk
             .par_iter()
-            .map(|&v| to.distance(Vec3::from(from_pos[v])))
-            .reduce(|| 0.0, f64::max);
+            .map(|&v| checked(to.distance(Vec3::from(from_pos[v]))))
+            .try_reduce(|| 0.0, max_ok);
+        let Ok(vmax) = vmax else {
+            return Some(Scan::Reached);
+        };
         m = m.max(vmax);
         done += chunk.len();
         if !keep_going(done as f64 / total) {
@@ -153,15 +183,61 @@ fn one_sided_with(
     for chunk in from_tris.chunks(FACES_PER_CHUNK) {
         let fmax = chunk
             .par_iter()
-            .map(|t| face_max(t, from_pos, to, spacing))
-            .reduce(|| 0.0, f64::max);
+            .map(|t| checked(face_max(t, from_pos, to, spacing)))
+            .try_reduce(|| 0.0, max_ok);
+        let Ok(fmax) = fmax else {
+            return Some(Scan::Reached);
+        };
         m = m.max(fmax);
         done += 16 * chunk.len();
         if !keep_going(done as f64 / total) {
             return None;
         }
     }
-    Some(m)
+    Some(Scan::Max(m))
+}
+
+/// [`hausdorff_sides_with_progress`] that stops as soon as one sample of either side has a
+/// distance `x` with `reach(x)`: `Some(None)` then, `Some(Some(sides))` (the same bytes as
+/// [`hausdorff_sides_with_progress`]) when no sample does, `None` when cancelled. For a
+/// monotone `reach` (`x ≤ y` and `reach(x)` imply `reach(y)`), `Some(None)` means exactly that
+/// `reach` holds for the two-sided maximum: a comparison of the measure against a bound is
+/// decided without measuring all of it. `output_first`: scan the output→input side first
+/// (where the caller expects the stop); the answer does not depend on it.
+pub fn hausdorff_sides_unless(
+    output: &TriMesh,
+    input: &TriMesh,
+    reach: &(dyn Fn(f64) -> bool + Sync),
+    output_first: bool,
+    keep_going: &mut dyn FnMut(f64) -> bool,
+) -> Option<Option<HausdorffSides>> {
+    let side = |out_in: bool, keep_going: &mut dyn FnMut(f64) -> bool| {
+        if out_in {
+            one_sided_until(output, &Surface::new(input), input, reach, keep_going)
+        } else {
+            one_sided_until(input, &Surface::new(output), input, reach, keep_going)
+        }
+    };
+    let first = side(output_first, &mut |f| keep_going(0.5 * f))?;
+    let Scan::Max(first) = first else {
+        return Some(None);
+    };
+    if !keep_going(0.5) {
+        return None;
+    }
+    let second = side(!output_first, &mut |f| keep_going(0.5 + 0.5 * f))?;
+    let Scan::Max(second) = second else {
+        return Some(None);
+    };
+    let (input_to_output, output_to_input) = if output_first {
+        (second, first)
+    } else {
+        (first, second)
+    };
+    Some(Some(HausdorffSides {
+        input_to_output,
+        output_to_input,
+    }))
 }
 
 /// The samples of the triangle soup `(pos, tris)` in this module's sampling (module docs) at
@@ -260,6 +336,20 @@ mod tests {
         assert_eq!(s.input_to_output, 0.25);
         assert_eq!(s.output_to_input, 0.25);
         assert_eq!(hausdorff_to_input(&square(0.0), &square(0.0)), 0.0);
+    }
+
+    /// A bound no sample reaches gives the full measure (same bytes, either side first); one
+    /// some sample reaches stops the scan.
+    #[test]
+    fn a_reached_bound_stops_the_measure() {
+        let (a, b) = (square(0.25), square(0.0));
+        let full = Some(Some(hausdorff_sides(&a, &b)));
+        for first in [false, true] {
+            let never = hausdorff_sides_unless(&a, &b, &|x| x > 0.3, first, &mut |_| true);
+            assert_eq!(never, full);
+            let reached = hausdorff_sides_unless(&a, &b, &|x| x >= 0.25, first, &mut |_| true);
+            assert_eq!(reached, Some(None));
+        }
     }
 
     #[test]

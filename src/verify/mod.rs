@@ -19,7 +19,7 @@ pub mod validity;
 
 pub use cage::{check_cage, clearance, min_distance, CageCheck, CageInput};
 pub use hausdorff::{
-    hausdorff_sides, hausdorff_sides_with_progress, hausdorff_to_input, input_to_surface,
-    HausdorffSides,
+    hausdorff_sides, hausdorff_sides_unless, hausdorff_sides_with_progress, hausdorff_to_input,
+    input_to_surface, HausdorffSides,
 };
 pub use validity::{MeshReport, ReportOptions, ValidityStage};
