@@ -93,9 +93,10 @@ impl Coverage {
         cand.into_par_iter()
             .filter_map(|s| {
                 let (p, b) = (self.points[s as usize], self.budget[s as usize]);
-                patch.face_within(p, b, 0).map(|k| Relying {
+                patch.face_within(p, b, 0).map(|(k, dist)| Relying {
                     sample: s,
                     face: k as u32,
+                    spare: b - dist,
                 })
             })
             .collect()
@@ -104,12 +105,24 @@ impl Coverage {
     /// Whether the faces `new` keep every sample of `relying` (from [`Coverage::relying_on`])
     /// within its budget; counts a refusal.
     pub fn keeps(&mut self, relying: &[Relying], new: &[[Vec3; 3]]) -> bool {
+        self.keeps_within(relying, new, None)
+    }
+
+    /// [`Coverage::keeps`]; with `moved = Some(δ)`, face `k` of `new` is face `k` of the
+    /// patch `relying` was computed on with no point moved farther than `δ`, so a sample whose
+    /// relied-on face had `spare ≥ δ` (plus [`box_cull_margin`], far beyond rounding) is kept
+    /// without a distance: `dist(s, new_k) ≤ dist(s, old_k) + δ ≤ b` (the triangle
+    /// inequality, each point of the face moving at most `δ`). The answer is the exact
+    /// predicate's, as with the box test.
+    fn keeps_within(&mut self, relying: &[Relying], new: &[[Vec3; 3]], moved: Option<f64>) -> bool {
         let patch = Patch::new(new);
         let ok = relying.par_iter().all(|r| {
             let s = r.sample as usize;
-            patch
-                .face_within(self.points[s], self.budget[s], r.face as usize)
-                .is_some()
+            let (p, b) = (self.points[s], self.budget[s]);
+            if moved.is_some_and(|m| r.spare >= m + box_cull_margin(p, b + m)) {
+                return true;
+            }
+            patch.face_within(p, b, r.face as usize).is_some()
         });
         if !ok {
             self.refused += 1;
@@ -134,6 +147,7 @@ impl Coverage {
         v: VertexId,
         q: Vec3,
     ) -> bool {
+        let moved = q.distance(Vec3::from(m.position(v)));
         let new: Vec<[Vec3; 3]> = m
             .vertex_faces(v)
             .map(|f| {
@@ -147,19 +161,22 @@ impl Coverage {
                 t
             })
             .collect();
-        self.keeps(relying, &new)
+        // the one-ring in the order `relying_on_ring` saw it, only `v` moved (by `moved`)
+        self.keeps_within(relying, &new, Some(moved))
     }
 }
 
 /// A sample that relies on a patch ([`Coverage::relying_on`]): the sample's index and the index
 /// of a patch face within its budget (where the replacement patch is checked first: a vertex
 /// move keeps the one-ring's face order).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Relying {
     /// Index of the sample.
     pub sample: u32,
     /// Index of the patch face found within the sample's budget.
     pub face: u32,
+    /// The sample's budget less its distance to that face (`≥ 0`).
+    pub spare: f64,
 }
 
 /// A patch of faces with their bounding boxes, for the coverage predicate.
@@ -177,22 +194,29 @@ impl<'a> Patch<'a> {
         Patch { tris, boxes }
     }
 
-    /// A face of the patch within `b` of `p` (`point_triangle_distance ≤ b`), trying face
+    /// A face of the patch within `b` of `p` (`point_triangle_distance ≤ b`) and that distance,
+    /// trying face
     /// `first` first, then the others in order; `None` when there is none. The answer to
     /// "is there one" is the exact predicate's: a face is skipped without its distance only
     /// when its box is farther than `b` by more than [`box_cull_margin`] — far beyond the
     /// rounding of either distance — so speed is all the boxes change.
-    fn face_within(&self, p: Vec3, b: f64, first: usize) -> Option<usize> {
+    fn face_within(&self, p: Vec3, b: f64, first: usize) -> Option<(usize, f64)> {
         let margin = box_cull_margin(p, b);
         let near = |k: usize| {
             let (lo, hi) = self.boxes[k];
-            box_distance(lo, hi, p) <= b + margin && point_triangle_distance(p, &self.tris[k]) <= b
+            if box_distance(lo, hi, p) > b + margin {
+                return None;
+            }
+            let dist = point_triangle_distance(p, &self.tris[k]);
+            (dist <= b).then_some((k, dist))
         };
         let n = self.tris.len();
-        if first < n && near(first) {
-            return Some(first);
+        if first < n {
+            if let Some(hit) = near(first) {
+                return Some(hit);
+            }
         }
-        (0..n).filter(|&k| k != first).find(|&k| near(k))
+        (0..n).filter(|&k| k != first).find_map(near)
     }
 }
 
@@ -237,7 +261,14 @@ mod tests {
         let tri = |z: f64| [v(-1.0, -1.0, z), v(2.0, -1.0, z), v(-1.0, 2.0, z)];
         let mut c = coverage(vec![v(0.0, 0.0, 0.0)], vec![1.0]);
         let relying = c.relying_on(&[tri(0.5)]);
-        assert_eq!(relying, vec![Relying { sample: 0, face: 0 }]);
+        assert_eq!(
+            relying,
+            vec![Relying {
+                sample: 0,
+                face: 0,
+                spare: 0.5
+            }]
+        );
         assert!(c.keeps(&relying, &[tri(0.9)]));
         assert!(!c.keeps(&relying, &[tri(1.5)]));
         assert_eq!(c.refused, 1);
