@@ -988,7 +988,8 @@ fn bake_level(
 /// with `keeps_fit(fitted, x, l)` decides it: the pre-fit measure stops there
 /// (`verify::hausdorff_sides_unless`), with the same decision as the full measure.
 fn keeps_fit(fitted: f64, pre: f64, l: f64) -> bool {
-    !(fitted > pre + FIT_HAUSDORFF_SLACK * l)
+    // not `fitted > pre + slack`, NaN included (no revert)
+    fitted.partial_cmp(&(pre + FIT_HAUSDORFF_SLACK * l)) != Some(std::cmp::Ordering::Greater)
 }
 
 /// The two-sided distance of measured `sides`.
