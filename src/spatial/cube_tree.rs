@@ -57,7 +57,7 @@ impl BoxF32 {
 fn down(x: f64) -> f32 {
     let y = x as f32;
     if f64::from(y) > x {
-        y.next_down()
+        step_down(y)
     } else {
         y
     }
@@ -67,9 +67,22 @@ fn down(x: f64) -> f32 {
 fn up(x: f64) -> f32 {
     let y = x as f32;
     if f64::from(y) < x {
-        y.next_up()
+        -step_down(-y)
     } else {
         y
+    }
+}
+
+/// The next `f32` below `y` (`f32::next_down`, stable only since Rust 1.86; the MSRV is 1.85).
+fn step_down(y: f32) -> f32 {
+    if y.is_nan() || y == f32::NEG_INFINITY {
+        y
+    } else if y == 0.0 {
+        -f32::from_bits(1)
+    } else if y > 0.0 {
+        f32::from_bits(y.to_bits() - 1)
+    } else {
+        f32::from_bits(y.to_bits() + 1)
     }
 }
 
