@@ -6,6 +6,7 @@
 //! intersection-free), with a rerun using exact checks only if the normal-cone shortcut ever
 //! let an intersection through (§4.3.3, last paragraph).
 
+use std::borrow::Cow;
 use std::time::Instant;
 
 use super::align::{align_sweep, reference_normals};
@@ -229,14 +230,26 @@ pub const LOD_COARSE_VOXEL_MIN_SCREEN_SIZE: f64 = 200.0;
 /// far more area than twice the leg's) peaked at 1592 MiB (VmHWM), 1056 B per estimated face;
 /// with no per-edge target array, the queue filled in chunks and the guard's old BVH freed
 /// before a rebuild, at 1195 MiB (VmHWM; 1190 MiB allocated, in the first pass's first BVH
-/// rebuild), 793 B per estimated face. 900 B bounds it with a 13% margin (formerly 1100 B).
-const BYTES_PER_WORK_FACE: f64 = 900.0;
+/// rebuild), 793 B per estimated face (900 B then); with the BVH builds streaming their boxes
+/// into parry (no 48 B-a-leaf copy during the guard's build and rebuilds) and round 0's
+/// convergence reference borrowed from the start surface (2026-11-28), at 1035 MiB allocated
+/// (again the first rebuild), 687 B per estimated face. 780 B bounds it with a 13% margin
+/// (formerly 1100, then 900 B).
+const BYTES_PER_WORK_FACE: f64 = 780.0;
 /// Peak bytes per input sample of the input-plane fit's coverage check (`coverage.rs`: the
 /// input sampled at `SPACING · d`, a budget and a box per sample, the tree over them), which
 /// grows like `n_p²` and does not depend on the offset voxel. Measured 2026-11-27:
-/// dirty_synth_flipped_s1 at n_p = 1000 (4.09 M samples) peaks at 1920 MiB in the fit where the
-/// loop before it peaked at 900 MiB: 487 B per sample over the input term.
-const BYTES_PER_FIT_SAMPLE: f64 = 500.0;
+/// dirty_synth_flipped_s1 at n_p = 1000 (4.09 M samples) peaked at 1920 MiB in the fit with
+/// parry's BVH over the samples' boxes (487 B a sample, formerly 500 B here); with the compact
+/// `spatial::CubeTree` and the samples' exact allocation (2026-11-28) a sample takes 24 B of
+/// position, 8 of budget, 4 of order and ≈ 4 of tree boxes, plus its 8 B Morton code during the
+/// build: 48 B, bounded here by 64 B.
+const BYTES_PER_FIT_SAMPLE: f64 = 64.0;
+/// Bytes per *estimated* offset face still alive in the fit (the guard's slot arrays of the
+/// dense start, the start surface kept for an exact rerun, the LOD before the fit). Measured
+/// 2026-11-27 as the live bytes at the fit's start: 238 MiB on dirty_beetle at n_p = 1000
+/// (1.58 M estimated faces: 158 B), 151 MiB on clean_homer, 97 MiB on dirty_synth_flipped_s1.
+const BYTES_PER_FIT_WORK_FACE: f64 = 200.0;
 /// Per-edge sample cap of the coverage check (`coverage::MAX_SUBDIVISIONS`).
 const FIT_MAX_SUBDIVISIONS: f64 = 32.0;
 
@@ -393,7 +406,8 @@ impl LodParams {
     /// offset surface, whose face count is about `2 · area / h²` with voxel edge
     /// `h = voxel_scale · d/√3` (area of a thin part's offset ≤ twice the input's, plus a
     /// sphere of radius `d` per component, bounded by the box), at [`BYTES_PER_WORK_FACE`] —
-    /// and, with `fit_to_input`, the fit's coverage samples at [`BYTES_PER_FIT_SAMPLE`].
+    /// and, with `fit_to_input`, the fit's: its coverage samples at [`BYTES_PER_FIT_SAMPLE`]
+    /// plus what the loop leaves alive, [`BYTES_PER_FIT_WORK_FACE`] per offset face.
     fn memory_estimate(&self, input: &TriMesh, voxel_scale: f64) -> f64 {
         let l = input.bbox_diagonal();
         let d = l / self.screen_size;
@@ -404,7 +418,7 @@ impl LodParams {
         let box_area = 2.0 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[0] * ext[2]);
         let faces = 2.0 * area.min(8.0 * box_area) / (h * h);
         let fit = if self.fit_to_input {
-            fit_samples(input, d) * BYTES_PER_FIT_SAMPLE
+            fit_samples(input, d) * BYTES_PER_FIT_SAMPLE + faces * BYTES_PER_FIT_WORK_FACE
         } else {
             0.0
         };
@@ -1170,7 +1184,7 @@ fn optimize(
     for i in 0..rounds {
         let frac = |x: f64| (i as f64 + x) / rounds as f64;
         rep.check("simplify", frac(0.0))?;
-        let before = g.mesh().to_trimesh();
+        let before = round_start(i, start, &g);
         let t0 = Instant::now();
         let sr = {
             let mut kg = |x: f64| rep.report("simplify", frac(0.5 * x));
@@ -1227,6 +1241,22 @@ fn optimize(
     }
     ls.guard = g.stats;
     Ok((g.mesh().to_trimesh(), ls))
+}
+
+/// The surface round `i` starts from, for the convergence test: round 0's is `start` itself
+/// (the guard's mesh is `start`'s half-edge form, unmodified, whose `to_trimesh` is `start`
+/// exactly), borrowed rather than copied — 24 B per offset face less in the first pass (issue 12
+/// part 4); later rounds copy the guard's mesh.
+fn round_start<'s>(i: u32, start: &'s TriMesh, g: &Guard<'_>) -> Cow<'s, TriMesh> {
+    if i == 0 {
+        debug_assert!(
+            g.mesh().to_trimesh() == *start,
+            "round 0 starts from `start`"
+        );
+        Cow::Borrowed(start)
+    } else {
+        Cow::Owned(g.mesh().to_trimesh())
+    }
 }
 
 /// The start surface `M_d`: the offset surface of stage 1 (§4.3.1) at distance `d`, which is

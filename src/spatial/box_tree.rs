@@ -20,12 +20,10 @@ impl BoxTree {
     /// Builds the tree over the closed boxes `(min, max)` (leaf `k` is `boxes[k]`) with parry's
     /// binned strategy.
     pub fn new(boxes: impl IntoIterator<Item = (Vec3, Vec3)>) -> BoxTree {
-        let aabbs: Vec<Aabb> = boxes
-            .into_iter()
-            .map(|(lo, hi)| Aabb::new(lo, hi))
-            .collect();
+        // streamed: the tree `from_leaves` builds, without a copy of the boxes alive
+        let aabbs = boxes.into_iter().map(|(lo, hi)| Aabb::new(lo, hi));
         BoxTree {
-            bvh: Bvh::from_leaves(BvhBuildStrategy::Binned, &aabbs),
+            bvh: Bvh::from_iter(BvhBuildStrategy::Binned, aabbs.enumerate()),
         }
     }
 

@@ -91,7 +91,7 @@ impl TriangleBvh {
     pub fn new(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Self {
         let boxes = (0..triangles.len()).map(|t| triangle_aabb(positions, triangles[t]));
         TriangleBvh {
-            bvh: build_tree(boxes.collect()),
+            bvh: build_tree(boxes),
             keys: LeafKeys::Identity,
             len: triangles.len(),
         }
@@ -112,7 +112,7 @@ impl TriangleBvh {
             }
         };
         TriangleBvh {
-            bvh: build_tree(boxes.collect()),
+            bvh: build_tree(boxes),
             keys,
             len: subset.len(),
         }
@@ -325,17 +325,19 @@ fn inverse(tri_of_leaf: &[u32]) -> HashMap<u32, u32> {
         .collect()
 }
 
-/// A parry tree whose leaf `k` has box `boxes[k]`.
-fn build_tree(boxes: Vec<Aabb>) -> Bvh {
+/// A parry tree whose leaf `k` has the `k`-th box of `boxes`. The boxes stream into parry's
+/// build (the tree `Bvh::from_leaves` builds from the same boxes, without a 48 B-a-leaf copy of
+/// them alive during the build: issue 12 part 4, the guard's rebuilds on a dense offset).
+fn build_tree(boxes: impl ExactSizeIterator<Item = Aabb>) -> Bvh {
     if boxes.len() <= 2 {
         // parry's bulk build special-cases one and two leaves; insertion is just as good.
         let mut bvh = Bvh::new();
-        for (k, aabb) in boxes.into_iter().enumerate() {
+        for (k, aabb) in boxes.enumerate() {
             bvh.insert(aabb, k as u32);
         }
         bvh
     } else {
-        Bvh::from_leaves(BvhBuildStrategy::Binned, &boxes)
+        Bvh::from_iter(BvhBuildStrategy::Binned, boxes.enumerate())
     }
 }
 

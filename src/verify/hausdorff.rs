@@ -255,20 +255,38 @@ pub(crate) fn surface_samples(
             used[v as usize] = true;
         }
     }
-    let mut out: Vec<Vec3> = (0..pos.len())
-        .filter(|&v| used[v])
-        .map(|v| Vec3::from(pos[v]))
-        .collect();
-    for t in tris {
+    // counted first so that the samples take exactly their bytes (the fit's coverage check
+    // holds millions of them; a growing vector would keep up to twice that)
+    let grid = |t: &[u32; 3]| {
         let corners = t.map(|v| pos[v as usize]);
-        if is_collinear(corners[0], corners[1], corners[2]) {
-            continue;
-        }
-        let tri = corners.map(Vec3::from);
-        let k = resolution(&tri, spacing, max_k);
+        let area = !is_collinear(corners[0], corners[1], corners[2]);
+        area.then(|| {
+            let tri = corners.map(Vec3::from);
+            (resolution(&tri, spacing, max_k), tri)
+        })
+    };
+    let vertices = used.iter().filter(|&&u| u).count();
+    let interior: usize = tris
+        .iter()
+        .filter_map(|t| grid(t).map(|(k, _)| interior_sample_count(k)))
+        .sum();
+    let mut out: Vec<Vec3> = Vec::with_capacity(vertices + interior);
+    out.extend(
+        (0..pos.len())
+            .filter(|&v| used[v])
+            .map(|v| Vec3::from(pos[v])),
+    );
+    for (k, tri) in tris.iter().filter_map(grid) {
         for_each_interior_sample(&tri, k, |p| out.push(p));
     }
+    debug_assert_eq!(out.len(), vertices + interior);
     out
+}
+
+/// How many points [`for_each_interior_sample`] gives at resolution `k`.
+fn interior_sample_count(k: usize) -> usize {
+    let k = k.max(1);
+    (k + 1) * (k + 2) / 2 - 3 + usize::from(k < 3)
 }
 
 /// Max distance to `to` over the interior samples of face `t` of `from_pos`.
@@ -321,6 +339,17 @@ fn resolution(t: &[Vec3; 3], spacing: f64, max_k: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The count `surface_samples` reserves is the number of points the grid gives.
+    #[test]
+    fn interior_sample_count_matches_the_grid() {
+        let t = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        for k in 0..40 {
+            let mut n = 0;
+            for_each_interior_sample(&t, k, |_| n += 1);
+            assert_eq!(interior_sample_count(k), n, "k = {k}");
+        }
+    }
 
     fn square(z: f64) -> TriMesh {
         TriMesh::new(
