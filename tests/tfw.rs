@@ -2406,6 +2406,38 @@ mod scene_speed {
         (stable, seconds_at(stable), final_waves, final_peak)
     }
 
+    /// The spread of the principal strains over the base's faces: how many faces sit near
+    /// the triple point `λ1 = λ2 = 0` of the relaxed density (where its third derivatives
+    /// grow like 1/(λ1 − λ2), so the Newton model is valid only in a tiny region).
+    fn print_strain_spread(scene: &Scene, base: &pleat::mesh::TriMesh) {
+        let model = scene.assemble().unwrap();
+        let p = base.positions();
+        let mut r: Vec<(f64, f64)> = model
+            .triangles
+            .iter()
+            .zip(&model.rest_forms)
+            .map(|(t, rest)| {
+                let q = t.map(|v| p[v as usize]);
+                let e1 = [0, 1, 2].map(|k| q[1][k] - q[0][k]);
+                let e2 = [0, 1, 2].map(|k| q[2][k] - q[0][k]);
+                let d = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+                let cur = [d(e1, e1), d(e1, e2), d(e2, e2)];
+                pleat::tfw::material::principal_strains(*rest, cur)
+            })
+            .collect();
+        let big = r.iter().fold(0.0f64, |m, s| m.max(s.0.abs()));
+        r.sort_by(|a, b| (a.0 - a.1).total_cmp(&(b.0 - b.1)));
+        let count = |f: f64| r.iter().filter(|s| s.0 - s.1 < f * big).count();
+        eprintln!(
+            "  base strains: max |λ1| {big:.2e}; faces with λ1 − λ2 below 1e-1 / 1e-2 / 1e-3 of it: \
+             {} / {} / {} of {}",
+            count(1e-1),
+            count(1e-2),
+            count(1e-3),
+            r.len()
+        );
+    }
+
     /// Every `every`-th SQP iteration (`PLEAT_TFW_SQP_HISTORY=every`): r/r₀, the rate of r over
     /// the last `every` iterations (geometric mean factor per iteration), the accepted step
     /// length t (line-search halvings), the shift σ, CG iterations, ΔE.
@@ -2482,12 +2514,15 @@ mod scene_speed {
         if std::env::var("PLEAT_TFW_BASE_HISTORY").is_ok() {
             for (k, h) in b.history.iter().enumerate() {
                 eprintln!(
-                    "  base {k:3} E {:.15e} |g| {:.3e} t {} shift {:.2e} cg {} {}{:.3} s",
+                    "  base {k:3} E {:.15e} |g| {:.3e} t {} |dx| {:.2e} shift {:.2e} cg {} \
+                     switched {} {}{:.3} s",
                     h.energy,
                     h.gradient_norm,
                     h.step,
+                    h.step_norm,
                     h.shift,
                     h.times.cg_iterations,
+                    h.branch_changes,
                     if h.gradient_step {
                         "gradient step "
                     } else {
@@ -2496,6 +2531,9 @@ mod scene_speed {
                     h.seconds
                 );
             }
+        }
+        if std::env::var("PLEAT_TFW_BASE_HISTORY").is_ok() {
+            print_strain_spread(&case.scene, &b.mesh);
         }
         let per_it = r.seconds.base / b.history.len().max(1) as f64;
         {

@@ -178,6 +178,10 @@ pub struct NewtonIteration {
     pub shift: f64,
     /// True when the Newton direction was replaced by the negative gradient.
     pub gradient_step: bool,
+    /// Faces whose branch of the relaxed density (A.2: slack, tension, wrinkled) differs
+    /// between the states before and after the step (where the Newton model, whose Hessian
+    /// jumps at a branch switch, can stop being valid).
+    pub branch_changes: usize,
     /// Wall-clock seconds since the start of [`solve_base`].
     pub seconds: f64,
     /// Where this iteration's time went ([`NewtonTimes`]).
@@ -555,6 +559,18 @@ impl BaseProblem {
         s
     }
 
+    /// The branch of the relaxed density (A.2) of every face at `x`, in face order.
+    pub fn branches(&self, x: &[f64]) -> Vec<Branch> {
+        (0..self.triangles.len())
+            .into_par_iter()
+            .map(|f| {
+                let cur = first_form(self.triangles[f].map(|v| vec3(x, v)));
+                let (l1, l2) = principal_strains(self.rest_forms[f], cur);
+                self.lame.relaxed_density(l1, l2).1
+            })
+            .collect()
+    }
+
     fn membrane_value(&self, f: usize, x: &[f64]) -> f64 {
         let cur = first_form(self.triangles[f].map(|v| vec3(x, v)));
         let (l1, l2) = principal_strains(self.rest_forms[f], cur);
@@ -897,6 +913,7 @@ pub fn solve_base(
                 break;
             };
             let step_norm = d.iter().fold(0.0f64, |m, v| m.max((t * v).abs()));
+            let branch_changes = count_changes(&problem.branches(&x), &problem.branches(&trial));
             x = trial;
             history.push(NewtonIteration {
                 load_step: step,
@@ -906,6 +923,7 @@ pub fn solve_base(
                 step_norm,
                 shift,
                 gradient_step,
+                branch_changes,
                 seconds: start.elapsed().as_secs_f64(),
                 times,
             });
@@ -951,6 +969,11 @@ pub fn solve_base(
         strain,
         warnings,
     })
+}
+
+/// How many entries of `a` and `b` differ.
+fn count_changes(a: &[Branch], b: &[Branch]) -> usize {
+    a.iter().zip(b).filter(|(p, q)| p != q).count()
 }
 
 /// `‖g‖∞` over the free coordinates.
