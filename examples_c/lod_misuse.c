@@ -6,6 +6,64 @@
 static const float P[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
 static const uint32_t I[] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2};
 
+/* The last error message names the offending field. */
+#define CHECK_NAMES(field) CHECK(strstr(pleat_last_error(), (field)) != NULL)
+
+/* Every appended field of PleatLodParams (start, reserved, offset_voxel_scale) rejects what it
+ * does not define, with a message naming it, for single LODs and chains alike. */
+static void check_appended_fields(PleatMesh *m, PleatMesh *open_sheet) {
+    PleatMesh *out = NULL;
+    PleatMesh *outs[1] = {NULL};
+    const double size[1] = {10.0};
+    const double bad_scales[] = {NAN, -1.0, INFINITY, -INFINITY, 2.5, 1e300, -0.0 - 1e-300};
+    PleatLodParams p = pleat_lod_params_default();
+    CHECK(p.start == PLEAT_LOD_START_AUTO && p.reserved == 0 && p.offset_voxel_scale == 0.0);
+    p.start = 3;
+    CHECK_STATUS(pleat_lod_generate(m, &p, NULL, NULL, &out, NULL),
+                 PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK_NAMES("params->start");
+    p.start = 0xFFFFFFFFu;
+    CHECK_STATUS(pleat_lod_generate_chain(m, size, 1, &p, NULL, NULL, outs, NULL),
+                 PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK_NAMES("params->start");
+    p = pleat_lod_params_default();
+    p.reserved = 1;
+    CHECK_STATUS(pleat_lod_generate(m, &p, NULL, NULL, &out, NULL),
+                 PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK_NAMES("params->reserved");
+    p.reserved = 0x80000000u;
+    CHECK_STATUS(pleat_lod_generate_chain(m, size, 1, &p, NULL, NULL, outs, NULL),
+                 PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK_NAMES("params->reserved");
+    if (pleat_has_feature("cage")) {
+        CHECK_STATUS(pleat_cage_generate(m, &p, NULL, NULL, &out, NULL),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_NAMES("params->reserved");
+    }
+    for (size_t i = 0; i < sizeof bad_scales / sizeof bad_scales[0]; i++) {
+        p = pleat_lod_params_default();
+        p.offset_voxel_scale = bad_scales[i];
+        CHECK_STATUS(pleat_lod_generate(m, &p, NULL, NULL, &out, NULL),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_NAMES("params->offset_voxel_scale");
+        CHECK_STATUS(pleat_lod_generate_chain(m, size, 1, &p, NULL, NULL, outs, NULL),
+                     PLEAT_STATUS_INVALID_ARGUMENT);
+        CHECK_NAMES("params->offset_voxel_scale");
+    }
+    /* start = input on an input that is not clean (an open sheet) is refused, not quietly
+     * switched to the offset */
+    p = pleat_lod_params_default();
+    p.screen_size = 10.0;
+    p.start = PLEAT_LOD_START_INPUT;
+    CHECK_STATUS(pleat_lod_generate(open_sheet, &p, NULL, NULL, &out, NULL),
+                 PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK_NAMES("start = input");
+    CHECK_STATUS(pleat_lod_generate_chain(open_sheet, size, 1, &p, NULL, NULL, outs, NULL),
+                 PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK_NAMES("start = input");
+    CHECK(out == NULL && outs[0] == NULL);
+}
+
 int main(void) {
     PleatMesh *m = NULL, *out = NULL;
     PleatMesh *outs[2] = {NULL, NULL};
@@ -72,6 +130,12 @@ int main(void) {
     CHECK_STATUS(pleat_lod_generate_chain(NULL, sizes, 1, &p, NULL, NULL, outs, NULL),
                  PLEAT_STATUS_INVALID_ARGUMENT);
     CHECK(outs[0] == NULL && outs[1] == NULL);
+    {
+        PleatMesh *sheet = NULL;
+        CHECK_STATUS(pleat_mesh_create_f32(P, 4, 0, I, 3, &sheet), PLEAT_STATUS_OK);
+        check_appended_fields(m, sheet);
+        pleat_mesh_destroy(sheet);
+    }
     pleat_mesh_destroy(m);
     return finish("lod_misuse");
 }
