@@ -193,8 +193,9 @@ pub struct NewtonIteration {
 pub struct NewtonTimes {
     /// Energy, gradient and per-face Hessian blocks (pressure blocks PSD-projected).
     pub evaluate: f64,
-    /// Gathering the free-DOF triplets and assembling the sparse matrix (and the exact
-    /// pressure correction, when there is pressure).
+    /// Scattering the free-DOF values into the fixed pattern and assembling the sparse
+    /// matrix (and the exact pressure correction, when there is pressure); the first
+    /// iteration also makes the assembly plan (one sort of the pattern).
     pub assemble: f64,
     /// Numeric Cholesky factorizations of `H + σI` (the symbolic analysis is made once per
     /// solve and reused: its time is in the first iteration's `assemble`).
@@ -998,7 +999,10 @@ impl ReducedAssembly {
     ) -> Result<(SparseMatrix, f64)> {
         let same = cache.as_ref().is_some_and(|p| {
             p.indices.len() == list.len()
-                && p.indices.iter().zip(list).all(|(&(r, c), &(lr, lc, _))| r == lr && c == lc)
+                && p.indices
+                    .iter()
+                    .zip(list)
+                    .all(|(&(r, c), &(lr, lc, _))| r == lr && c == lc)
         });
         if !same {
             *cache = Some(ReducedAssembly::new(list, reduced, nf)?);

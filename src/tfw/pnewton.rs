@@ -753,7 +753,10 @@ fn newton_direction(
                     *exact_plan =
                         Some(AssemblyPlan::new(ny, entries, "tfw exact reduced Hessian")?);
                 }
-                let hx = exact_plan.as_ref().expect("made above").assemble(&xe.values)?;
+                let hx = exact_plan
+                    .as_ref()
+                    .expect("made above")
+                    .assemble(&xe.values)?;
                 let (s, its) = refine_by_cg(&hx, &|r| chol.solve(r), &rhs, &d, cg);
                 if s.iter().all(|v| v.is_finite()) {
                     return Ok(Some((s, attempts, its)));
