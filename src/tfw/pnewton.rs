@@ -712,8 +712,8 @@ fn newton_direction(
             }
         }
     }
-    for i in 0..ny {
-        sink.push(i, i, if held[i] { mean } else { 0.0 });
+    for (i, &h) in held.iter().enumerate() {
+        sink.push(i, i, if h { mean } else { 0.0 });
     }
     let rhs: Vec<f64> = g
         .iter()
@@ -746,8 +746,8 @@ fn newton_direction(
                 };
                 let mut xe = ReducedSink::new(capacity, exact_plan.is_none());
                 reduced_hessian(problem, basis, exact, held, &mut xe);
-                for i in 0..ny {
-                    xe.push(i, i, if held[i] { mean } else { 0.0 });
+                for (i, &h) in held.iter().enumerate() {
+                    xe.push(i, i, if h { mean } else { 0.0 });
                 }
                 if let Some(entries) = &xe.entries {
                     *exact_plan =
