@@ -12,10 +12,10 @@
 //! default regularization, faer's global parallelism or sequential kernels), so results do not
 //! depend on which of the two a caller used.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky};
 use faer::sparse::FaerError;
@@ -242,6 +242,50 @@ pub struct CholeskyAnalysis {
     symbolic: Arc<SymbolicCholesky<usize>>,
     /// Value index of each diagonal entry in the analysed pattern.
     diagonal: Arc<Vec<usize>>,
+    /// Scratch buffers of the numeric factorizations and solves, kept between calls (a
+    /// Newton solve factors and solves with one pattern hundreds of times; allocating the
+    /// scratch each time cost page faults). Shared by the clones; never read before faer
+    /// writes it, so it does not change any result.
+    scratch: Arc<ScratchPool>,
+}
+
+/// A few scratch buffers, each with the requirement it was made for (reused only for the
+/// same requirement).
+#[derive(Default)]
+struct ScratchPool(Mutex<Vec<(StackReq, MemBuffer)>>);
+
+impl std::fmt::Debug for ScratchPool {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("ScratchPool")
+    }
+}
+
+/// Buffers a pool keeps at most (one for factoring, one for solving, a spare for a
+/// concurrent caller).
+const SCRATCH_POOL_LEN: usize = 3;
+
+impl ScratchPool {
+    /// Runs `work` on a buffer of requirement `req`: a pooled one when there is one of that
+    /// requirement, else a new one (`None` when it cannot be allocated); the buffer goes back
+    /// to the pool afterwards.
+    fn with<T>(&self, req: StackReq, work: impl FnOnce(&mut MemBuffer) -> T) -> Option<T> {
+        let pooled = {
+            let mut pool = self.0.lock().unwrap_or_else(|e| e.into_inner());
+            pool.iter()
+                .position(|(r, _)| *r == req)
+                .map(|k| pool.swap_remove(k).1)
+        };
+        let mut buf = match pooled {
+            Some(b) => b,
+            None => MemBuffer::try_new(req).ok()?,
+        };
+        let out = work(&mut buf);
+        let mut pool = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if pool.len() < SCRATCH_POOL_LEN {
+            pool.push((req, buf));
+        }
+        Some(out)
+    }
 }
 
 impl CholeskyAnalysis {
@@ -268,6 +312,7 @@ impl CholeskyAnalysis {
         Ok(CholeskyAnalysis {
             symbolic: Arc::new(symbolic),
             diagonal: Arc::new(diagonal),
+            scratch: Arc::default(),
         })
     }
 
@@ -381,18 +426,20 @@ impl CholeskyAnalysis {
             .try_reserve_exact(sym.len_val())
             .map_err(|_| LltError::Generic(FaerError::OutOfMemory))?;
         values.resize(sym.len_val(), 0.0);
-        let mut buf =
-            MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()))
-                .map_err(|_| LltError::Generic(FaerError::OutOfMemory))?;
-        sym.factorize_numeric_llt(
-            &mut values,
-            a.as_ref(),
-            Side::Lower,
-            LltRegularization::default(),
-            par,
-            MemStack::new(&mut buf),
-            Default::default(),
-        )?;
+        let req = sym.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+        self.scratch
+            .with(req, |buf| {
+                sym.factorize_numeric_llt(
+                    &mut values,
+                    a.as_ref(),
+                    Side::Lower,
+                    LltRegularization::default(),
+                    par,
+                    MemStack::new(buf),
+                    Default::default(),
+                )
+            })
+            .ok_or(LltError::Generic(FaerError::OutOfMemory))??;
         Ok(values)
     }
 
@@ -446,14 +493,18 @@ impl Cholesky {
         let mut m = Mat::<f64>::from_fn(n, 1, |i, _| b[i]);
         let par = self.par.par();
         let sym = &self.analysis.symbolic;
-        LltRef::new(sym, &self.values).solve_in_place_with_conj(
-            Conj::No,
-            m.as_mut(),
-            par,
-            MemStack::new(&mut MemBuffer::new(
-                sym.solve_in_place_scratch::<f64>(1, par),
-            )),
-        );
+        let req = sym.solve_in_place_scratch::<f64>(1, par);
+        let mut run = |buf: &mut MemBuffer| {
+            LltRef::new(sym, &self.values).solve_in_place_with_conj(
+                Conj::No,
+                m.as_mut(),
+                par,
+                MemStack::new(buf),
+            )
+        };
+        if self.analysis.scratch.with(req, &mut run).is_none() {
+            run(&mut MemBuffer::new(req)); // panics on allocation failure, as before
+        }
         (0..n).map(|i| m[(i, 0)]).collect()
     }
 

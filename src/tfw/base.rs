@@ -51,7 +51,7 @@ use super::dense::{cross, dot, scale, sub};
 use crate::mesh::TriMesh;
 use crate::report::{Progress, ProgressFn};
 use crate::solve::{
-    assemble, dot_n, steihaug, sym_matvec_lower_into, Cholesky, CholeskyAnalysis, Entry,
+    dot_n, steihaug, sym_matvec_lower_into, AssemblyPlan, Cholesky, CholeskyAnalysis, Entry,
     Parallelism, ShiftSchedule, SparseMatrix,
 };
 use crate::tfw::dense::project_psd;
@@ -193,8 +193,9 @@ pub struct NewtonIteration {
 pub struct NewtonTimes {
     /// Energy, gradient and per-face Hessian blocks (pressure blocks PSD-projected).
     pub evaluate: f64,
-    /// Gathering the free-DOF triplets and assembling the sparse matrix (and the exact
-    /// pressure correction, when there is pressure).
+    /// Scattering the free-DOF values into the fixed pattern and assembling the sparse
+    /// matrix (and the exact pressure correction, when there is pressure); the first
+    /// iteration also makes the assembly plan (one sort of the pattern).
     pub assemble: f64,
     /// Numeric Cholesky factorizations of `H + σI` (the symbolic analysis is made once per
     /// solve and reused: its time is in the first iteration's `assemble`).
@@ -410,7 +411,12 @@ impl BaseProblem {
     ) -> (BaseEval, Vec<(usize, usize, f64)>) {
         let n3 = x.len();
         let mut gradient = vec![0.0; n3];
-        let mut hessian = Vec::new();
+        // 45 lower entries per face block, 3 per bending entry (one per coordinate)
+        let mut hessian = Vec::with_capacity(
+            45 * self.triangles.len()
+                + 3 * self.bending_matrix.len()
+                + 6 * self.obstacles.len() * self.vertex_areas.len(),
+        );
         let with_pressure = terms.pressure && self.pressure != 0.0;
         let correction = correction && with_pressure && !exact_pressure;
         let blocks: Vec<(f64, [f64; 9], Block9, Option<Block9>)> = (0..self.triangles.len())
@@ -431,7 +437,11 @@ impl BaseProblem {
             })
             .collect();
         let mut energy = 0.0;
-        let mut exact_minus_projected = Vec::new();
+        let mut exact_minus_projected = Vec::with_capacity(if correction {
+            45 * self.triangles.len()
+        } else {
+            0
+        });
         for (t, (e, g, h, delta)) in self.triangles.iter().zip(&blocks) {
             energy += e;
             let dof = |k: usize| 3 * t[k / 3] as usize + k % 3;
@@ -761,6 +771,8 @@ pub fn solve_base(
     let mut status = BaseStatus::Converged;
     let mut relative_gradient = 0.0;
     let mut analysis: Option<CholeskyAnalysis> = None;
+    let mut hessian_plan: Option<ReducedAssembly> = None;
+    let mut correction_plan: Option<ReducedAssembly> = None;
     let mut last_shift = 0.0;
     let step_cap = obstacle_step_cap(model);
     // The CG refinement (exact Newton steps) where the Newton matrix is not the Hessian:
@@ -816,30 +828,17 @@ pub fn solve_base(
                 break;
             }
             let clock = Instant::now();
-            let reduce = |list: &[(usize, usize, f64)]| -> Vec<Entry> {
-                list.iter()
-                    .filter(|&&(r, c, _)| free[r] && free[c])
-                    .map(|&(r, c, v)| Entry::new(reduced[r], reduced[c], v))
-                    .chain((0..nf).map(|i| Entry::new(i, i, 0.0)))
-                    .collect()
-            };
-            let entries = reduce(&ev.hessian);
-            let h = assemble(nf, &entries, "tfw base Hessian")?;
+            let (h, diag_sum) =
+                ReducedAssembly::assemble(&mut hessian_plan, &ev.hessian, &reduced, nf)?;
             let exact_part = if correction.is_empty() {
                 None
             } else {
-                Some(assemble(nf, &reduce(&correction), "tfw base Hessian")?)
+                Some(ReducedAssembly::assemble(&mut correction_plan, &correction, &reduced, nf)?.0)
             };
             if analysis.is_none() {
                 analysis = Some(CholeskyAnalysis::new(&h)?);
             }
             let an = analysis.as_ref().expect("set above");
-            let mut diag_sum = 0.0;
-            for e in &entries {
-                if e.row == e.col {
-                    diag_sum += e.val.abs();
-                }
-            }
             let diag_scale = (diag_sum / nf as f64).max(f64::MIN_POSITIVE);
             times.assemble = clock.elapsed().as_secs_f64();
             let schedule = ShiftSchedule {
@@ -971,6 +970,81 @@ pub fn solve_base(
     })
 }
 
+/// The free-DOF matrix of a `(row, col, value)` list in the full `3n` numbering (entries
+/// touching a clamped coordinate dropped, a zero diagonal entry per free coordinate appended,
+/// duplicates summed), assembled through a fixed pattern: the sort that orders the entries
+/// is made once ([`AssemblyPlan`]) and reused while the list's indices stay the same (they
+/// depend only on the mesh, except for obstacle contacts, which re-plan). The same matrix,
+/// bit for bit, as `assemble` of the reduced triplets (the plan sums duplicates in the same
+/// order), and the same `Σ|diagonal entries|` in list order.
+struct ReducedAssembly {
+    /// The list's `(row, col)` indices the plan was made for.
+    indices: Vec<(usize, usize)>,
+    /// Per list entry, its position among the reduced entries (`usize::MAX`: dropped).
+    slots: Vec<usize>,
+    /// Per reduced entry, whether it is on the diagonal.
+    diagonal: Vec<bool>,
+    plan: AssemblyPlan,
+}
+
+impl ReducedAssembly {
+    /// The reduced matrix of `list` (`reduced[i]`: the free index of coordinate `i`, or
+    /// `usize::MAX` when clamped) and the sum of the absolute diagonal entries in list order;
+    /// `cache` holds the plan between calls.
+    fn assemble(
+        cache: &mut Option<ReducedAssembly>,
+        list: &[(usize, usize, f64)],
+        reduced: &[usize],
+        nf: usize,
+    ) -> Result<(SparseMatrix, f64)> {
+        let same = cache.as_ref().is_some_and(|p| {
+            p.indices.len() == list.len()
+                && p.indices
+                    .iter()
+                    .zip(list)
+                    .all(|(&(r, c), &(lr, lc, _))| r == lr && c == lc)
+        });
+        if !same {
+            *cache = Some(ReducedAssembly::new(list, reduced, nf)?);
+        }
+        let plan = cache.as_ref().expect("made above");
+        let mut values = vec![0.0; plan.diagonal.len()];
+        for (&slot, &(_, _, v)) in plan.slots.iter().zip(list) {
+            if slot != usize::MAX {
+                values[slot] = v;
+            }
+        }
+        let mut diag_sum = 0.0;
+        for (v, &d) in values.iter().zip(&plan.diagonal) {
+            if d {
+                diag_sum += v.abs();
+            }
+        }
+        Ok((plan.plan.assemble(&values)?, diag_sum))
+    }
+
+    fn new(list: &[(usize, usize, f64)], reduced: &[usize], nf: usize) -> Result<Self> {
+        let mut slots = Vec::with_capacity(list.len());
+        let mut entries = Vec::with_capacity(list.len() + nf);
+        for &(r, c, _) in list {
+            let (i, j) = (reduced[r], reduced[c]);
+            if i == usize::MAX || j == usize::MAX {
+                slots.push(usize::MAX);
+            } else {
+                slots.push(entries.len());
+                entries.push(Entry::new(i, j, 0.0));
+            }
+        }
+        entries.extend((0..nf).map(|i| Entry::new(i, i, 0.0)));
+        Ok(ReducedAssembly {
+            indices: list.iter().map(|&(r, c, _)| (r, c)).collect(),
+            slots,
+            diagonal: entries.iter().map(|e| e.row == e.col).collect(),
+            plan: AssemblyPlan::new(nf, &entries, "tfw base Hessian")?,
+        })
+    }
+}
+
 /// How many entries of `a` and `b` differ.
 fn count_changes(a: &[Branch], b: &[Branch]) -> usize {
     a.iter().zip(b).filter(|(p, q)| p != q).count()
@@ -1009,12 +1083,13 @@ fn newton_step(
     }
     let m_norm0 = (-dot_n(g, &d0)).max(0.0).sqrt(); // ‖s₀‖_M² = gᵀM⁻¹g
     let radius = 1e3;
+    let z = std::cell::RefCell::new(vec![0.0; g.len()]);
     let hess = |v: &[f64], y: &mut [f64]| {
         sym_matvec_lower_into(h, v, y);
         if let Some(c) = exact_part {
-            let mut z = vec![0.0; v.len()];
+            let mut z = z.borrow_mut();
             sym_matvec_lower_into(c, v, &mut z);
-            y.iter_mut().zip(&z).for_each(|(a, b)| *a += b);
+            y.iter_mut().zip(z.iter()).for_each(|(a, b)| *a += b);
         }
     };
     let precond = |r: &[f64]| ch.solve(r);

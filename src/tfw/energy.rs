@@ -113,6 +113,19 @@ impl Scalar for Jet {
         r
     }
 
+    /// One pass instead of `scale`, `scale`, `add` (the same products and sums, so the same
+    /// bits: no fused multiply-add).
+    fn lin(&self, s: f64, o: &Jet, t: f64) -> Jet {
+        let mut r = Jet::constant(self.v * s + o.v * t);
+        for i in 0..L {
+            r.g[i] = self.g[i] * s + o.g[i] * t;
+            for j in 0..L {
+                r.h[i][j] = self.h[i][j] * s + o.h[i][j] * t;
+            }
+        }
+        r
+    }
+
     fn mul(&self, o: &Jet) -> Jet {
         let mut r = Jet::constant(self.v * o.v);
         for i in 0..L {

@@ -334,15 +334,41 @@ fn generator_form(
     h
 }
 
-/// `Bᵀ H B` as lower-triangle entries (entries touching a held unknown stored as 0, so the
-/// pattern never changes) and the mean positive diagonal of the unheld unknowns.
+/// Values of a reduced matrix in a fixed entry order, with the entries' indices too when
+/// `entries` is `Some` (the first assembly, which makes the [`AssemblyPlan`]; later ones
+/// only need the values in the same order).
+struct ReducedSink {
+    values: Vec<f64>,
+    entries: Option<Vec<Entry>>,
+}
+
+impl ReducedSink {
+    /// An empty sink for about `capacity` entries, recording indices when `with_indices`.
+    fn new(capacity: usize, with_indices: bool) -> ReducedSink {
+        ReducedSink {
+            values: Vec::with_capacity(capacity),
+            entries: with_indices.then(|| Vec::with_capacity(capacity)),
+        }
+    }
+
+    fn push(&mut self, row: usize, col: usize, v: f64) {
+        self.values.push(v);
+        if let Some(e) = &mut self.entries {
+            e.push(Entry::new(row, col, v));
+        }
+    }
+}
+
+/// `Bᵀ H B` as lower-triangle entries pushed to `sink` (entries touching a held unknown
+/// stored as 0, so the pattern never changes); returns the mean positive diagonal of the
+/// unheld unknowns.
 fn reduced_hessian(
     problem: &SqpProblem,
     basis: &CurlFreeBasis,
     hessian: &[(usize, usize, f64)],
     held: &[bool],
-) -> (Vec<Entry>, f64) {
-    let mut entries: Vec<Entry> = Vec::with_capacity(4 * hessian.len() + basis.ny);
+    sink: &mut ReducedSink,
+) -> f64 {
     let mut diag = vec![0.0; basis.ny];
     for &(r, c, v) in hessian {
         let (sr, sc) = (problem.slot[r], problem.slot[c]);
@@ -365,17 +391,16 @@ fn reduced_hessian(
                 if i == j {
                     diag[i] += w;
                 }
-                entries.push(Entry::new(i.max(j), i.min(j), w));
+                sink.push(i.max(j), i.min(j), w);
             }
         }
     }
     let pos: Vec<f64> = diag.iter().copied().filter(|&d| d > 0.0).collect();
-    let mean = if pos.is_empty() {
+    if pos.is_empty() {
         1.0
     } else {
         pos.iter().sum::<f64>() / pos.len() as f64
-    };
-    (entries, mean)
+    }
 }
 
 /// The projected gradient's max norm: `g` on unknowns off the bound, `min(g, 0)` at `a = 0`.
@@ -669,33 +694,37 @@ fn newton_direction(
         last_full,
     } = state;
     let ny = basis.ny;
-    let (mut entries, mean) = reduced_hessian(problem, basis, &eval.hessian, held);
+    let capacity = 4 * eval.hessian.len() + 2 * ny;
+    let mut sink = ReducedSink::new(capacity, plan.is_none());
+    let mean = reduced_hessian(problem, basis, &eval.hessian, held, &mut sink);
     // the shift σ Bᵀ W B (W = the first iteration's diagonal of H: the clarabel QP's σ I in
     // its scaled variables), then one diagonal entry per unknown for the held ones
-    let first_shift = entries.len();
+    let first_shift = sink.values.len();
     let mut shift_base = Vec::new();
     for (row, &w) in basis.rows.iter().zip(weights) {
         for &(i, bi) in row {
             for &(j, bj) in row {
                 if i >= j {
                     let v = if held[i] || held[j] { 0.0 } else { w * bi * bj };
-                    entries.push(Entry::new(i, j, 0.0));
+                    sink.push(i, j, 0.0);
                     shift_base.push(v);
                 }
             }
         }
     }
-    entries.extend((0..ny).map(|i| Entry::new(i, i, if held[i] { mean } else { 0.0 })));
+    for (i, &h) in held.iter().enumerate() {
+        sink.push(i, i, if h { mean } else { 0.0 });
+    }
     let rhs: Vec<f64> = g
         .iter()
         .zip(held)
         .map(|(&gi, &h)| if h { 0.0 } else { -gi })
         .collect();
-    if plan.is_none() {
-        *plan = Some(AssemblyPlan::new(ny, &entries, "tfw projected Newton")?);
+    if let Some(entries) = &sink.entries {
+        *plan = Some(AssemblyPlan::new(ny, entries, "tfw projected Newton")?);
     }
     let plan = plan.as_ref().expect("made above");
-    let mut values: Vec<f64> = entries.iter().map(|e| e.val).collect();
+    let mut values = sink.values;
     let mut attempts = 0;
     loop {
         attempts += 1;
@@ -715,13 +744,19 @@ fn newton_direction(
                 let Some(exact) = exact.filter(|_| refine) else {
                     return Ok(Some((d, attempts, 0)));
                 };
-                let (mut xe, _) = reduced_hessian(problem, basis, exact, held);
-                xe.extend((0..ny).map(|i| Entry::new(i, i, if held[i] { mean } else { 0.0 })));
-                if exact_plan.is_none() {
-                    *exact_plan = Some(AssemblyPlan::new(ny, &xe, "tfw exact reduced Hessian")?);
+                let mut xe = ReducedSink::new(capacity, exact_plan.is_none());
+                reduced_hessian(problem, basis, exact, held, &mut xe);
+                for (i, &h) in held.iter().enumerate() {
+                    xe.push(i, i, if h { mean } else { 0.0 });
                 }
-                let xv: Vec<f64> = xe.iter().map(|e| e.val).collect();
-                let hx = exact_plan.as_ref().expect("made above").assemble(&xv)?;
+                if let Some(entries) = &xe.entries {
+                    *exact_plan =
+                        Some(AssemblyPlan::new(ny, entries, "tfw exact reduced Hessian")?);
+                }
+                let hx = exact_plan
+                    .as_ref()
+                    .expect("made above")
+                    .assemble(&xe.values)?;
                 let (s, its) = refine_by_cg(&hx, &|r| chol.solve(r), &rhs, &d, cg);
                 if s.iter().all(|v| v.is_finite()) {
                     return Ok(Some((s, attempts, its)));
