@@ -233,9 +233,13 @@ pub const LOD_COARSE_VOXEL_MIN_SCREEN_SIZE: f64 = 200.0;
 /// rebuild), 793 B per estimated face (900 B then); with the BVH builds streaming their boxes
 /// into parry (no 48 B-a-leaf copy during the guard's build and rebuilds) and round 0's
 /// convergence reference borrowed from the start surface (2026-11-28), at 1035 MiB allocated
-/// (again the first rebuild), 687 B per estimated face. 780 B bounds it with a 13% margin
-/// (formerly 1100, then 900 B).
-const BYTES_PER_WORK_FACE: f64 = 780.0;
+/// (again the first rebuild), 687 B per estimated face (780 B then). With the guard's parry BVH
+/// replaced by the compact `spatial::TriTree` (2026-11-28: ≈ 12 B a face instead of ≈ 160 B,
+/// and no rebuild workspace), the beetle peaks at 502 MiB allocated (first pass; VmHWM 533 MiB),
+/// 333 B per estimated face, the offset stage's interior removal at 424 MiB (281 B), and
+/// dirty_truck (5.34 M estimated faces) at 1469 MiB (first pass; 288 B). 400 B bounds the
+/// beetle's with a 20% margin (formerly 1100, 900, then 780 B).
+const BYTES_PER_WORK_FACE: f64 = 400.0;
 /// Peak bytes per input sample of the input-plane fit's coverage check (`coverage.rs`: the
 /// input sampled at `SPACING · d`, a budget and a box per sample, the tree over them), which
 /// grows like `n_p²` and does not depend on the offset voxel. Measured 2026-11-27:
