@@ -358,8 +358,7 @@ impl LodParams {
         // The cheap estimates only: a request that fits neither start is refused before the
         // clean-input check (a self-intersection pass) runs; which start is taken, and so which
         // estimate binds, is known only after it (`run`, `choose_start`).
-        if self.offset_voxel_scale(input, Mode::Lod).is_none() && !self.input_start_may_fit(input)
-        {
+        if self.offset_voxel_scale(input, Mode::Lod).is_none() && !self.input_start_may_fit(input) {
             return Err(self.offset_over_budget(input, None));
         }
         Ok(())
@@ -1464,10 +1463,7 @@ mod tests {
         let chain = run_chain(&m, &[10.0, 5.0], &p, Mode::Lod, &mut |_| true).unwrap();
         assert!(chain[0].1.started_from_input);
         for (start, mode) in [(LodStart::Offset, Mode::Lod), (LodStart::Auto, Mode::Cage)] {
-            let q = LodParams {
-                start,
-                ..p.clone()
-            };
+            let q = LodParams { start, ..p.clone() };
             assert!(matches!(
                 run(&m, &q, mode, &mut |_| true),
                 Err(Error::LimitExceeded(_))

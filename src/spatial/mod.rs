@@ -9,18 +9,18 @@ pub mod bvh;
 pub mod closest;
 mod cube_tree;
 pub mod self_intersect;
-pub mod tritri;
 mod tri_tree;
+pub mod tritri;
 pub mod winding;
 
 pub use box_tree::BoxTree;
 pub use bvh::{ClosestPoint, TriangleBvh};
 pub use cube_tree::CubeTree;
-pub use tri_tree::TriTree;
 pub use self_intersect::{
     degenerate_faces, find_self_intersections, find_self_intersections_in, has_self_intersection,
     has_self_intersection_in, self_intersections, SelfIntersections,
 };
+pub use tri_tree::TriTree;
 pub use tritri::{
     are_coplanar, coplanar_same_side, faces_intersect, faces_intersect_at, is_collinear, orient2d,
     orient3d, segment_triangle_intersect, sharing, triangles_intersect, Sharing,

@@ -58,12 +58,16 @@ impl TriTree {
     /// Builds the tree over the triangles `subset` (indices into `triangles`, each at most
     /// once, below 2³² − 1). Deterministic.
     pub fn from_subset(positions: &[[f64; 3]], triangles: &[[u32; 3]], subset: &[u32]) -> Self {
-        assert!(triangles.len() < ABSENT as usize, "fewer than 2^32 - 1 triangles");
+        assert!(
+            triangles.len() < ABSENT as usize,
+            "fewer than 2^32 - 1 triangles"
+        );
         let order: Vec<u32> = {
             let centroids: Vec<Vec3> = subset
                 .par_iter()
                 .map(|&t| {
-                    let [a, b, c] = triangles[t as usize].map(|v| Vec3::from(positions[v as usize]));
+                    let [a, b, c] =
+                        triangles[t as usize].map(|v| Vec3::from(positions[v as usize]));
                     (a + b + c) / 3.0
                 })
                 .collect();
