@@ -10,7 +10,9 @@
 //! seconds), the peak per stage name, and the estimate the budget check used.
 //!
 //! `... -- --estimates NP MESH...` prints instead, per mesh, the memory estimate at every
-//! voxel scale of `LOD_VOXEL_SCALES` and the scale the default 2 GiB budget takes (no bake).
+//! voxel scale of `LOD_VOXEL_SCALES` and the scale the default 2 GiB budget takes, the estimate
+//! of a start from the input, whether `LodStart::Auto` starts from the input (the clean-input
+//! check), and whether the estimate of the start taken fits (no bake).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -90,7 +92,10 @@ fn estimates(n_p: f64, paths: &[String]) {
     };
     let scales = pleat::lowpoly::LOD_VOXEL_SCALES;
     let head: Vec<String> = scales.iter().map(|s| format!("MiB@{s}")).collect();
-    println!("mesh,faces,{},chosen", head.join(","));
+    println!(
+        "mesh,faces,{},chosen,MiB@input,starts_from_input,fits",
+        head.join(",")
+    );
     let mut fit = 0;
     for p in paths {
         let Ok(mesh) = pleat::mesh::io::read_mesh(std::path::Path::new(p)) else {
@@ -107,15 +112,24 @@ fn estimates(n_p: f64, paths: &[String]) {
             })
             .collect();
         let chosen = params.lod_voxel_scale(&mesh);
-        fit += chosen.is_some() as usize;
+        let input_est = params.input_start_memory_estimate_bytes(&mesh);
+        // the start `generate` takes (runs the clean-input check), and whether its estimate fits
+        let from_input = params.lod_starts_from_input(&mesh).unwrap_or(false);
+        let fits = if from_input {
+            input_est <= params.memory_budget_bytes as f64
+        } else {
+            chosen.is_some()
+        };
+        fit += fits as usize;
         let name = std::path::Path::new(p)
             .file_name()
             .map_or(p.clone(), |n| n.to_string_lossy().into_owned());
         println!(
-            "{name},{},{},{}",
+            "{name},{},{},{},{:.0},{from_input},{fits}",
             mesh.triangle_count(),
             est.join(","),
-            chosen.map_or("none".into(), |s| s.to_string())
+            chosen.map_or("none".into(), |s| s.to_string()),
+            mib(input_est as usize)
         );
     }
     println!("FIT {fit} of {} at n_p {n_p} in 2 GiB", paths.len());
@@ -142,7 +156,13 @@ fn main() {
         params.memory_budget_bytes = b.parse::<u64>().expect("B") << 20;
     }
     let scale = params.lod_voxel_scale(&mesh);
-    let estimate = scale.map(|s| params.memory_estimate_bytes(&mesh, s));
+    let from_input = params.lod_starts_from_input(&mesh).unwrap_or(false);
+    let estimate = if from_input {
+        println!("starts from the input");
+        Some(params.input_start_memory_estimate_bytes(&mesh))
+    } else {
+        scale.map(|s| params.memory_estimate_bytes(&mesh, s))
+    };
     println!(
         "mesh {} faces {} n_p {n_p} voxel scale {scale:?} estimate {:.1} MiB; live before bake {:.1} MiB",
         args[1],

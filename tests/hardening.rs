@@ -260,7 +260,7 @@ fn cwfa_substeps_that_overflow_the_frame_count_are_rejected() {
 #[cfg(feature = "lod")]
 mod lod_limits {
     use super::*;
-    use pleat::lowpoly::{generate, LodParams};
+    use pleat::lowpoly::{generate, LodParams, LodStart};
 
     fn tetra(scale: f64) -> TriMesh {
         let p = [
@@ -317,14 +317,61 @@ mod lod_limits {
 
     #[test]
     fn a_screen_size_needing_100_gb_is_refused_before_allocating() {
-        // (1e5)^3 grid cells: far beyond the default 2 GiB budget
-        let r = within(5, "n_p = 1e5", || bake(&tetra(1.0), 1e5));
+        // (1e5)^3 grid cells of the offset stage: far beyond the default 2 GiB budget. Forced
+        // to start from the offset, and an open tetrahedron (not clean: `LodStart::Auto` takes
+        // the offset), are refused before any large allocation.
+        let (p, mut tris) = tetra(1.0).into_parts();
+        tris.pop();
+        let open = TriMesh::new(p, tris).unwrap();
+        let offset = LodParams {
+            screen_size: 1e5,
+            max_rounds: 2,
+            start: LodStart::Offset,
+            ..LodParams::default()
+        };
+        let auto = LodParams {
+            start: LodStart::Auto,
+            ..offset.clone()
+        };
+        let cases = [
+            ("n_p = 1e5 from the offset", tetra(1.0), offset),
+            ("n_p = 1e5, an open tetrahedron", open, auto),
+        ];
+        for (what, m, p) in cases {
+            let r = within(5, what, || generate(&m, &p, &mut |_| true));
+            match r {
+                Err(Error::LimitExceeded(m)) => println!("  {m}"),
+                other => panic!(
+                    "{what}: expected LimitExceeded, got {:?}",
+                    other.map(|(m, _)| m.triangle_count())
+                ),
+            }
+        }
+    }
+
+    /// A clean input starts from itself (`LodStart::Auto`), whose estimate does not grow with
+    /// the offset grid (2026-11-28): the clean tetrahedron at n_p = 1e5 bakes from its input
+    /// within the default budget, in seconds, or is refused; never the 100 GB offset.
+    #[test]
+    fn a_clean_input_at_a_huge_screen_size_bakes_from_itself_or_is_refused() {
+        let p = LodParams {
+            screen_size: 1e5,
+            max_rounds: 2,
+            ..LodParams::default()
+        };
+        let m = tetra(1.0);
+        assert!(p.input_start_memory_estimate_bytes(&m) < p.memory_budget_bytes as f64);
+        let r = within(5, "clean tetrahedron at n_p = 1e5", || {
+            generate(&m, &p, &mut |_| true)
+        });
         match r {
+            Ok((lod, rep)) => {
+                assert!(rep.started_from_input);
+                assert!(rep.verified.all_hold(), "{:?}", rep.verified);
+                println!("  {} faces", lod.triangle_count());
+            }
             Err(Error::LimitExceeded(m)) => println!("  {m}"),
-            other => panic!(
-                "expected LimitExceeded, got {:?}",
-                other.map(|m| m.triangle_count())
-            ),
+            Err(e) => panic!("{e}"),
         }
     }
 

@@ -291,7 +291,10 @@ pub(crate) struct Guard<'a> {
     /// Triangles by face id (stale for deleted faces), mirrored for the BVH (raw vertex
     /// indices: the BVH's boundary).
     tris: FaceData<[u32; 3]>,
-    bvh: TriangleBvh,
+    /// The tree over the live faces' boxes (a compact [`sp::TriTree`]: parry's BVH cost
+    /// ≈ 160 B a face plus a rebuild workspace of the same order, the first pass's peak on a
+    /// dense offset surface; issue 12 part 4). Its queries give the same face sets.
+    bvh: sp::TriTree,
     input: &'a InputModel,
     cage: bool,
     /// Cage mode: the smallest distance to the input a modified face may have (model units;
@@ -322,7 +325,7 @@ impl<'a> Guard<'a> {
             tris[f] = raw_corners(&mesh, f);
         }
         let bvh =
-            TriangleBvh::from_subset(mesh.positions(), tris.as_slice(), FaceId::raw_slice(&live));
+            sp::TriTree::from_subset(mesh.positions(), tris.as_slice(), FaceId::raw_slice(&live));
         Guard {
             mesh,
             tris,
@@ -752,11 +755,18 @@ impl<'a> Guard<'a> {
         let m_e = &s.m_1[..s.n_e];
         let (lo, hi) = bbox(m_e.iter().flat_map(|f| f.t));
         s.cand.clear();
-        s.cand.extend(
-            self.bvh
-                .query_box(lo.to_array(), hi.to_array())
-                .map(FaceId::new)
-                .filter(|&g| s.excluded.binary_search(&g).is_err() && self.mesh.is_face_live(g)),
+        let (mesh, excluded, cand) = (&self.mesh, &s.excluded, &mut s.cand);
+        self.bvh.for_each_in_box(
+            mesh.positions(),
+            self.tris.as_slice(),
+            lo.to_array(),
+            hi.to_array(),
+            &mut |t| {
+                let g = FaceId::new(t);
+                if excluded.binary_search(&g).is_err() && mesh.is_face_live(g) {
+                    cand.push(g);
+                }
+            },
         );
         for &g in &s.cand {
             let gt = self.tris[g].map(|v| self.mesh.position(VertexId::new(v)));
@@ -833,15 +843,18 @@ impl<'a> Guard<'a> {
             .iter()
             .map(|f| (f.v, f.t.map(Vec3::from)))
             .collect();
-        others.extend(
-            self.bvh
-                .query_box((lo - pad).to_array(), (hi + pad).to_array())
-                .map(FaceId::new)
-                .filter(|&g| s.excluded.binary_search(&g).is_err() && self.mesh.is_face_live(g))
-                .map(|g| {
+        self.bvh.for_each_in_box(
+            self.mesh.positions(),
+            self.tris.as_slice(),
+            (lo - pad).to_array(),
+            (hi + pad).to_array(),
+            &mut |t| {
+                let g = FaceId::new(t);
+                if s.excluded.binary_search(&g).is_err() && self.mesh.is_face_live(g) {
                     let v = self.tris[g].map(VertexId::new);
-                    (v, v.map(|u| Vec3::from(self.mesh.position(u))))
-                }),
+                    others.push((v, v.map(|u| Vec3::from(self.mesh.position(u)))));
+                }
+            },
         );
         let new_gap = self_gap(&new, &others, c, st);
         if new_gap >= c || new_gap >= self_gap(&old, &others, c, st) {
@@ -889,12 +902,12 @@ fn rebuild_threshold(mesh: &HalfEdgeMesh) -> usize {
 fn rebuild_bvh(
     mesh: &HalfEdgeMesh,
     tris: &FaceData<[u32; 3]>,
-    bvh: &mut TriangleBvh,
+    bvh: &mut sp::TriTree,
     edits: &mut usize,
 ) {
     let live: Vec<FaceId> = mesh.faces().collect();
-    *bvh = TriangleBvh::default();
-    *bvh = TriangleBvh::from_subset(mesh.positions(), tris.as_slice(), FaceId::raw_slice(&live));
+    *bvh = sp::TriTree::default();
+    *bvh = sp::TriTree::from_subset(mesh.positions(), tris.as_slice(), FaceId::raw_slice(&live));
     *edits = 0;
 }
 
@@ -903,7 +916,7 @@ fn rebuild_bvh(
 fn flush_bvh_parts(
     mesh: &HalfEdgeMesh,
     tris: &FaceData<[u32; 3]>,
-    bvh: &mut TriangleBvh,
+    bvh: &mut sp::TriTree,
     pending: &mut Vec<FaceId>,
     edits: &mut usize,
 ) {

@@ -233,9 +233,13 @@ pub const LOD_COARSE_VOXEL_MIN_SCREEN_SIZE: f64 = 200.0;
 /// rebuild), 793 B per estimated face (900 B then); with the BVH builds streaming their boxes
 /// into parry (no 48 B-a-leaf copy during the guard's build and rebuilds) and round 0's
 /// convergence reference borrowed from the start surface (2026-11-28), at 1035 MiB allocated
-/// (again the first rebuild), 687 B per estimated face. 780 B bounds it with a 13% margin
-/// (formerly 1100, then 900 B).
-const BYTES_PER_WORK_FACE: f64 = 780.0;
+/// (again the first rebuild), 687 B per estimated face (780 B then). With the guard's parry BVH
+/// replaced by the compact `spatial::TriTree` (2026-11-28: ≈ 12 B a face instead of ≈ 160 B,
+/// and no rebuild workspace), the beetle peaks at 502 MiB allocated (first pass; VmHWM 533 MiB),
+/// 333 B per estimated face, the offset stage's interior removal at 424 MiB (281 B), and
+/// dirty_truck (5.34 M estimated faces) at 1469 MiB (first pass; 288 B). 400 B bounds the
+/// beetle's with a 20% margin (formerly 1100, 900, then 780 B).
+const BYTES_PER_WORK_FACE: f64 = 400.0;
 /// Peak bytes per input sample of the input-plane fit's coverage check (`coverage.rs`: the
 /// input sampled at `SPACING · d`, a budget and a box per sample, the tree over them), which
 /// grows like `n_p²` and does not depend on the offset voxel. Measured 2026-11-27:
@@ -351,18 +355,62 @@ impl LodParams {
                 self.clearance
             ));
         }
-        if self.offset_voxel_scale(input, Mode::Lod).is_none() {
-            let est = self.memory_estimate(input, MAX_LOD_VOXEL_SCALE);
-            return Err(Error::LimitExceeded(format!(
-                "the bake needs about {:.0} MiB at screen size {} (offset voxel {}× the default) \
-                 but the memory budget is {:.0} MiB",
-                est / (1u64 << 20) as f64,
-                self.screen_size,
-                MAX_LOD_VOXEL_SCALE,
-                self.memory_budget_bytes as f64 / (1u64 << 20) as f64
-            )));
+        // The cheap estimates only: a request that fits neither start is refused before the
+        // clean-input check (a self-intersection pass) runs; which start is taken, and so which
+        // estimate binds, is known only after it (`run`, `choose_start`).
+        if self.offset_voxel_scale(input, Mode::Lod).is_none() && !self.input_start_may_fit(input) {
+            return Err(self.offset_over_budget(input, None));
         }
         Ok(())
+    }
+
+    /// `LimitExceeded` for a LOD whose offset start fits no voxel scale, with the estimate at
+    /// the coarsest; `why_not_input` says why the input is not started from, when known.
+    fn offset_over_budget(&self, input: &TriMesh, why_not_input: Option<&str>) -> Error {
+        let est = self.memory_estimate(input, MAX_LOD_VOXEL_SCALE);
+        let mib = |b: f64| b / (1u64 << 20) as f64;
+        let input_start = match (self.start, why_not_input) {
+            (LodStart::Offset, _) => String::new(),
+            (_, Some(why)) => format!("; it does not start from the input ({why})"),
+            (_, None) => format!(
+                "; starting from the input would need about {:.0} MiB",
+                mib(self.input_start_estimate(input))
+            ),
+        };
+        Error::LimitExceeded(format!(
+            "the bake needs about {:.0} MiB at screen size {} (offset voxel {}× the default) \
+             but the memory budget is {:.0} MiB{input_start}",
+            mib(est),
+            self.screen_size,
+            MAX_LOD_VOXEL_SCALE,
+            mib(self.memory_budget_bytes as f64)
+        ))
+    }
+
+    /// Whether a LOD with these parameters may start from the input within the budget: the
+    /// start is not forced to the offset and [`input_start_memory_estimate_bytes`]
+    /// (Self::input_start_memory_estimate_bytes) fits. Cheap (no clean-input check).
+    fn input_start_may_fit(&self, input: &TriMesh) -> bool {
+        self.start != LodStart::Offset
+            && self.input_start_estimate(input) <= self.memory_budget_bytes as f64
+    }
+
+    /// The estimated peak bytes of a LOD of `input` that starts from the (welded) input itself
+    /// ([`LodStart`]) — the figure compared with `memory_budget_bytes` when that start is
+    /// taken; meant to be an upper bound of the measured peak (README, "Large screen sizes").
+    /// It does not depend on the offset voxel (no offset surface is built).
+    pub fn input_start_memory_estimate_bytes(&self, input: &TriMesh) -> f64 {
+        self.input_start_estimate(input)
+    }
+
+    /// Whether a LOD of `input` with these parameters starts from the input ([`LodStart`]):
+    /// the decision `generate` takes, including the clean-input check (a self-intersection
+    /// pass on a clean-topology input) and the budget. `Err` as `generate` for
+    /// [`LodStart::Input`] on an input that is not clean or does not fit. For tools.
+    pub fn lod_starts_from_input(&self, input: &TriMesh) -> Result<bool> {
+        let mut quiet = |_: Progress<'_>| true;
+        let mut rep = Reporter::new(&mut quiet);
+        choose_start(input, self, Mode::Lod, &mut rep).map(|s| s.is_some())
     }
 
     /// The offset voxel scale a LOD of `input` with these parameters starts from (see the
@@ -425,6 +473,24 @@ impl LodParams {
         // the loop's peak and the fit's come one after the other (the fit's LOD is small)
         (faces * BYTES_PER_WORK_FACE).max(fit)
             + input.triangle_count() as f64 * BYTES_PER_INPUT_FACE
+    }
+
+    /// Estimated peak bytes of a LOD that starts from the welded input (2026-11-28): the
+    /// input structures, plus the larger of the loop's term on the input's faces (the first
+    /// pass works through them as through an offset surface's, at [`BYTES_PER_WORK_FACE`]) and,
+    /// with `fit_to_input`, the fit's (its coverage samples at [`BYTES_PER_FIT_SAMPLE`] plus
+    /// [`BYTES_PER_FIT_WORK_FACE`] per start face). The same constants as the offset path's
+    /// [`memory_estimate`](Self::memory_estimate) with the start's real face count in place of
+    /// the offset's estimated one.
+    fn input_start_estimate(&self, input: &TriMesh) -> f64 {
+        let d = input.bbox_diagonal() / self.screen_size;
+        let faces = input.triangle_count() as f64;
+        let fit = if self.fit_to_input {
+            fit_samples(input, d) * BYTES_PER_FIT_SAMPLE + faces * BYTES_PER_FIT_WORK_FACE
+        } else {
+            0.0
+        };
+        (faces * BYTES_PER_WORK_FACE).max(fit) + faces * BYTES_PER_INPUT_FACE
     }
 }
 
@@ -619,6 +685,21 @@ fn choose_start(
         return Ok(None);
     }
     let auto = params.start == LodStart::Auto;
+    // the budget decision honours the start taken: an input start must fit its own estimate
+    let fits = params.input_start_may_fit(input);
+    if !fits && params.start == LodStart::Input {
+        return Err(Error::LimitExceeded(format!(
+            "starting from the input needs about {:.0} MiB at screen size {} but the memory \
+             budget is {:.0} MiB",
+            params.input_start_estimate(input) / (1u64 << 20) as f64,
+            params.screen_size,
+            params.memory_budget_bytes as f64 / (1u64 << 20) as f64
+        )));
+    }
+    if auto && !fits {
+        // Auto then takes the offset (no clean-input check); `run` checks its budget
+        return Ok(None);
+    }
     // Auto never starts from an input it refuses by topology: no self-intersection pass then
     let skip = |t: &CleanTopology| auto && t.auto_refuses();
     let clean =
@@ -736,6 +817,7 @@ pub(crate) fn run(
             .ok_or(Error::Cancelled)?;
     rep.check("setup", 0.0)?;
     let start = choose_start(input, params, mode, &mut rep)?;
+    check_offset_budget(params, input, mode, start.is_some())?;
     let level = Level::new(&model, input, mode);
     let (mesh, mut stats) = bake_level(&level, params, start.as_ref(), &mut rep, (0.0, 1.0))?;
     stats.started_from_input = start.is_some();
@@ -777,6 +859,7 @@ pub(crate) fn run_chain(
     let mut out: Vec<Option<(TriMesh, LodReport)>> = vec![None; screen_sizes.len()];
     // the finest level starts from the welded input when it is clean (`LodStart`)
     let mut prev: Option<TriMesh> = choose_start(input, &level_params[order[0]], mode, &mut rep)?;
+    check_offset_budget(&level_params[order[0]], input, mode, prev.is_some())?;
     let from_input = prev.is_some();
     let n = order.len() as f64;
     for (rank, &i) in order.iter().enumerate() {
@@ -800,9 +883,13 @@ pub(crate) fn run_chain(
 }
 
 /// Refuses, before any allocation, a bake whose memory estimate fits no voxel scale allowed in
-/// `mode` ([`LodParams::validate`] checks the LOD scales; cages allow only scale 1).
+/// `mode` ([`LodParams::validate`] checks the LOD scales; cages allow only scale 1) — for a
+/// LOD unless it may start from the input within the budget (then [`check_offset_budget`]
+/// decides once the start is known).
 fn check_mode_budget(p: &LodParams, input: &TriMesh, mode: Mode) -> Result<()> {
-    if p.offset_voxel_scale(input, mode).is_some() {
+    if p.offset_voxel_scale(input, mode).is_some()
+        || (mode == Mode::Lod && p.input_start_may_fit(input))
+    {
         return Ok(());
     }
     Err(Error::LimitExceeded(format!(
@@ -811,6 +898,24 @@ fn check_mode_budget(p: &LodParams, input: &TriMesh, mode: Mode) -> Result<()> {
         p.screen_size,
         p.memory_budget_bytes as f64 / (1u64 << 20) as f64
     )))
+}
+
+/// Once the start is known (`from_input`: [`choose_start`] took the input, whose estimate it
+/// checked): a bake from the offset surface needs a voxel scale whose estimate fits, else
+/// `LimitExceeded` before the offset stage allocates. The scale is the one
+/// [`LodParams::offset_voxel_scale`] gives whatever the start, so outputs from the offset are
+/// those of the budget rule before the input start was estimated on its own.
+fn check_offset_budget(p: &LodParams, input: &TriMesh, mode: Mode, from_input: bool) -> Result<()> {
+    if from_input || p.offset_voxel_scale(input, mode).is_some() {
+        return Ok(());
+    }
+    let why = match p.start {
+        LodStart::Auto if p.input_start_may_fit(input) => {
+            "LodStart::Auto: it is not clean, connected and of low genus"
+        }
+        _ => "over the budget",
+    };
+    Err(p.offset_over_budget(input, Some(why)))
 }
 
 /// Whether a cage baked with `p` keeps a positive clearance (its sign does not depend on `d`).
@@ -1325,6 +1430,62 @@ mod tests {
     /// The unit cube (the guard tests' shape).
     fn cube() -> TriMesh {
         crate::lowpoly::guard::tests::cube(1.0, 0.0)
+    }
+
+    /// The budget decision honours the start taken (issue 12 part 4, 2026-11-28): a clean
+    /// input whose offset fits no voxel scale still bakes from itself when its own estimate
+    /// fits; forced to the offset, or as a cage, it is refused before any work; an input start
+    /// that does not fit is refused (`Input`) or not taken (`Auto`).
+    #[test]
+    fn a_clean_input_start_has_its_own_budget() {
+        let m = cube();
+        let auto = LodParams {
+            screen_size: 10.0,
+            max_rounds: 2,
+            ..LodParams::default()
+        };
+        let from_input = auto.input_start_estimate(&m);
+        assert!(from_input >= fit_samples(&m, m.bbox_diagonal() / 10.0) * BYTES_PER_FIT_SAMPLE);
+        assert!(from_input < auto.memory_estimate(&m, MAX_LOD_VOXEL_SCALE));
+        // between the two estimates: only the input start fits
+        let p = LodParams {
+            memory_budget_bytes: from_input.ceil() as u64,
+            ..auto.clone()
+        };
+        assert_eq!(p.offset_voxel_scale(&m, Mode::Lod), None);
+        assert!(p.validate(&m).is_ok());
+        assert!(p.lod_starts_from_input(&m).unwrap());
+        let (lod, rep) = run(&m, &p, Mode::Lod, &mut |_| true).unwrap();
+        assert!(rep.started_from_input);
+        assert_eq!(rep.offset_voxel_scale, None);
+        assert!(rep.verified.all_hold(), "{:?}", rep.verified);
+        assert!(lod.triangle_count() >= 4);
+        let chain = run_chain(&m, &[10.0, 5.0], &p, Mode::Lod, &mut |_| true).unwrap();
+        assert!(chain[0].1.started_from_input);
+        for (start, mode) in [(LodStart::Offset, Mode::Lod), (LodStart::Auto, Mode::Cage)] {
+            let q = LodParams { start, ..p.clone() };
+            assert!(matches!(
+                run(&m, &q, mode, &mut |_| true),
+                Err(Error::LimitExceeded(_))
+            ));
+        }
+        // below the input start's estimate too: refused by validate whatever the start
+        let tight = LodParams {
+            memory_budget_bytes: from_input as u64 - 1,
+            ..auto.clone()
+        };
+        assert!(matches!(tight.validate(&m), Err(Error::LimitExceeded(_))));
+        // an input start over the budget: `Input` is refused before the clean-input check
+        let forced = LodParams {
+            start: LodStart::Input,
+            memory_budget_bytes: from_input as u64 - 1,
+            screen_size: 10.0,
+            ..auto.clone()
+        };
+        assert!(matches!(
+            forced.lod_starts_from_input(&m),
+            Err(Error::LimitExceeded(_))
+        ));
     }
 
     #[test]

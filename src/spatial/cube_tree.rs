@@ -16,22 +16,22 @@ use rayon::prelude::*;
 use crate::geom::Vec3;
 
 /// Cubes per leaf box.
-const LEAF: usize = 8;
+pub(super) const LEAF: usize = 8;
 /// Boxes of a level per box of the level above.
-const FANOUT: usize = 8;
+pub(super) const FANOUT: usize = 8;
 /// Bits of a Morton code per axis.
 const MORTON_BITS: u32 = 21;
 
 /// A box with `f32` corners.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct BoxF32 {
-    lo: [f32; 3],
-    hi: [f32; 3],
+pub(super) struct BoxF32 {
+    pub(super) lo: [f32; 3],
+    pub(super) hi: [f32; 3],
 }
 
 impl BoxF32 {
     /// The smallest `f32` box containing the `f64` box `[lo, hi]`.
-    fn outward(lo: Vec3, hi: Vec3) -> BoxF32 {
+    pub(super) fn outward(lo: Vec3, hi: Vec3) -> BoxF32 {
         BoxF32 {
             lo: [down(lo.x), down(lo.y), down(lo.z)],
             hi: [up(hi.x), up(hi.y), up(hi.z)],
@@ -39,7 +39,7 @@ impl BoxF32 {
     }
 
     /// The union of `boxes` (non-empty).
-    fn union(boxes: &[BoxF32]) -> BoxF32 {
+    pub(super) fn union(boxes: &[BoxF32]) -> BoxF32 {
         boxes[1..].iter().fold(boxes[0], |a, b| BoxF32 {
             lo: [0, 1, 2].map(|k| a.lo[k].min(b.lo[k])),
             hi: [0, 1, 2].map(|k| a.hi[k].max(b.hi[k])),
@@ -47,7 +47,7 @@ impl BoxF32 {
     }
 
     /// Whether this box meets the closed `f64` box `[lo, hi]` (touching counts).
-    fn meets(&self, lo: Vec3, hi: Vec3) -> bool {
+    pub(super) fn meets(&self, lo: Vec3, hi: Vec3) -> bool {
         let (ql, qh) = (lo.to_array(), hi.to_array());
         (0..3).all(|k| f64::from(self.lo[k]) <= qh[k] && ql[k] <= f64::from(self.hi[k]))
     }
@@ -184,7 +184,7 @@ fn leaf_box(run: &[u32], points: &[Vec3], half: &[f64]) -> BoxF32 {
 
 /// The indices of `points` sorted by the Morton code of the point in the points' bounding box
 /// (ties by index): nearby points end up in the same leaf.
-fn morton_order(points: &[Vec3]) -> Vec<u32> {
+pub(super) fn morton_order(points: &[Vec3]) -> Vec<u32> {
     let Some(&first) = points.first() else {
         return Vec::new();
     };

@@ -9,6 +9,7 @@ pub mod bvh;
 pub mod closest;
 mod cube_tree;
 pub mod self_intersect;
+mod tri_tree;
 pub mod tritri;
 pub mod winding;
 
@@ -19,6 +20,7 @@ pub use self_intersect::{
     degenerate_faces, find_self_intersections, find_self_intersections_in, has_self_intersection,
     has_self_intersection_in, self_intersections, SelfIntersections,
 };
+pub use tri_tree::TriTree;
 pub use tritri::{
     are_coplanar, coplanar_same_side, faces_intersect, faces_intersect_at, is_collinear, orient2d,
     orient3d, segment_triangle_intersect, sharing, triangles_intersect, Sharing,
