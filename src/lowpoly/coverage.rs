@@ -132,7 +132,7 @@ impl Coverage {
                 .with_min_len(64)
                 .filter_map(|s| {
                     let (p, b) = (points[s as usize], budget[s as usize]);
-                    patch.near(k, p, b).map(|dist| Relying {
+                    patch.near_or_inside(k, p, b).map(|dist| Relying {
                         sample: s,
                         face: k as u32,
                         spare: b - dist,
@@ -225,7 +225,8 @@ pub(crate) struct Relying {
     pub sample: u32,
     /// Index of the patch face found within the sample's budget.
     pub face: u32,
-    /// The sample's budget less its distance to that face (`≥ 0`).
+    /// At most the sample's budget less its distance to that face (`≥ 0`; exact, or lower by
+    /// the rounding bounds of [`Patch::near_or_inside`]).
     pub spare: f64,
 }
 
@@ -265,6 +266,18 @@ impl<'a> Patch<'a> {
             }
         }
         (0..n).filter(|&k| k != first).find_map(near)
+    }
+
+    /// [`Patch::near`], or an upper bound on the distance when the [`Prism`] shows `p` over
+    /// face `k` within `b` by more than [`box_cull_margin`] (then the exact distance is `≤ b`
+    /// too, so the same faces answer; the bound only lowers a [`Relying::spare`], which
+    /// [`Coverage::keeps`] uses as a sufficient condition).
+    fn near_or_inside(&self, k: usize, p: Vec3, b: f64) -> Option<f64> {
+        let margin = box_cull_margin(p, b);
+        match self.prisms[k].and_then(|pr| pr.over(p)) {
+            Some(up) if up + margin <= b => Some(up + margin),
+            _ => self.near(k, p, b),
+        }
     }
 
     /// `point_triangle_distance(p, face k)` when it is `≤ b`, else `None`; the face's box and
@@ -328,6 +341,17 @@ impl Prism {
         })
     }
 
+    /// When `p` projects into the triangle (`s_e ≥ 0` for every edge), where its distance is
+    /// `|h|`: `|h|` plus [`Prism::slack`], an upper bound on that distance; else `None`.
+    fn over(&self, p: Vec3) -> Option<f64> {
+        let inside = self
+            .starts
+            .iter()
+            .zip(&self.inward)
+            .all(|(s, m)| m.dot(p - *s) >= 0.0);
+        inside.then(|| self.n.dot(p - self.a).abs() + self.slack)
+    }
+
     /// Whether `p` is provably farther than `r` (plus the rounding [`Prism::slack`]) from the
     /// triangle: `h² + min(0, min_e s_e)² > (r + slack)²` (type docs).
     fn farther_than(&self, p: Vec3, r: f64) -> bool {
@@ -382,14 +406,10 @@ mod tests {
         let tri = |z: f64| [v(-1.0, -1.0, z), v(2.0, -1.0, z), v(-1.0, 2.0, z)];
         let mut c = coverage(vec![v(0.0, 0.0, 0.0)], vec![1.0]);
         let relying = c.relying_on(&[tri(0.5)]);
-        assert_eq!(
-            relying,
-            vec![Relying {
-                sample: 0,
-                face: 0,
-                spare: 0.5
-            }]
-        );
+        assert_eq!(relying.len(), 1);
+        assert_eq!((relying[0].sample, relying[0].face), (0, 0));
+        // over the face: the spare is `b − |h|` less the rounding bounds, far below 10⁻⁶
+        assert!(relying[0].spare <= 0.5 && relying[0].spare > 0.5 - 1e-6);
         assert!(c.keeps(&relying, &[tri(0.9)]));
         assert!(!c.keeps(&relying, &[tri(1.5)]));
         assert_eq!(c.refused, 1);
