@@ -87,8 +87,9 @@ fn step_down(y: f32) -> f32 {
 }
 
 /// Whether the cube `p ± b` — corners computed as `p − (b, b, b)` and `p + (b, b, b)` — meets
-/// the closed box `[lo, hi]` (touching counts; `false` when a comparison involves NaN).
-fn cube_meets(p: Vec3, b: f64, lo: Vec3, hi: Vec3) -> bool {
+/// the closed box `[lo, hi]` (touching counts; `false` when a comparison involves NaN): the test
+/// [`CubeTree::overlapping`] answers.
+pub fn cube_meets(p: Vec3, b: f64, lo: Vec3, hi: Vec3) -> bool {
     let r = Vec3::new(b, b, b);
     let (cl, ch) = (p - r, p + r);
     cl.x <= hi.x && cl.y <= hi.y && cl.z <= hi.z && lo.x <= ch.x && lo.y <= ch.y && lo.z <= ch.z
