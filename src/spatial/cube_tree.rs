@@ -224,13 +224,7 @@ mod tests {
     /// pseudo-random cloud with varied half-widths and boxes.
     #[test]
     fn overlapping_is_the_brute_force_set() {
-        let mut s = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::spatial::test_uniform(0x2545_f491_4f6c_dd1du64);
         let points: Vec<Vec3> = (0..3000)
             .map(|_| Vec3::new(rnd() * 10.0 - 5.0, rnd() * 3.0, rnd() * 0.1))
             .collect();

@@ -28,3 +28,16 @@ pub use tritri::{
 pub use winding::{
     solid_angle, winding_number, winding_number_in, winding_numbers, FastWindingNumber,
 };
+
+/// A deterministic xorshift64 stream of uniform numbers in `[0, 1)` from `seed` (non-zero), for
+/// the trees' randomized tests (the same numbers on every platform).
+#[cfg(test)]
+pub(crate) fn test_uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut s = seed;
+    move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

@@ -186,13 +186,7 @@ mod tests {
     /// brute-force set of triangles whose current box meets the query box, touching included.
     #[test]
     fn queries_after_updates_are_the_brute_force_set() {
-        let mut s = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::spatial::test_uniform(0x9e37_79b9_7f4a_7c15u64);
         let mut positions: Vec<[f64; 3]> = (0..2000)
             .map(|_| [rnd() * 10.0, rnd() * 4.0, rnd() * 0.5])
             .collect();
