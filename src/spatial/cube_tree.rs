@@ -112,19 +112,11 @@ impl CubeTree {
         assert_eq!(points.len(), half.len(), "a half-width per point");
         assert!(points.len() <= u32::MAX as usize, "at most 2^32 cubes");
         let order = morton_order(points);
-        let mut levels = Vec::new();
-        if !order.is_empty() {
-            let leaves: Vec<BoxF32> = order
-                .par_chunks(LEAF)
-                .map(|run| leaf_box(run, points, half))
-                .collect();
-            levels.push(leaves);
-            while levels.last().is_some_and(|l| l.len() > 1) {
-                let below = levels.last().expect("non-empty");
-                let next: Vec<BoxF32> = below.chunks(FANOUT).map(BoxF32::union).collect();
-                levels.push(next);
-            }
-        }
+        let leaves: Vec<BoxF32> = order
+            .par_chunks(LEAF)
+            .map(|run| leaf_box(run, points, half))
+            .collect();
+        let levels = pyramid(leaves);
         CubeTree { order, levels }
     }
 
@@ -185,6 +177,21 @@ fn leaf_box(run: &[u32], points: &[Vec3], half: &[f64]) -> BoxF32 {
 
 /// The indices of `points` sorted by the Morton code of the point in the points' bounding box
 /// (ties by index): nearby points end up in the same leaf.
+/// The levels of a box pyramid over `leaves`: `leaves` itself, then the union of every
+/// [`FANOUT`] boxes of the level below, up to a single root (no level for no leaves).
+pub(super) fn pyramid(leaves: Vec<BoxF32>) -> Vec<Vec<BoxF32>> {
+    let mut levels = Vec::new();
+    if !leaves.is_empty() {
+        levels.push(leaves);
+        while levels.last().is_some_and(|l| l.len() > 1) {
+            let below = levels.last().expect("non-empty");
+            let next: Vec<BoxF32> = below.chunks(FANOUT).map(BoxF32::union).collect();
+            levels.push(next);
+        }
+    }
+    levels
+}
+
 pub(super) fn morton_order(points: &[Vec3]) -> Vec<u32> {
     let Some(&first) = points.first() else {
         return Vec::new();

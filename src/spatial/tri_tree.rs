@@ -18,7 +18,7 @@
 
 use rayon::prelude::*;
 
-use super::cube_tree::{morton_order, BoxF32, FANOUT, LEAF};
+use super::cube_tree::{morton_order, pyramid, BoxF32, FANOUT, LEAF};
 use crate::geom::Vec3;
 
 /// Marks a triangle index that is not in the tree.
@@ -81,26 +81,18 @@ impl TriTree {
         for (i, &t) in order.iter().enumerate() {
             slot[t as usize] = i as u32;
         }
-        let mut levels = Vec::new();
-        if !order.is_empty() {
-            let leaves: Vec<BoxF32> = order
-                .par_chunks(LEAF)
-                .map(|run| {
-                    let first = tri_box(positions, triangles[run[0] as usize]);
-                    let (lo, hi) = run[1..].iter().fold(first, |(lo, hi), &t| {
-                        let (a, b) = tri_box(positions, triangles[t as usize]);
-                        (lo.min(a), hi.max(b))
-                    });
-                    BoxF32::outward(lo, hi)
-                })
-                .collect();
-            levels.push(leaves);
-            while levels.last().is_some_and(|l| l.len() > 1) {
-                let below = levels.last().expect("non-empty");
-                let next: Vec<BoxF32> = below.chunks(FANOUT).map(BoxF32::union).collect();
-                levels.push(next);
-            }
-        }
+        let leaves: Vec<BoxF32> = order
+            .par_chunks(LEAF)
+            .map(|run| {
+                let first = tri_box(positions, triangles[run[0] as usize]);
+                let (lo, hi) = run[1..].iter().fold(first, |(lo, hi), &t| {
+                    let (a, b) = tri_box(positions, triangles[t as usize]);
+                    (lo.min(a), hi.max(b))
+                });
+                BoxF32::outward(lo, hi)
+            })
+            .collect();
+        let levels = pyramid(leaves);
         TriTree {
             order,
             slot,
