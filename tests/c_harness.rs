@@ -6,6 +6,8 @@
 //! - When `valgrind` is on PATH (and `PLEAT_NO_VALGRIND` is unset) every program also runs under
 //!   memcheck: any invalid access or definite leak fails the test (`examples_c/valgrind.supp`
 //!   suppresses the leaks of the vendored xatlas only).
+//! - The programs run side by side, one per core (memcheck runs a program on one core): the
+//!   harness's wall time is about the longest program's plus the rest shared among the cores.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -134,7 +136,9 @@ fn compile(src: &Path, out: &Path, libdir: &Path, cxx: bool, extra: &[String]) {
     );
 }
 
-fn run(exe: &Path, valgrind: bool) {
+/// Runs `exe` (under memcheck when `valgrind`) from the crate root and returns its stdout and
+/// stderr, or the failure as a message with the same text.
+fn run(exe: &Path, valgrind: bool) -> Result<String, String> {
     let mut cmd = if valgrind {
         let mut c = Command::new("valgrind");
         c.args([
@@ -157,16 +161,47 @@ fn run(exe: &Path, valgrind: bool) {
         Command::new(exe)
     };
     let o = cmd.current_dir(root()).output().expect("run C program");
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    print!("{stdout}");
-    eprint!("{stderr}");
-    assert!(
-        o.status.success(),
-        "{} failed (valgrind: {valgrind}, status {:?})",
-        exe.display(),
-        o.status
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
     );
+    if o.status.success() {
+        Ok(text)
+    } else {
+        Err(format!(
+            "{text}{} failed (valgrind: {valgrind}, status {:?})",
+            exe.display(),
+            o.status
+        ))
+    }
+}
+
+/// Runs every `(exe, valgrind)` job on as many workers as the machine has cores (at most 4):
+/// memcheck runs a program on one core, and the programs are independent (each writes its own
+/// files). Prints each program's output as it ends and returns the failures' messages.
+fn run_all(jobs: &[(PathBuf, bool)]) -> Vec<String> {
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get().min(4));
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let failures = std::sync::Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..workers {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some((exe, valgrind)) = jobs.get(i) else {
+                    break;
+                };
+                match run(exe, *valgrind) {
+                    Ok(text) => print!("{text}"),
+                    Err(msg) => {
+                        print!("{msg}");
+                        failures.lock().unwrap().push(msg);
+                    }
+                }
+            });
+        }
+    });
+    failures.into_inner().unwrap()
 }
 
 #[test]
@@ -191,7 +226,7 @@ fn c_programs_pass() {
         .filter(|p| p.extension().is_some_and(|x| x == "c" || x == "cpp"))
         .collect();
     srcs.sort();
-    let mut ran = 0;
+    let mut jobs = Vec::new();
     for src in &srcs {
         let stem = src.file_stem().unwrap().to_string_lossy().to_string();
         let cxx = src.extension().is_some_and(|x| x == "cpp");
@@ -213,10 +248,15 @@ fn c_programs_pass() {
         // threads.c bakes 17 LODs on 4 host threads: minutes under memcheck, which serializes
         // threads; exhaustion.c builds 10⁶-element inputs. They run natively here and under
         // ASan (threads.c also TSan) in .ci/asan.sh.
-        run(&exe, valgrind && stem != "threads" && stem != "exhaustion");
-        ran += 1;
+        jobs.push((exe, valgrind && stem != "threads" && stem != "exhaustion"));
     }
-    assert!(ran > 0, "no C program ran");
+    assert!(!jobs.is_empty(), "no C program ran");
+    let failures = run_all(&jobs);
+    assert!(
+        failures.is_empty(),
+        "C programs failed:\n{}",
+        failures.join("\n")
+    );
     run_python_bindings(&libdir);
 }
 
