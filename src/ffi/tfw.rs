@@ -144,6 +144,13 @@ pub struct PleatTfwParams {
     pub qp: u32,
     /// Reserved, set to 0.
     pub reserved3: u32,
+    /// 1 (default): snap the periods of ω around the base's non-contractible loops (a
+    /// cylinder's ring, a torus's generators) to multiples of 2π before the phase, so the
+    /// Knöppel phase has no seam there; 0: off. Appended 2026-11-29: a shorter struct
+    /// (without it) gets the default.
+    pub snap_periods: u32,
+    /// Reserved, set to 0.
+    pub reserved4: u32,
 }
 
 /// Material and loads of `pleat_tfw_scene_from_arrays` (SI units). Get the defaults from
@@ -359,6 +366,8 @@ impl From<&crate::tfw::TfwParams> for PleatTfwParams {
                 crate::tfw::QpMethod::ProjectedNewton => PLEAT_TFW_QP_PROJECTED_NEWTON,
             },
             reserved3: 0,
+            snap_periods: u32::from(p.snap_periods),
+            reserved4: 0,
         }
     }
 }
@@ -389,6 +398,8 @@ pub(super) fn defaults_without_tfw() -> PleatTfwParams {
         reserved2: 0,
         qp: PLEAT_TFW_QP_PROJECTED_NEWTON,
         reserved3: 0,
+        snap_periods: 1,
+        reserved4: 0,
     }
 }
 
@@ -1082,6 +1093,7 @@ pub(super) mod imp {
                 )))
             }
         };
+        check_range(p.snap_periods, 0, 1, "params->snap_periods")?;
         let f = p.out_of_scope_slack_fraction;
         let f_ok = (0.0..=1.0).contains(&f);
         check_f64(f, f_ok, "params->out_of_scope_slack_fraction", "in [0, 1]")?;
@@ -1123,6 +1135,7 @@ pub(super) mod imp {
             curvature,
             knoppel: KnoppelOptions::default(),
             out_of_scope_slack_fraction: f,
+            snap_periods: p.snap_periods == 1,
         })
     }
 

@@ -79,6 +79,7 @@ pub mod measure;
 pub mod pipeline;
 pub mod pnewton;
 pub mod scene;
+pub mod snap;
 pub mod sqp;
 pub mod wfree;
 
@@ -92,4 +93,5 @@ pub use scene::{
     Dirichlet, Material, Model, Motion, Obstacle, ObstacleShape, Panel, Rotation, Scene,
     DEFAULT_OBSTACLE_STIFFNESS,
 };
+pub use snap::{snap_periods, PeriodSnap, SnappedLoop};
 pub use sqp::{CgRefinement, QpMethod, SqpIteration, SqpOptions, SqpResult, SqpStatus};
