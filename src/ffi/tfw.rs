@@ -1437,6 +1437,28 @@ mod tests {
         assert!(e.contains("params->qp"), "{e}");
     }
 
+    /// `snap_periods` (appended 2026-11-29): read from a full struct, defaulted (on) for an
+    /// older, shorter one, a value other than 0 or 1 rejected with a message naming the field.
+    #[test]
+    fn snap_periods_field_is_versioned_and_checked() {
+        let read = |p: &PleatTfwParams| {
+            // SAFETY: `p` is a live struct of at least `p.struct_size` bytes.
+            let v = unsafe { crate::ffi::boundary::read_versioned(p, "params") }?;
+            imp::params(&v)
+        };
+        let mut p = pleat_tfw_params_default();
+        assert_eq!(p.snap_periods, 1);
+        assert!(read(&p).unwrap().snap_periods);
+        p.snap_periods = 0;
+        assert!(!read(&p).unwrap().snap_periods);
+        p.struct_size = std::mem::offset_of!(PleatTfwParams, snap_periods) as u32;
+        assert!(read(&p).unwrap().snap_periods);
+        p.struct_size = std::mem::size_of::<PleatTfwParams>() as u32;
+        p.snap_periods = 2;
+        let e = read(&p).unwrap_err().to_string();
+        assert!(e.contains("params->snap_periods"), "{e}");
+    }
+
     /// `pleat_tfw_scene_add_obstacle` gives the scene a JSON `obstacles` entry gives, takes
     /// the defaults for an older (shorter) struct, and rejects bad fields naming them with the
     /// scene unchanged.

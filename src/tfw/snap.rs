@@ -71,6 +71,9 @@ pub struct PeriodSnap {
     /// Independent cycles of K that are contractible in the base mesh (around W islands);
     /// their periods are kept.
     pub kept_loops: usize,
+    /// `∮ω` around those kept cycles (rad; unchanged by the snapping; empty when no loop is
+    /// snapped).
+    pub kept_periods: Vec<f64>,
     /// `‖δω‖`: the correction's L² norm in the rest metric over the faces of K (rad).
     pub correction_norm: f64,
     /// `‖ω‖` before snapping, same norm (rad), for a relative size.
@@ -119,6 +122,7 @@ pub fn snap_periods(
         omega: omega.to_vec(),
         loops: Vec::new(),
         kept_loops,
+        kept_periods: Vec::new(),
         correction_norm: 0.0,
         omega_norm,
         max_correction: 0.0,
@@ -159,11 +163,7 @@ pub fn snap_periods(
         .collect();
     let gram: Vec<Vec<f64>> = eta
         .iter()
-        .map(|a| {
-            eta.iter()
-                .map(|b| metric.inner(a, b))
-                .collect()
-        })
+        .map(|a| eta.iter().map(|b| metric.inner(a, b)).collect())
         .collect();
     let waves = nearest_waves(&loop_periods[..rank], &gram);
     let mut correction = vec![0.0; omega.len()];
@@ -188,6 +188,7 @@ pub fn snap_periods(
         omega: snapped,
         loops,
         kept_loops: n - rank,
+        kept_periods: after[rank..].to_vec(),
         omega_norm,
     })
 }
@@ -549,7 +550,9 @@ mod tests {
         (0..mesh.triangle_count())
             .map(|f| {
                 (0..3)
-                    .map(|i| f64::from(el.face_edge_sign[f][i]) * omega[el.face_edges[f][i] as usize])
+                    .map(|i| {
+                        f64::from(el.face_edge_sign[f][i]) * omega[el.face_edges[f][i] as usize]
+                    })
                     .sum::<f64>()
                     .abs()
             })
@@ -589,12 +592,18 @@ mod tests {
             assert!((l.before.abs() - TAU * (7.0 + frac)).abs() < 1e-10, "{l:?}");
             assert!(s.max_period_error() <= 1e-10, "{l:?}");
             // the ring's own sum, measured independently of the basis
-            let ring: f64 = (0..n).map(|k| th_edge_sum(&mesh, &s.omega, k, (k + 1) % n)).sum();
+            let ring: f64 = (0..n)
+                .map(|k| th_edge_sum(&mesh, &s.omega, k, (k + 1) % n))
+                .sum();
             assert!((ring - TAU * expect as f64).abs() <= 1e-10, "ring {ring}");
             assert!(max_curl(&mesh, &s.omega) <= 1e-12);
             let closed = expect as f64 - 7.0 - frac;
             for (e, (&d, &t)) in add(&s.omega, &omega, -1.0).iter().zip(&th).enumerate() {
-                assert!((d - closed * t).abs() <= 1e-10, "edge {e}: {d} vs {}", closed * t);
+                assert!(
+                    (d - closed * t).abs() <= 1e-10,
+                    "edge {e}: {d} vs {}",
+                    closed * t
+                );
             }
             let expected_norm = closed.abs() * TAU * (0.3 * (m - 1) as f64 / TAU).sqrt();
             // ‖c dθ‖² = c² ∫ |∇θ|² = c² (2π)² · height / (2π · radius) on the prism (n large)
@@ -683,7 +692,9 @@ mod tests {
     /// No loop on a disk: nothing changes, bit for bit.
     #[test]
     fn disk_is_a_bit_identical_no_op() {
-        let mesh = grid(7, 6, false, |k, j| [k as f64 + 0.1 * (j as f64).sin(), j as f64, 0.0]);
+        let mesh = grid(7, 6, false, |k, j| {
+            [k as f64 + 0.1 * (j as f64).sin(), j as f64, 0.0]
+        });
         // grid() wraps the first direction; cut it open by dropping the wrapping quads
         let t: Vec<[u32; 3]> = mesh
             .triangles()
@@ -763,7 +774,8 @@ mod tests {
             x
         });
         let red = integer_row_reduce(&homology);
-        let island = |v: &[f64]| -> f64 { red.u[1].iter().zip(v).map(|(&k, x)| k as f64 * x).sum() };
+        let island =
+            |v: &[f64]| -> f64 { red.u[1].iter().zip(v).map(|(&k, x)| k as f64 * x).sum() };
         assert!((island(&pa) - island(&pb)).abs() <= 1e-10);
         assert!((island(&pb) - island(&before)).abs() > 0.1);
         assert!(max_curl_on(&p, &mesh, &s.omega) <= 1e-12);
@@ -794,7 +806,11 @@ mod tests {
             }
         }
         let ua: Vec<Vec<i64>> = (0..n)
-            .map(|i| (0..3).map(|c| (0..n).map(|k| r.u[i][k] * a[k][c]).sum()).collect())
+            .map(|i| {
+                (0..3)
+                    .map(|c| (0..n).map(|k| r.u[i][k] * a[k][c]).sum())
+                    .collect()
+            })
             .collect();
         assert_eq!(r.rank, 2);
         for row in &ua[r.rank..] {
