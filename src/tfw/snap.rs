@@ -279,6 +279,14 @@ struct Reduction {
     rank: usize,
 }
 
+/// `m[i] −= q · m[p]`.
+fn sub_row(m: &mut [Vec<i64>], i: usize, p: usize, q: i64) {
+    let src = m[p].clone();
+    for (x, y) in m[i].iter_mut().zip(&src) {
+        *x -= q * y;
+    }
+}
+
 /// Integer row echelon form of `a` (`n` rows of equal length) by Euclid's algorithm on each
 /// column (row swaps and integer row additions only, so `u` is unimodular and `u⁻¹` integer).
 fn integer_row_reduce(a: &[Vec<i64>]) -> Reduction {
@@ -295,14 +303,11 @@ fn integer_row_reduce(a: &[Vec<i64>]) -> Reduction {
         if pivot == n {
             break;
         }
-        loop {
-            // the row with the smallest nonzero entry in `col` becomes the pivot row
-            let Some(p) = (pivot..n)
-                .filter(|&i| rows[i][col] != 0)
-                .min_by_key(|&i| (rows[i][col].abs(), i))
-            else {
-                break;
-            };
+        // the row with the smallest nonzero entry in `col` becomes the pivot row
+        while let Some(p) = (pivot..n)
+            .filter(|&i| rows[i][col] != 0)
+            .min_by_key(|&i| (rows[i][col].abs(), i))
+        {
             rows.swap(p, pivot);
             u.swap(p, pivot);
             for r in &mut u_inv {
@@ -313,12 +318,8 @@ fn integer_row_reduce(a: &[Vec<i64>]) -> Reduction {
                 let q = rows[i][col] / rows[pivot][col];
                 if q != 0 {
                     // row_i −= q row_pivot; u⁻¹: column pivot += q column i
-                    for c in 0..m {
-                        rows[i][c] -= q * rows[pivot][c];
-                    }
-                    for c in 0..n {
-                        u[i][c] -= q * u[pivot][c];
-                    }
+                    sub_row(&mut rows, i, pivot, q);
+                    sub_row(&mut u, i, pivot, q);
                     for r in &mut u_inv {
                         r[pivot] += q * r[i];
                     }
