@@ -1034,6 +1034,13 @@ typedef struct PleatTfwParams {
   uint32_t qp;
   // Reserved, set to 0.
   uint32_t reserved3;
+  // 1 (default): snap the periods of ω around the base's non-contractible loops (a
+  // cylinder's ring, a torus's generators) to multiples of 2π before the phase, so the
+  // Knöppel phase has no seam there; 0: off. Appended 2026-11-29: a shorter struct
+  // (without it) gets the default.
+  uint32_t snap_periods;
+  // Reserved, set to 0.
+  uint32_t reserved4;
 } PleatTfwParams;
 
 // Material and loads of `pleat_tfw_scene_from_arrays` (SI units). Get the defaults from

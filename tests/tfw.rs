@@ -724,6 +724,111 @@ fn report_base_solve_on_spec_sizes() {
     }
 }
 
+/// Period snapping on (default) unless `PLEAT_TFW_SNAP=0` (test-side switch for before/after
+/// measurements; the library reads no environment).
+fn snap_from_env(params: &mut pleat::tfw::TfwParams) {
+    params.snap_periods = std::env::var("PLEAT_TFW_SNAP").map_or(true, |v| v != "0");
+}
+
+/// Prints the period snapping of `r` and the phase's defects where the wrinkles show: per
+/// edge whose ends both have `a ≥ 10%` of the peak, `δ = wrap(arg z_j − arg z_i − ω_ij)`
+/// (Knöppel's phase against ω); "seam edges" have `|δ| > 0.5 rad`, and singular faces (all
+/// three corners at ≥ 10%) have a nonzero index `Σδ / 2π`. Returns (seam edges, singular
+/// faces).
+fn print_phase(r: &pleat::tfw::TfwResult) -> (usize, usize) {
+    use std::f64::consts::{PI, TAU};
+    if let Some(s) = &r.snap {
+        let loops: Vec<String> = s
+            .loops
+            .iter()
+            .map(|l| format!("{:.4}->{:.4} rad (k {})", l.before, l.after, l.waves))
+            .collect();
+        eprintln!(
+            "  period snapping: loops [{}], kept {}, |δω| {:.3e} of |ω| {:.3e} ({:.2e} relative), \
+             max |δω_e| {:.3e}",
+            loops.join(", "),
+            s.kept_loops,
+            s.correction_norm,
+            s.omega_norm,
+            s.correction_norm / s.omega_norm.max(1e-300),
+            s.max_correction
+        );
+        let turns: Vec<String> = s
+            .kept_periods
+            .iter()
+            .map(|p| format!("{:.3}", p / TAU))
+            .collect();
+        eprintln!("  kept loops' periods (turns): [{}]", turns.join(", "));
+    } else {
+        eprintln!("  period snapping: off");
+    }
+    let cwf = &r.cwf;
+    let mesh = cwf.base();
+    let el = mesh.edges();
+    let a = cwf.amplitude();
+    let peak = a.iter().fold(0.0f64, |m, &x| m.max(x));
+    let shows = |v: u32| a[v as usize] >= 0.1 * peak && peak > 0.0;
+    let z = cwf.zeta();
+    let wrap = |x: f64| (x + PI).rem_euclid(TAU) - PI;
+    let delta: Vec<f64> = el
+        .edges
+        .iter()
+        .zip(cwf.omega())
+        .map(|(e, &w)| wrap(z[e.0[1] as usize].arg() - z[e.0[0] as usize].arg() - w))
+        .collect();
+    let seam = el
+        .edges
+        .iter()
+        .zip(&delta)
+        .filter(|(e, d)| shows(e.0[0]) && shows(e.0[1]) && d.abs() > 0.5)
+        .count();
+    let singular = (0..mesh.triangle_count())
+        .filter(|&f| mesh.triangles()[f].iter().all(|&v| shows(v)))
+        .filter(|&f| {
+            let sum: f64 = (0..3)
+                .map(|i| f64::from(el.face_edge_sign[f][i]) * delta[el.face_edges[f][i] as usize])
+                .sum();
+            (sum / TAU).round() != 0.0
+        })
+        .count();
+    if std::env::var("PLEAT_DEBUG_SEAM").is_ok() {
+        let p = mesh.positions();
+        let az = |v: u32| p[v as usize][1].atan2(p[v as usize][0]).to_degrees();
+        let mut hist = vec![0usize; 36];
+        for (f, t) in mesh.triangles().iter().enumerate() {
+            if r.w_faces[f] {
+                hist[(((az(t[0]) + 180.0) / 10.0) as usize).min(35)] += 1;
+            }
+        }
+        eprintln!("  W faces per 10° of azimuth from -180: {hist:?}");
+        let mut amp = vec![0.0f64; 36];
+        for (v, &x) in a.iter().enumerate() {
+            let b = (((az(v as u32) + 180.0) / 10.0) as usize).min(35);
+            amp[b] = amp[b].max(x / peak);
+        }
+        eprintln!(
+            "  max a/peak per 10°: {:?}",
+            amp.iter().map(|x| (x * 100.0).round()).collect::<Vec<_>>()
+        );
+        for (e, d) in el.edges.iter().zip(&delta) {
+            if shows(e.0[0]) && shows(e.0[1]) && d.abs() > 0.5 {
+                let q = p[e.0[0] as usize];
+                eprintln!(
+                    "  seam edge at azimuth {:.1}°, z {:.4}, r {:.4}, δ {d:.2}",
+                    az(e.0[0]),
+                    q[2],
+                    q[0].hypot(q[1])
+                );
+            }
+        }
+    }
+    eprintln!(
+        "  phase where a ≥ 10% of the peak: {seam} seam edges (|δ| > 0.5 rad), {singular} \
+         singular faces"
+    );
+    (seam, singular)
+}
+
 mod wrinkle_free {
     use super::*;
     use pleat::mesh::TriMesh;
@@ -1651,6 +1756,7 @@ mod twisted_cylinder_check {
     pub fn report(scene: &Scene, params: &TfwParams) -> f64 {
         let model = scene.assemble().unwrap();
         let r = solve(scene, params, &mut no_progress()).unwrap();
+        super::print_phase(&r);
         let sqp = r.sqp.as_ref().unwrap();
         let ring = mid_ring(&r, &model);
         let waves = mid_ring_waves(&r.cwf);
@@ -1704,6 +1810,7 @@ mod twisted_cylinder_check {
         let iters: usize = env("PLEAT_CYL_ITERS", "1000").parse().unwrap();
         let mut params = TfwParams::default();
         params.sqp.max_iterations = iters;
+        super::snap_from_env(&mut params);
         params.curvature = match env("PLEAT_CYL_KAPPA", "quadric").as_str() {
             "normals" => CurvatureMethod::VertexNormals,
             _ => CurvatureMethod::QuadricFit,
@@ -1992,7 +2099,9 @@ mod balloon_check {
         if let Ok(n) = std::env::var("PLEAT_BALLOON_ITERS") {
             params.sqp.max_iterations = n.parse().unwrap();
         }
+        super::snap_from_env(&mut params);
         let r = solve(scene, &params, &mut no_progress()).unwrap();
+        super::print_phase(&r);
         let sqp = r.sqp.as_ref().expect("balloons are compressed");
         let p = r.base.mesh.positions();
         let zc = p.iter().map(|q| q[2]).sum::<f64>() / p.len() as f64;

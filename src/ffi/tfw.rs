@@ -144,6 +144,13 @@ pub struct PleatTfwParams {
     pub qp: u32,
     /// Reserved, set to 0.
     pub reserved3: u32,
+    /// 1 (default): snap the periods of ω around the base's non-contractible loops (a
+    /// cylinder's ring, a torus's generators) to multiples of 2π before the phase, so the
+    /// Knöppel phase has no seam there; 0: off. Appended 2026-11-29: a shorter struct
+    /// (without it) gets the default.
+    pub snap_periods: u32,
+    /// Reserved, set to 0.
+    pub reserved4: u32,
 }
 
 /// Material and loads of `pleat_tfw_scene_from_arrays` (SI units). Get the defaults from
@@ -359,6 +366,8 @@ impl From<&crate::tfw::TfwParams> for PleatTfwParams {
                 crate::tfw::QpMethod::ProjectedNewton => PLEAT_TFW_QP_PROJECTED_NEWTON,
             },
             reserved3: 0,
+            snap_periods: u32::from(p.snap_periods),
+            reserved4: 0,
         }
     }
 }
@@ -389,6 +398,8 @@ pub(super) fn defaults_without_tfw() -> PleatTfwParams {
         reserved2: 0,
         qp: PLEAT_TFW_QP_PROJECTED_NEWTON,
         reserved3: 0,
+        snap_periods: 1,
+        reserved4: 0,
     }
 }
 
@@ -1082,6 +1093,7 @@ pub(super) mod imp {
                 )))
             }
         };
+        check_range(p.snap_periods, 0, 1, "params->snap_periods")?;
         let f = p.out_of_scope_slack_fraction;
         let f_ok = (0.0..=1.0).contains(&f);
         check_f64(f, f_ok, "params->out_of_scope_slack_fraction", "in [0, 1]")?;
@@ -1123,6 +1135,7 @@ pub(super) mod imp {
             curvature,
             knoppel: KnoppelOptions::default(),
             out_of_scope_slack_fraction: f,
+            snap_periods: p.snap_periods == 1,
         })
     }
 
@@ -1422,6 +1435,28 @@ mod tests {
         p.qp = 9;
         let e = read(&p).unwrap_err().to_string();
         assert!(e.contains("params->qp"), "{e}");
+    }
+
+    /// `snap_periods` (appended 2026-11-29): read from a full struct, defaulted (on) for an
+    /// older, shorter one, a value other than 0 or 1 rejected with a message naming the field.
+    #[test]
+    fn snap_periods_field_is_versioned_and_checked() {
+        let read = |p: &PleatTfwParams| {
+            // SAFETY: `p` is a live struct of at least `p.struct_size` bytes.
+            let v = unsafe { crate::ffi::boundary::read_versioned(p, "params") }?;
+            imp::params(&v)
+        };
+        let mut p = pleat_tfw_params_default();
+        assert_eq!(p.snap_periods, 1);
+        assert!(read(&p).unwrap().snap_periods);
+        p.snap_periods = 0;
+        assert!(!read(&p).unwrap().snap_periods);
+        p.struct_size = std::mem::offset_of!(PleatTfwParams, snap_periods) as u32;
+        assert!(read(&p).unwrap().snap_periods);
+        p.struct_size = std::mem::size_of::<PleatTfwParams>() as u32;
+        p.snap_periods = 2;
+        let e = read(&p).unwrap_err().to_string();
+        assert!(e.contains("params->snap_periods"), "{e}");
     }
 
     /// `pleat_tfw_scene_add_obstacle` gives the scene a JSON `obstacles` entry gives, takes

@@ -31,8 +31,8 @@
 //!   convexified Hessian, Armijo line search, termination tests, per-iteration history);
 //!   [`pnewton`]: the same SQP with the curl eliminated, projected Newton steps
 //!   ([`QpMethod::ProjectedNewton`]).
-//! - [`pipeline`]: [`solve`] — scene → base → W, init → SQP → [`crate::wrinkle::Cwf`] (Knöppel
-//!   phase), with a report; the wrinkled mesh comes from [`crate::wrinkle::Cwf::evaluate`]
+//! - [`pipeline`]: [`solve`] — scene → base → W, init → SQP → period snapping →
+//!   [`crate::wrinkle::Cwf`] (Knöppel phase), with a report; the wrinkled mesh comes from [`crate::wrinkle::Cwf::evaluate`]
 //!   with [`crate::wrinkle::EvalOptions::in_plane_v2`] (the v2 term of eq. 2.19).
 //!
 //! - [`pnewton`]: the SQP step by projected Newton with the curl constraint eliminated
@@ -41,7 +41,11 @@
 //! - Obstacles: planes and spheres by a one-sided cubic penalty in the base energy
 //!   ([`scene::Obstacle`], [`base`]).
 //!
-//! **Not implemented yet**: period snapping on non-contractible loops.
+//! - [`snap`]: period snapping (spec step 8's pre-step, Risk 9) — between the SQP and the
+//!   phase, the periods of ω around the base's non-contractible loops (cylinder ring, torus
+//!   generators, panel holes) go to the nearest multiple of 2π by the least-squares harmonic
+//!   correction; loops around W islands keep theirs ([`TfwParams::snap_periods`], on by
+//!   default; reported in [`TfwResult::snap`]).
 //!
 //! **Departures from the spec, and why:**
 //! - The built-in stretched sheet and [`Scene::twisted_cylinder`] use structured grids with
@@ -79,6 +83,7 @@ pub mod measure;
 pub mod pipeline;
 pub mod pnewton;
 pub mod scene;
+pub mod snap;
 pub mod sqp;
 pub mod wfree;
 
@@ -92,4 +97,5 @@ pub use scene::{
     Dirichlet, Material, Model, Motion, Obstacle, ObstacleShape, Panel, Rotation, Scene,
     DEFAULT_OBSTACLE_STIFFNESS,
 };
+pub use snap::{snap_periods, PeriodSnap, SnappedLoop};
 pub use sqp::{CgRefinement, QpMethod, SqpIteration, SqpOptions, SqpResult, SqpStatus};

@@ -1,6 +1,7 @@
 //! The whole TFW statics pipeline (spec "Algorithm" 2–8): base surface → strains, W,
-//! curvature → initialization with Helmholtz projection → wrinkle SQP → `Cwf` (phase by the
-//! existing Knöppel solve). One call, [`solve`], with a params struct in and a result with its
+//! curvature → initialization with Helmholtz projection → wrinkle SQP → period snapping on
+//! the non-contractible loops ([`crate::tfw::snap`]) → `Cwf` (phase by the existing Knöppel
+//! solve). One call, [`solve`], with a params struct in and a result with its
 //! report out, and a progress/cancel callback: the shape a thin C layer wraps.
 
 use crate::mesh::TriMesh;
@@ -10,6 +11,7 @@ use crate::tfw::curvature::{tension_curvature_by, CurvatureMethod};
 use crate::tfw::energy::{WfTerms, WrinkleEnergy};
 use crate::tfw::pnewton::run_sqp_projected_newton;
 use crate::tfw::scene::Scene;
+use crate::tfw::snap::{snap_periods, PeriodSnap};
 use crate::tfw::sqp::{run_sqp, QpMethod, SqpOptions, SqpProblem, SqpResult, SqpStatus};
 use crate::tfw::wfree::{
     face_strains, helmholtz_projection, initial_face_field, wrinkle_free_faces, WRule,
@@ -36,6 +38,9 @@ pub struct TfwParams {
     /// Rest-area fraction of slack faces above which the scene is out of scope (S:588;
     /// default 0.5).
     pub out_of_scope_slack_fraction: f64,
+    /// Snap the periods of ω around the base's non-contractible loops to 2πℤ before the phase
+    /// ([`crate::tfw::snap`]; default true). Off: the SQP's ω goes to Knöppel as it is.
+    pub snap_periods: bool,
 }
 
 impl Default for TfwParams {
@@ -48,6 +53,7 @@ impl Default for TfwParams {
             curvature: CurvatureMethod::default(),
             knoppel: KnoppelOptions::default(),
             out_of_scope_slack_fraction: 0.5,
+            snap_periods: true,
         }
     }
 }
@@ -90,7 +96,7 @@ pub struct TfwSeconds {
     pub init: f64,
     /// The SQP.
     pub sqp: f64,
-    /// The Knöppel phase.
+    /// The period snapping and the Knöppel phase.
     pub phase: f64,
 }
 
@@ -108,7 +114,11 @@ pub struct TfwResult {
     pub curvature: Vec<f64>,
     /// The SQP (history, status); `None` when it did not run (no compression, out of scope).
     pub sqp: Option<SqpResult>,
-    /// `E^wf` at the result (J; without the constant W_b¹).
+    /// The period snapping between the SQP and the phase (loops, periods before and after,
+    /// the correction's norm); `None` when it did not run (off, or no SQP).
+    pub snap: Option<PeriodSnap>,
+    /// `E^wf` of the returned field, after the period snapping (J; without the constant
+    /// W_b¹). The SQP's own final energy is the last entry of its history.
     pub energy: f64,
     /// `max |curl ω|` over the faces outside W after initialization.
     pub init_curl_residual: f64,
@@ -175,6 +185,7 @@ pub fn solve(
             w_faces,
             curvature,
             sqp: None,
+            snap: None,
             energy: e,
             init_curl_residual: 0.0,
             curl_residual: 0.0,
@@ -220,9 +231,18 @@ pub fn solve(
     seconds.sqp = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let amplitude = sqp.x[..nv].to_vec();
-    let omega = sqp.x[nv..].to_vec();
-    let energy_value = problem.energy().energy(&sqp.x, WfTerms::ALL);
-    let curl_residual = problem.curl_residual(&sqp.x);
+    let mut omega = sqp.x[nv..].to_vec();
+    let snap = if params.snap_periods {
+        let s = snap_periods(&problem, &mesh, &model.rest_forms, &w_faces, &omega)?;
+        omega.clone_from(&s.omega);
+        Some(s)
+    } else {
+        None
+    };
+    let mut x = amplitude.clone();
+    x.extend_from_slice(&omega);
+    let energy_value = problem.energy().energy(&x, WfTerms::ALL);
+    let curl_residual = problem.curl_residual(&x);
     let (cwf, _) = Cwf::from_one_form(mesh, omega, amplitude, &params.knoppel)?;
     seconds.phase = t.elapsed().as_secs_f64();
     let converged = sqp.status.converged()
@@ -247,6 +267,7 @@ pub fn solve(
         w_faces,
         curvature,
         sqp: Some(sqp),
+        snap,
         energy: energy_value,
         init_curl_residual,
         curl_residual,

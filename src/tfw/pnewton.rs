@@ -74,8 +74,18 @@ pub struct CurlFreeBasis {
 impl CurlFreeBasis {
     /// The tree–cotree basis of `problem`'s curl-free one-forms (module docs).
     pub fn new(problem: &SqpProblem) -> CurlFreeBasis {
-        let na = problem.n_free_a;
-        let ends = &problem.edge_ends;
+        CurlFreeBasis::of_complex(problem.n_free_a, &problem.edge_ends, &problem.curl)
+    }
+
+    /// The tree–cotree basis of the one-forms on the edges `ends` (`[tail, head]`) that are
+    /// curl-free on the faces `curl` (three `(na + edge, sign)` per face), behind `na`
+    /// amplitude unknowns (module docs). [`CurlFreeBasis::new`] is this on an [`SqpProblem`];
+    /// the period snapping ([`crate::tfw::snap`]) also runs it on the whole base mesh.
+    pub(crate) fn of_complex(
+        na: usize,
+        ends: &[[usize; 2]],
+        curl: &[[(usize, f64); 3]],
+    ) -> CurlFreeBasis {
         let ne = ends.len();
         let nv = ends
             .iter()
@@ -100,7 +110,7 @@ impl CurlFreeBasis {
                 ny += 1;
             }
         }
-        let (order, parent_edge) = dual_forest(problem, ne, &in_tree);
+        let (order, parent_edge) = dual_forest(na, curl, ne, &in_tree);
         let mut is_cotree = vec![false; ne];
         for &p in &parent_edge {
             if p != NONE {
@@ -121,7 +131,7 @@ impl CurlFreeBasis {
             r
         }));
         for &g in &generator_edges {
-            let h = generator_form(problem, ne, g, &order, &parent_edge);
+            let h = generator_form(na, curl, ne, g, &order, &parent_edge);
             for (j, v) in h.into_iter().enumerate() {
                 if v != 0.0 {
                     rows[na + j].push((ny, v));
@@ -147,6 +157,39 @@ impl CurlFreeBasis {
     /// Number of cohomology generators (closed, non-exact basis forms).
     pub fn generators(&self) -> usize {
         self.generator_edges.len()
+    }
+
+    /// The periods `∮_γg ω` of a curl-free `x_free` (as [`CurlFreeBasis::y_of`]) around the
+    /// generator cycles, one per generator: cycle `γg` runs along its generator edge (tail →
+    /// head, pleat's orientation) and back through the spanning forest. The basis form `h_g`
+    /// has period 1 on `γg` and 0 on the others (it is 1 on its own generator edge and 0 on the
+    /// forest and the other generator edges), so these are `y`'s `c` part.
+    pub fn periods(&self, x_free: &[f64]) -> Vec<f64> {
+        let y = self.y_of(x_free);
+        y[self.ny - self.generator_edges.len()..].to_vec()
+    }
+
+    /// The basis form `h_g` of generator `g` over the free unknowns (`B e_c(g)`: amplitudes 0,
+    /// closed on every curl row, period 1 on `γg`, 0 on the other generator cycles).
+    pub fn generator_values(&self, g: usize) -> Vec<f64> {
+        let mut y = vec![0.0; self.ny];
+        y[self.ny - self.generator_edges.len() + g] = 1.0;
+        self.x_of(&y)
+    }
+
+    /// Per vertex, the index of its exact-part unknown `u` counted from 0 (`None`: pinned
+    /// root of its component, or not in the complex).
+    pub(crate) fn exact_unknown(&self, v: usize) -> Option<usize> {
+        self.u_index
+            .get(v)
+            .filter(|&&i| i != NONE)
+            .map(|&i| i - self.na)
+    }
+
+    /// Number of exact-part unknowns `u` (vertices of the complex minus one root per
+    /// component).
+    pub(crate) fn exact_unknowns(&self) -> usize {
+        self.ny - self.na - self.generator_edges.len()
     }
 
     /// `x_free = B y`.
@@ -252,11 +295,15 @@ fn spanning_forest(nv: usize, ends: &[[usize; 2]]) -> Forest {
 /// Breadth-first spanning forest of the dual graph (curl rows as nodes, non-tree edges as dual
 /// edges, one virtual node joined to every boundary edge): `(rows in BFS order, per row its
 /// parent edge or NONE for the root of a closed component)`.
-fn dual_forest(problem: &SqpProblem, ne: usize, in_tree: &[bool]) -> (Vec<usize>, Vec<usize>) {
-    let na = problem.n_free_a;
-    let nf = problem.curl.len();
+fn dual_forest(
+    na: usize,
+    curl: &[[(usize, f64); 3]],
+    ne: usize,
+    in_tree: &[bool],
+) -> (Vec<usize>, Vec<usize>) {
+    let nf = curl.len();
     let mut edge_rows: Vec<Vec<usize>> = vec![Vec::new(); ne];
-    for (r, row) in problem.curl.iter().enumerate() {
+    for (r, row) in curl.iter().enumerate() {
         for &(k, _) in row {
             edge_rows[k - na].push(r);
         }
@@ -277,7 +324,7 @@ fn dual_forest(problem: &SqpProblem, ne: usize, in_tree: &[bool]) -> (Vec<usize>
     loop {
         while let Some(f) = queue.pop_front() {
             order.push(f);
-            for &(k, _) in &problem.curl[f] {
+            for &(k, _) in &curl[f] {
                 let j = k - na;
                 if in_tree[j] {
                     continue;
@@ -306,13 +353,13 @@ fn dual_forest(problem: &SqpProblem, ne: usize, in_tree: &[bool]) -> (Vec<usize>
 /// The closed form of generator edge `g` (module docs): 1 on `g`, cotree values solved from the
 /// leaves of the dual forest to its roots.
 fn generator_form(
-    problem: &SqpProblem,
+    na: usize,
+    curl: &[[(usize, f64); 3]],
     ne: usize,
     g: usize,
     order: &[usize],
     parent_edge: &[usize],
 ) -> Vec<f64> {
-    let na = problem.n_free_a;
     let mut h = vec![0.0; ne];
     h[g] = 1.0;
     for &f in order.iter().rev() {
@@ -322,7 +369,7 @@ fn generator_form(
         }
         let mut rest = 0.0;
         let mut sp = 0.0;
-        for &(k, s) in &problem.curl[f] {
+        for &(k, s) in &curl[f] {
             if k - na == p {
                 sp = s;
             } else {

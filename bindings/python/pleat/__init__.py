@@ -1409,7 +1409,8 @@ _TfwParams = _struct("PleatTfwParams",
                              "sqp_energy_tolerance", "sqp_step_tolerance", "sqp_armijo",
                              "sqp_initial_shift", "sqp_time_limit_seconds",
                              "out_of_scope_slack_fraction")
-                     + _u32s("curvature", "reserved2", "qp", "reserved3"))
+                     + _u32s("curvature", "reserved2", "qp", "reserved3", "snap_periods",
+                             "reserved4"))
 _TfwMaterial = _struct("PleatTfwMaterial", _u32s("struct_size", "reserved")
                        + _f64s("young", "poisson", "thickness", "density")
                        + [("gravity", _c.c_double * 3)] + _f64s("pressure"))
@@ -1480,7 +1481,7 @@ def _tfw_params(w_rule="text", curvature="quadric", qp=None, **kw):
         p.qp = _TFW_QP[qp]
     names = {n for n, _ in _TfwParams._fields_} - {"struct_size", "reserved", "w_rule",
                                                     "curvature", "reserved2", "qp",
-                                                    "reserved3"}
+                                                    "reserved3", "reserved4"}
     for k, v in kw.items():
         if k not in names:
             raise PleatError(1, f"unknown TFW parameter {k!r}; known: {sorted(names)}")
@@ -1565,7 +1566,8 @@ class TfwScene(_Handle):
     def solve(self, progress=None, **params):
         """Solves the scene (base surface, wrinkle SQP, phase); keywords are PleatTfwParams
         fields (e.g. ``sqp_max_iterations=50``, ``w_rule="reference"``,
-        ``curvature="normals"``, ``qp="newton"`` or ``"clarabel"``; default: the library's).
+        ``curvature="normals"``, ``qp="newton"`` or ``"clarabel"``, ``snap_periods=0`` to
+        keep ω's fractional periods around non-contractible loops; default: the library's).
         ``progress(stage, fraction)`` returning True cancels (PleatError CANCELLED)."""
         p = _tfw_params(**params)
         relay, h = _Relay(progress), _P()

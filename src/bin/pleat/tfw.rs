@@ -38,6 +38,10 @@ pub struct TfwArgs {
     /// Newton, curl eliminated) or `default` (the library's default).
     #[arg(long, default_value = "default")]
     pub qp: String,
+    /// Keep ω's periods around the base's non-contractible loops as the SQP leaves them
+    /// (default: snapped to multiples of 2π before the phase).
+    #[arg(long)]
+    pub no_snap: bool,
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
@@ -58,6 +62,7 @@ pub fn run(args: &TfwArgs) -> ExitCode {
     }
     let mut params = TfwParams::default();
     params.sqp.max_iterations = args.max_iterations;
+    params.snap_periods = !args.no_snap;
     params.sqp.qp = match super::bench_tfw::parse_qp(&args.qp, params.sqp.qp) {
         Ok(q) => q,
         Err(e) => {
@@ -131,6 +136,21 @@ fn print_summary(r: &TfwResult, qp: QpMethod) {
         println!(
             "energy        {:.6e} J → {:.6e} J; stationarity {:.3e} → {:.3e}",
             s.initial_energy, r.energy, s.initial_stationarity, last_r
+        );
+    }
+    if let Some(s) = &r.snap {
+        let loops: Vec<String> = s
+            .loops
+            .iter()
+            .map(|l| format!("{:.4} → {:.4} rad (k {})", l.before, l.after, l.waves))
+            .collect();
+        println!(
+            "period snap   {} loop(s) [{}], {} kept (around W islands); |δω| {:.3e} of |ω| {:.3e}",
+            s.loops.len(),
+            loops.join(", "),
+            s.kept_loops,
+            s.correction_norm,
+            s.omega_norm
         );
     }
     let max_a = r.cwf.amplitude().iter().fold(0.0f64, |m, &a| m.max(a));
