@@ -724,10 +724,10 @@ fn report_base_solve_on_spec_sizes() {
     }
 }
 
-/// Period snapping on (default) unless `PLEAT_TFW_SNAP=0` (test-side switch for before/after
-/// measurements; the library reads no environment).
+/// Period snapping off (the library's default) unless `PLEAT_TFW_SNAP=1` (test-side switch
+/// for before/after measurements; the library reads no environment).
 fn snap_from_env(params: &mut pleat::tfw::TfwParams) {
-    params.snap_periods = std::env::var("PLEAT_TFW_SNAP").map_or(true, |v| v != "0");
+    params.snap_periods = std::env::var("PLEAT_TFW_SNAP").is_ok_and(|v| v == "1");
 }
 
 /// Prints the period snapping of `r` and the phase's defects where the wrinkles show: per

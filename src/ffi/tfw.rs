@@ -144,10 +144,11 @@ pub struct PleatTfwParams {
     pub qp: u32,
     /// Reserved, set to 0.
     pub reserved3: u32,
-    /// 1 (default): snap the periods of ω around the base's non-contractible loops (a
-    /// cylinder's ring, a torus's generators) to multiples of 2π before the phase, so the
-    /// Knöppel phase has no seam there; 0: off. Appended 2026-11-29: a shorter struct
-    /// (without it) gets the default.
+    /// 1: snap the periods of ω around the base's non-contractible loops (a cylinder's ring,
+    /// a torus's generators) to multiples of 2π before the phase, so ω agrees with the
+    /// phase's integer winding there (E^wf leaves the SQP's minimum: +1.25% on the 690-v
+    /// twisted cylinder); 0 (default): off, the SQP's ω as it is. Appended 2026-11-29: a
+    /// shorter struct (without it) gets the default.
     pub snap_periods: u32,
     /// Reserved, set to 0.
     pub reserved4: u32,
@@ -398,7 +399,7 @@ pub(super) fn defaults_without_tfw() -> PleatTfwParams {
         reserved2: 0,
         qp: PLEAT_TFW_QP_PROJECTED_NEWTON,
         reserved3: 0,
-        snap_periods: 1,
+        snap_periods: 0,
         reserved4: 0,
     }
 }
@@ -1437,7 +1438,7 @@ mod tests {
         assert!(e.contains("params->qp"), "{e}");
     }
 
-    /// `snap_periods` (appended 2026-11-29): read from a full struct, defaulted (on) for an
+    /// `snap_periods` (appended 2026-11-29): read from a full struct, defaulted (off) for an
     /// older, shorter one, a value other than 0 or 1 rejected with a message naming the field.
     #[test]
     fn snap_periods_field_is_versioned_and_checked() {
@@ -1447,12 +1448,12 @@ mod tests {
             imp::params(&v)
         };
         let mut p = pleat_tfw_params_default();
-        assert_eq!(p.snap_periods, 1);
-        assert!(read(&p).unwrap().snap_periods);
-        p.snap_periods = 0;
+        assert_eq!(p.snap_periods, 0);
         assert!(!read(&p).unwrap().snap_periods);
-        p.struct_size = std::mem::offset_of!(PleatTfwParams, snap_periods) as u32;
+        p.snap_periods = 1;
         assert!(read(&p).unwrap().snap_periods);
+        p.struct_size = std::mem::offset_of!(PleatTfwParams, snap_periods) as u32;
+        assert!(!read(&p).unwrap().snap_periods);
         p.struct_size = std::mem::size_of::<PleatTfwParams>() as u32;
         p.snap_periods = 2;
         let e = read(&p).unwrap_err().to_string();

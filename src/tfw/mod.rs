@@ -44,7 +44,7 @@
 //! - [`snap`]: period snapping (spec step 8's pre-step, Risk 9) — between the SQP and the
 //!   phase, the periods of ω around the base's non-contractible loops (cylinder ring, torus
 //!   generators, panel holes) go to the nearest multiple of 2π by the least-squares harmonic
-//!   correction; loops around W islands keep theirs ([`TfwParams::snap_periods`], on by
+//!   correction; loops around W islands keep theirs ([`TfwParams::snap_periods`], off by
 //!   default; reported in [`TfwResult::snap`]).
 //!
 //! **Departures from the spec, and why:**

@@ -39,7 +39,11 @@ pub struct TfwParams {
     /// default 0.5).
     pub out_of_scope_slack_fraction: f64,
     /// Snap the periods of ω around the base's non-contractible loops to 2πℤ before the phase
-    /// ([`crate::tfw::snap`]; default true). Off: the SQP's ω goes to Knöppel as it is.
+    /// ([`crate::tfw::snap`]; default false). Off: the SQP's ω goes to Knöppel as it is, and
+    /// the Knöppel phase still winds an integer number of times around every loop (it spreads
+    /// the fractional part; no phase defect on the twisted cylinders). On: ω agrees with the
+    /// phase's winding, at the cost of leaving the SQP's stationary point (E^wf +1.25% on the
+    /// 690-v twisted cylinder; README "Period snapping").
     pub snap_periods: bool,
 }
 
@@ -53,7 +57,7 @@ impl Default for TfwParams {
             curvature: CurvatureMethod::default(),
             knoppel: KnoppelOptions::default(),
             out_of_scope_slack_fraction: 0.5,
-            snap_periods: true,
+            snap_periods: false,
         }
     }
 }

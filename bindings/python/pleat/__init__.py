@@ -1566,8 +1566,8 @@ class TfwScene(_Handle):
     def solve(self, progress=None, **params):
         """Solves the scene (base surface, wrinkle SQP, phase); keywords are PleatTfwParams
         fields (e.g. ``sqp_max_iterations=50``, ``w_rule="reference"``,
-        ``curvature="normals"``, ``qp="newton"`` or ``"clarabel"``, ``snap_periods=0`` to
-        keep ω's fractional periods around non-contractible loops; default: the library's).
+        ``curvature="normals"``, ``qp="newton"`` or ``"clarabel"``, ``snap_periods=1`` to
+        snap ω's periods around non-contractible loops to multiples of 2π; default: the library's).
         ``progress(stage, fraction)`` returning True cancels (PleatError CANCELLED)."""
         p = _tfw_params(**params)
         relay, h = _Relay(progress), _P()

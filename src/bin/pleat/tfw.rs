@@ -38,10 +38,10 @@ pub struct TfwArgs {
     /// Newton, curl eliminated) or `default` (the library's default).
     #[arg(long, default_value = "default")]
     pub qp: String,
-    /// Keep ω's periods around the base's non-contractible loops as the SQP leaves them
-    /// (default: snapped to multiples of 2π before the phase).
+    /// Snap ω's periods around the base's non-contractible loops to multiples of 2π before
+    /// the phase (default: as the SQP leaves them; see the README's "Period snapping").
     #[arg(long)]
-    pub no_snap: bool,
+    pub snap: bool,
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
@@ -62,7 +62,7 @@ pub fn run(args: &TfwArgs) -> ExitCode {
     }
     let mut params = TfwParams::default();
     params.sqp.max_iterations = args.max_iterations;
-    params.snap_periods = !args.no_snap;
+    params.snap_periods = args.snap;
     params.sqp.qp = match super::bench_tfw::parse_qp(&args.qp, params.sqp.qp) {
         Ok(q) => q,
         Err(e) => {
