@@ -245,7 +245,10 @@ pub const LOD_COARSE_VOXEL_MIN_SCREEN_SIZE: f64 = 200.0;
 /// and no rebuild workspace), the beetle peaks at 502 MiB allocated (first pass; VmHWM 533 MiB),
 /// 333 B per estimated face, the offset stage's interior removal at 424 MiB (281 B), and
 /// dirty_truck (5.34 M estimated faces) at 1469 MiB (first pass; 288 B). 400 B bounds the
-/// beetle's with a 20% margin (formerly 1100, 900, then 780 B).
+/// beetle's with a 20% margin (formerly 1100, 900, then 780 B). The measured admission
+/// ([`measured_start`]) applies it to the real offset faces: 241 B per real face on the beetle,
+/// 235 B on the truck, 232 B on dirty_synth_soup_s1 (913 MiB first pass, 4.13 M faces,
+/// 2026-11-29).
 const BYTES_PER_WORK_FACE: f64 = 400.0;
 /// Peak bytes per mixed cube (a cube of the distance grid the iso-surface crosses, counted by
 /// the extraction's first pass over the whole band, buried components included) of the
