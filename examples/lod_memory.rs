@@ -7,7 +7,8 @@
 //! [--budget-mib B] [--out OUT.obj]`
 //!
 //! Prints one line per stage episode (stage, live bytes at its start, peak bytes during it,
-//! seconds), the peak per stage name, and the estimate the budget check used.
+//! seconds), the peak per stage name, and the estimate the budget check used (the measured
+//! one, `LodReport::measured_estimate_bytes`, when the up-front estimate fitted no voxel scale).
 //!
 //! `... -- --estimates NP MESH...` prints instead, per mesh, the memory estimate at every
 //! voxel scale of `LOD_VOXEL_SCALES` and the scale the default 2 GiB budget takes, the estimate
@@ -240,14 +241,17 @@ fn main() {
     }
     match result {
         Ok((lod, rep)) => {
+            // admitted by measurement (the up-front estimate fitted no scale): its estimate
+            let estimate = estimate.or(rep.measured_estimate_bytes);
             println!(
-                "OK faces {} offset faces {} voxel {:?} hd/l {:.5} peak {:.1} MiB estimate {:.1} MiB bytes/offset face {:.0} wall {:.1} s",
+                "OK faces {} offset faces {} voxel {:?} hd/l {:.5} peak {:.1} MiB estimate {:.1} MiB{} bytes/offset face {:.0} wall {:.1} s",
                 lod.triangle_count(),
                 rep.faces_offset,
                 rep.offset_voxel_scale,
                 rep.hausdorff_rel,
                 mib(overall),
                 estimate.map_or(f64::NAN, |e| e / (1u64 << 20) as f64),
+                if rep.measured_estimate_bytes.is_some() { " (measured admission)" } else { "" },
                 overall as f64 / rep.faces_offset.max(1) as f64,
                 t0.elapsed().as_secs_f64()
             );

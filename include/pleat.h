@@ -877,6 +877,11 @@ typedef struct PleatLodStats {
   // 1 when the level's loop started from the welded input (`PleatLodParams::start`; in a
   // chain only the finest level can), 0 when from the offset surface or a finer level.
   uint32_t started_from_input;
+  // When the level was admitted by measurement (issue 12 part 4: its up-front memory
+  // estimate fitted no offset voxel scale, so the offset stage counted its surface before
+  // allocating it): the peak bytes estimated from those counts, which fitted the memory
+  // budget. NaN otherwise.
+  double measured_estimate_bytes;
 } PleatLodStats;
 
 // Parameters of `pleat_offset_surface`. Get defaults from `pleat_offset_params_default()` and

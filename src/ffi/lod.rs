@@ -166,6 +166,11 @@ pub struct PleatLodStats {
     /// 1 when the level's loop started from the welded input (`PleatLodParams::start`; in a
     /// chain only the finest level can), 0 when from the offset surface or a finer level.
     pub started_from_input: u32,
+    /// When the level was admitted by measurement (issue 12 part 4: its up-front memory
+    /// estimate fitted no offset voxel scale, so the offset stage counted its surface before
+    /// allocating it): the peak bytes estimated from those counts, which fitted the memory
+    /// budget. NaN otherwise.
+    pub measured_estimate_bytes: f64,
 }
 
 /// The defaults, with `struct_size = sizeof(PleatLodParams)`.
@@ -377,6 +382,7 @@ pub(super) mod imp {
             clearance_required: s.clearance.map_or(f64::NAN, |c| c.required),
             clearance_kept: s.clearance.is_some_and(|c| c.kept) as u32,
             started_from_input: s.started_from_input as u32,
+            measured_estimate_bytes: s.measured_estimate_bytes.unwrap_or(f64::NAN),
         }
     }
 }

@@ -345,18 +345,39 @@ fn cube_edge_key(g: [u32; 3], e: usize) -> u64 {
     )
 }
 
+/// What pass 1 of the extraction counts before anything proportional to the surface is
+/// allocated (pass 1 holds 8 B per crossed edge and per mixed cube): the figures the offset
+/// stage's measured admission (`offset::Admit`) decides from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Crossings {
+    /// Cubes with corners on both sides of the iso-value (over the whole band, buried
+    /// components included: interior removal comes later).
+    pub mixed_cubes: u64,
+    /// Crossed grid edges, i.e. iso-points.
+    pub iso_points: u64,
+    /// Bytes of the distance grid, alive until the iso-points are computed.
+    pub grid_bytes: u64,
+}
+
 /// Runs the extraction, consuming the grid (it is dropped as soon as the iso-points are
-/// known: pass 2 works from the decisions recorded in pass 1). `keep_going(fraction)` is
-/// called on this thread between chunks.
+/// known: pass 2 works from the decisions recorded in pass 1). After pass 1, `admit` is told
+/// the [`Crossings`]; its `Err` ends the extraction there, before the iso-points, normals and
+/// patches are allocated. `keep_going(fraction)` is called on this thread between chunks.
 pub(crate) fn extract(
     grid: DistanceGrid,
     input: &InputDistance,
     p: &ExtractParams,
+    admit: &mut dyn FnMut(Crossings) -> Result<()>,
     keep_going: &mut dyn FnMut(f64) -> bool,
 ) -> Result<PatchSet> {
     let mut counts = ExtractCounts::default();
     let chunk = 512;
     let (keys, mixed) = crossed_edges(&grid, p.d, chunk, &mut counts, keep_going)?;
+    admit(Crossings {
+        mixed_cubes: counts.mixed,
+        iso_points: keys.len() as u64,
+        grid_bytes: grid.memory_bytes(),
+    })?;
     // Iso-points and their normals (eq. 4.3).
     let (iso_pos, iso): (Vec<Vec3>, Vec<IsoNormal>) = keys
         .par_iter()

@@ -18,7 +18,7 @@ use super::distance::{
     band_bricks, band_radius, estimate_bricks, evaluate_band, BandParams, DistanceGrid, GridSpec,
     InputDistance, BRICK_BYTES,
 };
-use super::extract::{deviation, extract, ExtractParams, Mode, PatchSet};
+use super::extract::{deviation, extract, Crossings, ExtractParams, Mode, PatchSet};
 use super::filter::vertices_on_real_curves;
 use super::flips::{flip_to_features, FlipCounts};
 use super::interior::{visible_components, ComponentBox};
@@ -150,6 +150,50 @@ pub fn offset_surface_with_progress(
     params: &OffsetParams,
     progress: &mut ProgressFn<'_>,
 ) -> Result<(TriMesh, OffsetReport)> {
+    offset_surface_admitted(mesh, params, &mut |_| Ok(()), progress)
+}
+
+/// What the offset stage has counted when it asks its measured admission ([`Admit`]), each
+/// before the allocations that grow with it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum OffsetCount {
+    /// After the extraction's first pass, beside the distance grid: before the iso-points,
+    /// their normals and the patch set.
+    Crossings(Crossings),
+    /// After the extraction (the grid dropped), before the interior removal's winding-number
+    /// hierarchies (one alive at a time, `interior`): the mixed cubes (the patch set's size)
+    /// and the template triangles of the largest component (the largest hierarchy).
+    Components {
+        /// Mixed cubes of the extraction.
+        mixed_cubes: u64,
+        /// Template triangles of the component with the most.
+        largest_component_faces: u64,
+    },
+    /// After the interior removal, before the feature phases assemble the visible surface.
+    Visible {
+        /// Mixed cubes of the extraction.
+        mixed_cubes: u64,
+        /// Template triangles of the visible components.
+        visible_faces: u64,
+    },
+}
+
+/// A measured admission of the offset stage (issue 12 part 4), called with each
+/// [`OffsetCount`] in turn: once the band's distances are known and the extraction's first
+/// pass has counted the surface's [`Crossings`], then before the interior removal and before
+/// the feature phases. Its `Err` (e.g. `LimitExceeded` naming the measured figure) ends the
+/// stage there, before the allocation the count predicts; `Ok` continues with what is already
+/// computed (the grid, the patch set): nothing is recomputed.
+pub(crate) type Admit<'a> = dyn FnMut(OffsetCount) -> Result<()> + 'a;
+
+/// [`offset_surface_with_progress`] with a measured admission `admit` (see [`Admit`]): the
+/// same output whenever `admit` returns `Ok`.
+pub(crate) fn offset_surface_admitted(
+    mesh: &TriMesh,
+    params: &OffsetParams,
+    admit: &mut Admit<'_>,
+    progress: &mut ProgressFn<'_>,
+) -> Result<(TriMesh, OffsetReport)> {
     let r = params.resolve(mesh)?;
     let mut stats = OffsetReport {
         d: r.d,
@@ -175,12 +219,18 @@ pub fn offset_surface_with_progress(
     };
     let t = Instant::now();
     let grid_bytes = grid.memory_bytes();
-    let set = extract(grid, &input, &xp, &mut |f| {
-        progress(Progress {
-            stage: "extract",
-            fraction: 0.5 + 0.28 * f,
-        })
-    })?;
+    let set = extract(
+        grid,
+        &input,
+        &xp,
+        &mut |c| admit(OffsetCount::Crossings(c)),
+        &mut |f| {
+            progress(Progress {
+                stage: "extract",
+                fraction: 0.5 + 0.28 * f,
+            })
+        },
+    )?;
     stats
         .stages
         .push(OffsetStage::Extract, t.elapsed().as_secs_f64());
@@ -193,7 +243,7 @@ pub fn offset_surface_with_progress(
     step(progress, "interior", 0.8)?;
     let visible = if params.remove_interior {
         let t = Instant::now();
-        let v = visible_patches(&set, &mut stats);
+        let v = visible_patches(&set, admit, &mut stats)?;
         stats
             .stages
             .push(OffsetStage::Interior, t.elapsed().as_secs_f64());
@@ -201,6 +251,13 @@ pub fn offset_surface_with_progress(
     } else {
         vec![true; set.len()]
     };
+    admit(OffsetCount::Visible {
+        mixed_cubes: set.counts.mixed,
+        visible_faces: (0..set.len())
+            .filter(|&p| visible[p])
+            .map(|p| template_faces(&set, p))
+            .sum(),
+    })?;
     step(progress, "features", 0.85)?;
     let (pos, tris) = surface_with_features(&set, &visible, params, r.h, &mut stats)?;
     if tris.is_empty() {
@@ -233,9 +290,20 @@ fn step(progress: &mut ProgressFn<'_>, stage: &str, fraction: f64) -> Result<()>
     }
 }
 
+/// The distance band's area-based size estimate in bytes for `mesh` at offset distance `d`
+/// and voxel edge `h`: the figure [`offset_surface`] compares with its budget before any work.
+pub(crate) fn band_estimate_bytes(mesh: &TriMesh, d: f64, h: f64) -> f64 {
+    let band = BandParams {
+        d,
+        h,
+        memory_budget: u64::MAX,
+    };
+    estimate_bricks(mesh, &band) * BRICK_BYTES as f64
+}
+
 /// Rejects, before any work, bands whose area-based size estimate exceeds the budget.
 fn check_budget_estimate(mesh: &TriMesh, band: &BandParams) -> Result<()> {
-    let estimate = estimate_bricks(mesh, band) * BRICK_BYTES as f64;
+    let estimate = band_estimate_bytes(mesh, band.d, band.h);
     if estimate > band.memory_budget as f64 {
         return Err(Error::LimitExceeded(format!(
             "the distance band is estimated at {:.0} MiB, over the memory budget of {} MiB; \
@@ -410,11 +478,16 @@ fn mesh_bytes(nv: usize, nt: usize) -> u64 {
 }
 
 /// Interior removal (Algorithm 1, line 13) on the MC33 template surface, before the feature
-/// phase: per patch, whether its component is visible (not inside another component).
+/// phase: per patch, whether its component is visible (not inside another component). Asks
+/// `admit` with [`OffsetCount::Components`] before the first hierarchy is built.
 /// Feature vertices and flips change the surface only inside each patch's polyhedron and each
 /// flip's tetrahedron, which no other component enters, so neither components nor
 /// containment change afterwards — and invisible components cost no feature work.
-fn visible_patches(set: &PatchSet, stats: &mut OffsetReport) -> Vec<bool> {
+fn visible_patches(
+    set: &PatchSet,
+    admit: &mut Admit<'_>,
+    stats: &mut OffsetReport,
+) -> Result<Vec<bool>> {
     let (pcomp, n) = set.patch_components();
     let mut counts = InteriorCounts {
         components: n as u64,
@@ -422,8 +495,17 @@ fn visible_patches(set: &PatchSet, stats: &mut OffsetReport) -> Vec<bool> {
     };
     if n <= 1 {
         stats.interior = Some(counts);
-        return vec![true; set.len()];
+        return Ok(vec![true; set.len()]);
     }
+    let mut faces_of = vec![0u64; n];
+    for (p, &c) in pcomp.iter().enumerate() {
+        faces_of[c as usize] += template_faces(set, p);
+    }
+    admit(OffsetCount::Components {
+        mixed_cubes: set.counts.mixed,
+        largest_component_faces: faces_of.iter().copied().max().unwrap_or(0),
+    })?;
+    drop(faces_of);
     let mut boxes = vec![ComponentBox::empty(crate::geom::Vec3::ZERO); n];
     let mut patches_of: Vec<Vec<u32>> = vec![Vec::new(); n];
     for (p, &c) in pcomp.iter().enumerate() {
@@ -446,7 +528,13 @@ fn visible_patches(set: &PatchSet, stats: &mut OffsetReport) -> Vec<bool> {
     let keep = visible_components(&set.positions, &boxes, &triangles);
     counts.components_removed = keep.iter().filter(|&&k| !k).count() as u64;
     stats.interior = Some(counts);
-    pcomp.iter().map(|&c| keep[c as usize]).collect()
+    Ok(pcomp.iter().map(|&c| keep[c as usize]).collect())
+}
+
+/// Template triangles of patch `p` (what the interior removal's hierarchies and the feature
+/// phases' first assembly hold of it).
+fn template_faces(set: &PatchSet, p: usize) -> u64 {
+    (set.plain_off[p + 1] - set.plain_off[p]) as u64
 }
 
 /// Independent checks of the output ([`MeshReport`], code independent of this stage):

@@ -14,7 +14,9 @@ use super::fit::{fit_to_input, FitReport};
 use super::flow::flow_sweep;
 use super::guard::{Guard, InputModel};
 use super::measure::{self, Surface};
-use super::offset::{offset_surface_with_progress, OffsetDistance, OffsetParams};
+use super::offset::{
+    band_estimate_bytes, offset_surface_admitted, Admit, OffsetCount, OffsetDistance, OffsetParams,
+};
 use super::report::{
     ClearanceMeasure, FloorMeasure, GuardCounts, LodReport, LodStage, SimplifyCounts,
 };
@@ -97,7 +99,12 @@ pub struct LodParams {
     /// starts. A LOD takes the finest voxel of [`LOD_VOXEL_SCALES`] whose estimate fits, from
     /// the one its screen size starts from on (see [`LOD_VOXEL_SCALE`]; reported as
     /// [`LodReport::offset_voxel_scale`]); beyond the coarsest (cages: beyond scale 1) it fails
-    /// with `Error::LimitExceeded` before any large allocation.
+    /// with `Error::LimitExceeded` before any large allocation — except a LOD from the offset
+    /// whose input structures and distance band fit: the offset stage then counts its surface
+    /// before allocating it and the budget is checked against the peak estimated from those
+    /// counts (the measured admission, issue 12 part 4: a soup of overlapping pieces, whose
+    /// up-front estimate counts every piece's offset whole), refusing with `LimitExceeded` before
+    /// the allocation that would exceed it ([`LodReport::measured_estimate_bytes`]).
     pub memory_budget_bytes: u64,
     /// Run the feature-alignment step (Alg. 6). Default true.
     pub align: bool,
@@ -238,8 +245,32 @@ pub const LOD_COARSE_VOXEL_MIN_SCREEN_SIZE: f64 = 200.0;
 /// and no rebuild workspace), the beetle peaks at 502 MiB allocated (first pass; VmHWM 533 MiB),
 /// 333 B per estimated face, the offset stage's interior removal at 424 MiB (281 B), and
 /// dirty_truck (5.34 M estimated faces) at 1469 MiB (first pass; 288 B). 400 B bounds the
-/// beetle's with a 20% margin (formerly 1100, 900, then 780 B).
+/// beetle's with a 20% margin (formerly 1100, 900, then 780 B). The measured admission
+/// ([`measured_start`]) applies it to the real offset faces: 241 B per real face on the beetle,
+/// 235 B on the truck, 232 B on dirty_synth_soup_s1 (913 MiB first pass, 4.13 M faces,
+/// 2026-11-29).
 const BYTES_PER_WORK_FACE: f64 = 400.0;
+/// Peak bytes per mixed cube (a cube of the distance grid the iso-surface crosses, counted by
+/// the extraction's first pass over the whole band, buried components included) of the
+/// offset stage after that pass: the extraction's iso-points, normals, edge keys and packed
+/// cubes beside the distance grid, then the patch set, alive through the interior removal and
+/// the feature phases. Used only by the measured admission ([`measured_start`]). Measured
+/// 2026-11-29 (issue 12 part 4, counting allocator, n_p = 1000, scale 2): the extraction
+/// peaks at 105 B per mixed cube over the grid on dirty_synth_soup_s1 (7.52 M cubes), 78 B on
+/// dirty_beetle (1.09 M), 91 B on dirty_teapot (1.68 M), 99 B on dirty_synth_holes_s1
+/// (2.20 M); the patch set alive after it is 108, 95, 110 and 117 B. 130 B bounds them
+/// (with [`BYTES_PER_SURFACE_FACE`], the feature phases' estimate is 23–39% over their
+/// measured peak on these four).
+const BYTES_PER_MIXED_CUBE: f64 = 130.0;
+/// Peak bytes per template triangle of the offset stage beside its patch set
+/// ([`BYTES_PER_MIXED_CUBE`]): the interior removal's winding-number hierarchy (one component
+/// at a time, counted on the largest) and the feature phases' assembled and half-edge meshes
+/// (counted on the visible components). Used only by the measured admission. Measured
+/// 2026-11-29 (as above): the feature phases at 149 B per visible offset face on
+/// dirty_synth_soup_s1 (4.13 M) and dirty_beetle (2.18 M), 135 B on dirty_teapot (3.27 M),
+/// 144 B on dirty_synth_holes_s1 (4.40 M); the interior removal at 154 B per face of the
+/// outer sheet on the beetle, 115 B on the teapot; 200 B bounds them with a 30% margin.
+const BYTES_PER_SURFACE_FACE: f64 = 200.0;
 /// Peak bytes per input sample of the input-plane fit's coverage check (`coverage.rs`: the
 /// input sampled at `SPACING · d`, a budget and a box per sample, the tree over them), which
 /// grows like `n_p²` and does not depend on the offset voxel. Measured 2026-11-27:
@@ -358,7 +389,10 @@ impl LodParams {
         // The cheap estimates only: a request that fits neither start is refused before the
         // clean-input check (a self-intersection pass) runs; which start is taken, and so which
         // estimate binds, is known only after it (`run`, `choose_start`).
-        if self.offset_voxel_scale(input, Mode::Lod).is_none() && !self.input_start_may_fit(input) {
+        if self.offset_voxel_scale(input, Mode::Lod).is_none()
+            && !self.input_start_may_fit(input)
+            && !self.measured_admission_may_fit(input)
+        {
             return Err(self.offset_over_budget(input, None));
         }
         Ok(())
@@ -415,8 +449,11 @@ impl LodParams {
 
     /// The offset voxel scale a LOD of `input` with these parameters starts from (see the
     /// field `offset_voxel_scale` and [`LOD_VOXEL_SCALES`]), or `None`
-    /// when even the coarsest scale's estimate exceeds the budget (then `validate` refuses).
-    /// The same choice `generate` makes; for benchmarks and tools.
+    /// when even the coarsest scale's up-front estimate exceeds the budget: then the bake
+    /// starts from the input if it may, else the measured admission decides during the bake
+    /// (its scale is [`LodReport::offset_voxel_scale`], its estimate
+    /// [`LodReport::measured_estimate_bytes`]), else `validate` refuses. The same choice
+    /// `generate` makes; for benchmarks and tools.
     pub fn lod_voxel_scale(&self, input: &TriMesh) -> Option<f64> {
         self.offset_voxel_scale(input, Mode::Lod)
     }
@@ -465,6 +502,15 @@ impl LodParams {
         let ext: Vec<f64> = (0..3).map(|k| hi[k] - lo[k] + 2.0 * d).collect();
         let box_area = 2.0 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[0] * ext[2]);
         let faces = 2.0 * area.min(8.0 * box_area) / (h * h);
+        self.peak_from_start_faces(input, d, faces)
+    }
+
+    /// The input structures plus the larger of the loop's term, [`BYTES_PER_WORK_FACE`] per
+    /// start-surface face, and (with `fit_to_input`) the fit's: its coverage samples at
+    /// [`BYTES_PER_FIT_SAMPLE`] plus [`BYTES_PER_FIT_WORK_FACE`] per start face. `faces` is the
+    /// up-front estimate ([`memory_estimate`](Self::memory_estimate)) or, on the measured
+    /// admission's path, the offset surface's real face count ([`measured_start`]).
+    fn peak_from_start_faces(&self, input: &TriMesh, d: f64, faces: f64) -> f64 {
         let fit = if self.fit_to_input {
             fit_samples(input, d) * BYTES_PER_FIT_SAMPLE + faces * BYTES_PER_FIT_WORK_FACE
         } else {
@@ -492,6 +538,106 @@ impl LodParams {
         };
         (faces * BYTES_PER_WORK_FACE).max(fit) + faces * BYTES_PER_INPUT_FACE
     }
+
+    /// The voxel scales the measured admission ([`measured_start`]) may try for a LOD of
+    /// `input` from the offset surface, finest first — the finest the screen size starts from
+    /// ([`finest_voxel_scale`]) and the coarser ones of [`LOD_VOXEL_SCALES`], as the up-front
+    /// rule — keeping those whose a-priori part fits the budget: the input's structures plus
+    /// the distance band's estimate at that scale (the offset stage's own check), and the
+    /// input's structures plus the fit's coverage samples (no offset face counted). Empty when
+    /// none does: then the bake is refused before any work.
+    fn measured_scales(&self, input: &TriMesh) -> Vec<f64> {
+        let budget = self.memory_budget_bytes as f64;
+        let d = input.bbox_diagonal() / self.screen_size;
+        if self.peak_from_start_faces(input, d, 0.0) > budget {
+            return Vec::new();
+        }
+        let input_bytes = input.triangle_count() as f64 * BYTES_PER_INPUT_FACE;
+        let finest = finest_voxel_scale(Mode::Lod, self.screen_size, self.offset_voxel_scale);
+        std::iter::once(finest)
+            .chain(LOD_VOXEL_SCALES.iter().copied().filter(|&s| s > finest))
+            .filter(|&s| input_bytes + band_estimate_bytes(input, d, s * d / 3f64.sqrt()) <= budget)
+            .collect()
+    }
+
+    /// Whether a LOD of `input` from the offset surface is decided by the measured admission
+    /// ([`measured_start`]): the up-front estimate fits no voxel scale (so no bake admitted up
+    /// front changes), but some scale's a-priori part does ([`measured_scales`](Self::measured_scales)).
+    fn measured_admission_may_fit(&self, input: &TriMesh) -> bool {
+        self.offset_voxel_scale(input, Mode::Lod).is_none()
+            && !self.measured_scales(input).is_empty()
+    }
+
+    /// The peak bytes a measurement `m` at voxel scale `s0` estimates for scale `s`, with
+    /// `shrink = (s0 / s)²` (band and surface counts ∝ 1/scale²: a prediction for a coarser
+    /// scale; 1 for the measured scale itself): the input's structures plus, in the offset
+    /// stage, [`BYTES_PER_MIXED_CUBE`] per mixed cube (the iso-points and the patch set) and
+    /// the distance grid while it lives, or [`BYTES_PER_SURFACE_FACE`] per template triangle of
+    /// the largest component (the interior removal's hierarchy) or of the visible ones (the
+    /// feature phases' meshes); on the finished offset surface, [`peak_from_start_faces`]
+    /// (Self::peak_from_start_faces) with its real face count (the loop's and the fit's peak).
+    fn measured_peak(&self, input: &TriMesh, d: f64, m: Measured, shrink: f64) -> f64 {
+        let input_bytes = input.triangle_count() as f64 * BYTES_PER_INPUT_FACE;
+        let surface = |cubes: u64, faces: u64| {
+            cubes as f64 * BYTES_PER_MIXED_CUBE + faces as f64 * BYTES_PER_SURFACE_FACE
+        };
+        match m {
+            Measured::Offset(OffsetCount::Crossings(c)) => {
+                input_bytes + shrink * (c.grid_bytes as f64 + surface(c.mixed_cubes, 0))
+            }
+            Measured::Offset(OffsetCount::Components {
+                mixed_cubes,
+                largest_component_faces,
+            }) => input_bytes + shrink * surface(mixed_cubes, largest_component_faces),
+            Measured::Offset(OffsetCount::Visible {
+                mixed_cubes,
+                visible_faces,
+            }) => input_bytes + shrink * surface(mixed_cubes, visible_faces),
+            Measured::StartFaces(f) => self.peak_from_start_faces(input, d, shrink * f as f64),
+        }
+    }
+
+    /// `LimitExceeded` naming what the measured admission counted at `scale` and the peak
+    /// `peak` it estimates from it.
+    fn measured_refusal(&self, m: Measured, scale: f64, peak: f64) -> Error {
+        let mib = |b: f64| b / (1u64 << 20) as f64;
+        let what = match m {
+            Measured::Offset(OffsetCount::Crossings(c)) => format!(
+                "{} surface cells ({} iso-points) in a {:.0} MiB distance band",
+                c.mixed_cubes,
+                c.iso_points,
+                mib(c.grid_bytes as f64)
+            ),
+            Measured::Offset(OffsetCount::Components {
+                mixed_cubes,
+                largest_component_faces,
+            }) => format!(
+                "{mixed_cubes} surface cells and {largest_component_faces} faces in its largest \
+                 component"
+            ),
+            Measured::Offset(OffsetCount::Visible {
+                mixed_cubes,
+                visible_faces,
+            }) => format!("{mixed_cubes} surface cells and {visible_faces} visible faces"),
+            Measured::StartFaces(f) => format!("{f} offset-surface faces"),
+        };
+        Error::LimitExceeded(format!(
+            "the offset surface at screen size {} (offset voxel {scale}× the default) measured \
+             {what}: the bake would need about {:.0} MiB but the memory budget is {:.0} MiB",
+            self.screen_size,
+            mib(peak),
+            mib(self.memory_budget_bytes as f64)
+        ))
+    }
+}
+
+/// What the measured admission ([`measured_start`]) counted at one voxel scale.
+#[derive(Debug, Clone, Copy)]
+enum Measured {
+    /// A count of the offset stage, before the allocation it predicts.
+    Offset(OffsetCount),
+    /// The finished offset surface's faces, before the loop: the loop's and the fit's peak.
+    StartFaces(u64),
 }
 
 /// Largest coordinate magnitude a bake computes with, input and offset box (`2^128`, the
@@ -888,7 +1034,8 @@ pub(crate) fn run_chain(
 /// decides once the start is known).
 fn check_mode_budget(p: &LodParams, input: &TriMesh, mode: Mode) -> Result<()> {
     if p.offset_voxel_scale(input, mode).is_some()
-        || (mode == Mode::Lod && p.input_start_may_fit(input))
+        || (mode == Mode::Lod
+            && (p.input_start_may_fit(input) || p.measured_admission_may_fit(input)))
     {
         return Ok(());
     }
@@ -906,7 +1053,10 @@ fn check_mode_budget(p: &LodParams, input: &TriMesh, mode: Mode) -> Result<()> {
 /// [`LodParams::offset_voxel_scale`] gives whatever the start, so outputs from the offset are
 /// those of the budget rule before the input start was estimated on its own.
 fn check_offset_budget(p: &LodParams, input: &TriMesh, mode: Mode, from_input: bool) -> Result<()> {
-    if from_input || p.offset_voxel_scale(input, mode).is_some() {
+    if from_input
+        || p.offset_voxel_scale(input, mode).is_some()
+        || (mode == Mode::Lod && p.measured_admission_may_fit(input))
+    {
         return Ok(());
     }
     let why = match p.start {
@@ -966,10 +1116,18 @@ fn bake_level(
     let (start, slack) = match finer {
         Some(m) => (m.clone(), d),
         None => {
-            let scale = params
-                .offset_voxel_scale(level.input, mode)
-                .ok_or_else(|| Error::LimitExceeded("over the memory budget".into()))?;
-            let (m, dev) = initial_surface(level, params, d, scale, rep)?;
+            let (m, dev, scale) = match params.offset_voxel_scale(level.input, mode) {
+                Some(scale) => {
+                    let (m, dev) = initial_surface(level, params, d, scale, &mut |_| Ok(()), rep)?;
+                    (m, dev, scale)
+                }
+                None if mode == Mode::Lod => {
+                    let (m, dev, scale, peak) = measured_start(level, params, d, rep)?;
+                    stats.measured_estimate_bytes = Some(peak);
+                    (m, dev, scale)
+                }
+                None => return Err(Error::LimitExceeded("over the memory budget".into())),
+            };
             stats.offset_max_deviation_over_d = dev;
             stats.offset_voxel_scale = (scale != 1.0).then_some(scale);
             (m, 0.0)
@@ -1364,6 +1522,74 @@ fn round_start<'s>(i: u32, start: &'s TriMesh, g: &Guard<'_>) -> Cow<'s, TriMesh
     }
 }
 
+/// The offset start of a LOD whose up-front estimate ([`LodParams::memory_estimate`]) fits no
+/// voxel scale, admitted by measurement (issue 12 part 4): the up-front estimate counts every
+/// soup piece's offset whole (`2 · area / h²`), where overlapping and buried pieces leave far
+/// less after the interior removal. For each scale of [`LodParams::measured_scales`], finest
+/// first, the offset stage runs its band and distance step and the extraction's first pass;
+/// from the mixed cubes counted there the offset stage's peak is estimated
+/// ([`LodParams::measured_peak`]) and the stage refused (`LimitExceeded` naming the count)
+/// before it allocates the surface, else it continues on the grid already computed; the
+/// finished surface's real face count then estimates the loop's and the fit's peak, refused
+/// before the loop allocates. A refused scale predicts the coarser ones (counts ∝ 1/scale²):
+/// those predicted over the budget are skipped, the next is measured. Returns the surface,
+/// its deviation (as [`initial_surface`]), the scale and the larger of the two measured
+/// estimates. Deterministic: the counts do not depend on the thread count.
+fn measured_start(
+    level: &Level<'_>,
+    params: &LodParams,
+    d: f64,
+    rep: &mut Reporter<'_, '_>,
+) -> Result<(TriMesh, Option<f64>, f64, f64)> {
+    let input = level.input;
+    let budget = params.memory_budget_bytes as f64;
+    let mut refused: Option<(f64, Measured)> = None;
+    let mut error: Option<Error> = None;
+    for scale in params.measured_scales(input) {
+        if let Some((s0, m)) = refused {
+            if params.measured_peak(input, d, m, (s0 / scale).powi(2)) > budget {
+                continue;
+            }
+        }
+        // the offset stage's largest measured estimate, and the last count (refused or not)
+        let mut offset_stage: Option<(Measured, f64)> = None;
+        let result = {
+            let mut admit = |c: OffsetCount| {
+                let m = Measured::Offset(c);
+                let peak = params.measured_peak(input, d, m, 1.0);
+                let largest = offset_stage.map_or(0.0, |(_, p)| p).max(peak);
+                offset_stage = Some((m, largest));
+                if peak > budget {
+                    Err(params.measured_refusal(m, scale, peak))
+                } else {
+                    Ok(())
+                }
+            };
+            initial_surface(level, params, d, scale, &mut admit, rep)
+        };
+        match result {
+            Ok((mesh, dev)) => {
+                let m = Measured::StartFaces(mesh.triangle_count() as u64);
+                let peak = params.measured_peak(input, d, m, 1.0);
+                if peak <= budget {
+                    let offset_peak = offset_stage.map_or(0.0, |(_, p)| p);
+                    return Ok((mesh, dev, scale, peak.max(offset_peak)));
+                }
+                refused = Some((scale, m));
+                error = Some(params.measured_refusal(m, scale, peak));
+            }
+            Err(Error::LimitExceeded(msg)) => {
+                if let Some((m, _)) = offset_stage.filter(|&(_, p)| p > budget) {
+                    refused = Some((scale, m));
+                }
+                error = Some(Error::LimitExceeded(msg));
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    Err(error.unwrap_or_else(|| params.offset_over_budget(input, None)))
+}
+
 /// The start surface `M_d`: the offset surface of stage 1 (§4.3.1) at distance `d`, which is
 /// watertight, manifold and intersection-free, and encloses the input at distance about `d`,
 /// with its largest vertex deviation over `d` (cages only: a LOD's offset is not verified,
@@ -1374,6 +1600,7 @@ fn initial_surface(
     params: &LodParams,
     d: f64,
     voxel_scale: f64,
+    admit: &mut Admit<'_>,
     rep: &mut Reporter<'_, '_>,
 ) -> Result<(TriMesh, Option<f64>)> {
     let op = OffsetParams {
@@ -1392,7 +1619,7 @@ fn initial_surface(
     };
     let (mesh, ostats) = {
         let mut prog = |p: Progress<'_>| rep.report(p.stage, p.fraction);
-        offset_surface_with_progress(level.input, &op, &mut prog)?
+        offset_surface_admitted(level.input, &op, admit, &mut prog)?
     };
     let v = &ostats.verified;
     let essential = [
@@ -1432,6 +1659,24 @@ mod tests {
         crate::lowpoly::guard::tests::cube(1.0, 0.0)
     }
 
+    /// A LOD whose up-front estimate fits no voxel scale: admitted by measurement with its
+    /// measured estimate within the budget, or `LimitExceeded`.
+    fn assert_measured_or_refused(m: &TriMesh, p: &LodParams) {
+        assert_eq!(p.offset_voxel_scale(m, Mode::Lod), None);
+        match run(m, p, Mode::Lod, &mut |_| true) {
+            Ok((lod, rep)) => {
+                let measured = rep.measured_estimate_bytes;
+                if !rep.started_from_input {
+                    assert!(measured.is_some_and(|b| b <= p.memory_budget_bytes as f64));
+                }
+                assert!(rep.verified.all_hold(), "{:?}", rep.verified);
+                assert!(lod.triangle_count() >= 4);
+            }
+            Err(Error::LimitExceeded(_)) => {}
+            Err(e) => panic!("{e}"),
+        }
+    }
+
     /// The budget decision honours the start taken (issue 12 part 4, 2026-11-28): a clean
     /// input whose offset fits no voxel scale still bakes from itself when its own estimate
     /// fits; forced to the offset, or as a cage, it is refused before any work; an input start
@@ -1462,19 +1707,32 @@ mod tests {
         assert!(lod.triangle_count() >= 4);
         let chain = run_chain(&m, &[10.0, 5.0], &p, Mode::Lod, &mut |_| true).unwrap();
         assert!(chain[0].1.started_from_input);
-        for (start, mode) in [(LodStart::Offset, Mode::Lod), (LodStart::Auto, Mode::Cage)] {
-            let q = LodParams { start, ..p.clone() };
-            assert!(matches!(
-                run(&m, &q, mode, &mut |_| true),
-                Err(Error::LimitExceeded(_))
-            ));
-        }
-        // below the input start's estimate too: refused by validate whatever the start
+        // as a cage: refused before any work
+        let cage = LodParams {
+            start: LodStart::Auto,
+            ..p.clone()
+        };
+        assert!(matches!(
+            run(&m, &cage, Mode::Cage, &mut |_| true),
+            Err(Error::LimitExceeded(_))
+        ));
+        // forced to the offset: the measured admission decides (2026-11-29)
+        let offset = LodParams {
+            start: LodStart::Offset,
+            ..p.clone()
+        };
+        assert_measured_or_refused(&m, &offset);
+        // below the input start's estimate too: refused by validate whatever the start, unless
+        // the measured admission may still take the offset
         let tight = LodParams {
             memory_budget_bytes: from_input as u64 - 1,
             ..auto.clone()
         };
-        assert!(matches!(tight.validate(&m), Err(Error::LimitExceeded(_))));
+        assert_eq!(
+            tight.validate(&m).is_ok(),
+            tight.measured_admission_may_fit(&m)
+        );
+        assert_measured_or_refused(&m, &tight);
         // an input start over the budget: `Input` is refused before the clean-input check
         let forced = LodParams {
             start: LodStart::Input,
@@ -1531,12 +1789,20 @@ mod tests {
             run(&m, &p, Mode::Cage, &mut |_| true),
             Err(Error::LimitExceeded(_))
         ));
-        // below the coarsest scale's estimate: refused by validate
+        // below the coarsest scale's estimate: the measured admission decides (2026-11-29);
+        // below what is known before any offset (the input's structures): refused by validate
         let tight = LodParams {
             memory_budget_bytes: base.memory_estimate(&m, 2.0) as u64 - 1,
             ..base.clone()
         };
-        assert!(matches!(tight.validate(&m), Err(Error::LimitExceeded(_))));
+        assert_eq!(tight.offset_voxel_scale(&m, Mode::Lod), None);
+        assert_measured_or_refused(&m, &tight);
+        let tiny = LodParams {
+            memory_budget_bytes: (m.triangle_count() as f64 * BYTES_PER_INPUT_FACE) as u64 - 1,
+            ..base.clone()
+        };
+        assert!(!tiny.measured_admission_may_fit(&m));
+        assert!(matches!(tiny.validate(&m), Err(Error::LimitExceeded(_))));
         // the default budget keeps the default voxel: 1 below the threshold, LOD_VOXEL_SCALE
         // from it on (cages: 1)
         let (_, rep) = run(&m, &base, Mode::Lod, &mut |_| true).unwrap();

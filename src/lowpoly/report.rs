@@ -174,6 +174,11 @@ pub struct LodReport {
     /// coarser scale of `lowpoly::LOD_VOXEL_SCALES` when the memory budget needs one; `None` for cages (always 1) and in a chain level started
     /// from the finer level.
     pub offset_voxel_scale: Option<f64>,
+    /// Set when the bake was admitted by measurement (issue 12 part 4): the up-front memory
+    /// estimate fitted no voxel scale, so the offset stage counted its surface before
+    /// allocating it and the budget was checked against the peak estimated from those counts
+    /// (the larger of the offset stage's and the loop's/fit's, in bytes). `None` otherwise.
+    pub measured_estimate_bytes: Option<f64>,
     /// Faces of the start surface (offset surface, the welded input, or the finer level in a
     /// chain).
     pub faces_offset: u64,
@@ -259,6 +264,9 @@ impl LodReport {
         }
         if let Some(s) = self.offset_voxel_scale {
             e.metric_entry("offset_voxel_scale", s);
+        }
+        if let Some(b) = self.measured_estimate_bytes {
+            e.metric_entry("measured_estimate_bytes", b);
         }
         e.count_entry("faces_offset", self.faces_offset);
         e.count_entry("started_from_input", self.started_from_input as u64);

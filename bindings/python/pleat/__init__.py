@@ -149,7 +149,8 @@ _LodStats = _struct("PleatLodStats", _u32s("struct_size", "rounds")
                     + _f64s("hausdorff_in_to_out_relative", "hausdorff_out_to_in_relative",
                             "hausdorff_floor_relative", "min_clearance",
                             "min_clearance_relative", "clearance_required")
-                    + _u32s("clearance_kept", "started_from_input"))
+                    + _u32s("clearance_kept", "started_from_input")
+                    + _f64s("measured_estimate_bytes"))
 _OffsetParams = _struct("PleatOffsetParams", _u32s("struct_size", "use_absolute_distance")
                         + _f64s("screen_size", "distance", "voxel_scale", "theta0_deg")
                         + _u32s("l0", "features", "remove_interior", "iso_refinement_steps")
