@@ -1800,7 +1800,8 @@ mod twisted_cylinder_check {
     }
 
     /// Measurements (report only): `PLEAT_CYL_TARGET` (default 720) vertices, curvature
-    /// method `PLEAT_CYL_KAPPA` (`normals` or `quadric`), `PLEAT_CYL_ITERS` SQP iterations.
+    /// method `PLEAT_CYL_KAPPA` (`normals` or `quadric`), `PLEAT_CYL_ITERS` SQP iterations,
+    /// thickness × `PLEAT_CYL_THICKNESS_SCALE` (default 1; issue 13's "thickness × 10⁻²").
     #[test]
     #[ignore]
     fn twisted_cylinder_measure() {
@@ -1815,7 +1816,9 @@ mod twisted_cylinder_check {
             "normals" => CurvatureMethod::VertexNormals,
             _ => CurvatureMethod::QuadricFit,
         };
-        let scene = Scene::twisted_cylinder_delaunay(target, 10.0, 1).unwrap();
+        let mut scene = Scene::twisted_cylinder_delaunay(target, 10.0, 1).unwrap();
+        let h_scale: f64 = env("PLEAT_CYL_THICKNESS_SCALE", "1").parse().unwrap();
+        scene.material.thickness *= h_scale;
         report(&scene, &params);
     }
 
