@@ -278,6 +278,9 @@ static void arrays_scene(void) {
     p = pleat_tfw_params_default();
     p.qp = 7;
     CHECK_STATUS(pleat_tfw_solve(s, &p, NULL, NULL, &r), PLEAT_STATUS_INVALID_ARGUMENT);
+    p = pleat_tfw_params_default();
+    p.snap_periods = 2; /* appended 2026-11-29: 0 or 1 */
+    CHECK_STATUS(pleat_tfw_solve(s, &p, NULL, NULL, &r), PLEAT_STATUS_INVALID_ARGUMENT);
     CHECK_STATUS(pleat_tfw_solve(NULL, NULL, NULL, NULL, &r), PLEAT_STATUS_INVALID_ARGUMENT);
     CHECK_STATUS(pleat_tfw_solve(s, NULL, NULL, NULL, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
     CHECK(r == NULL);
