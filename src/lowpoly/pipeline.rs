@@ -578,23 +578,22 @@ impl LodParams {
     /// (Self::peak_from_start_faces) with its real face count (the loop's and the fit's peak).
     fn measured_peak(&self, input: &TriMesh, d: f64, m: Measured, shrink: f64) -> f64 {
         let input_bytes = input.triangle_count() as f64 * BYTES_PER_INPUT_FACE;
-        let surface = |cubes: u64, faces: u64| {
-            cubes as f64 * BYTES_PER_MIXED_CUBE + faces as f64 * BYTES_PER_SURFACE_FACE
-        };
-        match m {
-            Measured::Offset(OffsetCount::Crossings(c)) => {
-                input_bytes + shrink * (c.grid_bytes as f64 + surface(c.mixed_cubes, 0))
-            }
+        let (grid, cubes, faces) = match m {
+            Measured::Offset(OffsetCount::Crossings(c)) => (c.grid_bytes, c.mixed_cubes, 0),
             Measured::Offset(OffsetCount::Components {
                 mixed_cubes,
-                largest_component_faces,
-            }) => input_bytes + shrink * surface(mixed_cubes, largest_component_faces),
-            Measured::Offset(OffsetCount::Visible {
+                largest_component_faces: faces,
+            })
+            | Measured::Offset(OffsetCount::Visible {
                 mixed_cubes,
-                visible_faces,
-            }) => input_bytes + shrink * surface(mixed_cubes, visible_faces),
-            Measured::StartFaces(f) => self.peak_from_start_faces(input, d, shrink * f as f64),
-        }
+                visible_faces: faces,
+            }) => (0, mixed_cubes, faces),
+            Measured::StartFaces(f) => {
+                return self.peak_from_start_faces(input, d, shrink * f as f64)
+            }
+        };
+        let surface = cubes as f64 * BYTES_PER_MIXED_CUBE + faces as f64 * BYTES_PER_SURFACE_FACE;
+        input_bytes + shrink * (grid as f64 + surface)
     }
 
     /// `LimitExceeded` naming what the measured admission counted at `scale` and the peak
