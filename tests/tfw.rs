@@ -1760,14 +1760,19 @@ mod twisted_cylinder_check {
         let sqp = r.sqp.as_ref().unwrap();
         let ring = mid_ring(&r, &model);
         let waves = mid_ring_waves(&r.cwf);
+        let every: usize = std::env::var("PLEAT_CYL_HISTORY").map_or(50, |v| v.parse().unwrap());
         for (k, it) in sqp.history.iter().enumerate() {
-            if k % 50 == 0 || k + 1 == sqp.history.len() {
+            if k % every == 0 || k + 1 == sqp.history.len() {
                 eprintln!(
-                    "  it {k}: E {:.6e}, r/r0 {:.2e}, step {:.2e}, t {:.2}, {:.1}s",
+                    "  it {k}: E {:.10e}, r/r0 {:.2e}, step {:.2e}, t {:.2}, shift {:.1e}, cg {}, \
+                     held {}, {:.1}s",
                     it.energy,
                     it.stationarity / sqp.initial_stationarity,
                     it.step_norm,
                     it.step_length,
+                    it.shift,
+                    it.cg_iterations,
+                    it.held,
                     it.seconds
                 );
             }
@@ -1811,6 +1816,11 @@ mod twisted_cylinder_check {
         let iters: usize = env("PLEAT_CYL_ITERS", "1000").parse().unwrap();
         let mut params = TfwParams::default();
         params.sqp.max_iterations = iters;
+        params.sqp.cg_refinement = crate::scene_speed::cg_refinement_from_env();
+        params.sqp.valley_search = crate::scene_speed::valley_search_from_env();
+        params.initial_amplitude = std::env::var("PLEAT_CYL_K")
+            .ok()
+            .map(|v| v.parse().unwrap());
         super::snap_from_env(&mut params);
         params.curvature = match env("PLEAT_CYL_KAPPA", "quadric").as_str() {
             "normals" => CurvatureMethod::VertexNormals,
@@ -1820,6 +1830,44 @@ mod twisted_cylinder_check {
         let h_scale: f64 = env("PLEAT_CYL_THICKNESS_SCALE", "1").parse().unwrap();
         scene.material.thickness *= h_scale;
         report(&scene, &params);
+    }
+
+    /// Issue 13's "thickness × 10⁻² (≈10× more waves on the cylinder; no loss of
+    /// convergence)" on a coarse irregular twisted cylinder (378 v; main before the valley
+    /// search: 1000 iterations, r/r₀ 2.4e-4, the same failure as at 690 and 1289 v): the SQP
+    /// meets an A.6.3 test within the default 1000 iterations, every iterate keeps curl ≤ 1e-10
+    /// and E non-increasing, a ≥ 0 at the end, and ω's period around the mid ring is ≈10× the
+    /// thick shell's 46 turns (λ ∝ h^½, the spec's uniform-patch optimum |ω|* ∝ √(κ/h)).
+    #[test]
+    fn thin_twisted_cylinder_converges() {
+        use pleat::tfw::TfwStatus;
+        let mut scene = Scene::twisted_cylinder_delaunay(400, 10.0, 1).unwrap();
+        scene.material.thickness *= 1e-2;
+        let mut params = TfwParams::default();
+        // the snapping reports ω's period around the ring (it runs after the SQP)
+        params.snap_periods = true;
+        let r = solve(&scene, &params, &mut no_progress()).unwrap();
+        let sqp = r.sqp.as_ref().unwrap();
+        assert!(sqp.status.converged(), "{:?}", sqp.status);
+        assert_eq!(r.status, TfwStatus::Converged);
+        assert!(sqp.history.len() < 1000);
+        let mut last = sqp.initial_energy;
+        for h in &sqp.history {
+            assert!(h.energy <= last, "E rose: {} > {last}", h.energy);
+            assert!(h.curl_residual <= 1e-10, "curl {}", h.curl_residual);
+            last = h.energy;
+        }
+        let nv = r.base.mesh.vertex_count();
+        assert!(sqp.x[..nv].iter().all(|&a| a >= 0.0));
+        let snap = r.snap.as_ref().unwrap();
+        assert_eq!(snap.loops.len(), 1, "one loop around the cylinder");
+        let turns = (snap.loops[0].before / std::f64::consts::TAU).abs();
+        eprintln!(
+            "thin cylinder: {:?} in {} it, ring period {turns:.1} turns",
+            sqp.status,
+            sqp.history.len()
+        );
+        assert!((345.0..=575.0).contains(&turns), "{turns} turns");
     }
 
     /// Issue 13's twisted cylinder (r 1 m, height 5 m, h 0.1 mm, ν 0.44, Y 10 MPa, 10°) on
@@ -2362,7 +2410,7 @@ mod solver_comparison {
 mod scene_speed {
     use super::*;
     use pleat::tfw::measure::{count_waves, Section};
-    use pleat::tfw::{solve, CgRefinement, QpMethod, TfwParams, TfwResult};
+    use pleat::tfw::{solve, CgRefinement, QpMethod, SqpOptions, TfwParams, TfwResult};
 
     struct Case {
         name: &'static str,
@@ -2591,7 +2639,13 @@ mod scene_speed {
     /// The measurement switch `PLEAT_TFW_SQP_CG=iterations[,radius[,tolerance[,after_full_step[,
     /// max_shift]]]]` (`0` = the projected step alone; radius 1e3, tolerance 1e-3, every step
     /// unless given); unset: the library's default [`CgRefinement::DEFAULT`].
-    fn cg_refinement_from_env() -> CgRefinement {
+    /// The measurement switch `PLEAT_TFW_VALLEY=0` turns the projected Newton's valley search
+    /// off; unset: the library's default.
+    pub(crate) fn valley_search_from_env() -> bool {
+        std::env::var("PLEAT_TFW_VALLEY").map_or(SqpOptions::default().valley_search, |v| v != "0")
+    }
+
+    pub(crate) fn cg_refinement_from_env() -> CgRefinement {
         let Ok(v) = std::env::var("PLEAT_TFW_SQP_CG") else {
             return CgRefinement::DEFAULT;
         };
@@ -2618,6 +2672,7 @@ mod scene_speed {
         params.sqp.qp = qp;
         params.sqp.snapshot_every = every;
         params.sqp.cg_refinement = cg_refinement_from_env();
+        params.sqp.valley_search = valley_search_from_env();
         if let Ok(n) = std::env::var("PLEAT_TFW_BASE_ITERS") {
             params.base.max_iterations = n.parse().unwrap();
         }
@@ -2707,7 +2762,7 @@ mod scene_speed {
         let total = fixed + sqp_s;
         eprintln!(
             "| {} | {} v | {qp:?} | {:.2} | {:.2} | {k} it / {sqp_s:.2} | {:.2} | {:.2} | {:.2} | \
-             {} | {waves} | {:.3} mm | {:?} {} it, {:.2} s |",
+             {} | {waves} | {:.3} mm | {:?} {} it, {:.2} s, E {:.9e} |",
             case.name,
             b.mesh.vertex_count(),
             r.seconds.base,
@@ -2723,7 +2778,8 @@ mod scene_speed {
             peak * 1e3,
             s.status,
             s.history.len(),
-            s.seconds
+            s.seconds,
+            s.history.last().map_or(s.initial_energy, |h| h.energy)
         );
     }
 

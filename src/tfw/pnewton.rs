@@ -29,6 +29,18 @@
 //! on the **exact** `Bᵀ H B` preconditioned by that factorization ([`CgRefinement`],
 //! 2026-11-27): the projected matrix alone made the cylinders converge linearly (r × 0.985–0.994
 //! per full step, 526 iterations; now 77, README "Tension-field wrinkles").
+//! **Valley search** (2026-11-29, issue 13's thin shell): after a full step with σ ≤
+//! [`CgRefinement::max_shift`] (the refinement's gate), `E` is minimized over the scalar `μ`
+//! along `(a, ω) → (a/μ, μω)` ([`SqpOptions::valley_search`]). The membrane term sees the
+//! wrinkles only through `½a²ωωᵀ` (eq. 2.21), stiff ∝ h, while the split between amplitude
+//! and frequency at fixed `a|ω|` is set by W_s² ∝ h a²κ² against W_b² ∝ h³ a²|ω|⁴ (the
+//! spec's uniform-patch optimum `|ω|* ∝ √(κ/h)`): a valley whose floor is ∝ h² flatter than
+//! its walls, traversed globally (the wave count around the cylinder) at a linear rate by the
+//! projected-and-refined steps (thickness × 10⁻²: r/r₀ 3e-4 after 1000 iterations, the ring
+//! period still climbing 349 → 451 turns at 3545). The scaling keeps `a ≥ 0` and
+//! `curl ω = 0`, costs a few energy evaluations, and moves that mode in one go: 13 / 14
+//! iterations there, 77 / 76 → 14 / 15 on the thick cylinders, the other scenes' answers
+//! unchanged (README "Thickness × 10⁻² on the twisted cylinder").
 //! `Bᵀ H B` keeps one sparsity pattern (held entries are stored as zeros), so faer's symbolic
 //! analysis is done once. Every iterate is `x = B y`, curl-free to rounding by construction.
 //! The stationarity residual is the projected gradient in `y` (`∇_y E`, with `min(g, 0)` for
@@ -615,6 +627,19 @@ fn run(
             status = SqpStatus::LineSearchFailed;
             break;
         };
+        // the valley search near the optimum only (the refinement's gate: a full step at
+        // σ ≤ max_shift); from every full step it led the sheared rectangle and the torus to
+        // stationary points of higher energy (README "Thickness × 10⁻²")
+        let near = t >= 1.0 && state.shift <= cg.max_shift;
+        let (yn, xn, en) = if options.valley_search && near {
+            valley_search(&yn, xn, en, na, &|y| {
+                let xc = scatter(y);
+                let ec = e.energy(&xc, WfTerms::ALL);
+                (xc, ec)
+            })
+        } else {
+            (yn, xn, en)
+        };
         let (step_norm, scaled_step) = step_sizes(problem, &shape, &x, &xn);
         let de = eval.energy - en;
         y = yn;
@@ -677,6 +702,54 @@ fn next_shift(shift: f64, t: f64) -> f64 {
     } else {
         (shift * 4.0).min(1e2)
     }
+}
+
+/// The valley search (module docs, the uniform-patch balance of the spec's derived test):
+/// `E` along `y(s) = (e^{−s} a, e^{s} u, e^{s} c)` (every
+/// amplitude divided and ω multiplied by `μ = e^s`, so `a|ω|` and with it the membrane
+/// strain `½a²ωωᵀ` of eq. 2.21 stay put while the curvature and bending terms W_s², W_b²,
+/// which set the wavelength, change), minimized by at most four parabola steps through
+/// `s ∈ {−ε, 0, ε}` around the current best. Keeps `a ≥ 0` and `curl ω = 0` (a scaling of
+/// both), returns `(y, x, E)` with `E` never above `energy`.
+fn valley_search(
+    y: &[f64],
+    x: Vec<f64>,
+    energy: f64,
+    na: usize,
+    energy_at: &dyn Fn(&[f64]) -> (Vec<f64>, f64),
+) -> (Vec<f64>, Vec<f64>, f64) {
+    const EPS: f64 = 1e-3;
+    let sample = |s: f64| -> (f64, Vec<f64>, Vec<f64>, f64) {
+        let (down, up) = ((-s).exp(), s.exp());
+        let ys: Vec<f64> = y
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| if i < na { v * down } else { v * up })
+            .collect();
+        let (xs, es) = energy_at(&ys);
+        (s, ys, xs, es)
+    };
+    let mut best = (0.0, y.to_vec(), x, energy);
+    for _ in 0..4 {
+        let c = best.0;
+        let (l, r) = (sample(c - EPS), sample(c + EPS));
+        let curvature = (l.3 + r.3 - 2.0 * best.3) / (EPS * EPS);
+        let slope = (r.3 - l.3) / (2.0 * EPS);
+        let mut candidates = vec![l, r];
+        if curvature > 0.0 {
+            candidates.push(sample(c + (-slope / curvature).clamp(-0.5, 0.5)));
+        }
+        let before = best.3;
+        for cand in candidates {
+            if cand.3 < best.3 {
+                best = cand;
+            }
+        }
+        if best.3 >= before {
+            break;
+        }
+    }
+    (best.1, best.2, best.3)
 }
 
 /// Steihaug–Toint CG on `h` (exact reduced Hessian, lower triangle) with the right-hand side
