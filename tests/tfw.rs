@@ -1806,7 +1806,9 @@ mod twisted_cylinder_check {
 
     /// Measurements (report only): `PLEAT_CYL_TARGET` (default 720) vertices, curvature
     /// method `PLEAT_CYL_KAPPA` (`normals` or `quadric`), `PLEAT_CYL_ITERS` SQP iterations,
-    /// thickness × `PLEAT_CYL_THICKNESS_SCALE` (default 1; issue 13's "thickness × 10⁻²").
+    /// thickness × `PLEAT_CYL_THICKNESS_SCALE` (default 1; issue 13's "thickness × 10⁻²"),
+    /// initial amplitude `PLEAT_CYL_K` (m), only the stationarity test at `PLEAT_CYL_RTOL`,
+    /// every `PLEAT_CYL_HISTORY`-th SQP iteration printed (default 50).
     #[test]
     #[ignore]
     fn twisted_cylinder_measure() {
@@ -1818,6 +1820,11 @@ mod twisted_cylinder_check {
         params.sqp.max_iterations = iters;
         params.sqp.cg_refinement = crate::scene_speed::cg_refinement_from_env();
         params.sqp.valley_search = crate::scene_speed::valley_search_from_env();
+        if let Ok(v) = std::env::var("PLEAT_CYL_RTOL") {
+            params.sqp.stationarity_tolerance = v.parse().unwrap();
+            params.sqp.energy_tolerance = 0.0;
+            params.sqp.step_tolerance = 0.0;
+        }
         params.initial_amplitude = std::env::var("PLEAT_CYL_K")
             .ok()
             .map(|v| v.parse().unwrap());
@@ -1843,9 +1850,11 @@ mod twisted_cylinder_check {
         use pleat::tfw::TfwStatus;
         let mut scene = Scene::twisted_cylinder_delaunay(400, 10.0, 1).unwrap();
         scene.material.thickness *= 1e-2;
-        let mut params = TfwParams::default();
         // the snapping reports ω's period around the ring (it runs after the SQP)
-        params.snap_periods = true;
+        let params = TfwParams {
+            snap_periods: true,
+            ..TfwParams::default()
+        };
         let r = solve(&scene, &params, &mut no_progress()).unwrap();
         let sqp = r.sqp.as_ref().unwrap();
         assert!(sqp.status.converged(), "{:?}", sqp.status);

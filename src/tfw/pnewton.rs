@@ -65,6 +65,9 @@ const NONE: usize = usize::MAX;
 /// Hessian entries `(row, col, value)`, `row ≥ col`, as [`WfEval::hessian`].
 type HessianEntries = Vec<(usize, usize, f64)>;
 
+/// `y ↦ (x, E(x))` with `x` the full `[a | ω]` of the reduced unknowns `y`.
+type EnergyOfY<'a> = dyn Fn(&[f64]) -> (Vec<f64>, f64) + 'a;
+
 /// The map `x_free = B y` from the reduced unknowns `y = (a_free, u, c)` to the free unknowns
 /// of an [`SqpProblem`] (module docs).
 #[derive(Debug, Clone)]
@@ -716,7 +719,7 @@ fn valley_search(
     x: Vec<f64>,
     energy: f64,
     na: usize,
-    energy_at: &dyn Fn(&[f64]) -> (Vec<f64>, f64),
+    energy_at: &EnergyOfY<'_>,
 ) -> (Vec<f64>, Vec<f64>, f64) {
     const EPS: f64 = 1e-3;
     let sample = |s: f64| -> (f64, Vec<f64>, Vec<f64>, f64) {
