@@ -30,7 +30,9 @@
 //! - [`sqp`]: the wrinkle SQP of A.6.3 (clarabel QP per iteration, `a ≥ 0`, `curl ω = 0` off W,
 //!   convexified Hessian, Armijo line search, termination tests, per-iteration history);
 //!   [`pnewton`]: the same SQP with the curl eliminated, projected Newton steps
-//!   ([`QpMethod::ProjectedNewton`]).
+//!   ([`QpMethod::ProjectedNewton`]), refined on the exact Hessian and followed by a search
+//!   along the amplitude ↔ frequency valley `(a, ω) → (a/μ, μω)` near the optimum (the
+//!   thin-shell case: thickness × 10⁻² converges in 13 / 14 iterations).
 //! - [`pipeline`]: [`solve`] — scene → base → W, init → SQP → period snapping →
 //!   [`crate::wrinkle::Cwf`] (Knöppel phase), with a report; the wrinkled mesh comes from [`crate::wrinkle::Cwf::evaluate`]
 //!   with [`crate::wrinkle::EvalOptions::in_plane_v2`] (the v2 term of eq. 2.19).
