@@ -27,7 +27,7 @@ use rayon::prelude::*;
 use crate::geom::{normalized, tri_normal, Vec3};
 use crate::mesh::halfedge::{HalfEdgeMesh, VertexId};
 use crate::spatial::closest::point_triangle_distance;
-use crate::spatial::{cube_meets, CubeTree, TriangleBvh};
+use crate::spatial::{cube_meets, sort_in_tree_order, CubeTree, TriangleBvh};
 use crate::verify::hausdorff::surface_samples;
 
 use super::guard::InputModel;
@@ -60,7 +60,11 @@ impl Coverage {
     /// Samples `input` at [`SPACING`]` · d` and sets each sample's budget from its distance to
     /// `lod` (the LOD before the fit), at least `floor`.
     pub fn new(input: &InputModel, lod: &HalfEdgeMesh, d: f64, floor: f64) -> Coverage {
-        let points = surface_samples(&input.positions, &input.tris, SPACING * d, MAX_SUBDIVISIONS);
+        let mut points =
+            surface_samples(&input.positions, &input.tris, SPACING * d, MAX_SUBDIVISIONS);
+        // stored in the box tree's order: its queries, and the budgets' closest-point queries
+        // below, then read consecutive samples (the sample indices are internal)
+        sort_in_tree_order(&mut points);
         let tm = lod.to_trimesh();
         let bvh = TriangleBvh::new(tm.positions(), tm.triangles());
         let budget: Vec<f64> = points
@@ -109,6 +113,16 @@ impl Coverage {
     /// — every sample the face's box test would not cull — and not yet assigned an earlier
     /// face, so a high-valence ring no longer tests every candidate against every face.
     pub fn relying_on(&mut self, old: &[[Vec3; 3]]) -> Vec<Relying> {
+        self.relying_on_moved(old, None)
+    }
+
+    /// [`Coverage::relying_on`], leaving out, with `moved = Some(δ)`, the samples that
+    /// [`Coverage::keeps_within`] keeps without a distance for any replacement of `old` whose
+    /// points each move at most `δ` (`spare ≥ δ + box_cull_margin(s, b + δ)`, the margin
+    /// increasing in `δ`): the answer of [`Coverage::keeps_within`] with any `moved ≤ δ` is
+    /// the same as over the full set (issue 12 part 2: most samples stay well inside their
+    /// budget, and are no longer listed and re-checked on every line-search trial).
+    fn relying_on_moved(&mut self, old: &[[Vec3; 3]], moved: Option<f64>) -> Vec<Relying> {
         let Some((lo, hi)) = corners_box(old) else {
             return Vec::new();
         };
@@ -149,6 +163,13 @@ impl Coverage {
             let s = r.sample as usize;
             self.decided[s / 64] &= !(1 << (s % 64));
         }
+        if let Some(m) = moved {
+            let (points, budget) = (&self.points, &self.budget);
+            out.retain(|r| {
+                let (p, b) = (points[r.sample as usize], budget[r.sample as usize]);
+                r.spare < m + box_cull_margin(p, b + m)
+            });
+        }
         out
     }
 
@@ -180,16 +201,24 @@ impl Coverage {
         ok
     }
 
-    /// [`Coverage::relying_on`] the one-ring of `v`.
-    pub fn relying_on_ring(&mut self, m: &HalfEdgeMesh, v: VertexId) -> Vec<Relying> {
+    /// [`Coverage::relying_on`] the one-ring of `v`, for [`Coverage::keeps_move`] with moves of
+    /// `v` no longer than `max_move` (the samples it would keep unseen left out:
+    /// [`Coverage::relying_on_moved`]).
+    pub fn relying_on_ring(
+        &mut self,
+        m: &HalfEdgeMesh,
+        v: VertexId,
+        max_move: f64,
+    ) -> Vec<Relying> {
         let old: Vec<[Vec3; 3]> = m
             .vertex_faces(v)
             .map(|f| m.face_positions(f).map(Vec3::from))
             .collect();
-        self.relying_on(&old)
+        self.relying_on_moved(&old, Some(max_move))
     }
 
-    /// [`Coverage::keeps`] for moving `v` of `m` to `q` (its one-ring after the move).
+    /// [`Coverage::keeps`] for moving `v` of `m` to `q` (its one-ring after the move);
+    /// `relying` from [`Coverage::relying_on_ring`] with a `max_move` of at least the move.
     pub fn keeps_move(
         &mut self,
         relying: &[Relying],
