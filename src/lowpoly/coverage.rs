@@ -49,9 +49,6 @@ pub(crate) struct Coverage {
     /// At least twice the largest [`box_cull_margin`] of any sample: the growth of a face's
     /// box that finds every sample the face's box test would not cull.
     grow: f64,
-    /// One bit a sample, all clear between queries: the samples [`Coverage::relying_on`] has
-    /// already assigned a face.
-    decided: Vec<u64>,
     /// Operations refused because they would uncover a sample.
     pub refused: u64,
 }
@@ -91,13 +88,11 @@ impl Coverage {
         } else {
             f64::INFINITY
         };
-        let decided = vec![0; points.len().div_ceil(64)];
         Coverage {
             points,
             budget,
             tree,
             grow,
-            decided,
             refused: 0,
         }
     }
@@ -105,13 +100,14 @@ impl Coverage {
     /// The samples that may rely on the faces `old` (within their budget of them): the only
     /// ones a replacement of `old` must keep covered (module docs). Each comes with the index
     /// of the first `old` face within its budget and its spare, which [`Coverage::keeps`]
-    /// uses; deterministic order (by face, then the box tree's), not sorted.
+    /// uses; deterministic order (the box tree's), not sorted.
     ///
     /// Same answers as testing every sample whose cube `s ± b_s` meets the patch's box against
-    /// the faces in order ([`Patch::face_within`]), found faster (issue 12 part 2): face `k` is
-    /// tried only on the samples whose cube meets face `k`'s box grown by [`Coverage::grow`]
-    /// — every sample the face's box test would not cull — and not yet assigned an earlier
-    /// face, so a high-valence ring no longer tests every candidate against every face.
+    /// the faces in order ([`Patch::face_within`]), found faster (issue 12 part 2): one box
+    /// tree query with the patch's box, then face `k` is tried on a candidate only when its
+    /// cube meets face `k`'s box grown by [`Coverage::grow`] — every sample the face's box
+    /// test would not cull — so a high-valence ring does not test every candidate against
+    /// every face, and no part of the tree is walked once per face.
     pub fn relying_on(&mut self, old: &[[Vec3; 3]]) -> Vec<Relying> {
         self.relying_on_moved(old, None)
     }
@@ -128,49 +124,34 @@ impl Coverage {
         };
         let patch = Patch::new(old);
         let grow = Vec3::splat(self.grow);
-        let mut out: Vec<Relying> = Vec::new();
-        for (k, &(flo, fhi)) in patch.boxes.iter().enumerate() {
-            let cand: Vec<u32> = self
-                .tree
-                .overlapping(&self.points, &self.budget, flo - grow, fhi + grow)
-                .into_iter()
-                .filter(|&s| {
-                    let s = s as usize;
-                    self.decided[s / 64] & (1 << (s % 64)) == 0
-                        && cube_meets(self.points[s], self.budget[s], lo, hi)
+        let grown: Vec<(Vec3, Vec3)> = patch
+            .boxes
+            .iter()
+            .map(|&(flo, fhi)| (flo - grow, fhi + grow))
+            .collect();
+        let (points, budget) = (&self.points, &self.budget);
+        self.tree
+            .overlapping(points, budget, lo, hi)
+            .into_par_iter()
+            .with_min_len(64)
+            .filter_map(|s| {
+                let (p, b) = (points[s as usize], budget[s as usize]);
+                let (face, dist) = grown.iter().enumerate().find_map(|(k, &(flo, fhi))| {
+                    if !cube_meets(p, b, flo, fhi) {
+                        return None;
+                    }
+                    patch.near_or_inside(k, p, b).map(|dist| (k, dist))
+                })?;
+                let spare = b - dist;
+                // kept unseen by every trial (`keeps_within`'s shortcut): left out
+                let unseen = moved.is_some_and(|m| spare >= m + box_cull_margin(p, b + m));
+                (!unseen).then_some(Relying {
+                    sample: s,
+                    face: face as u32,
+                    spare,
                 })
-                .collect();
-            let (points, budget) = (&self.points, &self.budget);
-            let hits: Vec<Relying> = cand
-                .into_par_iter()
-                .with_min_len(64)
-                .filter_map(|s| {
-                    let (p, b) = (points[s as usize], budget[s as usize]);
-                    patch.near_or_inside(k, p, b).map(|dist| Relying {
-                        sample: s,
-                        face: k as u32,
-                        spare: b - dist,
-                    })
-                })
-                .collect();
-            for r in &hits {
-                let s = r.sample as usize;
-                self.decided[s / 64] |= 1 << (s % 64);
-            }
-            out.extend(hits);
-        }
-        for r in &out {
-            let s = r.sample as usize;
-            self.decided[s / 64] &= !(1 << (s % 64));
-        }
-        if let Some(m) = moved {
-            let (points, budget) = (&self.points, &self.budget);
-            out.retain(|r| {
-                let (p, b) = (points[r.sample as usize], budget[r.sample as usize]);
-                r.spare < m + box_cull_margin(p, b + m)
-            });
-        }
-        out
+            })
+            .collect()
     }
 
     /// Whether the faces `new` keep every sample of `relying` (from [`Coverage::relying_on`])
