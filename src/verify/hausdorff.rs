@@ -442,6 +442,47 @@ mod tests {
         assert_eq!((cancelled, n), (None, 2));
     }
 
+    /// A height field `z = 0.05 sin(7x) cos(5y)` on an `n × n` grid of the unit square.
+    fn bumpy(n: u32) -> TriMesh {
+        let mut pos = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                let (x, y) = (f64::from(i) / f64::from(n), f64::from(j) / f64::from(n));
+                pos.push([x, y, 0.05 * (7.0 * x).sin() * (5.0 * y).cos()]);
+            }
+        }
+        let at = |i: u32, j: u32| j * (n + 1) + i;
+        let mut tris = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                tris.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                tris.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        TriMesh::new(pos, tris).unwrap()
+    }
+
+    /// The scan that skips samples by their Lipschitz bounds (`face_max`) gives the bytes of
+    /// the maximum over every sample of the module's sampling, queried one by one, for fine and
+    /// coarse faces on either side.
+    #[test]
+    fn bounded_scan_is_the_maximum_over_every_sample() {
+        let brute = |from: &TriMesh, to: &TriMesh, input: &TriMesh| {
+            let spacing = input.bbox_diagonal() / SAMPLES_PER_DIAGONAL;
+            let surface = Surface::new(to);
+            surface_samples(from.positions(), from.triangles(), spacing, MAX_SUBDIVISIONS)
+                .into_iter()
+                .map(|p| surface.distance(p))
+                .fold(0.0, f64::max)
+        };
+        for (output, input) in [(bumpy(3), bumpy(40)), (square(0.01), bumpy(25))] {
+            let s = hausdorff_sides(&output, &input);
+            assert_eq!(s.input_to_output, brute(&input, &output, &input));
+            assert_eq!(s.output_to_input, brute(&output, &input, &input));
+            assert!(s.input_to_output > 0.0 && s.output_to_input > 0.0);
+        }
+    }
+
     #[test]
     fn grid_counts() {
         let t = [Vec3::ZERO, Vec3::X, Vec3::Y];
