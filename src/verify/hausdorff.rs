@@ -470,10 +470,15 @@ mod tests {
         let brute = |from: &TriMesh, to: &TriMesh, input: &TriMesh| {
             let spacing = input.bbox_diagonal() / SAMPLES_PER_DIAGONAL;
             let surface = Surface::new(to);
-            surface_samples(from.positions(), from.triangles(), spacing, MAX_SUBDIVISIONS)
-                .into_iter()
-                .map(|p| surface.distance(p))
-                .fold(0.0, f64::max)
+            surface_samples(
+                from.positions(),
+                from.triangles(),
+                spacing,
+                MAX_SUBDIVISIONS,
+            )
+            .into_iter()
+            .map(|p| surface.distance(p))
+            .fold(0.0, f64::max)
         };
         for (output, input) in [(bumpy(3), bumpy(40)), (square(0.01), bumpy(25))] {
             let s = hausdorff_sides(&output, &input);
