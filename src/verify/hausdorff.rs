@@ -8,7 +8,10 @@
 //! (`(k+1)(k+2)/2` points, corners included once via the vertices; the centroid is always
 //! added), with `spacing = l / `[`SAMPLES_PER_DIAGONAL`] and `l` the input's bounding-box
 //! diagonal. Each sample's exact distance to the other surface comes from a BVH closest-point
-//! query. The two-sided distance is the larger of the two one-sided maxima.
+//! query — skipped for a face sample whose 1-Lipschitz upper bound (from its face's corners
+//! and the last sample queried) cannot raise the maximum already found, which leaves the
+//! maximum's bytes unchanged (issue 12 part 2). The two-sided distance is the larger of the
+//! two one-sided maxima.
 //!
 //! The sampler is this module's own (it shares no code with the LOD loop's convergence test).
 //!
