@@ -27,7 +27,7 @@ use rayon::prelude::*;
 use crate::geom::{normalized, tri_normal, Vec3};
 use crate::mesh::halfedge::{HalfEdgeMesh, VertexId};
 use crate::spatial::closest::point_triangle_distance;
-use crate::spatial::{cube_meets, CubeTree, TriangleBvh};
+use crate::spatial::{cube_meets, sort_in_tree_order, CubeTree, TriangleBvh};
 use crate::verify::hausdorff::surface_samples;
 
 use super::guard::InputModel;
@@ -49,9 +49,6 @@ pub(crate) struct Coverage {
     /// At least twice the largest [`box_cull_margin`] of any sample: the growth of a face's
     /// box that finds every sample the face's box test would not cull.
     grow: f64,
-    /// One bit a sample, all clear between queries: the samples [`Coverage::relying_on`] has
-    /// already assigned a face.
-    decided: Vec<u64>,
     /// Operations refused because they would uncover a sample.
     pub refused: u64,
 }
@@ -60,7 +57,11 @@ impl Coverage {
     /// Samples `input` at [`SPACING`]` · d` and sets each sample's budget from its distance to
     /// `lod` (the LOD before the fit), at least `floor`.
     pub fn new(input: &InputModel, lod: &HalfEdgeMesh, d: f64, floor: f64) -> Coverage {
-        let points = surface_samples(&input.positions, &input.tris, SPACING * d, MAX_SUBDIVISIONS);
+        let mut points =
+            surface_samples(&input.positions, &input.tris, SPACING * d, MAX_SUBDIVISIONS);
+        // stored in the box tree's order: its queries, and the budgets' closest-point queries
+        // below, then read consecutive samples (the sample indices are internal)
+        sort_in_tree_order(&mut points);
         let tm = lod.to_trimesh();
         let bvh = TriangleBvh::new(tm.positions(), tm.triangles());
         let budget: Vec<f64> = points
@@ -87,13 +88,11 @@ impl Coverage {
         } else {
             f64::INFINITY
         };
-        let decided = vec![0; points.len().div_ceil(64)];
         Coverage {
             points,
             budget,
             tree,
             grow,
-            decided,
             refused: 0,
         }
     }
@@ -101,55 +100,58 @@ impl Coverage {
     /// The samples that may rely on the faces `old` (within their budget of them): the only
     /// ones a replacement of `old` must keep covered (module docs). Each comes with the index
     /// of the first `old` face within its budget and its spare, which [`Coverage::keeps`]
-    /// uses; deterministic order (by face, then the box tree's), not sorted.
+    /// uses; deterministic order (the box tree's), not sorted.
     ///
     /// Same answers as testing every sample whose cube `s ± b_s` meets the patch's box against
-    /// the faces in order ([`Patch::face_within`]), found faster (issue 12 part 2): face `k` is
-    /// tried only on the samples whose cube meets face `k`'s box grown by [`Coverage::grow`]
-    /// — every sample the face's box test would not cull — and not yet assigned an earlier
-    /// face, so a high-valence ring no longer tests every candidate against every face.
+    /// the faces in order ([`Patch::face_within`]), found faster (issue 12 part 2): one box
+    /// tree query with the patch's box, then face `k` is tried on a candidate only when its
+    /// cube meets face `k`'s box grown by [`Coverage::grow`] — every sample the face's box
+    /// test would not cull — so a high-valence ring does not test every candidate against
+    /// every face, and no part of the tree is walked once per face.
     pub fn relying_on(&mut self, old: &[[Vec3; 3]]) -> Vec<Relying> {
+        self.relying_on_moved(old, None)
+    }
+
+    /// [`Coverage::relying_on`], leaving out, with `moved = Some(δ)`, the samples that
+    /// [`Coverage::keeps_within`] keeps without a distance for any replacement of `old` whose
+    /// points each move at most `δ` (`spare ≥ δ + box_cull_margin(s, b + δ)`, the margin
+    /// increasing in `δ`): the answer of [`Coverage::keeps_within`] with any `moved ≤ δ` is
+    /// the same as over the full set (issue 12 part 2: most samples stay well inside their
+    /// budget, and are no longer listed and re-checked on every line-search trial).
+    fn relying_on_moved(&mut self, old: &[[Vec3; 3]], moved: Option<f64>) -> Vec<Relying> {
         let Some((lo, hi)) = corners_box(old) else {
             return Vec::new();
         };
         let patch = Patch::new(old);
         let grow = Vec3::splat(self.grow);
-        let mut out: Vec<Relying> = Vec::new();
-        for (k, &(flo, fhi)) in patch.boxes.iter().enumerate() {
-            let cand: Vec<u32> = self
-                .tree
-                .overlapping(&self.points, &self.budget, flo - grow, fhi + grow)
-                .into_iter()
-                .filter(|&s| {
-                    let s = s as usize;
-                    self.decided[s / 64] & (1 << (s % 64)) == 0
-                        && cube_meets(self.points[s], self.budget[s], lo, hi)
+        let grown: Vec<(Vec3, Vec3)> = patch
+            .boxes
+            .iter()
+            .map(|&(flo, fhi)| (flo - grow, fhi + grow))
+            .collect();
+        let (points, budget) = (&self.points, &self.budget);
+        self.tree
+            .overlapping(points, budget, lo, hi)
+            .into_par_iter()
+            .with_min_len(64)
+            .filter_map(|s| {
+                let (p, b) = (points[s as usize], budget[s as usize]);
+                let (face, dist) = grown.iter().enumerate().find_map(|(k, &(flo, fhi))| {
+                    if !cube_meets(p, b, flo, fhi) {
+                        return None;
+                    }
+                    patch.near_or_inside(k, p, b).map(|dist| (k, dist))
+                })?;
+                let spare = b - dist;
+                // kept unseen by every trial (`keeps_within`'s shortcut): left out
+                let unseen = moved.is_some_and(|m| spare >= m + box_cull_margin(p, b + m));
+                (!unseen).then_some(Relying {
+                    sample: s,
+                    face: face as u32,
+                    spare,
                 })
-                .collect();
-            let (points, budget) = (&self.points, &self.budget);
-            let hits: Vec<Relying> = cand
-                .into_par_iter()
-                .with_min_len(64)
-                .filter_map(|s| {
-                    let (p, b) = (points[s as usize], budget[s as usize]);
-                    patch.near_or_inside(k, p, b).map(|dist| Relying {
-                        sample: s,
-                        face: k as u32,
-                        spare: b - dist,
-                    })
-                })
-                .collect();
-            for r in &hits {
-                let s = r.sample as usize;
-                self.decided[s / 64] |= 1 << (s % 64);
-            }
-            out.extend(hits);
-        }
-        for r in &out {
-            let s = r.sample as usize;
-            self.decided[s / 64] &= !(1 << (s % 64));
-        }
-        out
+            })
+            .collect()
     }
 
     /// Whether the faces `new` keep every sample of `relying` (from [`Coverage::relying_on`])
@@ -180,16 +182,24 @@ impl Coverage {
         ok
     }
 
-    /// [`Coverage::relying_on`] the one-ring of `v`.
-    pub fn relying_on_ring(&mut self, m: &HalfEdgeMesh, v: VertexId) -> Vec<Relying> {
+    /// [`Coverage::relying_on`] the one-ring of `v`, for [`Coverage::keeps_move`] with moves of
+    /// `v` no longer than `max_move` (the samples it would keep unseen left out:
+    /// [`Coverage::relying_on_moved`]).
+    pub fn relying_on_ring(
+        &mut self,
+        m: &HalfEdgeMesh,
+        v: VertexId,
+        max_move: f64,
+    ) -> Vec<Relying> {
         let old: Vec<[Vec3; 3]> = m
             .vertex_faces(v)
             .map(|f| m.face_positions(f).map(Vec3::from))
             .collect();
-        self.relying_on(&old)
+        self.relying_on_moved(&old, Some(max_move))
     }
 
-    /// [`Coverage::keeps`] for moving `v` of `m` to `q` (its one-ring after the move).
+    /// [`Coverage::keeps`] for moving `v` of `m` to `q` (its one-ring after the move);
+    /// `relying` from [`Coverage::relying_on_ring`] with a `max_move` of at least the move.
     pub fn keeps_move(
         &mut self,
         relying: &[Relying],

@@ -297,7 +297,10 @@ fn place_vertices(
             None
         };
         let moved = capped.map_or(0.0, |step| {
-            let relying = cov.relying_on_ring(g.mesh(), v);
+            // the line search tries `SAFETY_FACTOR · step` and halvings of it, which move `v`
+            // (measured as `|(p + s) − p|`, rounding included) less than this
+            let max_move = step.length() + 1e-9 * (p.abs().max_element() + step.length());
+            let relying = cov.relying_on_ring(g.mesh(), v, max_move);
             let mut keeps = |g: &Guard<'_>, v, q| cov.keeps_move(&relying, g.mesh(), v, q);
             local_update_if(g, v, step, &mut keeps)
         });

@@ -95,6 +95,34 @@ pub fn cube_meets(p: Vec3, b: f64, lo: Vec3, hi: Vec3) -> bool {
     cl.x <= hi.x && cl.y <= hi.y && cl.z <= hi.z && lo.x <= ch.x && lo.y <= ch.y && lo.z <= ch.z
 }
 
+/// Reorders `points` in place into the order a [`CubeTree`] over them visits its cubes (Morton
+/// order in their bounding box, ties by index), so that a tree built afterwards has its leaves
+/// over consecutive points and queries read memory in sequence (issue 12 part 2). Only the
+/// indices change: a tree over the reordered points answers the same cubes, in the same order,
+/// under their new indices. Deterministic; in place (one byte a point beyond the order).
+pub fn sort_in_tree_order(points: &mut [Vec3]) {
+    let order = morton_order(points);
+    let mut done = vec![false; points.len()];
+    for start in 0..points.len() {
+        if done[start] {
+            continue;
+        }
+        // the cycle of the permutation `new[i] = old[order[i]]` through `start`
+        let first = points[start];
+        let mut i = start;
+        loop {
+            done[i] = true;
+            let k = order[i] as usize;
+            if k == start {
+                points[i] = first;
+                break;
+            }
+            points[i] = points[k];
+            i = k;
+        }
+    }
+}
+
 /// A static tree over the cubes `points[k] ± half[k]` (module docs). Queries take `&self` and
 /// may run concurrently.
 pub struct CubeTree {
@@ -226,6 +254,37 @@ fn spread(x: u64) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// After [`sort_in_tree_order`] a tree visits the points in index order, and answers the
+    /// same cubes as the tree over the unsorted points (mapped through the reordering).
+    #[test]
+    fn sorted_points_are_visited_in_index_order() {
+        let mut rnd = crate::spatial::test_uniform(0x9e37_79b9_7f4a_7c15u64);
+        let points: Vec<Vec3> = (0..2000)
+            .map(|_| Vec3::new(rnd() * 4.0, rnd() * 2.0, (rnd() * 8.0).floor()))
+            .collect();
+        let half = vec![0.05; points.len()];
+        let mut sorted = points.clone();
+        sort_in_tree_order(&mut sorted);
+        let tree = CubeTree::new(&sorted, &half);
+        assert!(tree.order.iter().enumerate().all(|(i, &k)| i == k as usize));
+        let old = CubeTree::new(&points, &half);
+        for q in 0..50 {
+            let c = Vec3::new(rnd() * 4.0, rnd() * 2.0, (q % 8) as f64);
+            let (lo, hi) = (c - Vec3::splat(0.3), c + Vec3::splat(0.3));
+            let a: Vec<Vec3> = old
+                .overlapping(&points, &half, lo, hi)
+                .iter()
+                .map(|&k| points[k as usize])
+                .collect();
+            let b: Vec<Vec3> = tree
+                .overlapping(&sorted, &half, lo, hi)
+                .iter()
+                .map(|&k| sorted[k as usize])
+                .collect();
+            assert_eq!(a, b);
+        }
+    }
 
     /// The tree answers exactly the brute-force set of meeting cubes, touching included, on a
     /// pseudo-random cloud with varied half-widths and boxes.

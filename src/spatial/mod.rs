@@ -15,7 +15,7 @@ pub mod winding;
 
 pub use box_tree::BoxTree;
 pub use bvh::{ClosestPoint, TriangleBvh};
-pub use cube_tree::{cube_meets, CubeTree};
+pub use cube_tree::{cube_meets, sort_in_tree_order, CubeTree};
 pub use self_intersect::{
     degenerate_faces, find_self_intersections, find_self_intersections_in, has_self_intersection,
     has_self_intersection_in, self_intersections, SelfIntersections,
