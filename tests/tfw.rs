@@ -2299,6 +2299,19 @@ mod balloon_check {
         let waves = balloon(&scene, "tfw_torus_balloon");
         assert!(waves > 0.0, "no wrinkles around the outer equator");
     }
+
+    /// The teabag of S:752 ([`Scene::teabag`], 2 × `PLEAT_BALLOON_V` (default 468, the
+    /// dissertation's 936 in all) vertices, `PLEAT_TEABAG_PA` (default 10) Pa): fine wrinkles
+    /// along the seam. Slow (ignored): `cargo test --release --test tfw teabag_wrinkles --
+    /// --ignored --nocapture`; writes docs/tfw_teabag.png.
+    #[test]
+    #[ignore]
+    fn teabag_wrinkles() {
+        let n = std::env::var("PLEAT_BALLOON_V").map_or(468, |v| v.parse().unwrap());
+        let pa = std::env::var("PLEAT_TEABAG_PA").map_or(10.0, |v| v.parse().unwrap());
+        let scene = Scene::teabag(n, pa, 1).unwrap();
+        balloon(&scene, "tfw_teabag");
+    }
 }
 
 /// Issue 13 "Speed": the clarabel QP against the projected Newton with the curl eliminated on
@@ -3001,5 +3014,35 @@ mod torus_stability {
             "converged torus base is not a local minimum: {a:e}"
         );
         let _ = (b, c);
+    }
+}
+
+/// The SQP's rescue (`SqpResult::rescued_at`): on the teabag at 10 Pa (S:752, 2 × 468 v) the
+/// first iteration's scales give a step of ~1e10 m on amplitudes the PSD projection left
+/// almost without curvature, and both step solvers used to stop at once with
+/// `LineSearchFailed`; with the rescue scales they converge, keeping the invariants.
+#[test]
+fn teabag_sqp_rescues_a_step_without_curvature() {
+    use pleat::tfw::{solve, QpMethod, TfwParams};
+    let scene = Scene::teabag(468, 10.0, 1).unwrap();
+    for qp in [QpMethod::ProjectedNewton, QpMethod::Clarabel] {
+        let mut p = TfwParams::default();
+        p.sqp.qp = qp;
+        let r = solve(&scene, &p, &mut no_progress()).unwrap();
+        let s = r.sqp.as_ref().unwrap();
+        assert!(s.status.converged(), "{qp:?}: {:?}", s.status);
+        assert_eq!(s.rescued_at, Some(0), "{qp:?}");
+        assert!(
+            r.energy < 0.9 * s.initial_energy,
+            "{qp:?}: E {} from {}",
+            r.energy,
+            s.initial_energy
+        );
+        let mut prev = s.initial_energy;
+        for it in &s.history {
+            assert!(it.curl_residual <= 1e-10 && it.energy <= prev, "{qp:?}");
+            prev = it.energy;
+        }
+        assert!(r.cwf.amplitude().iter().all(|&a| a >= 0.0));
     }
 }

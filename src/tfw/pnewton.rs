@@ -53,8 +53,8 @@ use crate::solve::{
 };
 use crate::tfw::energy::{HessianMode, WfEval, WfTerms};
 use crate::tfw::sqp::{
-    feasible_start, qp_shape, step_sizes, CgRefinement, FeasibleStart, SqpIteration, SqpOptions,
-    SqpProblem, SqpResult, SqpStatus,
+    feasible_start, qp_shape, rescue_weights, step_sizes, CgRefinement, FeasibleStart,
+    SqpIteration, SqpOptions, SqpProblem, SqpResult, SqpStatus, RESCUE_SHIFT,
 };
 use crate::{Error, Result};
 use std::collections::VecDeque;
@@ -535,11 +535,12 @@ fn run(
     let initial_energy = eval.energy;
     let shape = qp_shape(problem, &eval, initial_energy);
     // W = E₀ / D² = the first iteration's diagonal of H (floored), per free unknown
-    let weights: Vec<f64> = shape
+    let mut weights: Vec<f64> = shape
         .scale
         .iter()
         .map(|d| shape.energy_scale / (d * d))
         .collect();
+    let mut rescued_at = None;
     let mut x = scatter(&y);
     let evaluate = |x: &[f64]| -> (WfEval, Option<HessianEntries>) {
         if cg.iterations > 0 {
@@ -588,7 +589,7 @@ fn run(
         let held: Vec<bool> = (0..basis.ny)
             .map(|i| i < na && y[i] <= 0.0 && g[i] > 0.0)
             .collect();
-        let step = newton_direction(
+        let mut step = newton_direction(
             problem,
             &basis,
             &eval,
@@ -600,33 +601,39 @@ fn run(
             &mut state,
         )?;
         qp_seconds += t0.elapsed().as_secs_f64();
-        let Some((d, attempts, cg_iterations)) = step else {
+        let mut accepted = None;
+        // one rescue per iteration: the step from the first iteration's weights found no
+        // decrease, so retry it once with the rescue weights (`rescue_weights`) kept from then on
+        for attempt in 0..2 {
+            let Some((d, _, _)) = &step else { break };
+            accepted = armijo(&y, d, &g, na, &eval, options.armijo, &scatter, &|x| {
+                e.energy(x, WfTerms::ALL)
+            });
+            if accepted.is_some() || attempt == 1 || rescued_at.is_some() {
+                break;
+            }
+            rescued_at = Some(history.len());
+            weights = rescue_weights(&weights, na);
+            state.shift = state.shift.max(RESCUE_SHIFT);
+            let t1 = Instant::now();
+            step = newton_direction(
+                problem,
+                &basis,
+                &eval,
+                exact.as_deref(),
+                cg,
+                &g,
+                &held,
+                &weights,
+                &mut state,
+            )?;
+            qp_seconds += t1.elapsed().as_secs_f64();
+        }
+        let Some((_, attempts, cg_iterations)) = step else {
             status = SqpStatus::QpFailed;
             break;
         };
-        // Armijo along the projected arc
-        let mut t = 1.0;
-        let accepted = loop {
-            let mut cand: Vec<f64> = y.iter().zip(&d).map(|(a, b)| a + t * b).collect();
-            for v in &mut cand[..na] {
-                *v = v.max(0.0);
-            }
-            let slope: f64 = g
-                .iter()
-                .zip(cand.iter().zip(&y))
-                .map(|(gi, (c, o))| gi * (c - o))
-                .sum();
-            let xc = scatter(&cand);
-            let ec = e.energy(&xc, WfTerms::ALL);
-            if ec <= eval.energy + options.armijo * slope.min(0.0) && ec <= eval.energy {
-                break Some((cand, xc, ec));
-            }
-            t *= 0.5;
-            if t < 1e-10 {
-                break None;
-            }
-        };
-        let Some((yn, xn, en)) = accepted else {
+        let Some((yn, xn, en, t)) = accepted else {
             status = SqpStatus::LineSearchFailed;
             break;
         };
@@ -689,7 +696,44 @@ fn run(
         qp_seconds,
         seconds: start.elapsed().as_secs_f64(),
         snapshots,
+        rescued_at,
     })
+}
+
+/// Armijo backtracking along the projected arc `y + t d` (amplitudes `..na` clipped at 0):
+/// the first `t = 1, ½, ¼, … ≥ 1e-10` whose energy is at most `E + c · slope` and at most `E`;
+/// returns the candidate, its scattered `x`, energy and `t`.
+fn armijo(
+    y: &[f64],
+    d: &[f64],
+    g: &[f64],
+    na: usize,
+    eval: &WfEval,
+    c: f64,
+    scatter: &dyn Fn(&[f64]) -> Vec<f64>,
+    energy: &dyn Fn(&[f64]) -> f64,
+) -> Option<(Vec<f64>, Vec<f64>, f64, f64)> {
+    let mut t = 1.0;
+    loop {
+        let mut cand: Vec<f64> = y.iter().zip(d).map(|(a, b)| a + t * b).collect();
+        for v in &mut cand[..na] {
+            *v = v.max(0.0);
+        }
+        let slope: f64 = g
+            .iter()
+            .zip(cand.iter().zip(y))
+            .map(|(gi, (c, o))| gi * (c - o))
+            .sum();
+        let xc = scatter(&cand);
+        let ec = energy(&xc);
+        if ec <= eval.energy + c * slope.min(0.0) && ec <= eval.energy {
+            return Some((cand, xc, ec, t));
+        }
+        t *= 0.5;
+        if t < 1e-10 {
+            return None;
+        }
+    }
 }
 
 /// The relative shift σ after an accepted step of length `t` (a Levenberg–Marquardt-like

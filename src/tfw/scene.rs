@@ -859,6 +859,54 @@ impl Scene {
     }
 }
 
+impl Scene {
+    /// The teabag of S:752: two 1.4 × 0.74 m rectangles sewn along their whole boundary into
+    /// a pillow and inflated by `pressure` (Pa; the dissertation does not give it), h 1 mm,
+    /// ν 0.3, Y 0.1 MPa (S:752), about `target_vertices_per_panel` vertices per rectangle
+    /// (the dissertation's mesh: 936 in all), meshed irregularly (same outline, target and
+    /// seed, so both get identical boundary samples and sew). The corners are rounded (radius
+    /// 4 cm, 6 segments): at a square corner the mesher puts a triangle with three boundary
+    /// vertices, whose inner edge both panels would share, which does not sew into a manifold.
+    /// Initial state a thin tent ([`Panel::lens`], `z = ±0.05 · 0.37 m · d/d_max`). No Dirichlet
+    /// condition, as the balloons. Expected (S:752): fine wrinkles along the seam, no creases.
+    pub fn teabag(target_vertices_per_panel: usize, pressure: f64, seed: u64) -> Result<Scene> {
+        let (w, h) = (1.4, 0.74);
+        let outline = PolygonPanel {
+            outer: rounded_rectangle(w, h, 0.04, 6),
+            holes: vec![],
+            target_vertices: target_vertices_per_panel,
+            seed,
+        };
+        let panels = balloon_panels(&outline, 0.05 * 0.5 * h)?;
+        let name = format!(
+            "teabag 1.4 x 0.74 m, 2 x {target_vertices_per_panel} v (seed {seed}), {pressure} Pa"
+        );
+        let mut scene = balloon_scene(name, panels, pressure);
+        scene.material = Material {
+            young: 1e5,
+            poisson: 0.3,
+            thickness: 1e-3,
+            density: 0.0,
+        };
+        Ok(scene)
+    }
+}
+
+/// The `w × h` rectangle about the origin with its corners rounded to radius `r` (each arc
+/// `segments` chords), counter-clockwise.
+fn rounded_rectangle(w: f64, h: f64, r: f64, segments: usize) -> Vec<[f64; 2]> {
+    let (cx, cy) = (0.5 * w - r, 0.5 * h - r);
+    let centres = [[cx, -cy], [cx, cy], [-cx, cy], [-cx, -cy]];
+    let mut out = Vec::with_capacity(4 * (segments + 1));
+    for (q, c) in centres.iter().enumerate() {
+        for k in 0..=segments {
+            let t = std::f64::consts::FRAC_PI_2 * (q as f64 - 1.0 + k as f64 / segments as f64);
+            out.push([c[0] + r * t.cos(), c[1] + r * t.sin()]);
+        }
+    }
+    out
+}
+
 /// `n` corners of the circle of radius `r` about the origin, counter-clockwise.
 fn circle(r: f64, n: usize) -> Vec<[f64; 2]> {
     (0..n)

@@ -248,6 +248,10 @@ pub struct SqpResult {
     /// `(iterations done, x)` at the start and every [`SqpOptions::snapshot_every`]
     /// iterations (empty unless asked for).
     pub snapshots: Vec<(usize, Vec<f64>)>,
+    /// The iteration (0-based) whose step first found no decrease with the first iteration's
+    /// scales and was retried with the rescue scales (`rescue_weights`), kept from then on;
+    /// `None` when every step succeeded as planned.
+    pub rescued_at: Option<usize>,
 }
 
 /// The constraint structure of the SQP: free unknowns and curl rows.
@@ -433,6 +437,86 @@ impl Projector {
     }
 }
 
+/// The shift the rescue step starts from (relative to its weights): a damped step.
+pub(super) const RESCUE_SHIFT: f64 = 1.0;
+
+/// The step weights after a failed line search: each weight raised to the median of its
+/// kind's (amplitudes `..na`, then ω). The first iteration's diagonal of `H` can be ~1e-8 of
+/// the mean on unknowns the PSD projection left almost without curvature (the teabag at
+/// 10 Pa: 55% of them below 1e-6 of the mean), where the shift `σ W` then allows steps of
+/// 1e10 m; the median bounds them by the typical unknown's curvature. Only used once the
+/// solve has failed a line search, so solves that never do are unchanged.
+pub(super) fn rescue_weights(weights: &[f64], na: usize) -> Vec<f64> {
+    let median = |w: &[f64]| -> f64 {
+        let mut v: Vec<f64> = w
+            .iter()
+            .copied()
+            .filter(|x| x.is_finite() && *x > 0.0)
+            .collect();
+        if v.is_empty() {
+            return 0.0;
+        }
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let na = na.min(weights.len());
+    let (ma, mw) = (median(&weights[..na]), median(&weights[na..]));
+    weights
+        .iter()
+        .enumerate()
+        .map(|(i, &w)| w.max(if i < na { ma } else { mw }))
+        .collect()
+}
+
+/// `shape` with the scales of [`rescue_weights`] (`D = (E₀/w)^{1/2}`): the clarabel step's
+/// variables after a failed line search; the stop tests keep the first iteration's scales.
+fn rescued_shape(shape: &QpShape, na: usize) -> QpShape {
+    let weights: Vec<f64> = shape
+        .scale
+        .iter()
+        .map(|d| shape.energy_scale / (d * d))
+        .collect();
+    QpShape {
+        scale: rescue_weights(&weights, na)
+            .iter()
+            .map(|w| (shape.energy_scale / w).sqrt())
+            .collect(),
+        energy_scale: shape.energy_scale,
+    }
+}
+
+/// Armijo backtracking on `E` from `x` along `delta` (free unknowns), every candidate made
+/// exactly feasible by `projector`: the first `t = 1, ½, … ≥ 1e-10` with `E ≤ E₀ + c t slope`
+/// and `E ≤ E₀`; returns the candidate, its energy and `t`.
+fn line_search(
+    problem: &SqpProblem,
+    projector: &Projector,
+    x: &[f64],
+    delta: &[f64],
+    g_free: &[f64],
+    eval: &WfEval,
+    c: f64,
+) -> Option<(Vec<f64>, f64, f64)> {
+    let e = problem.energy();
+    let slope: f64 = delta.iter().zip(g_free).map(|(d, g)| d * g).sum();
+    let mut t = 1.0;
+    loop {
+        let mut cand = x.to_vec();
+        for (k, &gi) in problem.free.iter().enumerate() {
+            cand[gi] += t * delta[k];
+        }
+        projector.apply(problem, &mut cand);
+        let ec = e.energy(&cand, WfTerms::ALL);
+        if ec <= eval.energy + c * t * slope.min(0.0) && ec <= eval.energy {
+            return Some((cand, ec, t));
+        }
+        t *= 0.5;
+        if t < 1e-10 {
+            return None;
+        }
+    }
+}
+
 /// The QP data that does not change between iterations.
 pub(super) struct QpShape {
     /// `D` per free unknown.
@@ -553,6 +637,7 @@ pub(crate) fn feasible_start(problem: &SqpProblem, x0: &[f64]) -> Result<Feasibl
             qp_seconds: 0.0,
             seconds: start.elapsed().as_secs_f64(),
             snapshots: Vec::new(),
+            rescued_at: None,
         }));
     }
     Ok(FeasibleStart::Run {
@@ -584,7 +669,7 @@ pub fn run_sqp(
     };
     let e = &problem.energy;
     let initial_energy = eval.energy;
-    let done = |status, x, history, r0, qp_seconds, snapshots| SqpResult {
+    let done = |status, x, history, r0, qp_seconds, snapshots, rescued_at| SqpResult {
         x,
         status,
         initial_energy,
@@ -593,6 +678,7 @@ pub fn run_sqp(
         qp_seconds,
         seconds: start.elapsed().as_secs_f64(),
         snapshots,
+        rescued_at,
     };
     let mut snapshots = Vec::new();
     if options.snapshot_every > 0 {
@@ -617,6 +703,8 @@ pub fn run_sqp(
     let r0 = stationarity(&eval.gradient, &duals);
     let shape = qp_shape(problem, &eval, initial_energy);
     let mut shift = options.initial_shift;
+    let mut rescue_shape: Option<QpShape> = None;
+    let mut rescued_at = None;
     let mut history = Vec::new();
     let mut qp_seconds = 0.0;
     let mut status = SqpStatus::MaxIterations;
@@ -632,32 +720,37 @@ pub fn run_sqp(
             break;
         }
         let g_free: Vec<f64> = problem.free.iter().map(|&gi| eval.gradient[gi]).collect();
-        let t0 = Instant::now();
-        let qp = solve_qp(problem, &shape, &eval.hessian, &g_free, &x, &mut shift);
-        qp_seconds += t0.elapsed().as_secs_f64();
-        let Some((delta, z, qp_iterations)) = qp else {
+        let mut qp = None;
+        let mut accepted = None;
+        // one rescue (as the projected Newton's, `rescue_weights`): the step from the first
+        // iteration's scales found no decrease, so retry it once with the rescue scales, kept
+        for attempt in 0..2 {
+            let t0 = Instant::now();
+            let step_shape = rescue_shape.as_ref().unwrap_or(&shape);
+            qp = solve_qp(problem, step_shape, &eval.hessian, &g_free, &x, &mut shift);
+            qp_seconds += t0.elapsed().as_secs_f64();
+            let Some((delta, _, _)) = &qp else { break };
+            accepted = line_search(
+                problem,
+                &projector,
+                &x,
+                delta,
+                &g_free,
+                &eval,
+                options.armijo,
+            );
+            if accepted.is_some() || attempt == 1 || rescue_shape.is_some() {
+                break;
+            }
+            rescue_shape = Some(rescued_shape(&shape, problem.n_free_a));
+            rescued_at = Some(history.len());
+            shift = shift.max(RESCUE_SHIFT);
+        }
+        let Some((_, z, qp_iterations)) = qp else {
             status = SqpStatus::QpFailed;
             break;
         };
-        let slope: f64 = delta.iter().zip(&g_free).map(|(d, g)| d * g).sum();
-        // line search on E with exact feasibility of every candidate
-        let mut t = 1.0;
-        let accepted = loop {
-            let mut cand = x.clone();
-            for (k, &gi) in problem.free.iter().enumerate() {
-                cand[gi] += t * delta[k];
-            }
-            projector.apply(problem, &mut cand);
-            let ec = e.energy(&cand, WfTerms::ALL);
-            if ec <= eval.energy + options.armijo * t * slope.min(0.0) && ec <= eval.energy {
-                break Some((cand, ec));
-            }
-            t *= 0.5;
-            if t < 1e-10 {
-                break None;
-            }
-        };
-        let Some((xn, en)) = accepted else {
+        let Some((xn, en, t)) = accepted else {
             status = SqpStatus::LineSearchFailed;
             break;
         };
@@ -698,7 +791,9 @@ pub fn run_sqp(
             break;
         }
     }
-    Ok(done(status, x, history, r0, qp_seconds, snapshots))
+    Ok(done(
+        status, x, history, r0, qp_seconds, snapshots, rescued_at,
+    ))
 }
 
 /// One QP (module docs) in scaled variables; returns the step over the free unknowns, the
