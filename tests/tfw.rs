@@ -3046,3 +3046,50 @@ fn teabag_sqp_rescues_a_step_without_curvature() {
         assert!(r.cwf.amplitude().iter().all(|&a| a >= 0.0));
     }
 }
+
+/// Issue 13's "inverted or degenerate base triangles (reported, no panic)": the stretched sheet
+/// started with one interior vertex pushed across its neighbours (inverted triangles) and one
+/// moved onto the midpoint of its row neighbours (zero-area triangles). The solve returns (no panic); the base
+/// solve untangles the start (the membrane's energy is finite there) or, where faces stay
+/// collapsed, reports them in `strain.degenerate_faces` with a warning; the SQP keeps its
+/// invariants.
+#[test]
+fn inverted_and_collapsed_start_triangles_are_solved_or_reported() {
+    use pleat::tfw::{solve, TfwParams};
+    let (nx, ny) = (13, 6);
+    let mut scene = Scene::stretched_sheet(nx, ny, 0.05);
+    let pos = scene.panels[0].positions.as_mut().unwrap();
+    let (a, b) = (2 * nx + 4, 2 * nx + 5);
+    // invert: move vertex a two spacings to the far side of b; flatten: c onto the midpoint
+    // of its row neighbours (zero-area triangles; onto a neighbour it would be sewn to it)
+    let d = [pos[b][0] - pos[a][0], pos[b][1] - pos[a][1]];
+    pos[a] = [pos[a][0] + 2.0 * d[0], pos[a][1] + 2.0 * d[1], 0.0];
+    let c = 3 * nx + 8;
+    pos[c] = std::array::from_fn(|k| 0.5 * (pos[c - 1][k] + pos[c + 1][k]));
+    let r = solve(&scene, &TfwParams::default(), &mut no_progress());
+    let r = match r {
+        Ok(r) => r,
+        Err(e) => {
+            let m = e.to_string();
+            eprintln!("error: {m}");
+            assert!(
+                m.contains("invert") || m.contains("degenerate") || m.contains("collapsed"),
+                "{m}"
+            );
+            return;
+        }
+    };
+    eprintln!(
+        "base {:?}, degenerate {}, warnings {:?}",
+        r.base.status, r.base.strain.degenerate_faces, r.base.warnings
+    );
+    if r.base.strain.degenerate_faces > 0 {
+        assert!(
+            r.base.warnings.iter().any(|w| w.contains("collapsed")),
+            "{:?}",
+            r.base.warnings
+        );
+    }
+    assert!(r.curl_residual <= 1e-10);
+    assert!(r.cwf.amplitude().iter().all(|&x| x >= 0.0 && x.is_finite()));
+}
