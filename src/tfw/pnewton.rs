@@ -606,8 +606,10 @@ fn run(
         // decrease, so retry it once with the rescue weights (`rescue_weights`) kept from then on
         for attempt in 0..2 {
             let Some((d, _, _)) = &step else { break };
-            accepted = armijo(&y, d, &g, na, &eval, options.armijo, &scatter, &|x| {
-                e.energy(x, WfTerms::ALL)
+            accepted = armijo(&y, d, &g, na, eval.energy, options.armijo, &|y| {
+                let xc = scatter(y);
+                let ec = e.energy(&xc, WfTerms::ALL);
+                (xc, ec)
             });
             if accepted.is_some() || attempt == 1 || rescued_at.is_some() {
                 break;
@@ -700,18 +702,18 @@ fn run(
     })
 }
 
-/// Armijo backtracking along the projected arc `y + t d` (amplitudes `..na` clipped at 0):
-/// the first `t = 1, ½, ¼, … ≥ 1e-10` whose energy is at most `E + c · slope` and at most `E`;
-/// returns the candidate, its scattered `x`, energy and `t`.
+/// Armijo backtracking along the projected arc `y + t d` (amplitudes `..na` clipped at 0)
+/// from the energy `e0`: the first `t = 1, ½, ¼, … ≥ 1e-10` whose energy (`energy_at`: the
+/// scattered `x` and `E`) is at most `e0 + c · slope` and at most `e0`; returns the candidate,
+/// its `x`, energy and `t`.
 fn armijo(
     y: &[f64],
     d: &[f64],
     g: &[f64],
     na: usize,
-    eval: &WfEval,
+    e0: f64,
     c: f64,
-    scatter: &dyn Fn(&[f64]) -> Vec<f64>,
-    energy: &dyn Fn(&[f64]) -> f64,
+    energy_at: &EnergyOfY<'_>,
 ) -> Option<(Vec<f64>, Vec<f64>, f64, f64)> {
     let mut t = 1.0;
     loop {
@@ -724,9 +726,8 @@ fn armijo(
             .zip(cand.iter().zip(y))
             .map(|(gi, (c, o))| gi * (c - o))
             .sum();
-        let xc = scatter(&cand);
-        let ec = energy(&xc);
-        if ec <= eval.energy + c * slope.min(0.0) && ec <= eval.energy {
+        let (xc, ec) = energy_at(&cand);
+        if ec <= e0 + c * slope.min(0.0) && ec <= e0 {
             return Some((cand, xc, ec, t));
         }
         t *= 0.5;
