@@ -589,36 +589,9 @@ fn run(
         let held: Vec<bool> = (0..basis.ny)
             .map(|i| i < na && y[i] <= 0.0 && g[i] > 0.0)
             .collect();
-        let mut step = newton_direction(
-            problem,
-            &basis,
-            &eval,
-            exact.as_deref(),
-            cg,
-            &g,
-            &held,
-            &weights,
-            &mut state,
-        )?;
-        qp_seconds += t0.elapsed().as_secs_f64();
-        let mut accepted = None;
-        // one rescue per iteration: the step from the first iteration's weights found no
-        // decrease, so retry it once with the rescue weights (`rescue_weights`) kept from then on
-        for attempt in 0..2 {
-            let Some((d, _, _)) = &step else { break };
-            accepted = armijo(&y, d, &g, na, eval.energy, options.armijo, &|y| {
-                let xc = scatter(y);
-                let ec = e.energy(&xc, WfTerms::ALL);
-                (xc, ec)
-            });
-            if accepted.is_some() || attempt == 1 || rescued_at.is_some() {
-                break;
-            }
-            rescued_at = Some(history.len());
-            weights = rescue_weights(&weights, na);
-            state.shift = state.shift.max(RESCUE_SHIFT);
-            let t1 = Instant::now();
-            step = newton_direction(
+        // the step for given weights: the planned one, and the rescue retry below
+        let direction = |weights: &[f64], state: &mut NewtonState| {
+            newton_direction(
                 problem,
                 &basis,
                 &eval,
@@ -626,9 +599,31 @@ fn run(
                 cg,
                 &g,
                 &held,
-                &weights,
-                &mut state,
-            )?;
+                weights,
+                state,
+            )
+        };
+        let energy_at = |y: &[f64]| {
+            let xc = scatter(y);
+            let ec = e.energy(&xc, WfTerms::ALL);
+            (xc, ec)
+        };
+        let mut step = direction(&weights, &mut state)?;
+        qp_seconds += t0.elapsed().as_secs_f64();
+        let mut accepted = None;
+        // one rescue per iteration: the step from the first iteration's weights found no
+        // decrease, so retry it once with the rescue weights (`rescue_weights`) kept from then on
+        for attempt in 0..2 {
+            let Some((d, _, _)) = &step else { break };
+            accepted = armijo(&y, d, &g, na, eval.energy, options.armijo, &energy_at);
+            if accepted.is_some() || attempt == 1 || rescued_at.is_some() {
+                break;
+            }
+            rescued_at = Some(history.len());
+            weights = rescue_weights(&weights, na);
+            state.shift = state.shift.max(RESCUE_SHIFT);
+            let t1 = Instant::now();
+            step = direction(&weights, &mut state)?;
             qp_seconds += t1.elapsed().as_secs_f64();
         }
         let Some((_, attempts, cg_iterations)) = step else {
@@ -644,11 +639,7 @@ fn run(
         // stationary points of higher energy (README "Thickness × 10⁻²")
         let near = t >= 1.0 && state.shift <= cg.max_shift;
         let (yn, xn, en) = if options.valley_search && near {
-            valley_search(&yn, xn, en, na, &|y| {
-                let xc = scatter(y);
-                let ec = e.energy(&xc, WfTerms::ALL);
-                (xc, ec)
-            })
+            valley_search(&yn, xn, en, na, &energy_at)
         } else {
             (yn, xn, en)
         };
