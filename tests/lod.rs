@@ -317,6 +317,44 @@ fn chain_levels_are_valid_and_coarser() {
     assert!(levels[2].0.triangle_count() <= levels[1].0.triangle_count());
 }
 
+/// Two unit boxes `gap` apart along x (two components).
+fn two_boxes(gap: f64) -> TriMesh {
+    let b = shapes::box_grid(1.0, 1.0, 1.0, 6);
+    let n = b.positions().len() as u32;
+    let mut p = b.positions().to_vec();
+    p.extend(b.positions().iter().map(|q| [q[0] + 1.0 + gap, q[1], q[2]]));
+    let mut t = b.triangles().to_vec();
+    t.extend(b.triangles().iter().map(|f| f.map(|v| v + n)));
+    TriMesh::new(p, t).unwrap()
+}
+
+/// A coarser chain level whose own offset surface closes what the finer level kept open (here:
+/// merges two components, gap 0.08 < 2d at n_p = 50, > 2d at n_p = 200) starts from that
+/// offset surface and is the level `generate` bakes; a level of the same topology starts from
+/// the finer one (`LodReport::started_from_finer`).
+#[test]
+fn chain_level_whose_offset_merges_components_is_baked_from_it() {
+    let m = two_boxes(0.08);
+    let mut prog = |_: pleat::Progress<'_>| true;
+    let levels =
+        generate_chain(&m, &[50.0, 100.0, 200.0], &LodParams::default(), &mut prog).unwrap();
+    let (finest, fs) = &levels[2];
+    assert_valid(finest, fs, "chain n_p=200");
+    assert_eq!(MeshReport::compute(finest).n_components, 2);
+    let (same, s100) = &levels[1];
+    assert_valid(same, s100, "chain n_p=100");
+    assert!(
+        s100.started_from_finer,
+        "same topology: from the finer level"
+    );
+    let (merged, s50) = &levels[0];
+    assert_valid(merged, s50, "chain n_p=50");
+    assert!(!s50.started_from_finer);
+    assert_eq!(MeshReport::compute(merged).n_components, 1);
+    let (single, _) = generate(&m, &params(50.0), &mut prog).unwrap();
+    assert_eq!(merged, &single, "the level is the single bake");
+}
+
 #[test]
 fn extreme_scales_and_shapes_give_valid_output_or_a_clear_error() {
     let sphere = shapes::icosphere(1.0, 3);

@@ -241,6 +241,9 @@ pub struct LodReport {
     /// The loop started from the welded input (`LodParams::start`, issue 12 part 1) instead of
     /// the offset surface (in a chain: this level is the finest and started from the input).
     pub started_from_input: bool,
+    /// In a chain, a coarser level that started from the next finer level's output (same
+    /// topology as its own offset surface) rather than from its own offset surface.
+    pub started_from_finer: bool,
     /// Guarantees verified afterwards by `crate::verify`: watertight, manifold (and
     /// consistently oriented), self-intersection-free, same topology as the offset surface,
     /// and for cages enclosure without contact.
@@ -270,6 +273,9 @@ impl LodReport {
         }
         e.count_entry("faces_offset", self.faces_offset);
         e.count_entry("started_from_input", self.started_from_input as u64);
+        if self.chain_level.is_some_and(|l| l > 0) {
+            e.count_entry("started_from_finer", self.started_from_finer as u64);
+        }
         e.metric_entry("simplify_first_pass_s", self.simplify_first_pass_seconds);
         e.count_entry("rounds", self.rounds);
         for (i, f) in self.faces_per_round.iter().enumerate() {
