@@ -189,7 +189,7 @@ struct BakeArgs {
     #[arg(long, value_parser = parse_start, default_value = "auto")]
     start: pleat::lowpoly::LodStart,
     /// LODs: the offset voxel to start from, a multiple of d/√3 in (0, 2] (`1` = the
-    /// dissertation's voxel) [default: 2 from n_p = 200 on, 1 below]; a coarser one is taken
+    /// dissertation's voxel) [default: 2 from n_p = 200 on, 1.25 from 100, 1 below]; a coarser one is taken
     /// when the memory estimate needs it. Ignored for cages.
     #[arg(long)]
     voxel_scale: Option<f64>,

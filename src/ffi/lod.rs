@@ -81,8 +81,8 @@ pub struct PleatLodParams {
     /// Reserved, 0 (keeps the struct free of padding).
     pub reserved: u32,
     /// LODs only: the offset voxel the bake starts from, as a multiple of d/√3, in (0, 2];
-    /// 0 (the default) = automatic (2 from n_p = 200 on, 1 below; see README "A coarser first
-    /// stage"). A coarser voxel is still taken when the memory estimate needs it. NaN,
+    /// 0 (the default) = automatic (2 from n_p = 200 on, 1.25 from 100, 1 below; see README
+    /// "A coarser first stage"). A coarser voxel is still taken when the memory estimate needs it. NaN,
     /// negative or > 2 is `PLEAT_STATUS_INVALID_ARGUMENT`. Appended for issue 12 part 4;
     /// callers with an older `struct_size` get automatic.
     pub offset_voxel_scale: f64,

@@ -126,7 +126,8 @@ pub struct LodParams {
     pub start: LodStart,
     /// LODs only (ignored for cages): the offset voxel the bake starts from, as a multiple of
     /// `d/√3`. `None` (default) follows the rule of [`LOD_VOXEL_SCALE`] (scale 2 from
-    /// [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] on, 1 below); `Some(s)` starts from `s`, finite and
+    /// [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] on, [`LOD_MEDIUM_VOXEL_SCALE`] from
+    /// [`LOD_MEDIUM_VOXEL_MIN_SCREEN_SIZE`] on, 1 below); `Some(s)` starts from `s`, finite and
     /// in `(0, 2]` (else `InvalidArgument`), e.g. `Some(1.0)` for the dissertation's voxel. The
     /// memory-budget fallback still applies: when `s` does not fit, the finest of
     /// [`LOD_VOXEL_SCALES`] coarser than `s` that fits is taken. Replaces the former benchmark
@@ -229,6 +230,20 @@ pub const LOD_VOXEL_SCALE: f64 = 2.0;
 /// The smallest screen size `n_p` at which a LOD starts from [`LOD_VOXEL_SCALE`] (see there).
 pub const LOD_COARSE_VOXEL_MIN_SCREEN_SIZE: f64 = 200.0;
 
+/// The offset voxel a LOD at a screen size in [`LOD_MEDIUM_VOXEL_MIN_SCREEN_SIZE`]`..`
+/// [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] starts from (issue 12 part 2, 2026-11-29): 0.64× the
+/// offset faces of scale 1, the first simplification pass in proportion. Measured at n_p = 100
+/// on the 23 corpus meshes (README, "LOD benchmark", "Session 19"): with the coarser coverage
+/// spacing of the fit (`coverage::SPACING`), median wall 1.09 → 0.69 s (scale 1.5: 0.63 s,
+/// scale 2: 0.56 s, with larger per-mesh Hausdorff changes); `run_suite.py --target-from
+/// pleat` with MeshLab QEM and meshoptimizer: mean normal difference 0.0807 → 0.0804, PSNR
+/// 22.30 → 22.39 dB, silhouette 0.0097 → 0.0092, faces −1.3%, all 23 valid. Only LODs that
+/// start from the offset surface change (clean inputs start from themselves).
+pub const LOD_MEDIUM_VOXEL_SCALE: f64 = 1.25;
+
+/// The smallest screen size `n_p` at which a LOD starts from [`LOD_MEDIUM_VOXEL_SCALE`].
+pub const LOD_MEDIUM_VOXEL_MIN_SCREEN_SIZE: f64 = 100.0;
+
 /// Peak bytes per *estimated* offset face ([`LodParams::memory_estimate`]'s face count): the
 /// first simplification pass holds the half-edge mesh, the guard's BVH and caches, the pass's
 /// quadrics and queue, plus the offset surface kept for an exact rerun and round 0's copy.
@@ -314,10 +329,13 @@ const BYTES_PER_INPUT_FACE: f64 = 700.0;
 
 /// The finest voxel scale a bake in `mode` at `screen_size` starts from: for LODs the caller's
 /// `requested` scale (the field `LodParams::offset_voxel_scale`) or else [`LOD_VOXEL_SCALE`] from
-/// [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] on and 1 below; for cages 1.
+/// [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] on, [`LOD_MEDIUM_VOXEL_SCALE`] from
+/// [`LOD_MEDIUM_VOXEL_MIN_SCREEN_SIZE`] on and 1 below; for cages 1.
 fn finest_voxel_scale(mode: Mode, screen_size: f64, requested: Option<f64>) -> f64 {
     let rule = if screen_size >= LOD_COARSE_VOXEL_MIN_SCREEN_SIZE {
         LOD_VOXEL_SCALE
+    } else if screen_size >= LOD_MEDIUM_VOXEL_MIN_SCREEN_SIZE {
+        LOD_MEDIUM_VOXEL_SCALE
     } else {
         1.0
     };
@@ -1877,8 +1895,8 @@ mod tests {
         };
         assert!(!tiny.measured_admission_may_fit(&m));
         assert!(matches!(tiny.validate(&m), Err(Error::LimitExceeded(_))));
-        // the default budget keeps the default voxel: 1 below the threshold, LOD_VOXEL_SCALE
-        // from it on (cages: 1)
+        // the default budget keeps the default voxel: 1 below the thresholds,
+        // LOD_MEDIUM_VOXEL_SCALE and LOD_VOXEL_SCALE from them on (cages: 1)
         let (_, rep) = run(&m, &base, Mode::Lod, &mut |_| true).unwrap();
         assert_eq!(rep.offset_voxel_scale, None);
         let large = LodParams {
@@ -1890,6 +1908,15 @@ mod tests {
             Some(LOD_VOXEL_SCALE)
         );
         assert_eq!(large.offset_voxel_scale(&m, Mode::Cage), Some(1.0));
+        let medium = LodParams {
+            screen_size: LOD_MEDIUM_VOXEL_MIN_SCREEN_SIZE,
+            ..base.clone()
+        };
+        assert_eq!(
+            medium.offset_voxel_scale(&m, Mode::Lod),
+            Some(LOD_MEDIUM_VOXEL_SCALE)
+        );
+        assert_eq!(medium.offset_voxel_scale(&m, Mode::Cage), Some(1.0));
         // a requested scale replaces the rule (here: scale 1 below the threshold; also a scale
         // off the list), the budget's fallback
         // to the coarser listed scales still applies, cages ignore it

@@ -170,7 +170,8 @@ pub struct LodReport {
     /// started from the finer level.
     pub offset_max_deviation_over_d: Option<f64>,
     /// The offset stage's voxel edge over the offset's default `d/√3` when not 1: for a LOD at
-    /// `n_p ≥ lowpoly::LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`, `lowpoly::LOD_VOXEL_SCALE` (2), or a
+    /// `n_p ≥ lowpoly::LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`, `lowpoly::LOD_VOXEL_SCALE` (2), at
+    /// `n_p ≥ lowpoly::LOD_MEDIUM_VOXEL_MIN_SCREEN_SIZE`, `lowpoly::LOD_MEDIUM_VOXEL_SCALE` (1.25), or a
     /// coarser scale of `lowpoly::LOD_VOXEL_SCALES` when the memory budget needs one; `None` for cages (always 1) and in a chain level started
     /// from the finer level.
     pub offset_voxel_scale: Option<f64>,

@@ -58,7 +58,7 @@ pub struct LodBenchArgs {
     #[arg(long, value_parser = super::parse_clearance)]
     pub clearance: Option<pleat::lowpoly::Clearance>,
     /// LODs: the offset voxel to start from, a multiple of d/√3 in (0, 2] (`1` = the
-    /// dissertation's voxel) [default: 2 from n_p = 200 on, 1 below]; see `pleat lod
+    /// dissertation's voxel) [default: 2 from n_p = 200 on, 1.25 from 100, 1 below]; see `pleat lod
     /// --voxel-scale`.
     #[arg(long)]
     pub voxel_scale: Option<f64>,
