@@ -41,6 +41,11 @@ use super::guard::InputModel;
 /// safety revert still judge the fitted LOD.
 pub const SPACING: f64 = 1.0;
 
+/// Fewer samples than this are checked on the calling thread: a fit operation's patch is
+/// small, and below this the thread pool's wake-ups cost more than the work (issue 12 part 2:
+/// `sched_yield` and futex calls were ≈ 20% of a chain's CPU). The answers do not depend on it.
+const PARALLEL_MIN: usize = 2048;
+
 /// Cap on the per-edge subdivisions of one input triangle's samples.
 const MAX_SUBDIVISIONS: usize = 32;
 
@@ -135,28 +140,34 @@ impl Coverage {
             .map(|&(flo, fhi)| (flo - grow, fhi + grow))
             .collect();
         let (points, budget) = (&self.points, &self.budget);
-        self.tree
-            .overlapping(points, budget, lo, hi)
-            .into_par_iter()
-            .with_min_len(64)
-            .filter_map(|s| {
-                let (p, b) = (points[s as usize], budget[s as usize]);
-                let (face, dist) = grown.iter().enumerate().find_map(|(k, &(flo, fhi))| {
-                    if !cube_meets(p, b, flo, fhi) {
-                        return None;
-                    }
-                    patch.near_or_inside(k, p, b).map(|dist| (k, dist))
-                })?;
-                let spare = b - dist;
-                // kept unseen by every trial (`keeps_within`'s shortcut): left out
-                let unseen = moved.is_some_and(|m| spare >= m + box_cull_margin(p, b + m));
-                (!unseen).then_some(Relying {
-                    sample: s,
-                    face: face as u32,
-                    spare,
-                })
+        let candidates = self.tree.overlapping(points, budget, lo, hi);
+        let relying = |s: u32| {
+            let (p, b) = (points[s as usize], budget[s as usize]);
+            let (face, dist) = grown.iter().enumerate().find_map(|(k, &(flo, fhi))| {
+                if !cube_meets(p, b, flo, fhi) {
+                    return None;
+                }
+                patch.near_or_inside(k, p, b).map(|dist| (k, dist))
+            })?;
+            let spare = b - dist;
+            // kept unseen by every trial (`keeps_within`'s shortcut): left out
+            let unseen = moved.is_some_and(|m| spare >= m + box_cull_margin(p, b + m));
+            (!unseen).then_some(Relying {
+                sample: s,
+                face: face as u32,
+                spare,
             })
-            .collect()
+        };
+        // in the candidates' order either way (`collect` keeps it)
+        if candidates.len() >= PARALLEL_MIN {
+            candidates
+                .into_par_iter()
+                .with_min_len(64)
+                .filter_map(relying)
+                .collect()
+        } else {
+            candidates.into_iter().filter_map(relying).collect()
+        }
     }
 
     /// Whether the faces `new` keep every sample of `relying` (from [`Coverage::relying_on`])
@@ -173,14 +184,20 @@ impl Coverage {
     /// predicate's, as with the box test.
     fn keeps_within(&mut self, relying: &[Relying], new: &[[Vec3; 3]], moved: Option<f64>) -> bool {
         let patch = Patch::new(new);
-        let ok = relying.par_iter().all(|r| {
+        let kept = |r: &Relying| {
             let s = r.sample as usize;
             let (p, b) = (self.points[s], self.budget[s]);
             if moved.is_some_and(|m| r.spare >= m + box_cull_margin(p, b + m)) {
                 return true;
             }
             patch.face_within(p, b, r.face as usize).is_some()
-        });
+        };
+        // a conjunction: the same answer in any order
+        let ok = if relying.len() >= PARALLEL_MIN {
+            relying.par_iter().with_min_len(64).all(kept)
+        } else {
+            relying.iter().all(kept)
+        };
         if !ok {
             self.refused += 1;
         }
