@@ -43,6 +43,7 @@ pub use pipeline::{
     check_clean, generate, generate_chain, Clearance, LodParams, LodStart, AUTO_MAX_GENUS,
     DEFAULT_CLEARANCE_FRACTION, FIT_HAUSDORFF_SLACK, LOD_COARSE_VOXEL_MIN_SCREEN_SIZE,
     LOD_MEDIUM_VOXEL_MIN_SCREEN_SIZE, LOD_MEDIUM_VOXEL_SCALE, LOD_VOXEL_SCALE, LOD_VOXEL_SCALES,
+    STALL_ROUNDS,
 };
 #[cfg(feature = "cage")]
 pub(crate) use pipeline::{run, run_chain, Mode};

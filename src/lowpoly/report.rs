@@ -197,6 +197,9 @@ pub struct LodReport {
     pub target_relaxations: u64,
     /// The last round's convergence test passed (change below `ε·l`).
     pub converged: bool,
+    /// The loop ended because [`crate::lowpoly::STALL_ROUNDS`] rounds in a row made no new
+    /// smallest face count (LODs without a face target).
+    pub stalled: bool,
     /// Wall seconds of the first simplification pass (on the dense start surface).
     pub simplify_first_pass_seconds: f64,
     /// Total vertex motion of the flow steps (model units, summed over vertices and rounds).
@@ -306,6 +309,7 @@ impl LodReport {
         e.count_entry("target_met", self.target_met as u64);
         e.count_entry("target_relaxations", self.target_relaxations);
         e.count_entry("converged", self.converged as u64);
+        e.count_entry("stalled", self.stalled as u64);
         e.metric_entry("flow_motion", self.flow_motion);
         e.metric_entry("align_motion", self.align_motion);
         e.count_entry("fit_moves", self.fit_moves);
