@@ -1873,7 +1873,7 @@ mod tests {
         let s = STALL_ROUNDS as u64;
         // still falling, or too few rounds to tell
         assert!(!has_stalled(&(0..2 * s).rev().collect::<Vec<_>>()));
-        assert!(!has_stalled(&vec![100; STALL_ROUNDS]));
+        assert!(!has_stalled(&[100; STALL_ROUNDS]));
         // a plateau (with ups and downs above its floor) of STALL_ROUNDS rounds
         let mut f = vec![120, 100];
         f.extend((0..s).map(|i| 100 + 2 * (i % 2)));
