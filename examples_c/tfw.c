@@ -88,6 +88,9 @@ static void solve_sheet(void) {
     CHECK(st.vertex_count > 500 && st.sqp_iterations > 0);
     CHECK(st.peak_amplitude >= 0.28e-3 && st.peak_amplitude <= 0.50e-3);
     CHECK(st.energy <= st.initial_energy && st.curl_residual <= 1e-10);
+    /* appended 2026-11-29: nothing snapped (snapping is off by default), no SQP rescue */
+    CHECK(st.snapped_loops == 0 && st.snap_max_correction == 0.0);
+    CHECK(st.sqp_rescue_iteration == -1);
     printf("sheet: status %u, %llu vertices, %u SQP iterations, peak amplitude %.3f mm, "
            "base %.2f s, SQP %.2f s\n",
            st.status, (unsigned long long)st.vertex_count, st.sqp_iterations,
@@ -281,6 +284,11 @@ static void arrays_scene(void) {
     p = pleat_tfw_params_default();
     p.snap_periods = 2; /* appended 2026-11-29: 0 or 1 */
     CHECK_STATUS(pleat_tfw_solve(s, &p, NULL, NULL, &r), PLEAT_STATUS_INVALID_ARGUMENT);
+    p = pleat_tfw_params_default();
+    CHECK(p.valley_search == 1);
+    p.valley_search = 2; /* appended 2026-11-29: 0 or 1 */
+    CHECK_STATUS(pleat_tfw_solve(s, &p, NULL, NULL, &r), PLEAT_STATUS_INVALID_ARGUMENT);
+    CHECK(strstr(pleat_last_error(), "valley_search") != NULL);
     CHECK_STATUS(pleat_tfw_solve(NULL, NULL, NULL, NULL, &r), PLEAT_STATUS_INVALID_ARGUMENT);
     CHECK_STATUS(pleat_tfw_solve(s, NULL, NULL, NULL, NULL), PLEAT_STATUS_INVALID_ARGUMENT);
     CHECK(r == NULL);

@@ -1047,6 +1047,13 @@ typedef struct PleatTfwParams {
   uint32_t snap_periods;
   // Reserved, set to 0.
   uint32_t reserved4;
+  // 1 (default): the projected-Newton SQP's valley search near the optimum (a 1-D search
+  // along (a, ω) → (a/μ, μω), README "Thickness × 10⁻²"; what makes thin shells converge);
+  // 0: off, the plain projected Newton. Appended 2026-11-29: a shorter struct (without it)
+  // gets the default.
+  uint32_t valley_search;
+  // Reserved, set to 0.
+  uint32_t reserved5;
 } PleatTfwParams;
 
 // Material and loads of `pleat_tfw_scene_from_arrays` (SI units). Get the defaults from
@@ -1168,6 +1175,21 @@ typedef struct PleatTfwStats {
   double seconds_qp;
   // Wall seconds of the Knöppel phase.
   double seconds_phase;
+  // Loops whose period of ω was snapped to a multiple of 2π (`snap_periods`; 0 when off
+  // or none). Appended 2026-11-29, like every field below.
+  uint32_t snapped_loops;
+  // Independent loops around wrinkle-free islands whose periods were kept.
+  uint32_t snap_kept_loops;
+  // Largest `|period − 2π·waves|` over the snapped loops after snapping (rad); 0 when none.
+  double snap_max_period_error;
+  // `max_e |δω_e|` of the snapping correction (rad); 0 when none.
+  double snap_max_correction;
+  // `‖δω‖ / ‖ω‖` of the snapping correction (rest metric over the faces outside W); 0
+  // when none.
+  double snap_relative_correction;
+  // The SQP iteration at which a step without decrease was retried with raised weights
+  // and kept them (README "SQP rescue"); −1 when no rescue was needed.
+  int64_t sqp_rescue_iteration;
 } PleatTfwStats;
 
 // A wave count on the evaluated wrinkled surface (`pleat_tfw_result_count_waves`). Set

@@ -152,6 +152,13 @@ pub struct PleatTfwParams {
     pub snap_periods: u32,
     /// Reserved, set to 0.
     pub reserved4: u32,
+    /// 1 (default): the projected-Newton SQP's valley search near the optimum (a 1-D search
+    /// along (a, ω) → (a/μ, μω), README "Thickness × 10⁻²"; what makes thin shells converge);
+    /// 0: off, the plain projected Newton. Appended 2026-11-29: a shorter struct (without it)
+    /// gets the default.
+    pub valley_search: u32,
+    /// Reserved, set to 0.
+    pub reserved5: u32,
 }
 
 /// Material and loads of `pleat_tfw_scene_from_arrays` (SI units). Get the defaults from
@@ -227,6 +234,21 @@ pub struct PleatTfwStats {
     pub seconds_qp: f64,
     /// Wall seconds of the Knöppel phase.
     pub seconds_phase: f64,
+    /// Loops whose period of ω was snapped to a multiple of 2π (`snap_periods`; 0 when off
+    /// or none). Appended 2026-11-29, like every field below.
+    pub snapped_loops: u32,
+    /// Independent loops around wrinkle-free islands whose periods were kept.
+    pub snap_kept_loops: u32,
+    /// Largest `|period − 2π·waves|` over the snapped loops after snapping (rad); 0 when none.
+    pub snap_max_period_error: f64,
+    /// `max_e |δω_e|` of the snapping correction (rad); 0 when none.
+    pub snap_max_correction: f64,
+    /// `‖δω‖ / ‖ω‖` of the snapping correction (rest metric over the faces outside W); 0
+    /// when none.
+    pub snap_relative_correction: f64,
+    /// The SQP iteration at which a step without decrease was retried with raised weights
+    /// and kept them (README "SQP rescue"); −1 when no rescue was needed.
+    pub sqp_rescue_iteration: i64,
 }
 
 /// A rigid obstacle of the base solve (`pleat_tfw_scene_add_obstacle`; the scene file's
@@ -369,6 +391,8 @@ impl From<&crate::tfw::TfwParams> for PleatTfwParams {
             reserved3: 0,
             snap_periods: u32::from(p.snap_periods),
             reserved4: 0,
+            valley_search: u32::from(p.sqp.valley_search),
+            reserved5: 0,
         }
     }
 }
@@ -401,6 +425,8 @@ pub(super) fn defaults_without_tfw() -> PleatTfwParams {
         reserved3: 0,
         snap_periods: 0,
         reserved4: 0,
+        valley_search: 1,
+        reserved5: 0,
     }
 }
 
@@ -1095,6 +1121,7 @@ pub(super) mod imp {
             }
         };
         check_range(p.snap_periods, 0, 1, "params->snap_periods")?;
+        check_range(p.valley_search, 0, 1, "params->valley_search")?;
         let f = p.out_of_scope_slack_fraction;
         let f_ok = (0.0..=1.0).contains(&f);
         check_f64(f, f_ok, "params->out_of_scope_slack_fraction", "in [0, 1]")?;
@@ -1131,6 +1158,7 @@ pub(super) mod imp {
                 time_limit_seconds: if t > 0.0 { t } else { f64::INFINITY },
                 qp,
                 snapshot_every: 0,
+                valley_search: p.valley_search == 1,
                 ..SqpOptions::default()
             },
             curvature,
@@ -1251,6 +1279,7 @@ pub(super) mod imp {
     /// The C stats of a result.
     pub(in crate::ffi) fn stats(r: &TfwResult) -> PleatTfwStats {
         let sqp = r.sqp.as_ref();
+        let snap = r.snap.as_ref();
         let last = sqp.and_then(|s| s.history.last());
         let u32_of = |n: usize| n.min(u32::MAX as usize) as u32;
         PleatTfwStats {
@@ -1277,6 +1306,16 @@ pub(super) mod imp {
             seconds_sqp: r.seconds.sqp,
             seconds_qp: sqp.map_or(0.0, |s| s.qp_seconds),
             seconds_phase: r.seconds.phase,
+            snapped_loops: u32_of(snap.map_or(0, |s| s.loops.len())),
+            snap_kept_loops: u32_of(snap.map_or(0, |s| s.kept_loops)),
+            snap_max_period_error: snap.map_or(0.0, |s| s.max_period_error()),
+            snap_max_correction: snap.map_or(0.0, |s| s.max_correction),
+            snap_relative_correction: snap
+                .filter(|s| s.omega_norm > 0.0)
+                .map_or(0.0, |s| s.correction_norm / s.omega_norm),
+            sqp_rescue_iteration: sqp
+                .and_then(|s| s.rescued_at)
+                .map_or(-1, |i| i.min(i64::MAX as usize) as i64),
         }
     }
 
@@ -1458,6 +1497,28 @@ mod tests {
         p.snap_periods = 2;
         let e = read(&p).unwrap_err().to_string();
         assert!(e.contains("params->snap_periods"), "{e}");
+    }
+
+    /// `valley_search` (appended 2026-11-29): on by default and for an older, shorter
+    /// struct, off with 0, a value other than 0 or 1 rejected naming the field.
+    #[test]
+    fn valley_search_field_is_versioned_and_checked() {
+        let read = |p: &PleatTfwParams| {
+            // SAFETY: `p` is a live struct of at least `p.struct_size` bytes.
+            let v = unsafe { crate::ffi::boundary::read_versioned(p, "params") }?;
+            imp::params(&v)
+        };
+        let mut p = pleat_tfw_params_default();
+        assert_eq!(p.valley_search, 1);
+        assert!(read(&p).unwrap().sqp.valley_search);
+        p.valley_search = 0;
+        assert!(!read(&p).unwrap().sqp.valley_search);
+        p.struct_size = std::mem::offset_of!(PleatTfwParams, valley_search) as u32;
+        assert!(read(&p).unwrap().sqp.valley_search);
+        p.struct_size = std::mem::size_of::<PleatTfwParams>() as u32;
+        p.valley_search = 2;
+        let e = read(&p).unwrap_err().to_string();
+        assert!(e.contains("params->valley_search"), "{e}");
     }
 
     /// `pleat_tfw_scene_add_obstacle` gives the scene a JSON `obstacles` entry gives, takes

@@ -1411,7 +1411,7 @@ _TfwParams = _struct("PleatTfwParams",
                              "sqp_initial_shift", "sqp_time_limit_seconds",
                              "out_of_scope_slack_fraction")
                      + _u32s("curvature", "reserved2", "qp", "reserved3", "snap_periods",
-                             "reserved4"))
+                             "reserved4", "valley_search", "reserved5"))
 _TfwMaterial = _struct("PleatTfwMaterial", _u32s("struct_size", "reserved")
                        + _f64s("young", "poisson", "thickness", "density")
                        + [("gravity", _c.c_double * 3)] + _f64s("pressure"))
@@ -1422,7 +1422,11 @@ _TfwStats = _struct("PleatTfwStats",
                     + _f64s("energy", "initial_energy", "residual", "initial_residual",
                             "curl_residual", "peak_amplitude", "base_relative_gradient",
                             "seconds_base", "seconds_init", "seconds_sqp", "seconds_qp",
-                            "seconds_phase"))
+                            "seconds_phase")
+                    + _u32s("snapped_loops", "snap_kept_loops")
+                    + _f64s("snap_max_period_error", "snap_max_correction",
+                            "snap_relative_correction")
+                    + [("sqp_rescue_iteration", _c.c_int64)])
 _TfwObstacle = _struct("PleatTfwObstacle", _u32s("struct_size", "kind")
                        + [("point", _c.c_double * 3), ("normal", _c.c_double * 3)]
                        + _f64s("radius", "stiffness", "margin"))
@@ -1482,7 +1486,7 @@ def _tfw_params(w_rule="text", curvature="quadric", qp=None, **kw):
         p.qp = _TFW_QP[qp]
     names = {n for n, _ in _TfwParams._fields_} - {"struct_size", "reserved", "w_rule",
                                                     "curvature", "reserved2", "qp",
-                                                    "reserved3", "reserved4"}
+                                                    "reserved3", "reserved4", "reserved5"}
     for k, v in kw.items():
         if k not in names:
             raise PleatError(1, f"unknown TFW parameter {k!r}; known: {sorted(names)}")
@@ -1568,7 +1572,10 @@ class TfwScene(_Handle):
         """Solves the scene (base surface, wrinkle SQP, phase); keywords are PleatTfwParams
         fields (e.g. ``sqp_max_iterations=50``, ``w_rule="reference"``,
         ``curvature="normals"``, ``qp="newton"`` or ``"clarabel"``, ``snap_periods=1`` to
-        snap ω's periods around non-contractible loops to multiples of 2π; default: the library's).
+        snap ω's periods around non-contractible loops to multiples of 2π, ``valley_search=0``
+        to turn off the projected Newton's valley search; default: the library's). ``stats``
+        of the result then carry ``snapped_loops``, ``snap_max_period_error``, … and
+        ``sqp_rescue_iteration`` (−1: none).
         ``progress(stage, fraction)`` returning True cancels (PleatError CANCELLED)."""
         p = _tfw_params(**params)
         relay, h = _Relay(progress), _P()

@@ -100,6 +100,24 @@ def test_both_step_solvers():
     assert "qp" in str(e.value)
 
 
+def test_snap_rescue_stats_and_valley_switch(solved):
+    """The fields appended 2026-11-29: snapping statistics (a flat sheet has no
+    non-contractible loop: nothing snapped), the SQP rescue (none: −1), and
+    ``valley_search=0`` (same kind of field without the valley search); 2 is an error."""
+    s = solved.stats
+    assert s["snapped_loops"] == 0 and s["snap_max_correction"] == 0
+    assert s["sqp_rescue_iteration"] == -1
+    uv, tris, pos, clamped = sheet_arrays()
+    scene = pleat.TfwScene.from_arrays(uv, tris, pos, clamped, young=1e6, poisson=0.5,
+                                       thickness=1e-4)
+    off = scene.solve(sqp_max_iterations=40, valley_search=0, snap_periods=1).stats
+    assert off["curl_residual"] <= 1e-10 and off["energy"] <= off["initial_energy"]
+    assert off["snapped_loops"] == 0
+    with pytest.raises(pleat.PleatError) as e:
+        scene.solve(valley_search=2)
+    assert "valley_search" in str(e.value)
+
+
 def test_count_waves(solved):
     """``count_waves`` (pleat_tfw_result_count_waves): the automatic section crosses the
     sheet's waves; the same plane given explicitly gives the same count; bad input raises."""
