@@ -764,7 +764,9 @@ typedef struct PleatWrinkleInterpStats {
 typedef struct PleatLodParams {
   // `sizeof(PleatLodParams)`; at least the offset of `target_faces` (16).
   uint32_t struct_size;
-  // Maximum number of optimization rounds N (default 50; 0 returns the offset surface).
+  // Maximum number of optimization rounds N (default 50; 0 returns the offset surface). A
+  // LOD without a face target stops earlier after 5 rounds without a new smallest face
+  // count (README "Session 19").
   uint32_t max_rounds;
   // Screen size n_p in pixels covered by the input's bounding-box diagonal l (default 200).
   // The offset distance and error bound is d = l / n_p. Finite and > 0.

@@ -168,7 +168,7 @@ struct BakeArgs {
     /// batch: the pattern for the manifest rows that name no output (optional when all do).
     #[arg(short, long, required_unless_present = "manifest")]
     output: Option<PathBuf>,
-    /// Maximum optimization rounds N.
+    /// Maximum optimization rounds N (a LOD without --faces also stops after 5 rounds without a new smallest face count).
     #[arg(long, default_value_t = 50)]
     rounds: u32,
     /// Skip the feature-alignment step.

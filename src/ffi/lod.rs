@@ -44,7 +44,9 @@ pub const PLEAT_LOD_NO_FIT: u32 = 8;
 pub struct PleatLodParams {
     /// `sizeof(PleatLodParams)`; at least the offset of `target_faces` (16).
     pub struct_size: u32,
-    /// Maximum number of optimization rounds N (default 50; 0 returns the offset surface).
+    /// Maximum number of optimization rounds N (default 50; 0 returns the offset surface). A
+    /// LOD without a face target stops earlier after 5 rounds without a new smallest face
+    /// count (README "Session 19").
     pub max_rounds: u32,
     /// Screen size n_p in pixels covered by the input's bounding-box diagonal l (default 200).
     /// The offset distance and error bound is d = l / n_p. Finite and > 0.
