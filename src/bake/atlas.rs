@@ -190,8 +190,8 @@ impl Gutter {
 /// [`build_atlas`] that may grow the side so the gutters do not eat the texel density: with
 /// `grow = Some((ρ, max_side))` (ρ the density rule's texels per unit length), once the
 /// charts are known the side doubles, up to `max_side`, while the density planned for them
-/// with their gutters ([`pack_density`]) is below `ρ / 2` or the gutters alone do not fit
-/// ([`gutters_fit`]). Small atlases need it: at 64² the 15-texel gutters of a handful of charts
+/// with their gutters (`pack_density`) is below `ρ / 2` or the gutters alone do not fit
+/// (`gutters_fit`). Small atlases need it: at 64² the 15-texel gutters of a handful of charts
 /// alone exceed the atlas, and a soup's LOD with thousands of charts needs it at any side
 /// the rule picks. The returned [`Atlas::size`] is the side used. When the charts still do
 /// not fit (no growth allowed, or the cap reached), the padding is halved until they do

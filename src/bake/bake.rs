@@ -149,7 +149,7 @@ pub fn bake_level(
 /// [`bake_level`] with progress and cancellation: `progress` is called on this thread with
 /// the stages `bake: provenance` (untextured inputs), `bake: atlas`, `bake: tangents` (the
 /// normal map's MikkTSpace frame), `bake: rasterise`, `bake: texels` (every
-/// [`TEXELS_PER_CHECK`] texels, so a cancel is honoured within about 10 ms of work),
+/// `TEXELS_PER_CHECK` texels, so a cancel is honoured within about 10 ms of work),
 /// `bake: dilation` and `bake: measure`; fractions rise from 0 to 1. Returning `false` stops
 /// the bake with `Error::Cancelled`. The output is the same bytes as [`bake_level`]'s, whatever
 /// the thread count.

@@ -44,28 +44,28 @@ pub struct BakeReport {
     pub fallback_fraction: f64,
     /// Mean appearance error: |baked base colour − input base colour at the closest input
     /// point|, max over R, G, B, in sRGB units of 1/255, over up to
-    /// [`BakeParams::error_samples`] covered texels (vertices for vertex colours).
+    /// [`BakeParams::error_samples`](crate::bake::BakeParams::error_samples) covered texels (vertices for vertex colours).
     pub appearance_error_mean: f64,
     /// 95th percentile of the same error, in 1/255.
     pub appearance_error_p95: f64,
     /// Maximum of the same error, in 1/255.
     pub appearance_error_max: f64,
-    /// With [`BakeParams::evaluate`]: unlit PSNR (dB) of the level's render against the
+    /// With [`BakeParams::evaluate`](crate::bake::BakeParams::evaluate): unlit PSNR (dB) of the level's render against the
     /// input's, mean over 24 views at the level's screen size, over pixels both cover
     /// ([`super::render`]).
     pub appearance_psnr_db: Option<f64>,
-    /// With [`BakeParams::evaluate`]: the same PSNR for the level's geometry coloured by the
+    /// With [`BakeParams::evaluate`](crate::bake::BakeParams::evaluate): the same PSNR for the level's geometry coloured by the
     /// input at the closest input point (a perfect bake's score; the bake loses
     /// `appearance_psnr_reference_db − appearance_psnr_db`).
     pub appearance_psnr_reference_db: Option<f64>,
-    /// With [`BakeParams::evaluate`]: the unlit PSNR pooled over all views (one mean squared
+    /// With [`BakeParams::evaluate`](crate::bake::BakeParams::evaluate): the unlit PSNR pooled over all views (one mean squared
     /// error over every pixel both renders cover), which a view sharing only a few pixels (a
     /// flat asset seen edge-on) cannot dominate as it can the mean over views.
     pub appearance_psnr_pooled_db: Option<f64>,
-    /// With [`BakeParams::evaluate`]: the closest-point reference's pooled PSNR (the bake
+    /// With [`BakeParams::evaluate`](crate::bake::BakeParams::evaluate): the closest-point reference's pooled PSNR (the bake
     /// loses `appearance_psnr_reference_pooled_db − appearance_psnr_pooled_db` over all pixels).
     pub appearance_psnr_reference_pooled_db: Option<f64>,
-    /// With [`BakeParams::evaluate`] and a baked normal map: shaded PSNR with the normal map
+    /// With [`BakeParams::evaluate`](crate::bake::BakeParams::evaluate) and a baked normal map: shaded PSNR with the normal map
     /// minus shaded PSNR without it, dB (> 0: the map brings the level closer to the input).
     pub normal_map_gain_db: Option<f64>,
     /// Seconds spent on the evaluation renders (not in `total_seconds`).

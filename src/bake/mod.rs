@@ -5,7 +5,7 @@
 //! - [`appearance`]: glTF materials, textures (sRGB-correct), UV sets, texture transforms,
 //!   vertex colours, normals and tangents, in world space.
 //! - [`obj`]: the same from a Wavefront OBJ + MTL (`Kd`, `map_Kd`, `vt`, several materials).
-//! - [`provenance`]: LOD point → input triangle and barycentric coordinates (cast along the
+//! - [`provenance`](mod@provenance): LOD point → input triangle and barycentric coordinates (cast along the
 //!   LOD normal within an envelope of a few `d`, closest point as fallback).
 //! - [`atlas`]: xatlas charts and packing with a texel density rule from the screen size.
 //! - [`bake`](mod@bake): per-texel sampling, MikkTSpace normal map, dilation; vertex colours

@@ -232,7 +232,7 @@ const DEFAULT_EVAL_LEVELS: u32 = 3;
 
 #[cfg(feature = "wrinkle")]
 impl From<&crate::wrinkle::EvalOptions> for PleatWrinkleEvalParams {
-    /// `levels` is [`DEFAULT_EVAL_LEVELS`]; `want_z` sets `PLEAT_WRINKLE_FIELD_Z`.
+    /// `levels` is `DEFAULT_EVAL_LEVELS`; `want_z` sets `PLEAT_WRINKLE_FIELD_Z`.
     fn from(o: &crate::wrinkle::EvalOptions) -> Self {
         use crate::wrinkle::BoundaryRule;
         let bit = |on: bool, b: u32| if on { b } else { 0 };

@@ -4,7 +4,7 @@
 //!
 //! Two closest-point-on-triangle variants exist because pleat's stages have always rounded the
 //! face-interior case differently and their outputs depend on it bit for bit: both walk the
-//! same Voronoi regions (Ericson, *Real-Time Collision Detection*, §5.1.5, [`voronoi_walk`]);
+//! same Voronoi regions (Ericson, *Real-Time Collision Detection*, §5.1.5, `voronoi_walk`);
 //! [`closest_on_triangle`] (any triangle, degenerate ones via their edges) scales the
 //! barycentrics by the reciprocal of their sum, [`closest_on_nondegenerate_triangle`] (the
 //! distance field's primitives, slivers already removed) divides by the sum.

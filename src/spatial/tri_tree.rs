@@ -135,7 +135,7 @@ impl TriTree {
 
     /// Calls `f` with every triangle of the tree whose current box meets the closed box
     /// `[lo, hi]` (touching counts), in tree order; `positions` and `triangles` are the
-    /// current ones (every triangle moved since the build must have been [`update`]d
+    /// current ones (every triangle moved since the build must have been `update`d
     /// (Self::update)).
     pub fn for_each_in_box(
         &self,

@@ -13,7 +13,7 @@
 //! `a(q)` is the P1 interpolant, `da = (a1−a0, a2−a0)`, `ω_f = (ω(v0→v1), ω(v0→v2))` from the
 //! face's edges at corner 0 (`s0 ω[e0]`, `−s2 ω[e2]`). The energy is a polynomial of degree 8
 //! in the five local unknowns `(a0, a1, a2, ω01, ω02)`: value, gradient and Hessian come from
-//! one evaluation in second-order forward mode ([`Jet`]), so they are exact to rounding.
+//! one evaluation in second-order forward mode (`Jet`), so they are exact to rounding.
 //!
 //! Unknowns are numbered `[a_0 … a_{n−1}, ω_0 … ω_{m−1}]` (vertices, then edges).
 
@@ -38,7 +38,7 @@ pub(crate) struct Jet {
 
 /// The arithmetic the face energy needs, so one generic formula ([`WrinkleEnergy::face_energy`])
 /// gives the plain value (`f64`, for line searches: no derivatives carried) and the value
-/// with its exact gradient and Hessian ([`Jet`]).
+/// with its exact gradient and Hessian (`Jet`).
 pub(crate) trait Scalar: Copy {
     /// A constant.
     fn constant(v: f64) -> Self;
@@ -398,7 +398,7 @@ impl WrinkleEnergy {
     }
 
     /// The face energy (module docs, eqs. 2.21–2.26 with the 3-point rule) in the arithmetic
-    /// `T`: the value (`f64`) or the value with exact derivatives ([`Jet`]); one formula, so
+    /// `T`: the value (`f64`) or the value with exact derivatives (`Jet`); one formula, so
     /// the line search's energy is bit-for-bit the value the Newton step's evaluation gives.
     fn face_energy<T: Scalar>(&self, f: &FaceData, x: &[f64], terms: WfTerms) -> T {
         let (idx, sg) = self.local_map(f);

@@ -10,7 +10,7 @@
 //!    `δω(t)` is added back at the end.
 //! 2. **Amplitude (B.35):** `a(t) = (1−t) a⁰ + t a¹` per vertex.
 //! 3. **Frequency (B.34, B.36–B.46):** the explicit magnitude/angle path of
-//!    [`omega_path`](super::omega_path) (derivation there), applied to `ω_com` and to `δω`,
+//!    `omega_path` (derivation there), applied to `ω_com` and to `δω`,
 //!    with the linear fallback where an endpoint amplitude vanishes.
 //! 4. **Phase (eq. 3.12, B.29, B.47):** `z̃` on the guide times `t_n = n/N'` minimizes
 //!
@@ -36,7 +36,7 @@
 //! Hessian `K + D(z̃)`, never factorized as a whole: each subproblem is solved by Steihaug–Toint
 //! conjugate gradients preconditioned with a symmetric red–black block Gauss–Seidel sweep over
 //! the guide frames, whose per-frame blocks (`2V × 2V`, planar pattern) are factored with faer's
-//! sparse Cholesky in parallel (details and the argument in [`spacetime`](super::spacetime)).
+//! sparse Cholesky in parallel (details and the argument in `spacetime`).
 //! Negative curvature near singularities is followed to the trust-region boundary instead of
 //! being damped away; the radius is updated by the ratio of actual to predicted decrease
 //! (Nocedal & Wright Alg. 4.1), and CG stops at the inexact-Newton forcing tolerance
@@ -116,7 +116,7 @@ pub enum HessianModel {
     Exact = 2,
     /// The default: the exact Hessian, never factorized — a trust-region Newton method whose
     /// subproblems are solved by Steihaug–Toint CG preconditioned by a symmetric block
-    /// Gauss–Seidel sweep over the guide frames (see [`spacetime`](super::spacetime)).
+    /// Gauss–Seidel sweep over the guide frames (see `spacetime`).
     /// Negative curvature is followed to the trust-region boundary, not damped.
     #[default]
     TrustRegion = 3,
@@ -905,7 +905,7 @@ impl Problem {
     }
 }
 
-/// Trust-region Newton–CG ([`HessianModel::TrustRegion`], see [`spacetime`](super::spacetime)).
+/// Trust-region Newton–CG ([`HessianModel::TrustRegion`], see `spacetime`).
 impl Problem {
     /// The frame blocks of `K` and the time coupling, for the preconditioner.
     fn frame_blocks(&self) -> Result<FrameBlocks> {
