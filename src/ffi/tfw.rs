@@ -1367,6 +1367,14 @@ mod tests {
     use std::ffi::CString;
     use std::ptr::null_mut;
 
+    /// `params` as `pleat_tfw_solve` reads them: versioned (a shorter `struct_size` gets the
+    /// defaults beyond it), then validated.
+    fn read(p: &PleatTfwParams) -> crate::Result<crate::tfw::TfwParams> {
+        // SAFETY: `p` is a live struct of at least `p.struct_size` bytes.
+        let v = unsafe { crate::ffi::boundary::read_versioned(p, "params") }?;
+        imp::params(&v)
+    }
+
     /// Base positions, amplitudes and the history of a small sheet solved through the C API
     /// on `threads` worker threads.
     fn solve_small(threads: u32, qp: u32) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
@@ -1428,11 +1436,6 @@ mod tests {
     #[test]
     fn curvature_field_is_versioned_and_checked() {
         use crate::tfw::curvature::CurvatureMethod;
-        let read = |p: &PleatTfwParams| {
-            // SAFETY: `p` is a live struct of at least `p.struct_size` bytes.
-            let v = unsafe { crate::ffi::boundary::read_versioned(p, "params") }?;
-            imp::params(&v)
-        };
         let mut p = pleat_tfw_params_default();
         assert_eq!(p.curvature, PLEAT_TFW_CURVATURE_QUADRIC_FIT);
         p.curvature = PLEAT_TFW_CURVATURE_VERTEX_NORMALS;
@@ -1452,11 +1455,6 @@ mod tests {
     #[test]
     fn qp_field_is_versioned_and_checked() {
         use crate::tfw::QpMethod;
-        let read = |p: &PleatTfwParams| {
-            // SAFETY: `p` is a live struct of at least `p.struct_size` bytes.
-            let v = unsafe { crate::ffi::boundary::read_versioned(p, "params") }?;
-            imp::params(&v)
-        };
         let mut p = pleat_tfw_params_default();
         let default = crate::tfw::TfwParams::default().sqp.qp;
         assert_eq!(read(&p).unwrap().sqp.qp, default);
@@ -1481,11 +1479,6 @@ mod tests {
     /// older, shorter one, a value other than 0 or 1 rejected with a message naming the field.
     #[test]
     fn snap_periods_field_is_versioned_and_checked() {
-        let read = |p: &PleatTfwParams| {
-            // SAFETY: `p` is a live struct of at least `p.struct_size` bytes.
-            let v = unsafe { crate::ffi::boundary::read_versioned(p, "params") }?;
-            imp::params(&v)
-        };
         let mut p = pleat_tfw_params_default();
         assert_eq!(p.snap_periods, 0);
         assert!(!read(&p).unwrap().snap_periods);
@@ -1503,11 +1496,6 @@ mod tests {
     /// struct, off with 0, a value other than 0 or 1 rejected naming the field.
     #[test]
     fn valley_search_field_is_versioned_and_checked() {
-        let read = |p: &PleatTfwParams| {
-            // SAFETY: `p` is a live struct of at least `p.struct_size` bytes.
-            let v = unsafe { crate::ffi::boundary::read_versioned(p, "params") }?;
-            imp::params(&v)
-        };
         let mut p = pleat_tfw_params_default();
         assert_eq!(p.valley_search, 1);
         assert!(read(&p).unwrap().sqp.valley_search);
