@@ -598,8 +598,8 @@ fn bench_tfw_writes_csv_and_svg() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// `pleat tfw --qp newton|clarabel` picks the step solver (printed in the summary); an
-/// unknown name exits 2 naming the flag.
+/// `pleat tfw --qp newton|clarabel` picks the step solver (printed in the summary),
+/// `--no-valley-search` runs; an unknown solver name exits 2 naming the flag.
 #[cfg(feature = "tfw")]
 #[test]
 fn tfw_qp_flag_picks_the_step_solver() {
@@ -629,6 +629,17 @@ fn tfw_qp_flag_picks_the_step_solver() {
         assert!(text.contains(&format!("step solver   {printed}")), "{text}");
         assert!(out.exists());
     }
+    // the valley search can be turned off (C: `valley_search = 0`, Python `valley_search=0`)
+    let args = [
+        "--levels",
+        "1",
+        "--qp",
+        "newton",
+        "--no-valley-search",
+        "-q",
+    ];
+    let o = pleat(&[&["tfw", path_str(&scene), "-o", path_str(&out)][..], &args].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let o = pleat(&["tfw", path_str(&scene), "-o", path_str(&out), "--qp", "cg"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--qp"));

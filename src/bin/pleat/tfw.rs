@@ -42,6 +42,10 @@ pub struct TfwArgs {
     /// the phase (default: as the SQP leaves them; see the README's "Period snapping").
     #[arg(long)]
     pub snap: bool,
+    /// Turn off the projected Newton's valley search near the optimum (on by default; see
+    /// the README's "Thickness × 10⁻²").
+    #[arg(long)]
+    pub no_valley_search: bool,
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
@@ -63,6 +67,7 @@ pub fn run(args: &TfwArgs) -> ExitCode {
     let mut params = TfwParams::default();
     params.sqp.max_iterations = args.max_iterations;
     params.snap_periods = args.snap;
+    params.sqp.valley_search = !args.no_valley_search;
     params.sqp.qp = match super::bench_tfw::parse_qp(&args.qp, params.sqp.qp) {
         Ok(q) => q,
         Err(e) => {
@@ -137,6 +142,9 @@ fn print_summary(r: &TfwResult, qp: QpMethod) {
             "energy        {:.6e} J → {:.6e} J; stationarity {:.3e} → {:.3e}",
             s.initial_energy, r.energy, s.initial_stationarity, last_r
         );
+        if let Some(i) = s.rescued_at {
+            println!("SQP rescue    at iteration {i} (step weights raised; README \"SQP rescue\")");
+        }
     }
     if let Some(s) = &r.snap {
         let loops: Vec<String> = s
