@@ -100,6 +100,16 @@ static void bake_chain(const PleatMesh *input) {
         /* The floor is measured on the level baked from the offset surface (the finest, n_p =
            100); coarser levels start from the finer result and report NaN. */
         CHECK(stats[i].started_from_input == 0);
+        /* Ranks from the finest (n_p = 100, baked first); the finest never starts from a
+           finer level. The stage times listed are part of the total. */
+        CHECK(stats[i].chain_level == 2 - i);
+        CHECK(stats[i].started_from_finer <= 1 && (i < 2 || stats[i].started_from_finer == 0));
+        CHECK(stats[i].stalled <= 1 && stats[i].converged <= 1 && stats[i].fit_reverted <= 1);
+        CHECK(stats[i].seconds_fit >= 0.0 && stats[i].seconds_measure > 0.0);
+        CHECK(stats[i].seconds_offset + stats[i].seconds_simplify + stats[i].seconds_flow +
+                  stats[i].seconds_align + stats[i].seconds_fit + stats[i].seconds_verify +
+                  stats[i].seconds_measure <=
+              stats[i].seconds_total * (1.0 + 1e-9));
         if (i == 2) {
             CHECK(stats[i].hausdorff_floor_relative >= 0.0 &&
                   stats[i].hausdorff_floor_relative < 2.0 / sizes[i]);
@@ -123,6 +133,9 @@ static void bake_cage(const PleatMesh *input) {
     if (!cage) return;
     verify("cage", cage);
     CHECK(st.encloses_input == 1);
+    /* A single bake has no chain rank; a cage runs no fit. */
+    CHECK(st.chain_level == -1 && st.started_from_finer == 0);
+    CHECK(st.seconds_fit == 0.0 && st.fit_reverted == 0);
     /* The default clearance, a tenth of d, measured exactly (not sampled). */
     CHECK(params.clearance == 0.1);
     CHECK(st.clearance_kept == 1);

@@ -884,6 +884,27 @@ typedef struct PleatLodStats {
   // allocating it): the peak bytes estimated from those counts, which fitted the memory
   // budget. NaN otherwise.
   double measured_estimate_bytes;
+  // In a chain: 1 when this coarser level started from the next finer level's result
+  // (its own offset surface had the finer level's topology), 0 when from its own offset
+  // surface, and for the finest level or a single bake.
+  uint32_t started_from_finer;
+  // 1 when the loop ended because `STALL_ROUNDS` (5) rounds in a row made no new smallest
+  // face count (LODs without a face target).
+  uint32_t stalled;
+  // 1 when the last round's convergence test passed (change below `epsilon · l`).
+  uint32_t converged;
+  // 1 when the input-plane fit was reverted because the Hausdorff distance grew (the
+  // result is the loop's output).
+  uint32_t fit_reverted;
+  // Wall seconds of the input-plane fit (with the measurement of its safety revert).
+  double seconds_fit;
+  // Wall seconds of the Hausdorff measurement. With `seconds_offset`, `seconds_simplify`,
+  // `seconds_flow`, `seconds_align`, `seconds_fit`, `seconds_verify` and the stages not
+  // listed (convergence tests, the floor and, for cages, the clearance measurement), this
+  // makes up `seconds_total`.
+  double seconds_measure;
+  // Rank of the level in a chain, 0 = finest (baked first); -1 for a single bake.
+  int64_t chain_level;
 } PleatLodStats;
 
 // Parameters of `pleat_offset_surface`. Get defaults from `pleat_offset_params_default()` and

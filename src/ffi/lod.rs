@@ -173,6 +173,27 @@ pub struct PleatLodStats {
     /// allocating it): the peak bytes estimated from those counts, which fitted the memory
     /// budget. NaN otherwise.
     pub measured_estimate_bytes: f64,
+    /// In a chain: 1 when this coarser level started from the next finer level's result
+    /// (its own offset surface had the finer level's topology), 0 when from its own offset
+    /// surface, and for the finest level or a single bake.
+    pub started_from_finer: u32,
+    /// 1 when the loop ended because `STALL_ROUNDS` (5) rounds in a row made no new smallest
+    /// face count (LODs without a face target).
+    pub stalled: u32,
+    /// 1 when the last round's convergence test passed (change below `epsilon · l`).
+    pub converged: u32,
+    /// 1 when the input-plane fit was reverted because the Hausdorff distance grew (the
+    /// result is the loop's output).
+    pub fit_reverted: u32,
+    /// Wall seconds of the input-plane fit (with the measurement of its safety revert).
+    pub seconds_fit: f64,
+    /// Wall seconds of the Hausdorff measurement. With `seconds_offset`, `seconds_simplify`,
+    /// `seconds_flow`, `seconds_align`, `seconds_fit`, `seconds_verify` and the stages not
+    /// listed (convergence tests, the floor and, for cages, the clearance measurement), this
+    /// makes up `seconds_total`.
+    pub seconds_measure: f64,
+    /// Rank of the level in a chain, 0 = finest (baked first); -1 for a single bake.
+    pub chain_level: i64,
 }
 
 /// The defaults, with `struct_size = sizeof(PleatLodParams)`.
@@ -352,7 +373,7 @@ pub(super) mod imp {
     }
 
     /// The C stats, field by field from the typed report.
-    pub(super) fn to_c(mesh: &TriMesh, s: &LodReport) -> PleatLodStats {
+    pub(in crate::ffi) fn to_c(mesh: &TriMesh, s: &LodReport) -> PleatLodStats {
         let v = &s.verified;
         PleatLodStats {
             struct_size: std::mem::size_of::<PleatLodStats>() as u32,
@@ -385,6 +406,13 @@ pub(super) mod imp {
             clearance_kept: s.clearance.is_some_and(|c| c.kept) as u32,
             started_from_input: s.started_from_input as u32,
             measured_estimate_bytes: s.measured_estimate_bytes.unwrap_or(f64::NAN),
+            started_from_finer: s.started_from_finer as u32,
+            stalled: s.stalled as u32,
+            converged: s.converged as u32,
+            fit_reverted: s.fit_reverted as u32,
+            seconds_fit: s.stages.seconds(LodStage::Fit),
+            seconds_measure: s.stages.seconds(LodStage::Measure),
+            chain_level: s.chain_level.map_or(-1, |r| r as i64),
         }
     }
 }
@@ -533,4 +561,43 @@ pub unsafe extern "C" fn pleat_lod_generate_chain(
             })
         }
     )
+}
+
+#[cfg(all(test, feature = "lod"))]
+mod tests {
+    use super::imp::to_c;
+    use crate::lowpoly::{LodReport, LodStage};
+    use crate::mesh::TriMesh;
+
+    /// The fields appended in session 20 carry the typed report's: the chain rank (-1 outside
+    /// a chain), the loop's end flags and the fit and measure stage seconds.
+    #[test]
+    fn chain_and_loop_fields_come_from_the_report() {
+        let mesh = TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![[0, 1, 2]],
+        )
+        .unwrap();
+        let mut r = LodReport::default();
+        let single = to_c(&mesh, &r);
+        assert_eq!(single.chain_level, -1);
+        assert_eq!(
+            (single.started_from_finer, single.stalled, single.converged),
+            (0, 0, 0)
+        );
+        r.chain_level = Some(2);
+        r.started_from_finer = true;
+        r.stalled = true;
+        r.fit_reverted = true;
+        r.stages.push(LodStage::Fit, 0.25);
+        r.stages.push(LodStage::Measure, 0.5);
+        let c = to_c(&mesh, &r);
+        assert_eq!(c.chain_level, 2);
+        assert_eq!(
+            (c.started_from_finer, c.stalled, c.converged, c.fit_reverted),
+            (1, 1, 0, 1)
+        );
+        assert_eq!((c.seconds_fit, c.seconds_measure), (0.25, 0.5));
+        assert_eq!(c.seconds_total, 0.75);
+    }
 }

@@ -150,7 +150,10 @@ _LodStats = _struct("PleatLodStats", _u32s("struct_size", "rounds")
                             "hausdorff_floor_relative", "min_clearance",
                             "min_clearance_relative", "clearance_required")
                     + _u32s("clearance_kept", "started_from_input")
-                    + _f64s("measured_estimate_bytes"))
+                    + _f64s("measured_estimate_bytes")
+                    + _u32s("started_from_finer", "stalled", "converged", "fit_reverted")
+                    + _f64s("seconds_fit", "seconds_measure")
+                    + [("chain_level", _c.c_int64)])
 _OffsetParams = _struct("PleatOffsetParams", _u32s("struct_size", "use_absolute_distance")
                         + _f64s("screen_size", "distance", "voxel_scale", "theta0_deg")
                         + _u32s("l0", "features", "remove_interior", "iso_refinement_steps")
@@ -483,7 +486,8 @@ _LOD_KEYS = ("max_rounds", "target_faces", "flow_ratio", "epsilon", "theta0_deg"
              "memory_budget_bytes", "offset_voxel_scale")
 _LOD_FLOAT_KEYS = ("flow_ratio", "epsilon", "theta0_deg", "offset_voxel_scale")
 _LOD_STATS_FLAGS = ("watertight", "manifold", "self_intersection_free", "encloses_input",
-                    "exact_rerun", "target_met", "started_from_input")
+                    "exact_rerun", "target_met", "started_from_input", "started_from_finer",
+                    "stalled", "converged", "fit_reverted")
 _REPORT_FLAGS = ("is_closed", "is_edge_manifold", "is_manifold", "is_watertight",
                  "consistently_oriented", "self_intersections_checked", "self_intersection_free",
                  "self_intersecting_pair_count_is_lower_bound")
@@ -651,8 +655,10 @@ class Mesh(_Handle):
         return self._bake(_lib.pleat_cage_generate, screen_size, progress, params)
 
     def lod_chain(self, screen_sizes, progress=None, **params):
-        """One LOD per screen size (list of Mesh, in the order given); coarser levels start
-        from the next finer result, so a chain costs little more than its finest level.
+        """One LOD per screen size (list of Mesh, in the order given); a coarser level starts
+        from the next finer result when its own offset surface has the same topology
+        (``stats["started_from_finer"]``), so a chain costs less than baking each level alone.
+        ``stats["chain_level"]`` is the level's rank, 0 = finest.
         ``params`` as ``lod`` (``target_faces`` is ignored)."""
         sizes = _doubles(screen_sizes, _np.size(screen_sizes), "screen_sizes")
         n = int(_np.size(screen_sizes))

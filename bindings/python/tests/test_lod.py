@@ -58,6 +58,10 @@ def test_lod_chain(cube):
     for level in chain:
         assert level.stats["watertight"] and level.check()["is_watertight"]
     assert chain[0].stats["offset_distance"] < chain[1].stats["offset_distance"]
+    assert [level.stats["chain_level"] for level in chain] == [0, 1]
+    assert chain[0].stats["started_from_finer"] is False
+    assert chain[1].stats["seconds_measure"] > 0.0
+    assert cube.lod(screen_size=10).stats["chain_level"] == -1
     with pytest.raises(pleat.PleatError):
         cube.lod_chain([])
 
