@@ -33,7 +33,15 @@ use super::interp_bench::{svg_plot, Series};
 use super::{progress_bar, show_progress, EXIT_FAILED, EXIT_INPUT};
 
 /// Built-in scene names of `--builtin`.
-const BUILTINS: [&str; 3] = ["sheet", "sheet-small", "cylinder"];
+const BUILTINS: [&str; 7] = [
+    "sheet",
+    "sheet-small",
+    "cylinder",
+    "sheared-rectangle",
+    "disk-balloon",
+    "torus-balloon",
+    "teabag",
+];
 
 /// Options of `pleat bench tfw`.
 #[derive(clap::Args)]
@@ -42,7 +50,9 @@ pub struct TfwBenchArgs {
     pub scenes: Vec<PathBuf>,
     /// Built-in scenes, comma separated: `sheet` (the shipped stretched sheet, 37 × 14
     /// vertices, 5 % stretch), `sheet-small` (13 × 6), `cylinder` (twisted cylinder, 43 × 16,
-    /// 10°).
+    /// 10°), and the README's speed-table scenes: `sheared-rectangle` (1000 v, 3 mm shear),
+    /// `disk-balloon` (2 × 600 v, 600 Pa), `torus-balloon` (2 × 800 v, 600 Pa), `teabag`
+    /// (2 × 468 v, 10 Pa).
     #[arg(long, value_delimiter = ',')]
     pub builtin: Vec<String>,
     /// Folder for tfw_iterations.csv, tfw_scenes.csv and tfw_bench.svg (created if missing).
@@ -88,6 +98,11 @@ fn builtin(name: &str) -> Option<Scene> {
         "sheet" => Some(Scene::stretched_sheet(37, 14, 0.05)),
         "sheet-small" => Some(Scene::stretched_sheet(13, 6, 0.05)),
         "cylinder" => Some(Scene::twisted_cylinder(43, 16, 10.0)),
+        // the irregular meshers only fail on degenerate outlines: these are fixed
+        "sheared-rectangle" => Scene::sheared_rectangle(1000, 3.0, 0.0, 1).ok(),
+        "disk-balloon" => Scene::disk_balloon(600, 600.0, 1).ok(),
+        "torus-balloon" => Scene::torus_balloon(800, 600.0, 1).ok(),
+        "teabag" => Scene::teabag(468, 10.0, 1).ok(),
         _ => None,
     }
 }
@@ -453,5 +468,19 @@ fn print_summary(outcomes: &[Outcome]) {
             }
             Err(e) => println!("{:<16} error: {e}", o.name),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every name `--builtin` lists builds its scene, and no other name does.
+    #[test]
+    fn every_listed_builtin_builds() {
+        for name in BUILTINS {
+            assert!(builtin(name).is_some(), "{name}");
+        }
+        assert!(builtin("tea-bag").is_none());
     }
 }
