@@ -714,6 +714,54 @@ impl Scene {
         }
     }
 
+    /// The sphere drape of S:676 (Fig. 2.19): a square cloth of side `side` (m; the
+    /// dissertation's is 1 m) on a structured `n × n` vertex grid (alternating diagonals, not
+    /// jittered; `n = 41` gives the dissertation's 1.6k vertices), laid flat at height `r` over
+    /// a sphere of radius `r = 0.2` m centred at the origin ([`ObstacleShape::Sphere`], default
+    /// stiffness), under gravity `-9.81 z`; the cloth of S:676 (ρ 200 kg/m³, ν 0.3, Y 0.1 MPa,
+    /// h 1 mm). Departure: the vertex at the cloth's centre (`n` odd; the one right of it for
+    /// even `n`) is pinned where it lies — the dissertation's solvers have friction, and a
+    /// frictionless sphere's top is an unstable equilibrium from which a free sheet slides off.
+    pub fn sphere_drape(n: usize, side: f64) -> Scene {
+        let r = 0.2;
+        let (rest, triangles) = grid(n, n, side, side, false);
+        let positions = rest
+            .iter()
+            .map(|p| [p[0] - 0.5 * side, p[1] - 0.5 * side, r])
+            .collect();
+        let centre = (n / 2) * n + n / 2;
+        Scene {
+            name: format!("sphere drape {n}x{n}, {side} m on r {r} m"),
+            material: Material {
+                young: 1e5,
+                poisson: 0.3,
+                thickness: 1e-3,
+                density: 200.0,
+            },
+            panels: vec![Panel {
+                rest,
+                triangles,
+                positions: Some(positions),
+            }],
+            gravity: [0.0, 0.0, -9.81],
+            pressure: 0.0,
+            dirichlet: vec![Dirichlet {
+                panel: 0,
+                vertices: vec![centre as u32],
+                motion: Motion::default(),
+            }],
+            seam_tolerance: 1e-6,
+            obstacles: vec![Obstacle {
+                shape: ObstacleShape::Sphere {
+                    centre: [0.0; 3],
+                    radius: r,
+                },
+                stiffness: DEFAULT_OBSTACLE_STIFFNESS,
+                margin: 0.0,
+            }],
+        }
+    }
+
     /// The twisted cylinder of S:682: radius 1 m, height 5 m, h 0.1 mm, ν 0.44, Y 10 MPa. The
     /// pattern is the 2π × 5 m rectangle on a structured `n_around + 1` × `n_height` grid
     /// (jittered interior, see [`stretched_sheet`](Self::stretched_sheet)), rolled into the
