@@ -293,6 +293,18 @@ fn sheet_drapes_over_a_sphere_and_stays_outside() {
 /// `balloon_check::sphere_drape_wrinkles`.
 #[test]
 fn sphere_drape_wrinkles_where_the_skirt_is_compressed() {
+    for (n, side) in [
+        (0, 0.6),
+        (1, 0.6),
+        (5, 0.0),
+        (5, f64::NAN),
+        (5, f64::INFINITY),
+    ] {
+        let degenerate = Scene::sphere_drape(n, side);
+        assert!(n < 2 || degenerate.assemble().is_err(), "{n} {side}");
+    }
+    assert_eq!(Scene::sphere_drape(0, 0.6).panels[0].rest.len(), 4);
+    assert_eq!(Scene::sphere_drape(5, -0.6), Scene::sphere_drape(5, 0.6));
     let scene = Scene::sphere_drape(13, 0.6);
     let params = pleat::tfw::TfwParams::default();
     let r = pleat::tfw::solve(&scene, &params, &mut no_progress()).unwrap();

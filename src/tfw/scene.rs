@@ -722,7 +722,10 @@ impl Scene {
     /// h 1 mm). Departure: the vertex at the cloth's centre (`n` odd; the one right of it for
     /// even `n`) is pinned where it lies — the dissertation's solvers have friction, and a
     /// frictionless sphere's top is an unstable equilibrium from which a free sheet slides off.
+    /// `n` below 2 is taken as 2, `side` as its absolute value; a zero, infinite or NaN `side`
+    /// gives a scene that [`Scene::assemble`] refuses.
     pub fn sphere_drape(n: usize, side: f64) -> Scene {
+        let (n, side) = (n.max(2), side.abs());
         let r = 0.2;
         let (rest, triangles) = grid(n, n, side, side, false);
         let positions = rest
