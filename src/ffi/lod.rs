@@ -567,17 +567,13 @@ pub unsafe extern "C" fn pleat_lod_generate_chain(
 mod tests {
     use super::imp::to_c;
     use crate::lowpoly::{LodReport, LodStage};
-    use crate::mesh::TriMesh;
+    use crate::mesh::test_shapes::grid;
 
     /// The fields appended in session 20 carry the typed report's: the chain rank (-1 outside
     /// a chain), the loop's end flags and the fit and measure stage seconds.
     #[test]
     fn chain_and_loop_fields_come_from_the_report() {
-        let mesh = TriMesh::new(
-            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
-            vec![[0, 1, 2]],
-        )
-        .unwrap();
+        let mesh = grid(1, 1);
         let mut r = LodReport::default();
         let single = to_c(&mesh, &r);
         assert_eq!(single.chain_level, -1);

@@ -1946,24 +1946,17 @@ mod tests {
         // LOD_MEDIUM_VOXEL_SCALE and LOD_VOXEL_SCALE from them on (cages: 1)
         let (_, rep) = run(&m, &base, Mode::Lod, &mut |_| true).unwrap();
         assert_eq!(rep.offset_voxel_scale, None);
-        let large = LodParams {
-            screen_size: LOD_COARSE_VOXEL_MIN_SCREEN_SIZE,
-            ..base.clone()
-        };
-        assert_eq!(
-            large.offset_voxel_scale(&m, Mode::Lod),
-            Some(LOD_VOXEL_SCALE)
-        );
-        assert_eq!(large.offset_voxel_scale(&m, Mode::Cage), Some(1.0));
-        let medium = LodParams {
-            screen_size: LOD_MEDIUM_VOXEL_MIN_SCREEN_SIZE,
-            ..base.clone()
-        };
-        assert_eq!(
-            medium.offset_voxel_scale(&m, Mode::Lod),
-            Some(LOD_MEDIUM_VOXEL_SCALE)
-        );
-        assert_eq!(medium.offset_voxel_scale(&m, Mode::Cage), Some(1.0));
+        for (threshold, scale) in [
+            (LOD_COARSE_VOXEL_MIN_SCREEN_SIZE, LOD_VOXEL_SCALE),
+            (LOD_MEDIUM_VOXEL_MIN_SCREEN_SIZE, LOD_MEDIUM_VOXEL_SCALE),
+        ] {
+            let at = LodParams {
+                screen_size: threshold,
+                ..base.clone()
+            };
+            assert_eq!(at.offset_voxel_scale(&m, Mode::Lod), Some(scale));
+            assert_eq!(at.offset_voxel_scale(&m, Mode::Cage), Some(1.0));
+        }
         // a requested scale replaces the rule (here: scale 1 below the threshold; also a scale
         // off the list), the budget's fallback
         // to the coarser listed scales still applies, cages ignore it
