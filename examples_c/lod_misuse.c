@@ -1,6 +1,7 @@
 /* Misuse of the LOD and cage calls returns a status with a message; nothing aborts and no
  * output is written. */
 #include <math.h>
+#include <stddef.h>
 #include "test_util.h"
 
 static const float P[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
@@ -135,6 +136,24 @@ int main(void) {
         CHECK_STATUS(pleat_mesh_create_f32(P, 4, 0, I, 3, &sheet), PLEAT_STATUS_OK);
         check_appended_fields(m, sheet);
         pleat_mesh_destroy(sheet);
+    }
+    {
+        /* An older, shorter PleatLodStats (before the fields appended in session 20) is still
+           accepted and filled only up to its size. */
+        PleatLodStats old;
+        PleatMesh *lodm = NULL;
+        const uint32_t old_size = (uint32_t)offsetof(PleatLodStats, started_from_finer);
+        memset(&old, 0xAB, sizeof old);
+        old.struct_size = old_size;
+        p = pleat_lod_params_default();
+        p.screen_size = 10.0;
+        p.max_rounds = 2;
+        CHECK_STATUS(pleat_lod_generate(m, &p, NULL, NULL, &lodm, &old), PLEAT_STATUS_OK);
+        CHECK(old.struct_size == old_size);
+        CHECK(lodm != NULL && old.face_count == pleat_mesh_triangle_count(lodm));
+        CHECK(old.started_from_finer == 0xABABABABu && old.stalled == 0xABABABABu);
+        CHECK(old.chain_level == (int64_t)0xABABABABABABABABull);
+        pleat_mesh_destroy(lodm);
     }
     pleat_mesh_destroy(m);
     return finish("lod_misuse");
