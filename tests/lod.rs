@@ -355,6 +355,94 @@ fn chain_level_whose_offset_merges_components_is_baked_from_it() {
     assert_eq!(merged, &single, "the level is the single bake");
 }
 
+/// The chain {50, 100, 200} of `m` on a pool of `threads` threads: its levels and the
+/// fractions its progress reported.
+fn chain_on(m: &TriMesh, threads: usize) -> (Vec<(TriMesh, LodReport)>, Vec<f64>) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let mut fractions = Vec::new();
+    let levels = pool
+        .install(|| {
+            generate_chain(m, &[50.0, 100.0, 200.0], &LodParams::default(), &mut |p| {
+                fractions.push(p.fraction);
+                true
+            })
+        })
+        .unwrap();
+    (levels, fractions)
+}
+
+/// A level that starts from its own offset is baked beside the finest level when the pool
+/// has two threads, in turn with one; a clean input's chain loops each level beside the
+/// judging of the finer one. The same levels either way (meshes and every reported figure but
+/// the seconds), and the progress never goes back.
+#[test]
+fn chain_levels_baked_beside_each_other_are_those_of_one_thread() {
+    // two boxes: the n_p = 50 level merges them (its own offset); a torus starts from the input
+    let torus = shapes::torus(1.0, 0.3, 64, 24);
+    for (m, own_offset) in [(two_boxes(0.08), true), (torus, false)] {
+        assert_chain_on_one_and_two_threads(&m, own_offset);
+    }
+}
+
+fn assert_chain_on_one_and_two_threads(m: &TriMesh, own_offset: bool) {
+    let (one, fr1) = chain_on(m, 1);
+    let (two, fr2) = chain_on(m, 2);
+    assert_eq!(!one[0].1.started_from_finer, own_offset);
+    assert_eq!(one[2].1.started_from_input, !own_offset);
+    for ((a, sa), (b, sb)) in one.iter().zip(&two) {
+        assert_eq!(a, b);
+        assert_eq!(sa.faces, sb.faces);
+        assert_eq!(sa.hausdorff_rel, sb.hausdorff_rel);
+        assert_eq!(sa.chain_level, sb.chain_level);
+        assert_eq!(sa.started_from_finer, sb.started_from_finer);
+    }
+    for fr in [fr1, fr2] {
+        assert!(fr.windows(2).all(|w| w[0] <= w[1]), "progress went back");
+        assert!(fr.iter().all(|f| (0.0..=1.0).contains(f)));
+    }
+}
+
+/// A chain whose levels bake beside each other (a two-thread pool) cancels at whichever
+/// report the callback answers `false`, and the callback is not called after that; both
+/// kinds of chain (levels from their own offsets, levels from a clean input's finer ones).
+#[test]
+fn a_chain_with_levels_beside_cancels_at_any_report() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    for m in [two_boxes(0.08), shapes::torus(1.0, 0.3, 64, 24)] {
+        // the number of reports varies with the timing of the levels beside each other
+        let (_, fr) = chain_on(&m, 2);
+        let total = fr.len();
+        assert!(total >= 8, "{total} reports");
+        for stop_at in [1, 2, total / 4, total / 3, total / 2] {
+            let mut calls = 0;
+            let e = pool
+                .install(|| {
+                    generate_chain(
+                        &m,
+                        &[50.0, 100.0, 200.0],
+                        &LodParams::default(),
+                        &mut |_| {
+                            calls += 1;
+                            calls < stop_at
+                        },
+                    )
+                })
+                .unwrap_err();
+            assert_eq!(e, Error::Cancelled, "stop at {stop_at}");
+            assert_eq!(
+                calls, stop_at,
+                "a call after the cancel (stop at {stop_at})"
+            );
+        }
+    }
+}
+
 #[test]
 fn extreme_scales_and_shapes_give_valid_output_or_a_clear_error() {
     let sphere = shapes::icosphere(1.0, 3);

@@ -892,6 +892,9 @@ pub(crate) struct Reporter<'p, 'f> {
     f: &'p mut ProgressFn<'f>,
     base: f64,
     span: f64,
+    /// The largest fraction reported so far: reports never go back (a chain's levels baked
+    /// beside the finest one report before the levels between them).
+    reached: f64,
 }
 
 impl<'p, 'f> Reporter<'p, 'f> {
@@ -900,6 +903,7 @@ impl<'p, 'f> Reporter<'p, 'f> {
             f,
             base: 0.0,
             span: 1.0,
+            reached: 0.0,
         }
     }
 
@@ -909,11 +913,18 @@ impl<'p, 'f> Reporter<'p, 'f> {
         self.span = span;
     }
 
-    /// Reports `stage` at `fraction` of the current window.
+    /// Reports `stage` at `fraction` of the current window (never below an earlier report).
     pub fn report(&mut self, stage: &str, fraction: f64) -> bool {
+        self.report_absolute(stage, self.base + self.span * fraction.clamp(0.0, 1.0))
+    }
+
+    /// Reports `stage` at `fraction` of the whole operation, not of the window (never below
+    /// an earlier report).
+    pub fn report_absolute(&mut self, stage: &str, fraction: f64) -> bool {
+        self.reached = self.reached.max(fraction.clamp(0.0, 1.0));
         (self.f)(Progress {
             stage,
-            fraction: (self.base + self.span * fraction.clamp(0.0, 1.0)).clamp(0.0, 1.0),
+            fraction: self.reached,
         })
     }
 
@@ -959,6 +970,13 @@ pub fn generate(
 /// ([`LodReport::started_from_finer`]). `params.screen_size` and `params.target_faces` are ignored (a face target is per
 /// level: call [`generate`]). Each level's report has its [`LodReport::chain_level`]
 /// (0 = finest).
+///
+/// On a thread pool of more than one thread, levels that do not depend on each other run at
+/// the same time (the levels from their own offsets beside the finest level; a level's loop
+/// beside the finer level's verification and measurement, from that level's loop output, redone
+/// in the rare case the verification reruns or the fit is reverted): the levels are byte for
+/// byte those of a one-thread run. `progress` is called on this thread only, with fractions
+/// that never go back.
 pub fn generate_chain(
     input: &TriMesh,
     screen_sizes: &[f64],
@@ -1032,36 +1050,21 @@ pub(crate) fn run_chain(
             .ok_or(Error::Cancelled)?;
     rep.check("setup", 0.0)?;
     let level = Level::new(&model, input, mode);
-    let mut out: Vec<Option<(TriMesh, LodReport)>> = vec![None; screen_sizes.len()];
     // the finest level starts from the welded input when it is clean (`LodStart`)
-    let mut prev: Option<TriMesh> = choose_start(input, &level_params[order[0]], mode, &mut rep)?;
-    check_offset_budget(&level_params[order[0]], input, mode, prev.is_some())?;
-    let from_input = prev.is_some();
-    let n = order.len() as f64;
-    for (rank, &i) in order.iter().enumerate() {
-        let window = (rank as f64 / n, 1.0 / n);
-        rep.window(window.0, 0.2 * window.1);
-        let start = match prev.as_ref() {
-            // the welded clean input's topology is every level's (a single bake of this level
-            // would start from the input too)
-            Some(finer) if from_input => Start::Given(finer),
-            Some(finer) => {
-                let own = offset_start(&level, &level_params[i], &mut rep)?;
-                if starts_from_finer(finer, &own.mesh, &level_params[i], mode) {
-                    Start::Given(finer)
-                } else {
-                    Start::Offset(own)
-                }
-            }
-            None => Start::Offset(offset_start(&level, &level_params[i], &mut rep)?),
-        };
-        let from_finer = rank > 0 && matches!(start, Start::Given(_));
-        let (mesh, mut stats) = bake_level(&level, &level_params[i], start, &mut rep, window)?;
-        stats.started_from_finer = from_finer;
+    let welded = choose_start(input, &level_params[order[0]], mode, &mut rep)?;
+    check_offset_budget(&level_params[order[0]], input, mode, welded.is_some())?;
+    let levels: Vec<&LodParams> = order.iter().map(|&i| &level_params[i]).collect();
+    let by_rank = match &welded {
+        // the welded clean input's topology is every level's (a single bake of each level
+        // would start from the input too): each level from the next finer one
+        Some(w) => chain_from_finer(&level, &levels, w, &mut rep)?,
+        None => chain_from_offsets(&level, &levels, &mut rep)?,
+    };
+    let mut out: Vec<Option<(TriMesh, LodReport)>> = vec![None; screen_sizes.len()];
+    for (rank, (mesh, mut stats)) in by_rank.into_iter().enumerate() {
         stats.chain_level = Some(rank as u64);
-        stats.started_from_input = rank == 0 && from_input;
-        prev = Some(mesh.clone());
-        out[i] = Some((mesh, stats));
+        stats.started_from_input = rank == 0 && welded.is_some();
+        out[order[rank]] = Some((mesh, stats));
     }
     Ok(out
         .into_iter()
@@ -1069,16 +1072,276 @@ pub(crate) fn run_chain(
         .collect())
 }
 
-/// Whether a coarser chain level (offset surface `own`) starts from the next finer level
-/// `finer` instead: only when both have the same topology (components, Euler characteristic).
+/// The progress window of chain level `rank` of `n`.
+fn chain_window(rank: usize, n: usize) -> (f64, f64) {
+    (rank as f64 / n as f64, 1.0 / n as f64)
+}
+
+/// A chain whose finest level starts from the welded clean input `welded`: every level from
+/// the next finer result, finest first (`levels` by rank). Sets `started_from_finer`.
+fn chain_from_finer(
+    level: &Level<'_>,
+    levels: &[&LodParams],
+    welded: &TriMesh,
+    rep: &mut Reporter<'_, '_>,
+) -> Result<Vec<(TriMesh, LodReport)>> {
+    let mut baked = from_finer_run(level, levels, (0, levels.len()), welded, rep)?;
+    baked[0].1.started_from_finer = false;
+    Ok(baked)
+}
+
+/// Chain levels `first..first + run.len()` of `n` (`run` by rank), each from the next finer
+/// result, the first from `finer`; all marked `started_from_finer`.
+///
+/// When the pool has more than one thread, a level's loop starts from the next finer level's
+/// loop output while that level is verified and measured ([`judge_level`], [`run_beside`]):
+/// the output is the loop's unless the judging reruns the loop exactly or reverts the fit,
+/// and then the coarser level's loop runs again from the judged output. Every level is the
+/// one a sequential chain bakes, on any thread count (issue 12 part 2: the measurement at
+/// `l / 400` costs a coarse level as much as the finest).
+fn from_finer_run(
+    level: &Level<'_>,
+    run: &[&LodParams],
+    (first, n): (usize, usize),
+    finer: &TriMesh,
+    rep: &mut Reporter<'_, '_>,
+) -> Result<Vec<(TriMesh, LodReport)>> {
+    let beside = rayon::current_num_threads() > 1;
+    let mut baked: Vec<(TriMesh, LodReport)> = Vec::with_capacity(run.len());
+    let mut next = Some(loop_level(
+        level,
+        run[0],
+        Start::Given(finer),
+        rep,
+        chain_window(first, n),
+    )?);
+    for (k, &p) in run.iter().enumerate() {
+        let looped = next
+            .take()
+            .expect("each level is looped before it is judged");
+        let coarser = run.get(k + 1).map(|&q| (q, chain_window(first + k + 1, n)));
+        let (judged, guessed) = match coarser {
+            Some((q, window)) if beside => {
+                let guess = looped.mesh.clone();
+                let (judged, coarser_loop) = run_beside(
+                    rep,
+                    |r| judge_level(level, p, looped, r),
+                    |r| loop_level(level, q, Start::Given(&guess), r, window),
+                );
+                (judged?, Some((guess, coarser_loop)))
+            }
+            _ => (judge_level(level, p, looped, rep)?, None),
+        };
+        if let Some((q, window)) = coarser {
+            next = Some(match guessed {
+                Some((guess, coarser_loop)) if guess == judged.0 => coarser_loop?,
+                Some((_, Err(Error::Cancelled))) => return Err(Error::Cancelled),
+                _ => loop_level(level, q, Start::Given(&judged.0), rep, window)?,
+            });
+        }
+        let (mesh, mut stats) = judged;
+        stats.started_from_finer = true;
+        baked.push((mesh, stats));
+    }
+    Ok(baked)
+}
+
+/// A chain whose finest level starts from its offset surface (`levels` by rank, finest
+/// first). Each coarser level computes its own offset surface, and starts from it when its
+/// topology differs from the next finer level's ([`starts_from_finer`]; the loop keeps its
+/// start's topology, so a level's is its start's), else from the finer result.
+///
+/// The levels that start from their own offsets depend on nothing but the input: when the
+/// pool has more than one thread and the budget holds the finest level and any one coarser
+/// level at once ([`beside_fits`]), they are baked beside the finest level
+/// ([`run_beside`]); the levels that start from a finer result follow, finest first. Each
+/// level's computation is the same whichever thread runs it and whether it runs beside
+/// another, so the outputs do not depend on it (issue 12 part 2: a dirty input's chain
+/// bakes its coarser levels' offsets, and the levels those close, on the second core).
+fn chain_from_offsets(
+    level: &Level<'_>,
+    levels: &[&LodParams],
+    rep: &mut Reporter<'_, '_>,
+) -> Result<Vec<(TriMesh, LodReport)>> {
+    let n = levels.len();
+    rep.window(0.0, 0.2 * chain_window(0, n).1);
+    let finest = offset_start(level, levels[0], rep)?;
+    let finest_topology = topology_of(&finest.mesh);
+    let bake_finest = |r: &mut Reporter<'_, '_>| {
+        bake_level(
+            level,
+            levels[0],
+            Start::Offset(finest),
+            r,
+            chain_window(0, n),
+        )
+    };
+    let coarser = |r: &mut Reporter<'_, '_>| coarser_own_offsets(level, levels, finest_topology, r);
+    let (finest_level, own) =
+        if n > 1 && rayon::current_num_threads() > 1 && beside_fits(level, levels) {
+            let (a, b) = run_beside(rep, bake_finest, coarser);
+            (a?, b?)
+        } else {
+            let a = bake_finest(rep)?;
+            (a, coarser(rep)?)
+        };
+    let mut baked: Vec<(TriMesh, LodReport)> = vec![finest_level];
+    let mut own = own.into_iter().peekable();
+    while let Some(next) = own.next() {
+        if let Some(done) = next {
+            baked.push(done);
+            continue;
+        }
+        // a run of levels from the finer one, up to the next level from its own offset
+        let first = baked.len();
+        let mut len = 1;
+        while own.next_if(|o| o.is_none()).is_some() {
+            len += 1;
+        }
+        let finer = &baked[first - 1].0;
+        let run = from_finer_run(level, &levels[first..first + len], (first, n), finer, rep)?;
+        baked.extend(run);
+    }
+    Ok(baked)
+}
+
+/// The coarser levels (ranks `1..`) of [`chain_from_offsets`]: each one's own offset surface,
+/// and the bake of those that start from it (`Some`); `None` for a level that starts from
+/// the next finer result (its offset discarded). `finest_topology` is the finest level's
+/// start's.
+fn coarser_own_offsets(
+    level: &Level<'_>,
+    levels: &[&LodParams],
+    finest_topology: (usize, i64),
+    rep: &mut Reporter<'_, '_>,
+) -> Result<Vec<Option<(TriMesh, LodReport)>>> {
+    let n = levels.len();
+    let mut finer_topology = finest_topology;
+    let mut own = Vec::with_capacity(n.saturating_sub(1));
+    for (rank, p) in levels.iter().enumerate().skip(1) {
+        let window = chain_window(rank, n);
+        rep.window(window.0, 0.2 * window.1);
+        let start = offset_start(level, p, rep)?;
+        let topology = topology_of(&start.mesh);
+        if starts_from_finer(finer_topology, topology, p, level.mode) {
+            own.push(None);
+            continue;
+        }
+        finer_topology = topology;
+        own.push(Some(bake_level(
+            level,
+            p,
+            Start::Offset(start),
+            rep,
+            window,
+        )?));
+    }
+    Ok(own)
+}
+
+/// Whether the budget holds the finest level (`levels[0]`) and any one coarser level at once,
+/// by their up-front estimates ([`LodParams::memory_estimate`], the input's structures
+/// counted twice); `false` when a level has no up-front scale (its admission is measured).
+fn beside_fits(level: &Level<'_>, levels: &[&LodParams]) -> bool {
+    let (input, mode) = (level.input, level.mode);
+    let estimate = |p: &LodParams| {
+        p.offset_voxel_scale(input, mode)
+            .map(|s| p.memory_estimate(input, s))
+    };
+    let Some(finest) = estimate(levels[0]) else {
+        return false;
+    };
+    let coarser = levels[1..]
+        .iter()
+        .try_fold(0.0f64, |m, p| estimate(p).map(|e| m.max(e)));
+    coarser.is_some_and(|c| finest + c <= levels[0].memory_budget_bytes as f64)
+}
+
+/// Runs `a` on this thread with `rep` and `b` beside it on the thread pool, and returns both
+/// results. Progress reaches the caller's callback on this thread only: `b` reports into a
+/// relay that this thread forwards while it waits for `b` after `a`; a cancel (the callback's
+/// `false`) or an error of `a` stops `b` at its next report. A panic of either propagates.
+fn run_beside<A, B>(
+    rep: &mut Reporter<'_, '_>,
+    a: impl FnOnce(&mut Reporter<'_, '_>) -> Result<A>,
+    b: impl FnOnce(&mut Reporter<'_, '_>) -> Result<B> + Send,
+) -> (Result<A>, Result<B>)
+where
+    B: Send,
+{
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Mutex;
+    /// Sets its flag when dropped, also by a panic's unwinding.
+    struct SetOnDrop<'f>(&'f AtomicBool);
+    impl Drop for SetOnDrop<'_> {
+        fn drop(&mut self) {
+            self.0.store(true, Ordering::Release);
+        }
+    }
+    let stop = AtomicBool::new(false);
+    let done = AtomicBool::new(false);
+    let latest: Mutex<Option<(String, f64)>> = Mutex::new(None);
+    let b_result: Mutex<Option<Result<B>>> = Mutex::new(None);
+    let (a_result, went_on) = rayon::in_place_scope(|s| {
+        s.spawn(|_| {
+            let _done = SetOnDrop(&done);
+            let mut relay = |p: Progress<'_>| {
+                if let Ok(mut l) = latest.lock() {
+                    *l = Some((p.stage.to_string(), p.fraction));
+                }
+                !stop.load(Ordering::Acquire)
+            };
+            let r = b(&mut Reporter::new(&mut relay));
+            if let Ok(mut slot) = b_result.lock() {
+                *slot = Some(r);
+            }
+        });
+        let a_result = a(rep);
+        // the caller's callback is not called again once it cancelled or `a` failed
+        let mut go_on = a_result.is_ok();
+        if !go_on {
+            stop.store(true, Ordering::Release);
+        }
+        while !done.load(Ordering::Acquire) {
+            let last = latest.lock().ok().and_then(|mut l| l.take());
+            if let (true, Some((stage, fraction))) = (go_on, last) {
+                go_on = rep.report_absolute(&stage, fraction);
+                if !go_on {
+                    stop.store(true, Ordering::Release);
+                }
+            }
+            // run `b` here when no other thread has taken it; else wait a little
+            if !matches!(rayon::yield_now(), Some(rayon::Yield::Executed)) {
+                std::thread::sleep(std::time::Duration::from_millis(2));
+            }
+        }
+        (a_result, go_on)
+    });
+    let b_result = match b_result.into_inner().ok().flatten() {
+        // a cancel that came after `b`'s last report still cancels
+        Some(_) if a_result.is_ok() && !went_on => Err(Error::Cancelled),
+        Some(r) => r,
+        None => Err(Error::Internal("a chain level did not finish".into())),
+    };
+    (a_result, b_result)
+}
+
+/// Whether a coarser chain level whose own offset surface has topology `own` (components,
+/// Euler characteristic: [`topology_of`]) starts from the next finer level, of topology `finer`,
+/// instead: only when both are the same.
 /// The loop keeps its start's topology, and the coarser offset closes the handles, gaps and
 /// small components that the finer level's `d` kept open; from the finer level such a level
 /// kept them, with 2–7× the faces of its own bake (measured 2026-11-29 at n_p = 50 / 100:
 /// dirty_teapot 644 / 794 faces against 104 / 214, dirty_synth_tree_s1 2354 / 2752 against
 /// 332 / 1364). A cage with clearance never does: the finer cage keeps only the finer level's
 /// (smaller) clearance, which the coarser level's guard could then never raise to its own.
-fn starts_from_finer(finer: &TriMesh, own: &TriMesh, params: &LodParams, mode: Mode) -> bool {
-    !(mode == Mode::Cage && has_clearance(params)) && topology_of(finer) == topology_of(own)
+fn starts_from_finer(
+    finer: (usize, i64),
+    own: (usize, i64),
+    params: &LodParams,
+    mode: Mode,
+) -> bool {
+    !(mode == Mode::Cage && has_clearance(params)) && finer == own
 }
 
 /// Refuses, before any allocation, a bake whose memory estimate fits no voxel scale allowed in
@@ -1208,7 +1471,19 @@ fn bake_level(
     rep: &mut Reporter<'_, '_>,
     window: (f64, f64),
 ) -> Result<(TriMesh, LodReport)> {
-    let (model, input, mode) = (level.model, level.input, level.mode);
+    let looped = loop_level(level, params, start, rep, window)?;
+    judge_level(level, params, looped, rep)
+}
+
+/// The first part of [`bake_level`]: the start, the loop of Alg. 3 and the fit.
+fn loop_level(
+    level: &Level<'_>,
+    params: &LodParams,
+    start: Start<'_>,
+    rep: &mut Reporter<'_, '_>,
+    window: (f64, f64),
+) -> Result<Looped> {
+    let (model, mode) = (level.model, level.mode);
     let l = model.diag;
     let d = l / params.screen_size;
     let mut stats = LodReport {
@@ -1248,7 +1523,56 @@ fn bake_level(
         },
         fit: mode == Mode::Lod && params.fit_to_input,
     };
-    let (mut mesh, mut ls) = optimize(&start, model, &cfg, false, rep)?;
+    let (mesh, ls) = optimize(&start, level.model, &cfg, false, rep)?;
+    Ok(Looped {
+        mesh,
+        ls,
+        stats,
+        start,
+        start_topology,
+        cfg,
+        from_offset,
+        window,
+    })
+}
+
+/// A level after its loop and fit ([`loop_level`]), before its verification and measurement
+/// ([`judge_level`]).
+struct Looped {
+    /// The loop's (and fit's) output.
+    mesh: TriMesh,
+    ls: LoopStats,
+    /// The report so far (the start's figures).
+    stats: LodReport,
+    /// The start surface, for an exact rerun.
+    start: TriMesh,
+    start_topology: (usize, i64),
+    cfg: LoopConfig,
+    from_offset: bool,
+    window: (f64, f64),
+}
+
+/// The verification and measurement of a level after its loop ([`loop_level`]): the exact
+/// rerun when the independent check finds an intersection (§4.3.3), the two-sided Hausdorff
+/// distance, the fit's safety revert, the floor and clearance measures, the report.
+fn judge_level(
+    level: &Level<'_>,
+    params: &LodParams,
+    looped: Looped,
+    rep: &mut Reporter<'_, '_>,
+) -> Result<(TriMesh, LodReport)> {
+    let (model, input, mode) = (level.model, level.input, level.mode);
+    let l = model.diag;
+    let Looped {
+        mut mesh,
+        mut ls,
+        mut stats,
+        start,
+        start_topology,
+        cfg,
+        from_offset,
+        window: (w0, ws),
+    } = looped;
     rep.window(w0 + 0.9 * ws, 0.1 * ws);
     rep.check("verify", 0.0)?;
     let t0 = Instant::now();
