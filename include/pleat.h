@@ -1853,8 +1853,12 @@ PleatStatus pleat_cage_generate(const struct PleatMesh *input,
                                 struct PleatMesh **out,
                                 struct PleatLodStats *stats);
 
-// Bakes one LOD per screen size; coarser levels start from the next finer result, so a chain
-// costs little more than its finest level.
+// Bakes one LOD per screen size. A coarser level starts from the next finer result when its
+// own offset surface has that result's topology, else from that offset surface (then it is
+// the level `pleat_lod_generate` bakes). On a pool of more than one thread, independent levels
+// run at the same time, with the results of a one-thread run; the progress callback is still
+// called on the calling thread only, with fractions that never go back. A chain
+// {50, 100, 200} takes about 1.4x the wall time of its finest level alone (corpus median).
 //
 // - `screen_sizes`: `count` screen sizes (any order; each finite and > 0), `count` >= 1.
 // - `params`: as `pleat_lod_generate`; `screen_size` and `target_faces` are ignored.
