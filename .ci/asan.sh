@@ -42,7 +42,7 @@ for src in examples_c/*.c examples_c/*.cpp; do
   case "$name" in
     assimp_*) if [ -z "$assimp" ]; then echo "SKIPPED $name (no assimp)"; continue; fi
               read -r -a extra <<<"$assimp" ;;
-    threads) extra=(-pthread) ;;
+    threads|lod_chain) extra=(-pthread) ;;
   esac
   if [[ $src == *.cpp ]]; then cc=(c++ -std=c++17); else cc=(cc -std=c99); fi
   "${cc[@]}" "${flags[@]}" -fsanitize=address,undefined -fno-sanitize-recover=undefined \

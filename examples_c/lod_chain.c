@@ -5,7 +5,9 @@
  *   lod_chain FILE       any mesh file pleat reads (obj, ply, off, stl, gltf)
  */
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
+#include <string.h>
 #include "test_util.h"
 
 #define RING 24
@@ -121,6 +123,103 @@ static void bake_chain(const PleatMesh *input) {
     for (i = 0; i < 3; i++) pleat_mesh_destroy(levels[i]);
 }
 
+/* What a progress callback saw: the calling thread, the calls, the last fraction. */
+typedef struct {
+    pthread_t caller;
+    int calls, stop_at, off_thread, backwards;
+    double last;
+} Watch;
+
+static int watch_progress(void *user_data, const PleatProgress *info) {
+    Watch *w = (Watch *)user_data;
+    w->calls++;
+    if (!pthread_equal(pthread_self(), w->caller)) w->off_thread++;
+    if (info->fraction < w->last) w->backwards++;
+    w->last = info->fraction;
+    return w->stop_at > 0 && w->calls >= w->stop_at;
+}
+
+static Watch watch(int stop_at) {
+    Watch w;
+    memset(&w, 0, sizeof w);
+    w.caller = pthread_self();
+    w.stop_at = stop_at;
+    return w;
+}
+
+/* A level's positions and indices, copied out. */
+typedef struct {
+    size_t nv, nt;
+    double *pos;
+    uint32_t *idx;
+} Copy;
+
+static Copy copy_of(const PleatMesh *m) {
+    Copy c;
+    c.nv = pleat_mesh_vertex_count(m);
+    c.nt = pleat_mesh_triangle_count(m);
+    c.pos = (double *)malloc(3 * c.nv * sizeof(double) + 1);
+    c.idx = (uint32_t *)malloc(3 * c.nt * sizeof(uint32_t) + 1);
+    CHECK_STATUS(pleat_mesh_copy_positions_f64(m, c.pos, c.nv, 0), PLEAT_STATUS_OK);
+    CHECK_STATUS(pleat_mesh_copy_indices(m, c.idx, 3 * c.nt), PLEAT_STATUS_OK);
+    return c;
+}
+
+/* On a pool of two threads a chain runs independent levels beside each other: the levels are
+   those of a one-thread pool, the callback runs on this thread only with fractions that never
+   go back, and a cancel is honoured at the report that asked for it (no call after it). Both
+   starts: the clean torus's own (the input) and the offset surface. */
+static void chain_on_pools(const PleatMesh *input) {
+    const double sizes[3] = {25.0 * size_scale(), 50.0 * size_scale(), 100.0 * size_scale()};
+    PleatLodParams params = pleat_lod_params_default();
+    int start, run, i, k;
+    params.max_rounds = 8;
+    for (start = 0; start < 2; start++) {
+        Copy c[2][3];
+        int total = 0;
+        params.start = start == 0 ? PLEAT_LOD_START_AUTO : PLEAT_LOD_START_OFFSET;
+        for (run = 0; run < 2; run++) {
+            PleatMesh *levels[3] = {NULL, NULL, NULL};
+            Watch w = watch(0);
+            CHECK_STATUS(pleat_set_thread_count(run == 0 ? 1 : 2), PLEAT_STATUS_OK);
+            CHECK_STATUS(pleat_lod_generate_chain(input, sizes, 3, &params, watch_progress, &w,
+                                                  levels, NULL),
+                         PLEAT_STATUS_OK);
+            CHECK(w.calls > 0 && w.off_thread == 0 && w.backwards == 0);
+            total = w.calls;
+            for (i = 0; i < 3; i++) {
+                c[run][i] = copy_of(levels[i]);
+                pleat_mesh_destroy(levels[i]);
+            }
+        }
+        for (i = 0; i < 3; i++) {
+            CHECK(c[0][i].nv == c[1][i].nv && c[0][i].nt == c[1][i].nt);
+            if (c[0][i].nv == c[1][i].nv && c[0][i].nt == c[1][i].nt) {
+                CHECK(memcmp(c[0][i].pos, c[1][i].pos, 3 * c[0][i].nv * sizeof(double)) == 0);
+                CHECK(memcmp(c[0][i].idx, c[1][i].idx, 3 * c[0][i].nt * sizeof(uint32_t)) == 0);
+            }
+            for (run = 0; run < 2; run++) {
+                free(c[run][i].pos);
+                free(c[run][i].idx);
+            }
+        }
+        /* the number of reports varies with the timing of the levels beside each other */
+        for (k = 0; k < 2; k++) {
+            int stop_at = k == 0 ? 3 : total / 2;
+            PleatMesh *levels[3] = {NULL, NULL, NULL};
+            Watch w = watch(stop_at);
+            CHECK_STATUS(pleat_lod_generate_chain(input, sizes, 3, &params, watch_progress, &w,
+                                                  levels, NULL),
+                         PLEAT_STATUS_CANCELLED);
+            CHECK(w.calls == stop_at && w.off_thread == 0);
+            CHECK(levels[0] == NULL && levels[1] == NULL && levels[2] == NULL);
+        }
+        printf("chain on pools of 1 and 2 threads (start %s): same levels, %d reports\n",
+               start == 0 ? "auto" : "offset", total);
+    }
+    CHECK_STATUS(pleat_set_thread_count(0), PLEAT_STATUS_OK);
+}
+
 static void bake_cage(const PleatMesh *input) {
     PleatMesh *cage = NULL;
     PleatLodStats st;
@@ -189,6 +288,9 @@ int main(int argc, char **argv) {
     bake_chain(input);
     if (pleat_has_feature("cage")) bake_cage(input);
     cancel(input);
+    /* eight chains on pools of one and two threads: natively and under the sanitizers, not
+       under memcheck, which serializes threads */
+    if (!getenv("PLEAT_HARNESS_MEMCHECK")) chain_on_pools(input);
     pleat_mesh_destroy(input);
     return finish("lod_chain");
 }

@@ -240,7 +240,7 @@ fn c_programs_pass() {
                 }
             }
         }
-        if stem == "threads" {
+        if stem == "threads" || stem == "lod_chain" {
             extra.push("-pthread".into());
         }
         let exe = out_dir.join(&stem);
