@@ -67,6 +67,30 @@ def test_lod_chain(cube):
 
 
 @needs("lod")
+def test_lod_chain_on_two_threads_is_the_one_thread_chain(cube):
+    """Independent levels run beside each other on two threads: the same levels, the callback
+    on this thread only, fractions that never go back."""
+    import threading
+    soup = pleat.Mesh.from_arrays(*two_boxes())
+    for mesh in (cube, soup):
+        runs = []
+        for threads in (1, 2):
+            seen = []
+            pleat.set_thread_count(threads)
+            try:
+                chain = mesh.lod_chain(
+                    [40, 20, 10], progress=lambda stage, f: seen.append((threading.get_ident(), f)))
+            finally:
+                pleat.set_thread_count(0)
+            assert seen and all(t == threading.get_ident() for t, _ in seen)
+            fractions = [f for _, f in seen]
+            assert fractions == sorted(fractions)
+            runs.append([(level.positions(), level.triangles()) for level in chain])
+        for (p1, t1), (p2, t2) in zip(*runs):
+            assert np.array_equal(p1, p2) and np.array_equal(t1, t2)
+
+
+@needs("lod")
 def test_progress_and_cancel(cube):
     seen = []
     cube.lod(screen_size=10, progress=lambda stage, f: seen.append((stage, f)))
