@@ -726,43 +726,45 @@ impl Scene {
     /// gives a scene that [`Scene::assemble`] refuses.
     pub fn sphere_drape(n: usize, side: f64) -> Scene {
         let (n, side) = (n.max(2), side.abs());
-        let r = 0.2;
         let (rest, triangles) = grid(n, n, side, side, false);
-        let positions = rest
-            .iter()
-            .map(|p| [p[0] - 0.5 * side, p[1] - 0.5 * side, r])
-            .collect();
         let centre = (n / 2) * n + n / 2;
-        Scene {
-            name: format!("sphere drape {n}x{n}, {side} m on r {r} m"),
-            material: Material {
-                young: 1e5,
-                poisson: 0.3,
-                thickness: 1e-3,
-                density: 200.0,
-            },
-            panels: vec![Panel {
-                rest,
-                triangles,
-                positions: Some(positions),
-            }],
-            gravity: [0.0, 0.0, -9.81],
-            pressure: 0.0,
-            dirichlet: vec![Dirichlet {
-                panel: 0,
-                vertices: vec![centre as u32],
-                motion: Motion::default(),
-            }],
-            seam_tolerance: 1e-6,
-            obstacles: vec![Obstacle {
-                shape: ObstacleShape::Sphere {
-                    centre: [0.0; 3],
-                    radius: r,
-                },
-                stiffness: DEFAULT_OBSTACLE_STIFFNESS,
-                margin: 0.0,
-            }],
-        }
+        let name = format!("sphere drape {n}x{n}, {side} m on r {SPHERE_DRAPE_RADIUS} m");
+        sphere_drape_scene(name, rest, triangles, side, centre)
+    }
+
+    /// The sphere drape of [`sphere_drape`](Self::sphere_drape) on an irregular Delaunay mesh
+    /// of the square with about `target_vertices` vertices ([`crate::tfw::delaunay`]; `seed`
+    /// selects the sampling), as the dissertation's experiments use (irregular meshes, S:698):
+    /// no grid direction for the wrinkles to follow. The pinned vertex is the one nearest the
+    /// cloth's centre (the first such in index order). `side` as its absolute value. Errors as
+    /// [`Panel::from_polygon`] (e.g. a zero, infinite or NaN `side`, too few vertices).
+    pub fn sphere_drape_delaunay(target_vertices: usize, side: f64, seed: u64) -> Result<Scene> {
+        let side = side.abs();
+        let panel = Panel::from_polygon(&PolygonPanel {
+            outer: vec![[0.0, 0.0], [side, 0.0], [side, side], [0.0, side]],
+            holes: vec![],
+            target_vertices,
+            seed,
+        })?;
+        let dist = |p: &[f64; 2]| (p[0] - 0.5 * side).hypot(p[1] - 0.5 * side);
+        let centre = (0..panel.rest.len())
+            .min_by(|&a, &b| {
+                dist(&panel.rest[a])
+                    .total_cmp(&dist(&panel.rest[b]))
+                    .then(a.cmp(&b))
+            })
+            .unwrap_or(0);
+        let name = format!(
+            "sphere drape, Delaunay {target_vertices} v (seed {seed}), {side} m on r \
+             {SPHERE_DRAPE_RADIUS} m"
+        );
+        Ok(sphere_drape_scene(
+            name,
+            panel.rest,
+            panel.triangles,
+            side,
+            centre,
+        ))
     }
 
     /// The twisted cylinder of S:682: radius 1 m, height 5 m, h 0.1 mm, ν 0.44, Y 10 MPa. The
@@ -1136,6 +1138,55 @@ fn validate_panel(path: &str, p: &Panel) -> Result<()> {
 /// Structured grid of `nx × ny` vertices on `[0, lx] × [0, ly]` (row-major, `j·nx + i`), two
 /// triangles per cell with alternating diagonals, counter-clockwise. With `jitter`, interior
 /// vertices move by a deterministic pseudo-random offset of up to 20% of the spacing.
+/// Radius of the sphere of the drape (S:676), m.
+const SPHERE_DRAPE_RADIUS: f64 = 0.2;
+
+/// The drape of [`Scene::sphere_drape`] for a pattern `rest` / `triangles` of the square
+/// `[0, side]²`: laid flat at height `r` centred over the sphere, vertex `centre` pinned.
+fn sphere_drape_scene(
+    name: String,
+    rest: Vec<[f64; 2]>,
+    triangles: Vec<[u32; 3]>,
+    side: f64,
+    centre: usize,
+) -> Scene {
+    let r = SPHERE_DRAPE_RADIUS;
+    let positions = rest
+        .iter()
+        .map(|p| [p[0] - 0.5 * side, p[1] - 0.5 * side, r])
+        .collect();
+    Scene {
+        name,
+        material: Material {
+            young: 1e5,
+            poisson: 0.3,
+            thickness: 1e-3,
+            density: 200.0,
+        },
+        panels: vec![Panel {
+            rest,
+            triangles,
+            positions: Some(positions),
+        }],
+        gravity: [0.0, 0.0, -9.81],
+        pressure: 0.0,
+        dirichlet: vec![Dirichlet {
+            panel: 0,
+            vertices: vec![centre as u32],
+            motion: Motion::default(),
+        }],
+        seam_tolerance: 1e-6,
+        obstacles: vec![Obstacle {
+            shape: ObstacleShape::Sphere {
+                centre: [0.0; 3],
+                radius: r,
+            },
+            stiffness: DEFAULT_OBSTACLE_STIFFNESS,
+            margin: 0.0,
+        }],
+    }
+}
+
 fn grid(nx: usize, ny: usize, lx: f64, ly: f64, jitter: bool) -> (Vec<[f64; 2]>, Vec<[u32; 3]>) {
     let (dx, dy) = (lx / (nx - 1) as f64, ly / (ny - 1) as f64);
     let mut rest = Vec::with_capacity(nx * ny);

@@ -33,7 +33,7 @@ use super::interp_bench::{svg_plot, Series};
 use super::{progress_bar, show_progress, EXIT_FAILED, EXIT_INPUT};
 
 /// Built-in scene names of `--builtin`.
-const BUILTINS: [&str; 8] = [
+const BUILTINS: [&str; 9] = [
     "sheet",
     "sheet-small",
     "cylinder",
@@ -42,6 +42,7 @@ const BUILTINS: [&str; 8] = [
     "torus-balloon",
     "teabag",
     "sphere-drape",
+    "sphere-drape-delaunay",
 ];
 
 /// Options of `pleat bench tfw`.
@@ -53,7 +54,8 @@ pub struct TfwBenchArgs {
     /// vertices, 5 % stretch), `sheet-small` (13 × 6), `cylinder` (twisted cylinder, 43 × 16,
     /// 10°), and the README's speed-table scenes: `sheared-rectangle` (1000 v, 3 mm shear),
     /// `disk-balloon` (2 × 600 v, 600 Pa), `torus-balloon` (2 × 800 v, 600 Pa), `teabag`
-    /// (2 × 468 v, 10 Pa), and `sphere-drape` (S:676: 1 m cloth on a 0.2 m sphere, 41 × 41 v).
+    /// (2 × 468 v, 10 Pa), `sphere-drape` (S:676: 1 m cloth on a 0.2 m sphere, 41 × 41 v) and
+    /// `sphere-drape-delaunay` (the same cloth on an irregular Delaunay mesh of ~1681 v).
     #[arg(long, value_delimiter = ',')]
     pub builtin: Vec<String>,
     /// Folder for tfw_iterations.csv, tfw_scenes.csv and tfw_bench.svg (created if missing).
@@ -105,6 +107,7 @@ fn builtin(name: &str) -> Option<Scene> {
         "torus-balloon" => Scene::torus_balloon(800, 600.0, 1).ok(),
         "teabag" => Scene::teabag(468, 10.0, 1).ok(),
         "sphere-drape" => Some(Scene::sphere_drape(41, 1.0)),
+        "sphere-drape-delaunay" => Scene::sphere_drape_delaunay(1681, 1.0, 1).ok(),
         _ => None,
     }
 }
