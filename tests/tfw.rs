@@ -305,9 +305,15 @@ fn sphere_drape_wrinkles_where_the_skirt_is_compressed() {
     }
     assert_eq!(Scene::sphere_drape(0, 0.6).panels[0].rest.len(), 4);
     assert_eq!(Scene::sphere_drape(5, -0.6), Scene::sphere_drape(5, 0.6));
-    let scene = Scene::sphere_drape(13, 0.6);
+    assert_drape_wrinkles(&Scene::sphere_drape(13, 0.6));
+}
+
+/// Solves a 0.6 m sphere drape through: most faces wrinkle (outside W), the SQP's energy never
+/// increases and ends lower, the field is curl-free off W, and the amplitudes are
+/// non-negative and below the skirt's length.
+fn assert_drape_wrinkles(scene: &Scene) {
     let params = pleat::tfw::TfwParams::default();
-    let r = pleat::tfw::solve(&scene, &params, &mut no_progress()).unwrap();
+    let r = pleat::tfw::solve(scene, &params, &mut no_progress()).unwrap();
     let sqp = r.sqp.as_ref().expect("the drape is compressed");
     let free = r.w_faces.iter().filter(|&&w| w).count();
     assert!(
@@ -349,26 +355,7 @@ fn sphere_drape_on_a_delaunay_mesh_wrinkles_like_the_grid() {
     let pinned = scene.dirichlet[0].vertices[0] as usize;
     let off = |p: &[f64; 2]| (p[0] - 0.3).hypot(p[1] - 0.3);
     assert!(rest.iter().all(|p| off(p) >= off(&rest[pinned])));
-    let r = pleat::tfw::solve(
-        &scene,
-        &pleat::tfw::TfwParams::default(),
-        &mut no_progress(),
-    )
-    .unwrap();
-    let sqp = r.sqp.as_ref().expect("the drape is compressed");
-    let free = r.w_faces.iter().filter(|&&w| w).count();
-    assert!(
-        2 * free < r.w_faces.len(),
-        "{free} of {} faces wrinkle-free",
-        r.w_faces.len()
-    );
-    let e: Vec<f64> = sqp.history.iter().map(|h| h.energy).collect();
-    assert!(
-        e.windows(2).all(|w| w[1] <= w[0] * (1.0 + 1e-12)),
-        "energy increased"
-    );
-    assert!(r.curl_residual <= 1e-10, "curl {}", r.curl_residual);
-    assert!(r.cwf.amplitude().iter().all(|&x| x >= 0.0));
+    assert_drape_wrinkles(&scene);
 }
 
 #[test]
