@@ -1093,9 +1093,9 @@ fn chain_from_finer(
 /// Chain levels `first..first + run.len()` of `n` (`run` by rank), each from the next finer
 /// result, the first from `finer`; all marked `started_from_finer`.
 ///
-/// When the pool has more than one thread, a level's loop starts from the next finer level's
-/// loop output while that level is verified and measured ([`judge_level`], [`run_beside`]):
-/// the output is the loop's unless the judging reruns the loop exactly or reverts the fit,
+/// A level's loop starts from the next finer level's loop output while that level is verified
+/// and measured ([`judge_level`]; beside it when the pool has more than one thread,
+/// [`run_beside`]): the output is the loop's unless the judging reruns the loop exactly or reverts the fit,
 /// and then the coarser level's loop runs again from the judged output. Every level is the
 /// one a sequential chain bakes, on any thread count (issue 12 part 2: the measurement at
 /// `l / 400` costs a coarse level as much as the finest).
@@ -1106,7 +1106,6 @@ fn from_finer_run(
     finer: &TriMesh,
     rep: &mut Reporter<'_, '_>,
 ) -> Result<Vec<(TriMesh, LodReport)>> {
-    let beside = rayon::current_num_threads() > 1;
     let mut baked: Vec<(TriMesh, LodReport)> = Vec::with_capacity(run.len());
     let mut next = Some(loop_level(
         level,
@@ -1121,7 +1120,7 @@ fn from_finer_run(
             .expect("each level is looped before it is judged");
         let coarser = run.get(k + 1).map(|&q| (q, chain_window(first + k + 1, n)));
         let (judged, guessed) = match coarser {
-            Some((q, window)) if beside => {
+            Some((q, window)) => {
                 let guess = looped.mesh.clone();
                 let (judged, coarser_loop) = run_beside(
                     rep,
@@ -1177,14 +1176,13 @@ fn chain_from_offsets(
         )
     };
     let coarser = |r: &mut Reporter<'_, '_>| coarser_own_offsets(level, levels, finest_topology, r);
-    let (finest_level, own) =
-        if n > 1 && rayon::current_num_threads() > 1 && beside_fits(level, levels) {
-            let (a, b) = run_beside(rep, bake_finest, coarser);
-            (a?, b?)
-        } else {
-            let a = bake_finest(rep)?;
-            (a, coarser(rep)?)
-        };
+    let (finest_level, own) = if n > 1 && beside_fits(level, levels) {
+        let (a, b) = run_beside(rep, bake_finest, coarser);
+        (a?, b?)
+    } else {
+        let a = bake_finest(rep)?;
+        (a, coarser(rep)?)
+    };
     let mut baked: Vec<(TriMesh, LodReport)> = vec![finest_level];
     let mut own = own.into_iter().peekable();
     while let Some(next) = own.next() {
@@ -1261,6 +1259,7 @@ fn beside_fits(level: &Level<'_>, levels: &[&LodParams]) -> bool {
 /// results. Progress reaches the caller's callback on this thread only: `b` reports into a
 /// relay that this thread forwards while it waits for `b` after `a`; a cancel (the callback's
 /// `false`) or an error of `a` stops `b` at its next report. A panic of either propagates.
+/// On a pool of one thread, `a` then (unless it failed) `b`, both on this thread with `rep`.
 fn run_beside<A, B>(
     rep: &mut Reporter<'_, '_>,
     a: impl FnOnce(&mut Reporter<'_, '_>) -> Result<A>,
@@ -1271,6 +1270,14 @@ where
 {
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::Mutex;
+    if rayon::current_num_threads() == 1 {
+        let a_result = a(rep);
+        let b_result = match a_result {
+            Ok(_) => b(rep),
+            Err(_) => Err(Error::Cancelled),
+        };
+        return (a_result, b_result);
+    }
     /// Sets its flag when dropped, also by a panic's unwinding.
     struct SetOnDrop<'f>(&'f AtomicBool);
     impl Drop for SetOnDrop<'_> {
