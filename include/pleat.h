@@ -884,9 +884,9 @@ typedef struct PleatLodStats {
   // allocating it): the peak bytes estimated from those counts, which fitted the memory
   // budget. NaN otherwise.
   double measured_estimate_bytes;
-  // In a chain: 1 when this coarser level started from the next finer level's result
-  // (its own offset surface had the finer level's topology), 0 when from its own offset
-  // surface, and for the finest level or a single bake.
+  // In a chain: 1 when this coarser level started from the next finer level's loop output
+  // before its fit (its own offset surface had the finer level's topology), 0 when from its
+  // own offset surface, and for the finest level or a single bake.
   uint32_t started_from_finer;
   // 1 when the loop ended because `STALL_ROUNDS` (5) rounds in a row made no new smallest
   // face count (LODs without a face target).
@@ -1853,12 +1853,13 @@ PleatStatus pleat_cage_generate(const struct PleatMesh *input,
                                 struct PleatMesh **out,
                                 struct PleatLodStats *stats);
 
-// Bakes one LOD per screen size. A coarser level starts from the next finer result when its
-// own offset surface has that result's topology, else from that offset surface (then it is
-// the level `pleat_lod_generate` bakes). On a pool of more than one thread, independent levels
+// Bakes one LOD per screen size. A coarser level starts from the next finer level's loop
+// output (before that level's input-plane fit) when its own offset surface has the finer
+// level's topology, else from that offset surface (then it is the level `pleat_lod_generate`
+// bakes). On a pool of more than one thread, independent levels
 // run at the same time, with the results of a one-thread run; the progress callback is still
 // called on the calling thread only, with fractions that never go back. A chain
-// {50, 100, 200} takes about 1.4x the wall time of its finest level alone (corpus median).
+// {50, 100, 200} takes about 1.3x the wall time of its finest level alone (corpus median).
 //
 // - `screen_sizes`: `count` screen sizes (any order; each finite and > 0), `count` >= 1.
 // - `params`: as `pleat_lod_generate`; `screen_size` and `target_faces` are ignored.

@@ -358,6 +358,16 @@ fn chain_level_whose_offset_merges_components_is_baked_from_it() {
 /// The chain {50, 100, 200} of `m` on a pool of `threads` threads: its levels and the
 /// fractions its progress reported.
 fn chain_on(m: &TriMesh, threads: usize) -> (Vec<(TriMesh, LodReport)>, Vec<f64>) {
+    chain_of_sizes_on(m, &[50.0, 100.0, 200.0], threads)
+}
+
+/// The chain of `m` at `sizes` on a pool of `threads` threads: its levels and the fractions
+/// its progress reported.
+fn chain_of_sizes_on(
+    m: &TriMesh,
+    sizes: &[f64],
+    threads: usize,
+) -> (Vec<(TriMesh, LodReport)>, Vec<f64>) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -365,7 +375,7 @@ fn chain_on(m: &TriMesh, threads: usize) -> (Vec<(TriMesh, LodReport)>, Vec<f64>
     let mut fractions = Vec::new();
     let levels = pool
         .install(|| {
-            generate_chain(m, &[50.0, 100.0, 200.0], &LodParams::default(), &mut |p| {
+            generate_chain(m, sizes, &LodParams::default(), &mut |p| {
                 fractions.push(p.fraction);
                 true
             })
@@ -402,6 +412,33 @@ fn assert_chain_on_one_and_two_threads(m: &TriMesh, own_offset: bool) {
     for fr in [fr1, fr2] {
         assert!(fr.windows(2).all(|w| w[0] <= w[1]), "progress went back");
         assert!(fr.iter().all(|f| (0.0..=1.0).contains(f)));
+    }
+}
+
+/// A level from its own offset surface followed by a level from it (two boxes 0.08 apart: the
+/// n_p = 55 offset merges them, the n_p = 50 one has its topology): on two threads both bake
+/// beside the finest level, one after the other; the same levels as on one thread, the own
+/// level the one `generate` bakes.
+#[test]
+fn a_level_from_its_own_offset_and_the_level_from_it_bake_beside_the_finest() {
+    let m = two_boxes(0.08);
+    let sizes = [50.0, 55.0, 200.0];
+    let (one, fr1) = chain_of_sizes_on(&m, &sizes, 1);
+    let (two, fr2) = chain_of_sizes_on(&m, &sizes, 2);
+    let from_finer: Vec<bool> = one.iter().map(|l| l.1.started_from_finer).collect();
+    assert_eq!(from_finer, [true, false, false]);
+    assert_eq!(MeshReport::compute(&one[1].0).n_components, 1);
+    for ((a, sa), (b, sb)) in one.iter().zip(&two) {
+        assert_valid(a, sa, "chain level");
+        assert_eq!(a, b);
+        assert_eq!(sa.hausdorff_rel, sb.hausdorff_rel);
+        assert_eq!(sa.started_from_finer, sb.started_from_finer);
+    }
+    let mut prog = |_: pleat::Progress<'_>| true;
+    let (single, _) = generate(&m, &params(55.0), &mut prog).unwrap();
+    assert_eq!(one[1].0, single, "the own level is the single bake");
+    for fr in [fr1, fr2] {
+        assert!(fr.windows(2).all(|w| w[0] <= w[1]), "progress went back");
     }
 }
 

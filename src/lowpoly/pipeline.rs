@@ -961,22 +961,23 @@ pub fn generate(
 
 /// Bakes one LOD per screen size (in the given order of `screen_sizes`). The finest level is
 /// baked from the input (from its offset surface, or from the welded input itself as
-/// [`LodParams::start`] decides); a coarser level starts from the next finer result (which already
-/// has every Pro.III guarantee, so the guard keeps them), with the one-sided distance check of
-/// Alg. 5 relaxed to `d` of the coarser level — the distance its own offset surface would start
-/// from — when the finest level started from the input, or when the level's own offset surface
-/// has the finer result's topology; otherwise (its offset closed handles or merged components
-/// the finer level kept) from its own offset surface, exactly as [`generate`] would bake it
-/// ([`LodReport::started_from_finer`]). `params.screen_size` and `params.target_faces` are ignored (a face target is per
-/// level: call [`generate`]). Each level's report has its [`LodReport::chain_level`]
-/// (0 = finest).
+/// [`LodParams::start`] decides); a coarser level starts from the next finer level's loop
+/// output before that level's input-plane fit (which already has every Pro.III guarantee, so
+/// the guard keeps them; the coarser level's own rounds and fit follow), with the one-sided
+/// distance check of Alg. 5 relaxed to `d` of the coarser level — the distance its own offset
+/// surface would start from — when the finest level started from the input, or when the
+/// level's own offset surface has the finer level's topology; otherwise (its offset closed
+/// handles or merged components the finer level kept) from its own offset surface, exactly as
+/// [`generate`] would bake it ([`LodReport::started_from_finer`]). `params.screen_size` and
+/// `params.target_faces` are ignored (a face target is per level: call [`generate`]). Each
+/// level's report has its [`LodReport::chain_level`] (0 = finest).
 ///
 /// On a thread pool of more than one thread, levels that do not depend on each other run at
-/// the same time (the levels from their own offsets beside the finest level; a level's loop
-/// beside the finer level's verification and measurement, from that level's loop output, redone
-/// in the rare case the verification reruns or the fit is reverted): the levels are byte for
-/// byte those of a one-thread run. `progress` is called on this thread only, with fractions
-/// that never go back.
+/// the same time (the levels from their own offsets beside the finest level; the coarser
+/// levels' bakes beside the finer level's fit, verification and measurement, redone in the
+/// rare case the verification reruns the loop): the levels are byte for byte those of a
+/// one-thread run. `progress` is called on this thread only, with fractions that never go
+/// back.
 pub fn generate_chain(
     input: &TriMesh,
     screen_sizes: &[f64],
@@ -1013,7 +1014,9 @@ pub(crate) fn run(
             Start::Offset(offset_start(&level, params, &mut rep)?)
         }
     };
-    let (mesh, mut stats) = bake_level(&level, params, start, &mut rep, (0.0, 1.0))?;
+    let Judged {
+        mesh, mut stats, ..
+    } = bake_level(&level, params, start, &mut rep, (0.0, 1.0))?;
     stats.started_from_input = from_input;
     Ok((mesh, stats))
 }
@@ -1061,7 +1064,13 @@ pub(crate) fn run_chain(
         None => chain_from_offsets(&level, &levels, &mut rep)?,
     };
     let mut out: Vec<Option<(TriMesh, LodReport)>> = vec![None; screen_sizes.len()];
-    for (rank, (mesh, mut stats)) in by_rank.into_iter().enumerate() {
+    for (
+        rank,
+        Judged {
+            mesh, mut stats, ..
+        },
+    ) in by_rank.into_iter().enumerate()
+    {
         stats.chain_level = Some(rank as u64);
         stats.started_from_input = rank == 0 && welded.is_some();
         out[order[rank]] = Some((mesh, stats));
@@ -1078,90 +1087,127 @@ fn chain_window(rank: usize, n: usize) -> (f64, f64) {
 }
 
 /// A chain whose finest level starts from the welded clean input `welded`: every level from
-/// the next finer result, finest first (`levels` by rank). Sets `started_from_finer`.
+/// the next finer one, finest first (`levels` by rank). Sets `started_from_finer`.
 fn chain_from_finer(
     level: &Level<'_>,
     levels: &[&LodParams],
     welded: &TriMesh,
     rep: &mut Reporter<'_, '_>,
-) -> Result<Vec<(TriMesh, LodReport)>> {
-    let mut baked = from_finer_run(level, levels, (0, levels.len()), welded, rep)?;
-    baked[0].1.started_from_finer = false;
+) -> Result<Vec<Judged>> {
+    let mut baked = from_finer_run(level, levels, (0, levels.len()), welded, true, rep)?;
+    baked[0].stats.started_from_finer = false;
     Ok(baked)
 }
 
 /// Chain levels `first..first + run.len()` of `n` (`run` by rank), each from the next finer
-/// result, the first from `finer`; all marked `started_from_finer`.
+/// one, the first from `finer`; all marked `started_from_finer`.
 ///
-/// A level's loop starts from the next finer level's loop output while that level is verified
-/// and measured ([`judge_level`]; beside it when the pool has more than one thread,
-/// [`run_beside`]): the output is the loop's unless the judging reruns the loop exactly or reverts the fit,
-/// and then the coarser level's loop runs again from the judged output. Every level is the
-/// one a sequential chain bakes, on any thread count (issue 12 part 2: the measurement at
-/// `l / 400` costs a coarse level as much as the finest).
+/// A level starts from the next finer level's rounds output, before that level's fit
+/// ([`Judged::rounds_output`]): the fit pulls a level onto the input's planes for its shading,
+/// and the coarser level's own rounds and fit redo that at its own `d`. So the rest of the run
+/// is baked from it while the finer level is fitted, verified and measured ([`fit_level`],
+/// [`judge_level`]; beside it when the pool has more than one thread, [`run_beside`]); when
+/// the judging reruns the loop exactly (a different rounds output), the rest of the run is
+/// baked again from the rerun's. Every level is the one a sequential chain bakes, on any
+/// thread count (issue 12 part 2: a coarse level is mostly its fit and its measurement at
+/// `l / 400`, which now run beside the finer level's).
 fn from_finer_run(
     level: &Level<'_>,
     run: &[&LodParams],
     (first, n): (usize, usize),
     finer: &TriMesh,
+    beside: bool,
     rep: &mut Reporter<'_, '_>,
-) -> Result<Vec<(TriMesh, LodReport)>> {
-    let mut baked: Vec<(TriMesh, LodReport)> = Vec::with_capacity(run.len());
-    let mut next = Some(loop_level(
-        level,
-        run[0],
-        Start::Given(finer),
-        rep,
-        chain_window(first, n),
-    )?);
-    for (k, &p) in run.iter().enumerate() {
-        let looped = next
-            .take()
-            .expect("each level is looped before it is judged");
-        let coarser = run.get(k + 1).map(|&q| (q, chain_window(first + k + 1, n)));
-        let (judged, guessed) = match coarser {
-            Some((q, window)) => {
-                let guess = looped.mesh.clone();
-                let (judged, coarser_loop) = run_beside(
-                    rep,
-                    |r| judge_level(level, p, looped, r),
-                    |r| loop_level(level, q, Start::Given(&guess), r, window),
-                );
-                (judged?, Some((guess, coarser_loop)))
-            }
-            _ => (judge_level(level, p, looped, rep)?, None),
-        };
-        if let Some((q, window)) = coarser {
-            next = Some(match guessed {
-                Some((guess, coarser_loop)) if guess == judged.0 => coarser_loop?,
-                Some((_, Err(Error::Cancelled))) => return Err(Error::Cancelled),
-                _ => loop_level(level, q, Start::Given(&judged.0), rep, window)?,
-            });
-        }
-        let (mesh, mut stats) = judged;
-        stats.started_from_finer = true;
-        baked.push((mesh, stats));
+) -> Result<Vec<Judged>> {
+    run_from(level, run, (first, n), Start::Given(finer), beside, rep)
+}
+
+/// Chain levels `first..first + run.len()` of `n` (`run` by rank): the first from `start`
+/// (marked `started_from_finer` when it is [`Start::Given`]), each next one from the one
+/// before it as [`from_finer_run`] describes (marked `started_from_finer`). With `beside`, the
+/// rest of the run is baked beside the first level's fit and judging ([`run_beside`]), on one
+/// thread; without, in turn.
+fn run_from(
+    level: &Level<'_>,
+    run: &[&LodParams],
+    (first, n): (usize, usize),
+    start: Start<'_>,
+    beside: bool,
+    rep: &mut Reporter<'_, '_>,
+) -> Result<Vec<Judged>> {
+    let p = run[0];
+    let from_finer = matches!(start, Start::Given(_));
+    let rounded = round_level(level, p, start, rep, chain_window(first, n))?;
+    let finish = |rounded: Rounded<'_>, r: &mut Reporter<'_, '_>| {
+        let looped = fit_level(rounded, r)?;
+        let mut judged = judge_level(level, p, looped, r)?;
+        judged.stats.started_from_finer = from_finer;
+        Ok(judged)
+    };
+    let rest = &run[1..];
+    if rest.is_empty() {
+        return Ok(vec![finish(rounded, rep)?]);
     }
+    let (judged, coarser) = if beside {
+        // the rest on one thread, so that this level's fit keeps a core and the pool's other
+        // thread for its parallel parts
+        let guess = rounded.output();
+        let bake_rest = |r: &mut Reporter<'_, '_>| {
+            from_finer_run(level, rest, (first + 1, n), &guess, false, r)
+        };
+        let (judged, coarser) = run_beside(rep, |r| finish(rounded, r), bake_rest);
+        let judged = judged?;
+        let coarser = match coarser {
+            Ok(c) if judged.rounds_output == guess => c,
+            Err(Error::Cancelled) => return Err(Error::Cancelled),
+            Err(e) if judged.rounds_output == guess => return Err(e),
+            _ => from_finer_run(
+                level,
+                rest,
+                (first + 1, n),
+                &judged.rounds_output,
+                true,
+                rep,
+            )?,
+        };
+        (judged, coarser)
+    } else {
+        let judged = finish(rounded, rep)?;
+        let coarser = from_finer_run(
+            level,
+            rest,
+            (first + 1, n),
+            &judged.rounds_output,
+            false,
+            rep,
+        )?;
+        (judged, coarser)
+    };
+    let mut baked = Vec::with_capacity(run.len());
+    baked.push(judged);
+    baked.extend(coarser);
     Ok(baked)
 }
 
 /// A chain whose finest level starts from its offset surface (`levels` by rank, finest
 /// first). Each coarser level computes its own offset surface, and starts from it when its
 /// topology differs from the next finer level's ([`starts_from_finer`]; the loop keeps its
-/// start's topology, so a level's is its start's), else from the finer result.
+/// start's topology, so a level's is its start's), else from the finer level
+/// ([`from_finer_run`]).
 ///
-/// The levels that start from their own offsets depend on nothing but the input: when the
-/// pool has more than one thread and the budget holds the finest level and any one coarser
-/// level at once ([`beside_fits`]), they are baked beside the finest level
-/// ([`run_beside`]); the levels that start from a finer result follow, finest first. Each
-/// level's computation is the same whichever thread runs it and whether it runs beside
-/// another, so the outputs do not depend on it (issue 12 part 2: a dirty input's chain
-/// bakes its coarser levels' offsets, and the levels those close, on the second core).
+/// The levels that start from their own offsets, and the levels that follow them from the
+/// finer one, depend on nothing but the input: when the pool has more than one thread and the
+/// budget holds the finest level and any one coarser level at once ([`beside_fits`]), they are
+/// baked beside the finest level ([`run_beside`], [`coarser_own_offsets`]); the levels that
+/// follow the finest one from the finer one come after it ([`from_finer_run`]). Each level's
+/// computation is the same whichever thread runs it and whether it runs beside another, so
+/// the outputs do not depend on it (issue 12 part 2: a dirty input's chain bakes its coarser
+/// levels' offsets, and the levels those close, on the second core).
 fn chain_from_offsets(
     level: &Level<'_>,
     levels: &[&LodParams],
     rep: &mut Reporter<'_, '_>,
-) -> Result<Vec<(TriMesh, LodReport)>> {
+) -> Result<Vec<Judged>> {
     let n = levels.len();
     rep.window(0.0, 0.2 * chain_window(0, n).1);
     let finest = offset_start(level, levels[0], rep)?;
@@ -1183,7 +1229,7 @@ fn chain_from_offsets(
         let a = bake_finest(rep)?;
         (a, coarser(rep)?)
     };
-    let mut baked: Vec<(TriMesh, LodReport)> = vec![finest_level];
+    let mut baked: Vec<Judged> = vec![finest_level];
     let mut own = own.into_iter().peekable();
     while let Some(next) = own.next() {
         if let Some(done) = next {
@@ -1196,23 +1242,31 @@ fn chain_from_offsets(
         while own.next_if(|o| o.is_none()).is_some() {
             len += 1;
         }
-        let finer = &baked[first - 1].0;
-        let run = from_finer_run(level, &levels[first..first + len], (first, n), finer, rep)?;
+        let finer = &baked[first - 1].rounds_output;
+        let run = from_finer_run(
+            level,
+            &levels[first..first + len],
+            (first, n),
+            finer,
+            true,
+            rep,
+        )?;
         baked.extend(run);
     }
     Ok(baked)
 }
 
 /// The coarser levels (ranks `1..`) of [`chain_from_offsets`]: each one's own offset surface,
-/// and the bake of those that start from it (`Some`); `None` for a level that starts from
-/// the next finer result (its offset discarded). `finest_topology` is the finest level's
-/// start's.
+/// and the bake of those that start from it (`Some`); a level that starts from the next finer
+/// one (its offset discarded) is baked here too when that one was (`Some`, from its rounds
+/// output: [`from_finer_run`]), else it follows the finest level (`None`).
+/// `finest_topology` is the finest level's start's.
 fn coarser_own_offsets(
     level: &Level<'_>,
     levels: &[&LodParams],
     finest_topology: (usize, i64),
     rep: &mut Reporter<'_, '_>,
-) -> Result<Vec<Option<(TriMesh, LodReport)>>> {
+) -> Result<Vec<Option<Judged>>> {
     let n = levels.len();
     let mut finer_topology = finest_topology;
     let mut own = Vec::with_capacity(n.saturating_sub(1));
@@ -1222,7 +1276,16 @@ fn coarser_own_offsets(
         let start = offset_start(level, p, rep)?;
         let topology = topology_of(&start.mesh);
         if starts_from_finer(finer_topology, topology, p, level.mode) {
-            own.push(None);
+            drop(start);
+            let next = match own.last() {
+                Some(Some(finer)) => {
+                    let finer: &Judged = finer;
+                    let run = &levels[rank..=rank];
+                    from_finer_run(level, run, (rank, n), &finer.rounds_output, false, rep)?.pop()
+                }
+                _ => None,
+            };
+            own.push(next);
             continue;
         }
         finer_topology = topology;
@@ -1477,7 +1540,7 @@ fn bake_level(
     start: Start<'_>,
     rep: &mut Reporter<'_, '_>,
     window: (f64, f64),
-) -> Result<(TriMesh, LodReport)> {
+) -> Result<Judged> {
     let looped = loop_level(level, params, start, rep, window)?;
     judge_level(level, params, looped, rep)
 }
@@ -1490,6 +1553,18 @@ fn loop_level(
     rep: &mut Reporter<'_, '_>,
     window: (f64, f64),
 ) -> Result<Looped> {
+    let rounded = round_level(level, params, start, rep, window)?;
+    fit_level(rounded, rep)
+}
+
+/// The first part of [`loop_level`]: the start and the rounds of Alg. 3, before the fit.
+fn round_level<'m>(
+    level: &Level<'m>,
+    params: &LodParams,
+    start: Start<'_>,
+    rep: &mut Reporter<'_, '_>,
+    window: (f64, f64),
+) -> Result<Rounded<'m>> {
     let (model, mode) = (level.model, level.mode);
     let l = model.diag;
     let d = l / params.screen_size;
@@ -1530,7 +1605,32 @@ fn loop_level(
         },
         fit: mode == Mode::Lod && params.fit_to_input,
     };
-    let (mesh, ls) = optimize(&start, level.model, &cfg, false, rep)?;
+    let (guard, ls) = optimize_rounds(&start, level.model, &cfg, false, rep)?;
+    Ok(Rounded {
+        guard,
+        ls,
+        stats,
+        start,
+        start_topology,
+        cfg,
+        from_offset,
+        window,
+    })
+}
+
+/// The second part of [`loop_level`]: the fit after the rounds ([`optimize_fit`]).
+fn fit_level(rounded: Rounded<'_>, rep: &mut Reporter<'_, '_>) -> Result<Looped> {
+    let Rounded {
+        guard,
+        ls,
+        stats,
+        start,
+        start_topology,
+        cfg,
+        from_offset,
+        window,
+    } = rounded;
+    let (mesh, ls) = optimize_fit(guard, &cfg, ls, rep)?;
     Ok(Looped {
         mesh,
         ls,
@@ -1541,6 +1641,26 @@ fn loop_level(
         from_offset,
         window,
     })
+}
+
+/// A level after the rounds of its loop ([`round_level`]), before its fit ([`fit_level`]).
+struct Rounded<'m> {
+    /// The guard holding the rounds' output.
+    guard: Guard<'m>,
+    ls: LoopStats,
+    stats: LodReport,
+    start: TriMesh,
+    start_topology: (usize, i64),
+    cfg: LoopConfig,
+    from_offset: bool,
+    window: (f64, f64),
+}
+
+impl Rounded<'_> {
+    /// The rounds' output: the surface a coarser chain level starts from.
+    fn output(&self) -> TriMesh {
+        self.guard.mesh().to_trimesh()
+    }
 }
 
 /// A level after its loop and fit ([`loop_level`]), before its verification and measurement
@@ -1567,7 +1687,7 @@ fn judge_level(
     params: &LodParams,
     looped: Looped,
     rep: &mut Reporter<'_, '_>,
-) -> Result<(TriMesh, LodReport)> {
+) -> Result<Judged> {
     let (model, input, mode) = (level.model, level.input, level.mode);
     let l = model.diag;
     let Looped {
@@ -1596,6 +1716,7 @@ fn judge_level(
         v = verify_level(&mesh, level, rep, (0.0, 0.5))?;
     }
     let mut verify_s = t0.elapsed().as_secs_f64();
+    let rounds_output = ls.prefit.clone().unwrap_or_else(|| mesh.clone());
     rep.check("measure", 0.5)?;
     let t0 = Instant::now();
     // chunked so that a cancel is seen within tens of milliseconds (issue 15)
@@ -1681,7 +1802,21 @@ fn judge_level(
     stats.faces = mesh.triangle_count() as u64;
     stats.vertices = mesh.vertex_count() as u64;
     rep.check("done", 1.0)?;
-    Ok((mesh, stats))
+    Ok(Judged {
+        mesh,
+        stats,
+        rounds_output,
+    })
+}
+
+/// A baked level ([`judge_level`]).
+struct Judged {
+    /// The output.
+    mesh: TriMesh,
+    stats: LodReport,
+    /// The output of the rounds of the run the output comes from (of the exact rerun if there
+    /// was one), before the fit: the surface the next coarser chain level starts from.
+    rounds_output: TriMesh,
 }
 
 /// Whether a pre-fit Hausdorff distance `pre` keeps a fit that measured `fitted` (the fit's
@@ -1882,6 +2017,19 @@ fn optimize(
     exact_only: bool,
     rep: &mut Reporter<'_, '_>,
 ) -> Result<(TriMesh, LoopStats)> {
+    let (g, ls) = optimize_rounds(start, model, cfg, exact_only, rep)?;
+    optimize_fit(g, cfg, ls, rep)
+}
+
+/// The rounds of [`optimize`] (simplify, flow, align until converged, stalled, at the target
+/// or after `N` rounds): the guard holding their output, and their totals.
+fn optimize_rounds<'m>(
+    start: &TriMesh,
+    model: &'m InputModel,
+    cfg: &LoopConfig,
+    exact_only: bool,
+    rep: &mut Reporter<'_, '_>,
+) -> Result<(Guard<'m>, LoopStats)> {
     let he = HalfEdgeMesh::from_trimesh(start)
         .map_err(|e| Error::Internal(format!("the start surface is not manifold: {e}")))?;
     let mut g = Guard::new(he, model, cfg.mode == Mode::Cage);
@@ -1949,6 +2097,17 @@ fn optimize(
             break;
         }
     }
+    Ok((g, ls))
+}
+
+/// The end of [`optimize`] after its rounds: the input-plane fit when `cfg.fit` (the rounds'
+/// output kept in `ls.prefit` for the safety revert), then the output and the totals.
+fn optimize_fit(
+    mut g: Guard<'_>,
+    cfg: &LoopConfig,
+    mut ls: LoopStats,
+    rep: &mut Reporter<'_, '_>,
+) -> Result<(TriMesh, LoopStats)> {
     if cfg.fit {
         rep.check("fit", 1.0)?;
         let t0 = Instant::now();
@@ -2112,6 +2271,71 @@ mod tests {
     /// The unit cube (the guard tests' shape).
     fn cube() -> TriMesh {
         crate::lowpoly::guard::tests::cube(1.0, 0.0)
+    }
+
+    /// A torus of radii 1 and 0.3, `nu × nv` quads split in two.
+    fn torus(nu: usize, nv: usize) -> TriMesh {
+        let tau = std::f64::consts::TAU;
+        let mut p = Vec::with_capacity(nu * nv);
+        for i in 0..nu {
+            for j in 0..nv {
+                let (u, v) = (tau * i as f64 / nu as f64, tau * j as f64 / nv as f64);
+                let r = 1.0 + 0.3 * v.cos();
+                p.push([r * u.cos(), r * u.sin(), 0.3 * v.sin()]);
+            }
+        }
+        let id = |i: usize, j: usize| ((i % nu) * nv + j % nv) as u32;
+        let mut t = Vec::with_capacity(2 * nu * nv);
+        for i in 0..nu {
+            for j in 0..nv {
+                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        TriMesh::new(p, t).unwrap()
+    }
+
+    /// A coarser chain level starts from the next finer level's rounds output, before that
+    /// level's fit (issue 12 part 2, session 22): the chain's n_p = 50 level is the bake of the
+    /// n_p = 100 level's rounds output, whose fit and judging it ran beside.
+    #[test]
+    fn a_chain_level_is_baked_from_the_finer_levels_rounds_output() {
+        let m = torus(48, 16);
+        let params = LodParams::default();
+        let chain = run_chain(&m, &[50.0, 100.0], &params, Mode::Lod, &mut |_| true).unwrap();
+        assert!(chain[0].1.started_from_finer && chain[1].1.started_from_input);
+        let model = InputModel::new_with_stop(&m, false, &mut || true).unwrap();
+        let level = Level::new(&model, &m, Mode::Lod);
+        let mut prog = |_: Progress<'_>| true;
+        let mut rep = Reporter::new(&mut prog);
+        let p = |s: f64| LodParams {
+            screen_size: s,
+            ..params.clone()
+        };
+        let welded = choose_start(&m, &p(100.0), Mode::Lod, &mut rep)
+            .unwrap()
+            .unwrap();
+        let finer = round_level(
+            &level,
+            &p(100.0),
+            Start::Given(&welded),
+            &mut rep,
+            (0.0, 1.0),
+        );
+        let finer = finer.unwrap();
+        let start = finer.output();
+        let fitted = judge_level(
+            &level,
+            &p(100.0),
+            fit_level(finer, &mut rep).unwrap(),
+            &mut rep,
+        );
+        let fitted = fitted.unwrap();
+        assert_eq!(fitted.mesh, chain[1].0);
+        assert_eq!(fitted.rounds_output, start);
+        assert_ne!(fitted.mesh, start, "the fit moved the finer level");
+        let coarse = bake_level(&level, &p(50.0), Start::Given(&start), &mut rep, (0.0, 1.0));
+        assert_eq!(coarse.unwrap().mesh, chain[0].0);
     }
 
     /// A LOD whose up-front estimate fits no voxel scale: admitted by measurement with its

@@ -245,8 +245,9 @@ pub struct LodReport {
     /// The loop started from the welded input (`LodParams::start`, issue 12 part 1) instead of
     /// the offset surface (in a chain: this level is the finest and started from the input).
     pub started_from_input: bool,
-    /// In a chain, a coarser level that started from the next finer level's output (same
-    /// topology as its own offset surface) rather than from its own offset surface.
+    /// In a chain, a coarser level that started from the next finer level's loop output before
+    /// its fit (same topology as its own offset surface) rather than from its own offset
+    /// surface.
     pub started_from_finer: bool,
     /// Guarantees verified afterwards by `crate::verify`: watertight, manifold (and
     /// consistently oriented), self-intersection-free, same topology as the offset surface,

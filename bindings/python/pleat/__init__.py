@@ -656,7 +656,8 @@ class Mesh(_Handle):
 
     def lod_chain(self, screen_sizes, progress=None, **params):
         """One LOD per screen size (list of Mesh, in the order given); a coarser level starts
-        from the next finer result when its own offset surface has the same topology
+        from the next finer level's loop output (before its fit) when its own offset surface
+        has the same topology
         (``stats["started_from_finer"]``), so a chain costs less than baking each level alone;
         independent levels run at the same time on more than one thread, with the results of
         one thread (``progress`` is still called on this thread only).
