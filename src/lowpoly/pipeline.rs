@@ -1609,38 +1609,35 @@ fn round_level<'m>(
     Ok(Rounded {
         guard,
         ls,
-        stats,
-        start,
-        start_topology,
-        cfg,
-        from_offset,
-        window,
+        run: LevelRun {
+            stats,
+            start,
+            start_topology,
+            cfg,
+            from_offset,
+            window,
+        },
     })
 }
 
 /// The second part of [`loop_level`]: the fit after the rounds ([`optimize_fit`]).
 fn fit_level(rounded: Rounded<'_>, rep: &mut Reporter<'_, '_>) -> Result<Looped> {
-    let Rounded {
-        guard,
-        ls,
-        stats,
-        start,
-        start_topology,
-        cfg,
-        from_offset,
-        window,
-    } = rounded;
-    let (mesh, ls) = optimize_fit(guard, &cfg, ls, rep)?;
-    Ok(Looped {
-        mesh,
-        ls,
-        stats,
-        start,
-        start_topology,
-        cfg,
-        from_offset,
-        window,
-    })
+    let Rounded { guard, ls, run } = rounded;
+    let (mesh, ls) = optimize_fit(guard, &run.cfg, ls, rep)?;
+    Ok(Looped { mesh, ls, run })
+}
+
+/// What a level's run carries from its start to its judging ([`round_level`] to
+/// [`judge_level`]).
+struct LevelRun {
+    /// The report so far (the start's figures).
+    stats: LodReport,
+    /// The start surface, for an exact rerun.
+    start: TriMesh,
+    start_topology: (usize, i64),
+    cfg: LoopConfig,
+    from_offset: bool,
+    window: (f64, f64),
 }
 
 /// A level after the rounds of its loop ([`round_level`]), before its fit ([`fit_level`]).
@@ -1648,12 +1645,7 @@ struct Rounded<'m> {
     /// The guard holding the rounds' output.
     guard: Guard<'m>,
     ls: LoopStats,
-    stats: LodReport,
-    start: TriMesh,
-    start_topology: (usize, i64),
-    cfg: LoopConfig,
-    from_offset: bool,
-    window: (f64, f64),
+    run: LevelRun,
 }
 
 impl Rounded<'_> {
@@ -1669,14 +1661,7 @@ struct Looped {
     /// The loop's (and fit's) output.
     mesh: TriMesh,
     ls: LoopStats,
-    /// The report so far (the start's figures).
-    stats: LodReport,
-    /// The start surface, for an exact rerun.
-    start: TriMesh,
-    start_topology: (usize, i64),
-    cfg: LoopConfig,
-    from_offset: bool,
-    window: (f64, f64),
+    run: LevelRun,
 }
 
 /// The verification and measurement of a level after its loop ([`loop_level`]): the exact
@@ -1693,12 +1678,15 @@ fn judge_level(
     let Looped {
         mut mesh,
         mut ls,
-        mut stats,
-        start,
-        start_topology,
-        cfg,
-        from_offset,
-        window: (w0, ws),
+        run:
+            LevelRun {
+                mut stats,
+                start,
+                start_topology,
+                cfg,
+                from_offset,
+                window: (w0, ws),
+            },
     } = looped;
     rep.window(w0 + 0.9 * ws, 0.1 * ws);
     rep.check("verify", 0.0)?;
@@ -2273,34 +2261,12 @@ mod tests {
         crate::lowpoly::guard::tests::cube(1.0, 0.0)
     }
 
-    /// A torus of radii 1 and 0.3, `nu × nv` quads split in two.
-    fn torus(nu: usize, nv: usize) -> TriMesh {
-        let tau = std::f64::consts::TAU;
-        let mut p = Vec::with_capacity(nu * nv);
-        for i in 0..nu {
-            for j in 0..nv {
-                let (u, v) = (tau * i as f64 / nu as f64, tau * j as f64 / nv as f64);
-                let r = 1.0 + 0.3 * v.cos();
-                p.push([r * u.cos(), r * u.sin(), 0.3 * v.sin()]);
-            }
-        }
-        let id = |i: usize, j: usize| ((i % nu) * nv + j % nv) as u32;
-        let mut t = Vec::with_capacity(2 * nu * nv);
-        for i in 0..nu {
-            for j in 0..nv {
-                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
-        TriMesh::new(p, t).unwrap()
-    }
-
     /// A coarser chain level starts from the next finer level's rounds output, before that
     /// level's fit (issue 12 part 2, session 22): the chain's n_p = 50 level is the bake of the
     /// n_p = 100 level's rounds output, whose fit and judging it ran beside.
     #[test]
     fn a_chain_level_is_baked_from_the_finer_levels_rounds_output() {
-        let m = torus(48, 16);
+        let m = crate::spatial::winding::tests::torus(48, 16);
         let params = LodParams::default();
         let chain = run_chain(&m, &[50.0, 100.0], &params, Mode::Lod, &mut |_| true).unwrap();
         assert!(chain[0].1.started_from_finer && chain[1].1.started_from_input);

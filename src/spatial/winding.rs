@@ -456,7 +456,7 @@ fn centroid(positions: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     fn tetra() -> TriMesh {
@@ -468,7 +468,7 @@ mod tests {
     }
 
     /// A UV torus (major radius 2, minor 0.5) around the z axis, outward oriented.
-    fn torus(n: u32, m: u32) -> TriMesh {
+    pub(crate) fn torus(n: u32, m: u32) -> TriMesh {
         let mut p = Vec::new();
         for i in 0..n {
             for j in 0..m {
