@@ -444,31 +444,33 @@ fn a_level_from_its_own_offset_and_the_level_from_it_bake_beside_the_finest() {
 
 /// A chain whose levels bake beside each other (a two-thread pool) cancels at whichever
 /// report the callback answers `false`, and the callback is not called after that; both
-/// kinds of chain (levels from their own offsets, levels from a clean input's finer ones).
+/// kinds of chain (levels from their own offsets, alone or followed by a level from them;
+/// levels from a clean input's finer ones).
 #[test]
 fn a_chain_with_levels_beside_cancels_at_any_report() {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build()
         .unwrap();
-    for m in [two_boxes(0.08), shapes::torus(1.0, 0.3, 64, 24)] {
+    let chains = [
+        (two_boxes(0.08), [50.0, 100.0, 200.0]),
+        // a level from its own offset followed by a level from it, beside the finest
+        (two_boxes(0.08), [50.0, 55.0, 200.0]),
+        (shapes::torus(1.0, 0.3, 64, 24), [50.0, 100.0, 200.0]),
+    ];
+    for (m, sizes) in chains {
         // the number of reports varies with the timing of the levels beside each other
-        let (_, fr) = chain_on(&m, 2);
+        let (_, fr) = chain_of_sizes_on(&m, &sizes, 2);
         let total = fr.len();
         assert!(total >= 8, "{total} reports");
         for stop_at in [1, 2, total / 4, total / 3, total / 2] {
             let mut calls = 0;
             let e = pool
                 .install(|| {
-                    generate_chain(
-                        &m,
-                        &[50.0, 100.0, 200.0],
-                        &LodParams::default(),
-                        &mut |_| {
-                            calls += 1;
-                            calls < stop_at
-                        },
-                    )
+                    generate_chain(&m, &sizes, &LodParams::default(), &mut |_| {
+                        calls += 1;
+                        calls < stop_at
+                    })
                 })
                 .unwrap_err();
             assert_eq!(e, Error::Cancelled, "stop at {stop_at}");
