@@ -1148,7 +1148,7 @@ fn run_from(
     if rest.is_empty() {
         return Ok(vec![finish(rounded, rep)?]);
     }
-    let (judged, coarser) = if beside {
+    let (judged, guessed) = if beside {
         // the rest on one thread, so that this level's fit keeps a core and the pool's other
         // thread for its parallel parts
         let guess = rounded.output();
@@ -1156,32 +1156,23 @@ fn run_from(
             from_finer_run(level, rest, (first + 1, n), &guess, false, r)
         };
         let (judged, coarser) = run_beside(rep, |r| finish(rounded, r), bake_rest);
-        let judged = judged?;
-        let coarser = match coarser {
-            Ok(c) if judged.rounds_output == guess => c,
-            Err(Error::Cancelled) => return Err(Error::Cancelled),
-            Err(e) if judged.rounds_output == guess => return Err(e),
-            _ => from_finer_run(
-                level,
-                rest,
-                (first + 1, n),
-                &judged.rounds_output,
-                true,
-                rep,
-            )?,
-        };
-        (judged, coarser)
+        (judged?, Some((guess, coarser)))
     } else {
-        let judged = finish(rounded, rep)?;
-        let coarser = from_finer_run(
+        (finish(rounded, rep)?, None)
+    };
+    let coarser = match guessed {
+        Some((guess, Ok(c))) if *judged.rounds_output() == guess => c,
+        Some((_, Err(Error::Cancelled))) => return Err(Error::Cancelled),
+        Some((guess, Err(e))) if *judged.rounds_output() == guess => return Err(e),
+        // in turn, or again from the rerun's rounds output
+        _ => from_finer_run(
             level,
             rest,
             (first + 1, n),
-            &judged.rounds_output,
-            false,
+            judged.rounds_output(),
+            beside,
             rep,
-        )?;
-        (judged, coarser)
+        )?,
     };
     let mut baked = Vec::with_capacity(run.len());
     baked.push(judged);
@@ -1242,7 +1233,7 @@ fn chain_from_offsets(
         while own.next_if(|o| o.is_none()).is_some() {
             len += 1;
         }
-        let finer = &baked[first - 1].rounds_output;
+        let finer = baked[first - 1].rounds_output();
         let run = from_finer_run(
             level,
             &levels[first..first + len],
@@ -1269,7 +1260,7 @@ fn coarser_own_offsets(
 ) -> Result<Vec<Option<Judged>>> {
     let n = levels.len();
     let mut finer_topology = finest_topology;
-    let mut own = Vec::with_capacity(n.saturating_sub(1));
+    let mut own: Vec<Option<Judged>> = Vec::with_capacity(n.saturating_sub(1));
     for (rank, p) in levels.iter().enumerate().skip(1) {
         let window = chain_window(rank, n);
         rep.window(window.0, 0.2 * window.1);
@@ -1279,9 +1270,8 @@ fn coarser_own_offsets(
             drop(start);
             let next = match own.last() {
                 Some(Some(finer)) => {
-                    let finer: &Judged = finer;
                     let run = &levels[rank..=rank];
-                    from_finer_run(level, run, (rank, n), &finer.rounds_output, false, rep)?.pop()
+                    from_finer_run(level, run, (rank, n), finer.rounds_output(), false, rep)?.pop()
                 }
                 _ => None,
             };
@@ -1704,7 +1694,8 @@ fn judge_level(
         v = verify_level(&mesh, level, rep, (0.0, 0.5))?;
     }
     let mut verify_s = t0.elapsed().as_secs_f64();
-    let rounds_output = ls.prefit.clone().unwrap_or_else(|| mesh.clone());
+    // the pre-fit mesh when the fit is kept; `None`: the output is the rounds output
+    let mut rounds_output = None;
     rep.check("measure", 0.5)?;
     let t0 = Instant::now();
     // chunked so that a cancel is seen within tens of milliseconds (issue 15)
@@ -1735,6 +1726,8 @@ fn judge_level(
             ls.fit_reverted = true;
             v = verify_level(&mesh, level, rep, (1.0, 1.0))?;
             verify_s += t0.elapsed().as_secs_f64();
+        } else {
+            rounds_output = Some(pre);
         }
     }
     ls.write(&mut stats);
@@ -1802,9 +1795,16 @@ struct Judged {
     /// The output.
     mesh: TriMesh,
     stats: LodReport,
+    /// The rounds output ([`Judged::rounds_output`]) when it is not `mesh` (the fit was kept).
+    rounds_output: Option<TriMesh>,
+}
+
+impl Judged {
     /// The output of the rounds of the run the output comes from (of the exact rerun if there
     /// was one), before the fit: the surface the next coarser chain level starts from.
-    rounds_output: TriMesh,
+    fn rounds_output(&self) -> &TriMesh {
+        self.rounds_output.as_ref().unwrap_or(&self.mesh)
+    }
 }
 
 /// Whether a pre-fit Hausdorff distance `pre` keeps a fit that measured `fitted` (the fit's
@@ -2298,7 +2298,7 @@ mod tests {
         );
         let fitted = fitted.unwrap();
         assert_eq!(fitted.mesh, chain[1].0);
-        assert_eq!(fitted.rounds_output, start);
+        assert_eq!(*fitted.rounds_output(), start);
         assert_ne!(fitted.mesh, start, "the fit moved the finer level");
         let coarse = bake_level(&level, &p(50.0), Start::Given(&start), &mut rep, (0.0, 1.0));
         assert_eq!(coarse.unwrap().mesh, chain[0].0);
