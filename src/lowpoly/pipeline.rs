@@ -1160,12 +1160,11 @@ fn run_from(
     } else {
         (finish(rounded, rep)?, None)
     };
-    let coarser = match guessed {
-        Some((guess, Ok(c))) if *judged.rounds_output() == guess => c,
-        Some((_, Err(Error::Cancelled))) => return Err(Error::Cancelled),
-        Some((guess, Err(e))) if *judged.rounds_output() == guess => return Err(e),
+    let (guess, coarser) = guessed.unzip();
+    let coarser = match taken_guess(judged.rounds_output(), guess.as_ref().zip(coarser))? {
+        Some(c) => c,
         // in turn, or again from the rerun's rounds output
-        _ => from_finer_run(
+        None => from_finer_run(
             level,
             rest,
             (first + 1, n),
@@ -1189,11 +1188,15 @@ fn run_from(
 /// The levels that start from their own offsets, and the levels that follow them from the
 /// finer one, depend on nothing but the input: when the pool has more than one thread and the
 /// budget holds the finest level and any one coarser level at once ([`beside_fits`]), they are
-/// baked beside the finest level ([`run_beside`], [`coarser_own_offsets`]); the levels that
-/// follow the finest one from the finer one come after it ([`from_finer_run`]). Each level's
-/// computation is the same whichever thread runs it and whether it runs beside another, so
-/// the outputs do not depend on it (issue 12 part 2: a dirty input's chain bakes its coarser
-/// levels' offsets, and the levels those close, on the second core).
+/// baked beside the finest level ([`run_beside`], [`coarser_own_offsets`]). The levels that
+/// follow the finest one start from its rounds output, which it publishes before its fit
+/// ([`FinestRounds`]): the thread beside it bakes them from there while the finest level is
+/// fitted, verified and measured, as [`from_finer_run`] does for a clean chain (again after it
+/// when its judging reran the loop, or when the finest level was done first: then beside each
+/// other's fits). Each level's computation is the same whichever thread runs it and whether
+/// it runs beside another, so the outputs do not depend on it (issue 12 part 2: a dirty
+/// input's chain bakes its coarser levels' offsets, the levels those close, and the levels
+/// that follow the finest one on the second core).
 fn chain_from_offsets(
     level: &Level<'_>,
     levels: &[&LodParams],
@@ -1203,25 +1206,54 @@ fn chain_from_offsets(
     rep.window(0.0, 0.2 * chain_window(0, n).1);
     let finest = offset_start(level, levels[0], rep)?;
     let finest_topology = topology_of(&finest.mesh);
+    let rounds = FinestRounds::default();
     let bake_finest = |r: &mut Reporter<'_, '_>| {
-        bake_level(
+        let _done = rounds.done_on_drop();
+        let rounded = round_level(
             level,
             levels[0],
             Start::Offset(finest),
             r,
             chain_window(0, n),
-        )
+        )?;
+        let claimed = rounds.publish(rounded.output());
+        let fit_and_judge = |r: &mut Reporter<'_, '_>| {
+            let looped = fit_level(rounded, r)?;
+            judge_level(level, levels[0], looped, r)
+        };
+        match claimed {
+            None => Ok((fit_and_judge(r)?, None)),
+            Some((k, finest_rounds)) => {
+                let following = |r: &mut Reporter<'_, '_>| {
+                    from_finer_run(level, &levels[1..=k], (1, n), finest_rounds, false, r)
+                };
+                let (judged, following) = run_beside(r, fit_and_judge, following);
+                Ok((judged?, Some(following)))
+            }
+        }
     };
-    let coarser = |r: &mut Reporter<'_, '_>| coarser_own_offsets(level, levels, finest_topology, r);
-    let (finest_level, own) = if n > 1 && beside_fits(level, levels) {
+    let coarser = |r: &mut Reporter<'_, '_>| {
+        let own = coarser_own_offsets(level, levels, finest_topology, r)?;
+        // the leading levels that follow the finest one (`coarser_own_offsets` bakes the rest)
+        let k = own.iter().take_while(|o| o.is_none()).count();
+        let following = rounds.free(k).map(|finest_rounds| {
+            from_finer_run(level, &levels[1..=k], (1, n), finest_rounds, false, r)
+        });
+        Ok((own, following))
+    };
+    let ((finest_level, by_a), (own, by_b)) = if n > 1 && beside_fits(level, levels) {
         let (a, b) = run_beside(rep, bake_finest, coarser);
         (a?, b?)
     } else {
         let a = bake_finest(rep)?;
         (a, coarser(rep)?)
     };
+    let guessed = by_a.or(by_b).and_then(|f| Some((rounds.published()?, f)));
     let mut baked: Vec<Judged> = vec![finest_level];
-    let mut own = own.into_iter().peekable();
+    if let Some(run) = taken_guess(baked[0].rounds_output(), guessed)? {
+        baked.extend(run);
+    }
+    let mut own = own.into_iter().skip(baked.len() - 1).peekable();
     while let Some(next) = own.next() {
         if let Some(done) = next {
             baked.push(done);
@@ -1245,6 +1277,91 @@ fn chain_from_offsets(
         baked.extend(run);
     }
     Ok(baked)
+}
+
+/// The finest level's rounds output in [`chain_from_offsets`], and who bakes the levels that
+/// follow the finest one from it before its judging: the finest level's thread, beside its
+/// fit, when the thread beside it is free by then; else that thread, when it becomes free
+/// while the finest level is still being fitted or judged; else (the finest level done first,
+/// or a pool of one thread) nobody here, and the caller bakes them after it.
+#[derive(Default)]
+struct FinestRounds {
+    /// The rounds output, once the rounds are done.
+    rounds: std::sync::OnceLock<TriMesh>,
+    state: std::sync::Mutex<FollowingState>,
+}
+
+/// Who has done what in [`FinestRounds`].
+#[derive(Default)]
+struct FollowingState {
+    /// The finest level's bake has ended (done, failed or unwound).
+    finest_done: bool,
+    /// The thread beside the finest level is free, and this many levels follow the finest one.
+    free: Option<usize>,
+    /// The levels that follow the finest one are being baked from the rounds output.
+    claimed: bool,
+}
+
+/// Marks the finest level's bake ended in [`FinestRounds`] when it drops, whatever way it ends.
+struct FinestDone<'r>(&'r FinestRounds);
+
+impl Drop for FinestDone<'_> {
+    fn drop(&mut self) {
+        if let Ok(mut s) = self.0.state.lock() {
+            s.finest_done = true;
+        }
+    }
+}
+
+impl FinestRounds {
+    /// A guard that marks the finest level's bake ended when it drops.
+    fn done_on_drop(&self) -> FinestDone<'_> {
+        FinestDone(self)
+    }
+
+    /// Publishes the finest level's rounds output; `Some((k, rounds))` when the thread beside
+    /// it is already free and `k > 0` levels follow it: the caller bakes them, beside its fit.
+    fn publish(&self, rounds: TriMesh) -> Option<(usize, &TriMesh)> {
+        let _ = self.rounds.set(rounds);
+        let mut s = self.state.lock().ok()?;
+        let k = s.free.filter(|&k| k > 0 && !s.claimed)?;
+        s.claimed = true;
+        Some((k, self.rounds.get()?))
+    }
+
+    /// The thread beside the finest level is free and `k` levels follow the finest one:
+    /// `Some(rounds)` when they are to be baked by it now, from the published rounds output
+    /// (the finest level is still being fitted or judged).
+    fn free(&self, k: usize) -> Option<&TriMesh> {
+        let mut s = self.state.lock().ok()?;
+        s.free = Some(k);
+        if k == 0 || self.rounds.get().is_none() || s.finest_done || s.claimed {
+            return None;
+        }
+        s.claimed = true;
+        self.rounds.get()
+    }
+
+    /// The published rounds output, if any.
+    fn published(&self) -> Option<&TriMesh> {
+        self.rounds.get()
+    }
+}
+
+/// The coarser levels baked from a guess of the finer level's rounds output (`guessed`: the
+/// guess and their bake), taken when the finer level's judged rounds output `judged` is the
+/// guess (`Ok(Some)`; its error too); `Ok(None)`: to be baked again from `judged`. A cancel is
+/// a cancel whichever the guess.
+fn taken_guess(
+    judged: &TriMesh,
+    guessed: Option<(&TriMesh, Result<Vec<Judged>>)>,
+) -> Result<Option<Vec<Judged>>> {
+    match guessed {
+        Some((guess, Ok(c))) if *judged == *guess => Ok(Some(c)),
+        Some((_, Err(Error::Cancelled))) => Err(Error::Cancelled),
+        Some((guess, Err(e))) if *judged == *guess => Err(e),
+        _ => Ok(None),
+    }
 }
 
 /// The coarser levels (ranks `1..`) of [`chain_from_offsets`]: each one's own offset surface,
@@ -2259,6 +2376,35 @@ mod tests {
     /// The unit cube (the guard tests' shape).
     fn cube() -> TriMesh {
         crate::lowpoly::guard::tests::cube(1.0, 0.0)
+    }
+
+    /// The levels that follow a dirty chain's finest level are baked from its rounds output
+    /// by exactly one thread: the finest level's when the thread beside it was free first,
+    /// that thread when it became free after the rounds and before the finest level was done,
+    /// else nobody (the caller, after the finest level).
+    #[test]
+    fn the_levels_following_the_finest_are_claimed_once() {
+        let rounds = cube();
+        // the thread beside is free first: the finest level's thread bakes them
+        let f = FinestRounds::default();
+        assert!(f.free(2).is_none());
+        assert_eq!(f.publish(rounds.clone()), Some((2, &rounds)));
+        // the rounds first: the thread beside bakes them when it becomes free
+        let f = FinestRounds::default();
+        assert!(f.publish(rounds.clone()).is_none());
+        assert_eq!(f.free(1), Some(&rounds));
+        assert!(f.free(1).is_none(), "claimed once");
+        // the finest level done first, or no level following it: nobody
+        let f = FinestRounds::default();
+        {
+            let _done = f.done_on_drop();
+            assert!(f.publish(rounds.clone()).is_none());
+        }
+        assert!(f.free(2).is_none());
+        let f = FinestRounds::default();
+        assert!(f.free(0).is_none());
+        assert!(f.publish(rounds.clone()).is_none());
+        assert_eq!(f.published(), Some(&rounds));
     }
 
     /// A coarser chain level starts from the next finer level's rounds output, before that
