@@ -184,6 +184,64 @@ fn offset_rejects_bad_screen_size() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("screen size"));
 }
 
+/// `pleat bench chain` on a folder with a clean mesh and an unreadable file: one CSV row each,
+/// the mesh's with both times, their ratio and its chain's finest level equal to the single
+/// bake; the unreadable file's with its load error; the median printed.
+#[cfg(feature = "lod")]
+#[test]
+fn bench_chain_writes_one_row_per_mesh() {
+    let dir = std::env::temp_dir().join(format!("pleat-cli-bench-chain-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("meshes")).unwrap();
+    std::fs::write(
+        dir.join("meshes/oct.obj"),
+        "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
+         f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("meshes/bad.obj"), "f 1 2 3\n").unwrap();
+    let o = pleat(&[
+        "bench",
+        "chain",
+        dir.join("meshes").to_str().unwrap(),
+        "--screen-sizes",
+        "25,50",
+        "--reps",
+        "1",
+        "--out-dir",
+        dir.to_str().unwrap(),
+        "-q",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{out}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        out.contains("median") && out.contains("over 1 meshes"),
+        "{out}"
+    );
+    let csv = std::fs::read_to_string(dir.join("chain_bench.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3, "{csv}");
+    assert_eq!(rows[0][4], "ratio");
+    let (bad, oct) = (&rows[1], &rows[2]);
+    assert!(
+        bad[0] == "bad.obj" && bad[8].starts_with("load error"),
+        "{csv}"
+    );
+    assert_eq!(
+        (oct[0], oct[1], oct[7], oct[8]),
+        ("oct.obj", "8", "true", "ok")
+    );
+    let ratio: f64 = oct[4].parse().unwrap();
+    assert!(ratio.is_finite() && ratio > 0.0, "{csv}");
+    let o = pleat(&["bench", "chain", dir.to_str().unwrap(), "--reps", "0"]);
+    assert_eq!(o.status.code(), Some(2));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A fresh scratch directory holding the regular octahedron as `oct.obj`.
 #[cfg(feature = "wrinkle")]
 fn scratch_with_octahedron(name: &str) -> std::path::PathBuf {

@@ -16,6 +16,10 @@ use std::process::ExitCode;
 #[cfg(feature = "lod")]
 #[path = "pleat/bench_lod.rs"]
 mod bench_lod;
+
+#[cfg(feature = "lod")]
+#[path = "pleat/bench_chain.rs"]
+mod bench_chain;
 #[cfg(feature = "wrinkle")]
 #[path = "pleat/interp_bench.rs"]
 mod interp_bench;
@@ -128,6 +132,10 @@ enum BenchCommand {
     /// lod_bench.csv and lod_bench.svg (Hausdorff/l against seconds, log-log).
     #[cfg(feature = "lod")]
     Lod(bench_lod::LodBenchArgs),
+    /// A LOD chain against its finest level alone: per mesh, interleaved best-of wall times
+    /// and their ratio; writes chain_bench.csv.
+    #[cfg(feature = "lod")]
+    Chain(bench_chain::ChainBenchArgs),
     /// Tension-field wrinkles: energy and residual against wall time per scene (built-ins or
     /// scene files); writes tfw_iterations.csv, tfw_scenes.csv and tfw_bench.svg.
     #[cfg(feature = "tfw")]
@@ -445,6 +453,8 @@ fn bench(cmd: BenchCommand) -> ExitCode {
     match cmd {
         #[cfg(feature = "lod")]
         BenchCommand::Lod(args) => bench_lod::run(&args),
+        #[cfg(feature = "lod")]
+        BenchCommand::Chain(args) => bench_chain::run(&args),
         #[cfg(feature = "tfw")]
         BenchCommand::Tfw(args) => bench_tfw::run(&args),
         cmd @ BenchCommand::Wrinkle { .. } => wrinkle_cmd::bench(cmd),

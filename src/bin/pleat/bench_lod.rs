@@ -30,7 +30,7 @@ use pleat::mesh::io::read_mesh;
 use pleat::mesh::TriMesh;
 
 #[path = "../../../benches/common/lod_sweep.rs"]
-mod lod_sweep;
+pub(crate) mod lod_sweep;
 
 use lod_sweep::{
     bake_case, csv_text, file_name, mesh_files, parse_csv, print_summary, read_face_targets,
