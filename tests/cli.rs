@@ -11,6 +11,17 @@ fn pleat(args: &[&str]) -> std::process::Output {
         .expect("run pleat")
 }
 
+/// The stdout of a run that must have succeeded (else fails with its stdout and stderr).
+fn stdout_of_success(o: &std::process::Output) -> String {
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        o.status.success(),
+        "{out}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    out
+}
+
 #[test]
 fn check_prints_report_and_exits_zero() {
     let o = pleat(&["check", "assets/dirty_two_boxes.obj"]);
@@ -190,39 +201,27 @@ fn offset_rejects_bad_screen_size() {
 #[cfg(feature = "lod")]
 #[test]
 fn bench_chain_writes_one_row_per_mesh() {
-    let dir = std::env::temp_dir().join(format!("pleat-cli-bench-chain-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(dir.join("meshes")).unwrap();
-    std::fs::write(
-        dir.join("meshes/oct.obj"),
-        "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
-         f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n",
-    )
-    .unwrap();
-    std::fs::write(dir.join("meshes/bad.obj"), "f 1 2 3\n").unwrap();
+    let dir = scratch_with_octahedron("bench-chain");
+    std::fs::write(dir.join("bad.obj"), "f 1 2 3\n").unwrap();
+    let out_dir = dir.join("out");
     let o = pleat(&[
         "bench",
         "chain",
-        dir.join("meshes").to_str().unwrap(),
+        path_str(&dir),
         "--screen-sizes",
         "25,50",
         "--reps",
         "1",
         "--out-dir",
-        dir.to_str().unwrap(),
+        path_str(&out_dir),
         "-q",
     ]);
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        o.status.success(),
-        "{out}{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let out = stdout_of_success(&o);
     assert!(
         out.contains("median") && out.contains("over 1 meshes"),
         "{out}"
     );
-    let csv = std::fs::read_to_string(dir.join("chain_bench.csv")).unwrap();
+    let csv = std::fs::read_to_string(out_dir.join("chain_bench.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 3, "{csv}");
     assert_eq!(rows[0][4], "ratio");
@@ -237,13 +236,13 @@ fn bench_chain_writes_one_row_per_mesh() {
     );
     let ratio: f64 = oct[4].parse().unwrap();
     assert!(ratio.is_finite() && ratio > 0.0, "{csv}");
-    let o = pleat(&["bench", "chain", dir.to_str().unwrap(), "--reps", "0"]);
+    let o = pleat(&["bench", "chain", path_str(&dir), "--reps", "0"]);
     assert_eq!(o.status.code(), Some(2));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// A fresh scratch directory holding the regular octahedron as `oct.obj`.
-#[cfg(feature = "wrinkle")]
+#[cfg(any(feature = "wrinkle", feature = "lod"))]
 fn scratch_with_octahedron(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("pleat-cli-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -257,7 +256,7 @@ fn scratch_with_octahedron(name: &str) -> std::path::PathBuf {
     dir
 }
 
-#[cfg(feature = "wrinkle")]
+#[cfg(any(feature = "wrinkle", feature = "lod"))]
 fn path_str(p: &std::path::Path) -> &str {
     p.to_str().unwrap()
 }
@@ -598,12 +597,7 @@ fn bench_tfw_writes_csv_and_svg() {
         path_str(&dir),
         "-q",
     ]);
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        o.status.success(),
-        "{out}{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    stdout_of_success(&o);
     let scenes = std::fs::read_to_string(dir.join("tfw_scenes.csv")).unwrap();
     let rows: Vec<Vec<&str>> = scenes.lines().map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 3, "{scenes}");
