@@ -35,7 +35,8 @@
 //! project onto the sheet's plane, stop that far apart instead of collapsing onto each other;
 //! and the coverage check (`coverage.rs`): no line-search trial or flip may leave an
 //! input sample farther from the LOD than `max(`[`COVERAGE_FLOOR`]`·d, its distance before the
-//! fit)`, so the fit cannot pull the surface off a rim or a thin part of the input. The pipeline skips the fit for cages (a cage must stay outside the input) and
+//! fit)` (input buried deeper than `2 d`: up to one `d` more, never beyond the farthest), so
+//! the fit cannot pull the surface off a rim or a thin part of the input. The pipeline skips the fit for cages (a cage must stay outside the input) and
 //! reverts it when the measured Hausdorff distance grew (`pipeline.rs`).
 //!
 //! Deterministic for any thread count: closest points and flip decisions are computed in
@@ -68,7 +69,8 @@ pub const MAX_STEP: f64 = 3.0;
 pub const DRIFT_CAP: f64 = 1.0;
 
 /// The coverage floor, in `d`: no fit operation leaves an input sample farther from the LOD
-/// than `max(COVERAGE_FLOOR · d, its distance before the fit)` (`coverage.rs`).
+/// than `max(COVERAGE_FLOOR · d, its distance before the fit)`, plus up to one `d` for input
+/// buried deeper than `2 d` (`coverage.rs`).
 pub const COVERAGE_FLOOR: f64 = 1.0;
 
 /// The self-clearance of the fit, in `d`: no fit operation brings a LOD face closer than
