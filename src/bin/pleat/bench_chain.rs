@@ -21,6 +21,7 @@ use pleat::mesh::io::read_mesh;
 use pleat::mesh::TriMesh;
 
 use crate::bench_lod::lod_sweep::{file_name, median, mesh_files, timed, MESH_EXTENSIONS};
+use crate::bench_lod::{check_screen_sizes, write_file};
 
 use super::{progress_bar, EXIT_FAILED, EXIT_INPUT};
 
@@ -99,10 +100,7 @@ pub fn run(args: &ChainBenchArgs) -> ExitCode {
 /// folder — a failing mesh is a CSV row with its status.
 fn sweep(args: &ChainBenchArgs) -> Result<(), (u8, String)> {
     let sizes = &args.screen_sizes;
-    if sizes.is_empty() || sizes.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
-        let msg = format!("--screen-sizes must be finite and > 0, got {sizes:?}");
-        return Err((EXIT_INPUT, msg));
-    }
+    check_screen_sizes(sizes)?;
     if args.reps == 0 {
         return Err((EXIT_INPUT, "--reps must be at least 1".into()));
     }
@@ -167,8 +165,7 @@ fn sweep(args: &ChainBenchArgs) -> Result<(), (u8, String)> {
         text.push_str(&r.csv_line());
         text.push('\n');
     }
-    std::fs::write(&csv, text)
-        .map_err(|e| (EXIT_FAILED, format!("cannot write {}: {e}", csv.display())))?;
+    write_file(&csv, &text)?;
     let ratios: Vec<f64> = rows
         .iter()
         .filter(|r| r.status == "ok")

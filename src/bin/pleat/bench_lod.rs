@@ -240,22 +240,18 @@ fn replot(args: &LodBenchArgs) -> Result<(), (u8, String)> {
     Ok(())
 }
 
+/// Rejects an empty `--screen-sizes` or one that is not finite and > 0 (exit code 2).
+pub(crate) fn check_screen_sizes(sizes: &[f64]) -> Result<(), (u8, String)> {
+    if sizes.is_empty() || sizes.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+        let msg = format!("--screen-sizes must be finite and > 0, got {sizes:?}");
+        return Err((EXIT_INPUT, msg));
+    }
+    Ok(())
+}
+
 /// Rejects bad screen sizes and a cage request without the `cage` feature.
 fn check_arguments(args: &LodBenchArgs) -> Result<(), (u8, String)> {
-    if args.screen_sizes.is_empty()
-        || args
-            .screen_sizes
-            .iter()
-            .any(|s| !(s.is_finite() && *s > 0.0))
-    {
-        return Err((
-            EXIT_INPUT,
-            format!(
-                "--screen-sizes must be finite and > 0, got {:?}",
-                args.screen_sizes
-            ),
-        ));
-    }
+    check_screen_sizes(&args.screen_sizes)?;
     if args.bake && !cfg!(feature = "bake") {
         return Err((EXIT_INPUT, "--bake needs the `bake` feature".into()));
     }
@@ -363,7 +359,8 @@ fn keep_mesh(out_dir: &Path, name: &str, n_p: f64, out: &TriMesh) {
     }
 }
 
-fn write_file(path: &Path, text: &str) -> Result<(), (u8, String)> {
+/// Writes `text` to `path`; `Err` with exit code 1 and the reason.
+pub(crate) fn write_file(path: &Path, text: &str) -> Result<(), (u8, String)> {
     std::fs::write(path, text)
         .map_err(|e| (EXIT_FAILED, format!("cannot write {}: {e}", path.display())))
 }
