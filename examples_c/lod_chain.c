@@ -235,10 +235,10 @@ static void bake_cage(const PleatMesh *input) {
     /* A single bake has no chain rank; a cage runs no fit. */
     CHECK(st.chain_level == -1 && st.started_from_finer == 0);
     CHECK(st.seconds_fit == 0.0 && st.fit_reverted == 0);
-    /* The default clearance, a tenth of d, measured exactly (not sampled). */
-    CHECK(params.clearance == 0.1);
+    /* The default clearance, a twentieth of d, measured exactly (not sampled). */
+    CHECK(params.clearance == 0.05);
     CHECK(st.clearance_kept == 1);
-    CHECK(st.clearance_required == 0.1 * st.offset_distance);
+    CHECK(st.clearance_required == 0.05 * st.offset_distance);
     CHECK(st.min_clearance >= st.clearance_required);
     CHECK(st.min_clearance_relative > 0.0);
     printf("cage n_p=%g: %llu triangles, min clearance %.3g d\n",

@@ -787,7 +787,7 @@ typedef struct PleatLodParams {
   // with `PLEAT_STATUS_LIMIT_EXCEEDED` before the expensive work.
   uint64_t memory_budget_bytes;
   // Cages only: the distance the cage keeps from the input, as a fraction of d (default
-  // 0.1: a tenth of a pixel at the cage's screen size, see README "Cages with clearance"), or
+  // 0.05: a twentieth of a pixel at the cage's screen size, see README "Cages with clearance"), or
   // in model units with `PLEAT_LOD_CLEARANCE_ABSOLUTE`. Must be >= 0 and below d; 0 keeps
   // only "no contact". Appended for issue 12; callers with an older `struct_size` get the
   // default.

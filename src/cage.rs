@@ -11,7 +11,7 @@
 //!   must be 0.
 //!
 //! - **clearance** (issue 12 part 3): no modified face comes closer to the input than
-//!   [`crate::lowpoly::LodParams::clearance`] (default a tenth of `d`; exact
+//!   [`crate::lowpoly::LodParams::clearance`] (default a twentieth of `d`; exact
 //!   triangle–triangle distances), so the cage does not merely avoid contact but keeps a real
 //!   gap. The independent verification measures the exact minimum distance between cage and
 //!   input triangles ([`LodReport::clearance`], `min_clearance`) and says when the requested

@@ -186,7 +186,7 @@ struct BakeArgs {
     /// about d outside the input with rounded creases; ignored for cages).
     #[arg(long)]
     no_fit: bool,
-    /// Cages: the distance kept from the input, a fraction of d with a `d` suffix (`0.1d`,
+    /// Cages: the distance kept from the input, a fraction of d with a `d` suffix (`0.05d`,
     /// the default) or a length in model units (`0.002`); below d. `0d` only forbids contact.
     #[arg(long, value_parser = parse_clearance)]
     clearance: Option<pleat::lowpoly::Clearance>,

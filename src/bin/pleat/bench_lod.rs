@@ -53,7 +53,7 @@ pub struct LodBenchArgs {
     /// Bake cages instead of LODs (adds the enclosure and contact columns).
     #[arg(long)]
     pub cage: bool,
-    /// With --cage: the clearance, `0.1d` (fraction of d, the default) or a length in model
+    /// With --cage: the clearance, `0.05d` (fraction of d, the default) or a length in model
     /// units (see `pleat cage --clearance`).
     #[arg(long, value_parser = super::parse_clearance)]
     pub clearance: Option<pleat::lowpoly::Clearance>,
