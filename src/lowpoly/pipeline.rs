@@ -45,11 +45,9 @@ pub const DEFAULT_CLEARANCE_FRACTION: f64 = 0.05;
 /// 0.1): over the 69 corpus cages at n_p = 25/50/100, a tenth of `d` cost a median +12% faces
 /// against a cage without clearance and 10 cages more than +20% (issue 12 part 3's bound); a
 /// twentieth costs a median +6%, 2 cages above +20% (62 → 76 and 100 → 122 faces at n_p = 25;
-/// README cage table). Both
-/// are far below a pixel and far above rounding (without a clearance cages ended ~1e-15 l from
-/// the input). It must stay below `d`: the cage starts from the
-/// offset surface at distance `d`, whose faces dip a few percent of `d` closer (chords of its
-/// rounded parts).
+/// README cage table). Both are far below a pixel and far above rounding. It must stay below
+/// `d`: the cage starts from the offset surface at distance `d`, whose faces dip a few percent
+/// of `d` closer (chords of its rounded parts).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Clearance {
     /// A fraction of the offset distance `d`, in `[0, 1)`.
