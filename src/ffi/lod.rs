@@ -262,7 +262,7 @@ pub(super) fn defaults_without_lod() -> PleatLodParams {
         l0: 4,
         flags: 0,
         memory_budget_bytes: 2 << 30,
-        clearance: 0.1,
+        clearance: 0.05,
         start: PLEAT_LOD_START_AUTO,
         reserved: 0,
         offset_voxel_scale: 0.0,
