@@ -21,7 +21,10 @@
 //!   strict budget, 29.82 dB with this slack, 39.97 dB unchecked. A slack from any depth
 //!   (`x_s > d`) gained more there (30.77 dB) but let the fit pull the bridge between two cubes
 //!   sharing an edge (input 1–2 `d` inside it) into a twist (dirty_synth_nonmanifold at
-//!   n_p = 100: 25.49 → 22.84 dB).
+//!   n_p = 100: 25.49 → 22.84 dB). Session 24, not taken either: samples deeper than `2 d`
+//!   free up to `X` (no one-`d` limit) — 42722 31.69 dB, the 23-mesh mean +0.08 dB, but the
+//!   tree's measured Hausdorff distance +0.0008 l (many samples at the cap, the measurement
+//!   sampling between them); README, "Buried input and the fit".
 //! - Invariant: every sample is within its budget of the LOD. A vertex move or a flip replaces
 //!   a patch of faces (the one-ring, the flip's two faces); a sample within its budget of the
 //!   *old* patch may rely on it, so it must be within its budget of the *new* patch, or the

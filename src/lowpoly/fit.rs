@@ -36,8 +36,9 @@
 //! and the coverage check (`coverage.rs`): no line-search trial or flip may leave an
 //! input sample farther from the LOD than `max(`[`COVERAGE_FLOOR`]`·d, its distance before the
 //! fit)` (input buried deeper than `2 d`: up to one `d` more, never beyond the farthest), so
-//! the fit cannot pull the surface off a rim or a thin part of the input. The pipeline skips the fit for cages (a cage must stay outside the input) and
-//! reverts it when the measured Hausdorff distance grew (`pipeline.rs`).
+//! the fit cannot pull the surface off a rim or a thin part of the input. The pipeline skips
+//! the fit for cages (a cage must stay outside the input) and reverts it when the measured
+//! Hausdorff distance grew (`pipeline.rs`).
 //!
 //! Deterministic for any thread count: closest points and flip decisions are computed in
 //! parallel from an unchanged mesh, quadrics are summed and every operation applied
