@@ -27,7 +27,11 @@
 //! Candidate positions are tried in order — the quadric optimum, the edge midpoint, the two
 //! endpoints — and the first that passes every check is used: on convex parts of an offset
 //! surface the quadric optimum lies slightly *outside* (farther from the input) while the
-//! midpoint lies on the chord, closer to it.
+//! midpoint lies on the chord, closer to it. A guard refusal ends the list (moving along the
+//! edge rarely cures a self-intersection, and retrying would double the cost of those
+//! refusals), unless the pass is asked to retry (`SimplifyOptions::retry_guard`): the rounds
+//! of a cage with a clearance, once they have stalled, where a refusal is mostly the clearance
+//! or contact, which depend on where along the edge the vertex lands (see `pipeline`).
 //!
 //! The pass stops when the queue is empty or the face count reaches the target `n_F`.
 //!
@@ -72,6 +76,9 @@ pub(crate) struct SimplifyOptions {
     pub slack: f64,
     /// Sample spacing of the distance checks.
     pub spacing: f64,
+    /// Try the next candidate position after a guard refusal too (module docs; a cage with a
+    /// clearance once its loop has stalled).
+    pub retry_guard: bool,
 }
 
 /// A symmetric quadric `Q(x) = xᵀAx + 2bᵀx + c`.
@@ -713,16 +720,19 @@ impl<'g, 'a> Pass<'g, 'a> {
                 n += 1;
             }
         }
+        let retry_guard = self.opt.retry_guard;
         for &c in &candidates[..n] {
             match self.try_position(h, a, b, c, &mut ev, s) {
                 Ok(acc) => {
                     ev.outcome = Ok(acc);
                     return ev;
                 }
-                // Another position can cure a fold-over or a patch farther from the input;
-                // a too large change or a guard refusal is rarely cured by moving along the
-                // edge, and retrying would double the cost of those rejections.
+                // Another position can cure a fold-over or a patch farther from the input,
+                // and a cage's clearance; a too large change or another guard refusal is
+                // rarely cured by moving along the edge, and retrying would double the cost
+                // of those rejections (module docs).
                 Err(r @ (Rejection::Fold | Rejection::Distance)) => ev.outcome = Err(r),
+                Err(r @ Rejection::Guard) if retry_guard => ev.outcome = Err(r),
                 Err(r) => {
                     ev.outcome = Err(r);
                     break;
