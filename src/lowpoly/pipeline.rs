@@ -2571,6 +2571,32 @@ mod tests {
         ));
     }
 
+    /// Guard refusals are retried only by a cage with a clearance, and not in its first pass;
+    /// the guard keeps the clearance with its margin, and no clearance stays none.
+    #[test]
+    fn only_cages_with_a_clearance_retry_guard_refusals_after_the_first_pass() {
+        let cfg = |mode, clearance| LoopConfig {
+            d: 1.0,
+            slack: 0.0,
+            target_faces: None,
+            max_rounds: 50,
+            r: 0.5,
+            epsilon_abs: 1e-4,
+            align: true,
+            mode,
+            clearance,
+            fit: false,
+        };
+        for i in 0..3 {
+            assert_eq!(retries_guard_refusals(&cfg(Mode::Cage, 0.05), i), i >= 1);
+            assert!(!retries_guard_refusals(&cfg(Mode::Cage, 0.0), i));
+            assert!(!retries_guard_refusals(&cfg(Mode::Lod, 0.0), i));
+        }
+        assert_eq!(guard_clearance(0.0), 0.0);
+        let c = 0.05;
+        assert!(guard_clearance(c) > c && guard_clearance(c) <= c * (1.0 + 2e-9));
+    }
+
     #[test]
     fn the_loop_stalls_after_rounds_without_a_new_smallest_face_count() {
         let s = STALL_ROUNDS as u64;
