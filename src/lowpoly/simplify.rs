@@ -30,8 +30,9 @@
 //! midpoint lies on the chord, closer to it. A guard refusal ends the list (moving along the
 //! edge rarely cures a self-intersection, and retrying would double the cost of those
 //! refusals), unless the pass is asked to retry (`SimplifyOptions::retry_guard`): the rounds
-//! of a cage with a clearance, once they have stalled, where a refusal is mostly the clearance
-//! or contact, which depend on where along the edge the vertex lands (see `pipeline`).
+//! of a cage with a clearance after its first pass, where a refusal is mostly the clearance
+//! or contact, which depend on where along the edge the vertex lands (see
+//! `pipeline::retries_guard_refusals`).
 //!
 //! The pass stops when the queue is empty or the face count reaches the target `n_F`.
 //!
@@ -77,7 +78,7 @@ pub(crate) struct SimplifyOptions {
     /// Sample spacing of the distance checks.
     pub spacing: f64,
     /// Try the next candidate position after a guard refusal too (module docs; a cage with a
-    /// clearance once its loop has stalled).
+    /// clearance after its first pass).
     pub retry_guard: bool,
 }
 
@@ -727,10 +728,10 @@ impl<'g, 'a> Pass<'g, 'a> {
                     ev.outcome = Ok(acc);
                     return ev;
                 }
-                // Another position can cure a fold-over or a patch farther from the input,
-                // and a cage's clearance; a too large change or another guard refusal is
-                // rarely cured by moving along the edge, and retrying would double the cost
-                // of those rejections (module docs).
+                // Another position can cure a fold-over or a patch farther from the input, and
+                // in a cage with a clearance a guard refusal (when the pass retries them); a
+                // too large change, or a guard refusal elsewhere, is rarely cured by moving
+                // along the edge, and retrying would double the cost of those rejections.
                 Err(r @ (Rejection::Fold | Rejection::Distance)) => ev.outcome = Err(r),
                 Err(r @ Rejection::Guard) if retry_guard => ev.outcome = Err(r),
                 Err(r) => {
