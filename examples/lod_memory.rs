@@ -1,6 +1,6 @@
-//! Where a LOD bake's memory goes, per stage, in bytes (issue 12 part 4): a counting global
-//! allocator (this example only — never the library or the `pleat` binary) keeps the live and
-//! peak heap bytes; each time the progress callback reports a new stage name, the previous
+//! Where a LOD bake's memory goes, per stage, in bytes (to check the memory budget): a counting
+//! global allocator (this example only — never the library or the `pleat` binary) keeps the live
+//! and peak heap bytes; each time the progress callback reports a new stage name, the previous
 //! stage's peak is recorded and the peak restarts from the live bytes.
 //!
 //! `cargo run --release --example lod_memory --features lod -- MESH NP [--voxel-scale S]

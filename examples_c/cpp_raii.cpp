@@ -58,7 +58,7 @@ static void wrinkles(const pleat::Mesh &base) {
         calls++;
         return true;
     });
-    EXPECT(fine.triangle_count() == 4 * 64 && stats.triangle_count == 4 * 64 && calls == 3 * 6); // 6 progress calls per level (issue 15)
+    EXPECT(fine.triangle_count() == 4 * 64 && stats.triangle_count == 4 * 64 && calls == 3 * 6); // 6 progress calls per level
     EXPECT(fields.count(PLEAT_WRINKLE_FIELD_PHASE) == fine.vertex_count());
     EXPECT(fields.get(PLEAT_WRINKLE_FIELD_NORMALS).size() == 3 * fine.vertex_count());
     try {

@@ -1,4 +1,4 @@
-/* Resource exhaustion from C (issue 15): a soup of 10^6 tiny components and a soup of 10^6
+/* Resource exhaustion from C: a soup of 10^6 tiny components and a soup of 10^6
  * coincident vertices each get a clear answer (a report, a LOD or PLEAT_STATUS_LIMIT_EXCEEDED)
  * within the memory budget, and a LOD bake cancelled from the progress callback returns
  * PLEAT_STATUS_CANCELLED promptly, and so does pleat_mesh_check_with_progress (the latencies
@@ -147,7 +147,7 @@ static void cancellation_latency(PleatMesh *m) {
     size_t i;
     if (m == NULL) return;
     lp.screen_size = 16;
-    /* This measures cancellation, not the budget: the memory estimate (issue 12 part 4) counts
+    /* This measures cancellation, not the budget: the up-front memory estimate counts
      * the fit's coverage samples, about 3.5 GiB for 10^6 tiny components at n_p 16 (measured
      * peak 1.96 GiB), which the default 2 GiB refuses up front. */
     lp.memory_budget_bytes = (uint64_t)8 << 30;

@@ -138,7 +138,7 @@ int main(void) {
         pleat_mesh_destroy(sheet);
     }
     {
-        /* An older, shorter PleatLodStats (before the fields appended in session 20) is still
+        /* An older, shorter PleatLodStats (before the fields appended 2026-11-29) is still
            accepted and filled only up to its size. */
         PleatLodStats old;
         PleatMesh *lodm = NULL;

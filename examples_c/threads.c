@@ -1,4 +1,4 @@
-/* The C API from several host threads at once (issue 15, part 4).
+/* The C API from several host threads at once.
  *
  * Four host threads each build their own meshes and wrinkle fields (distinct handles) and call
  * pleat concurrently: a LOD bake, a mesh check and (when built with wrinkles) a wrinkle

@@ -1,4 +1,4 @@
-/* Wrinkle design and region edits through the C ABI (issue 14, dissertation ch. 3.6):
+/* Wrinkle design and region edits through the C ABI (dissertation ch. 3.6):
    grow a region, rotate the wrinkles in it, check the fixed part is copied bit for bit, an
    identity edit returns the input, design from a source, evaluate the edited keyframe, and
    misuse answers a status with a message; the adaptive interface width (compat_target) and the
@@ -41,7 +41,7 @@ static int count_calls(void *user_data, const PleatProgress *info) {
     return c->cancel_at > 0 && c->calls >= c->cancel_at;
 }
 
-/* pleat_cwf_design_with_progress / pleat_cwf_edit_with_progress (issue 15): the same field as
+/* pleat_cwf_design_with_progress / pleat_cwf_edit_with_progress: the same field as
  * without a callback, and a cancel at the first or a middle call gives
  * PLEAT_STATUS_CANCELLED with nothing written (valgrind checks for leaks). */
 static void progress_and_cancel(const PleatMesh *m, const PleatCwf *a,
@@ -94,7 +94,7 @@ static void progress_and_cancel(const PleatMesh *m, const PleatCwf *a,
     free(x0), free(x1), free(labels);
 }
 
-/* Misuse of the _with_progress calls themselves (issue 15): NULL base, field, sources,
+/* Misuse of the _with_progress calls themselves: NULL base, field, sources,
  * regions or out, counts beyond the address space, a bad region struct size and a source
  * vertex out of range answer PLEAT_STATUS_INVALID_ARGUMENT with a message naming the
  * argument, before any progress call, and write nothing. */

@@ -579,7 +579,7 @@ typedef struct PleatCwfEditParams {
   // 2026-11-27: an older, shorter struct gets the default.
   double edit_weight;
   // Adaptive interface width: target RMS compatibility residual over edit + interface edges,
-  // radians, finite, ≥ 0; default 0.3 (issue 14's smoothness target; also what an older,
+  // radians, finite, ≥ 0; default 0.3 (the smoothness asked of an interface; also what an older,
   // shorter struct gets), 0 = off: the regions' `interface_rings` exactly. While the
   // residual exceeds it, every band is widened by one ring (up to `max_interface_rings`) and
   // the edit redone; the edit with the smallest residual is returned
@@ -766,7 +766,8 @@ typedef struct PleatLodParams {
   uint32_t struct_size;
   // Maximum number of optimization rounds N (default 50; 0 returns the offset surface). A
   // LOD without a face target stops earlier after 5 rounds without a new smallest face
-  // count (README "Session 19").
+  // count (since 2026-11-29: later rounds only moved vertices, and the 23-mesh benchmark
+  // kept or improved every aggregate).
   uint32_t max_rounds;
   // Screen size n_p in pixels covered by the input's bounding-box diagonal l (default 200).
   // The offset distance and error bound is d = l / n_p. Finite and > 0.
@@ -789,7 +790,7 @@ typedef struct PleatLodParams {
   // Cages only: the distance the cage keeps from the input, as a fraction of d (default
   // 0.05: a twentieth of a pixel at the cage's screen size, see README "Cages with clearance"), or
   // in model units with `PLEAT_LOD_CLEARANCE_ABSOLUTE`. Must be >= 0 and below d; 0 keeps
-  // only "no contact". Appended for issue 12; callers with an older `struct_size` get the
+  // only "no contact". Appended 2026-11-25; callers with an older `struct_size` get the
   // default.
   double clearance;
   // LODs only: the surface the loop starts from: 0 = auto (the welded input when it is
@@ -797,7 +798,7 @@ typedef struct PleatLodParams {
   // self-intersection-free — else the offset surface), 1 = the offset surface at d,
   // 2 = the welded input (`PLEAT_STATUS_INVALID_ARGUMENT` naming the failing property when
   // it is not clean). Other values are `PLEAT_STATUS_INVALID_ARGUMENT`. Cages always start
-  // from the offset surface. Appended for issue 12; callers with an older `struct_size`
+  // from the offset surface. Appended 2026-11-27; callers with an older `struct_size`
   // get 0 (auto).
   uint32_t start;
   // Reserved, 0 (keeps the struct free of padding).
@@ -805,8 +806,8 @@ typedef struct PleatLodParams {
   // LODs only: the offset voxel the bake starts from, as a multiple of d/√3, in (0, 2];
   // 0 (the default) = automatic (2 from n_p = 200 on, 1.25 from 100, 1 below; see README
   // "A coarser first stage"). A coarser voxel is still taken when the memory estimate needs it. NaN,
-  // negative or > 2 is `PLEAT_STATUS_INVALID_ARGUMENT`. Appended for issue 12 part 4;
-  // callers with an older `struct_size` get automatic.
+  // negative or > 2 is `PLEAT_STATUS_INVALID_ARGUMENT`. Appended 2026-11-27; callers with
+  // an older `struct_size` get automatic.
   double offset_voxel_scale;
 } PleatLodParams;
 
@@ -879,10 +880,9 @@ typedef struct PleatLodStats {
   // 1 when the level's loop started from the welded input (`PleatLodParams::start`; in a
   // chain only the finest level can), 0 when from the offset surface or a finer level.
   uint32_t started_from_input;
-  // When the level was admitted by measurement (issue 12 part 4: its up-front memory
-  // estimate fitted no offset voxel scale, so the offset stage counted its surface before
-  // allocating it): the peak bytes estimated from those counts, which fitted the memory
-  // budget. NaN otherwise.
+  // When the level was admitted by measurement (its up-front memory estimate fitted no offset
+  // voxel scale, so the offset stage counted its surface before allocating it): the peak bytes
+  // estimated from those counts, which fitted the memory budget. NaN otherwise.
   double measured_estimate_bytes;
   // In a chain: 1 when this coarser level started from the next finer level's loop output
   // before its fit (its own offset surface had the finer level's topology), 0 when from its
@@ -1003,7 +1003,7 @@ typedef struct PleatMeshReport {
   // 1 when `self_intersecting_pair_count` is a lower bound, not the exact count: counting
   // stops once 2²² exact tests have found an intersection (a pile of near-copies of one
   // triangle; stacked exact copies are counted per group without using it up).
-  // `self_intersection_free` is exact (0) then. Appended 2026-11-27 (issue 15).
+  // `self_intersection_free` is exact (0) then. Appended 2026-11-27.
   uint32_t self_intersecting_pair_count_is_lower_bound;
   // Padding; written as 0.
   uint32_t reserved;
@@ -1562,7 +1562,7 @@ PleatStatus pleat_cwf_design(const struct PleatMesh *base,
                              const struct PleatKnoppelParams *knoppel_params,
                              struct PleatCwf **out);
 
-// As `pleat_cwf_design`, with a progress callback that can cancel (issue 15).
+// As `pleat_cwf_design`, with a progress callback that can cancel.
 //
 // - `progress`, `user_data`: optional callback (NULL for none), called on this thread with
 //   stage `"design"` after each step (regions, each vector heat solve, ω, the amplitude) and
@@ -1606,7 +1606,7 @@ PleatStatus pleat_cwf_edit(const struct PleatCwf *cwf,
                            struct PleatCwf **out,
                            uint8_t *face_labels_out);
 
-// As `pleat_cwf_edit`, with a progress callback that can cancel (issue 15).
+// As `pleat_cwf_edit`, with a progress callback that can cancel.
 //
 // - `progress`, `user_data`: optional callback (NULL for none), called on this thread with
 //   stage `"edit"` after each step of every attempt (labels, the interface ω and amplitude
@@ -2033,7 +2033,7 @@ PleatStatus pleat_mesh_check(const struct PleatMesh *mesh,
                              uint32_t flags,
                              struct PleatMeshReport *out);
 
-// As `pleat_mesh_check`, with a progress callback that can cancel (issue 15).
+// As `pleat_mesh_check`, with a progress callback that can cancel.
 //
 // - `progress`, `user_data`: optional callback (NULL for none), called on this thread with
 //   stage `"check"` after each topology phase and, in the self-intersection test, after each

@@ -1,6 +1,6 @@
 #!/bin/sh
 # Bakes meshes with two pleat binaries back to back and compares the OBJ bytes and the times
-# (issue 12 part 2, "same bytes, less work"). Usage:
+# (a speed change must give the same bytes with less work). Usage:
 #   scripts/lodspeed_compare.sh BASE_BIN NEW_BIN OUT_DIR "SIZES..." mesh1 mesh2 ...
 # SIZES are screen sizes n_p; a comma-separated list (`50,100,200`) bakes that chain.
 # Prints one line per (mesh, sizes): same/DIFFERENT, wall and user seconds of each binary,

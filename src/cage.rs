@@ -10,7 +10,7 @@
 //!   box swept by the operation, computed from the solid angles of the patch before and after,
 //!   must be 0.
 //!
-//! - **clearance** (issue 12 part 3): no modified face comes closer to the input than
+//! - **clearance**: no modified face comes closer to the input than
 //!   [`crate::lowpoly::LodParams::clearance`] (default a twentieth of `d`; exact
 //!   triangle–triangle distances), so the cage does not merely avoid contact but keeps a real
 //!   gap. The independent verification measures the exact minimum distance between cage and

@@ -715,8 +715,8 @@ fn shared_torus_bakes_with_normal_map() {
     check_output(&chain_glb(&[b]).unwrap(), 1);
 }
 
-/// Issue 11 target 1b on every generated shared asset (`gen_*`, each with its analytic colour
-/// field c(p) in a sidecar): the level baked at n_p = 200 shows, at area-weighted samples of
+/// The colour-transfer target on every generated shared asset (`gen_*`, each with its analytic
+/// colour field c(p) in a sidecar): the level baked at n_p = 200 shows, at area-weighted samples of
 /// the LOD surface (four interior points per triangle), c(q) at the closest input point q.
 ///
 /// Bound from the screen size: the field's gradient is at most `G = 255 · 0.5 · 2π f_max /
@@ -1257,8 +1257,8 @@ fn obj_mtl_bakes_through_the_cli_and_matches_the_field() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// `pleat lod in.obj --bake -o 'out_{np}.glb'` writes one GLB per level (issue 11: "or one
-/// file per level"), each a one-level chain.
+/// `pleat lod in.obj --bake -o 'out_{np}.glb'` writes one GLB per level (the
+/// alternative to one file holding the chain), each a one-level chain.
 #[test]
 fn cli_bake_writes_one_file_per_level_with_a_placeholder() {
     let dir = scratch("objcli_per_level");
@@ -1377,7 +1377,7 @@ fn edit_glb(data: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
     glb(&doc, bin)
 }
 
-/// Issue 11's bad inputs on the glTF reader: a missing external image, non-finite UVs, and
+/// Bad inputs on the glTF reader: a missing external image, non-finite UVs, and
 /// non-triangle primitives (points and lines skipped as the geometry reader skips them,
 /// strips and fans decoded: the appearance's mesh stays the geometry reader's).
 #[test]

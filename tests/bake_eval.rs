@@ -1,4 +1,4 @@
-//! Measuring textured bakes (issue 11, "Targets"): renders of the input and of its baked LOD
+//! Measuring textured bakes against their targets: renders of the input and of its baked LOD
 //! at `n_p = 200` compared by the independent rasterizer of `pleat::bake::render` (PSNR within
 //! 2 dB of the closest-point reference, normal-map gain > 0), and the chart gutters checked
 //! down to the mip level the texel rule implies (no texel a LOD UV samples mixes in another
@@ -209,7 +209,7 @@ fn shared_vertex_colour_teapot_meets_the_appearance_target() {
     assert!(level.uvs.is_some() && level.colors.is_none());
     check_appearance("teapot", &level);
     // Its 554 charts mixed 0.11 % of mip-2 samples with the nearest-chart dilation and the
-    // 15-texel gutter; the block-owning dilation keeps them clean (issue 11).
+    // 15-texel gutter; the block-owning dilation keeps them clean.
     check_seams("teapot", &level, 0.0);
 }
 
@@ -689,7 +689,7 @@ fn bake_speed() {
     }
 }
 
-/// Issue 11 speed target 2: the whole `--bake` chain {50, 100, 200} (geometry, bake, PNG
+/// Bake speed: the whole `--bake` chain {50, 100, 200} (geometry, bake, PNG
 /// encoding) against the geometry-only chain, measured in one process on the same assets
 /// (`PLEAT_ASSETS=a.glb,b.glb`, default duck, spot, torus). The geometry seconds are
 /// `lowpoly::generate_chain`'s inside `bake_chain` — exactly the geometry-only chain. Prints

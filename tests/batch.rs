@@ -1,4 +1,4 @@
-//! `pleat lod` as a batch build step (issue 16 part 4): many inputs, `--jobs`, atomic outputs,
+//! `pleat lod` as a batch build step: many inputs, `--jobs`, atomic outputs,
 //! the content-addressed `--cache`, the JSON `--report`, and a corrupt asset that fails its row
 //! but not the batch.
 #![cfg(all(feature = "cli", feature = "lod"))]

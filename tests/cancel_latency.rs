@@ -1,5 +1,5 @@
-//! Cancellation latency of every long operation (issue 15: "every long operation honours
-//! cancellation within 0.5 s of the request; measure the worst case per operation").
+//! Cancellation latency of every long operation (requirement: every long operation honours
+//! cancellation within 0.5 s of the request; the worst case is measured per operation).
 //!
 //! Ignored tests (timings are not asserted; run in the release test profile):
 //! `cargo test --release --test cancel_latency -- --ignored --nocapture --test-threads 1`.
@@ -264,7 +264,7 @@ fn measure_mesh_check(name: &str, m: &TriMesh) {
 
 /// The validity report of a pile of 20 000 near-copies of one triangle (corners jittered by
 /// ±10⁻⁹, `shapes::jittered_pile`): one broad-phase chunk of 2·10⁸ candidate pairs, counted in
-/// rounds with a call after each (issue 15) and stopped at the cap on counted hits.
+/// rounds with a call after each and stopped at the cap on counted hits.
 #[test]
 #[ignore = "measurement: seconds per run"]
 fn mesh_check_pile_cancellation_latency() {

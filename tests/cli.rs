@@ -835,7 +835,7 @@ fn wrinkle_edit_compat_target_widens_and_interp_no_locality() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// `--start` (issue 12 part 1): `input` on a clean mesh says so in the summary, on a dirty
+/// `--start`: `input` on a clean mesh says so in the summary, on a dirty
 /// soup fails with the property that fails; an unknown value is a usage error.
 #[cfg(feature = "lod")]
 #[test]

@@ -1,4 +1,4 @@
-//! Determinism across thread counts and entry points (issue 15, part 5): the bytes of a LOD,
+//! Determinism across thread counts and entry points: the bytes of a LOD,
 //! a cage and an evaluated wrinkle field are identical for 1, 2 and 8 worker threads, and
 //! identical between the CLI (`pleat lod|cage|wrinkle eval`, pool size from
 //! `RAYON_NUM_THREADS`) and the C API (`pleat_set_thread_count`) for the same call.

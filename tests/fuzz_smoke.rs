@@ -1,5 +1,5 @@
-//! A bounded fuzzing run on the stable toolchain, in `cargo test` (issue 15: "CI runs each target
-//! for a short bounded time within the CI budget").
+//! A bounded fuzzing run on the stable toolchain, in `cargo test` (requirement: CI runs each
+//! target for a short bounded time within the CI budget).
 //!
 //! The cargo-fuzz targets (fuzz/, libFuzzer + ASan) need a nightly ASan build that takes 20–30
 //! minutes from a cold cache on 2 cores: more than `.ci/run`'s budget. This test runs the same

@@ -1,4 +1,4 @@
-//! Regression tests for issue 15 (hardening): defects found by fuzzing and while writing the
+//! Hardening regression tests: defects found by fuzzing and while writing the
 //! fuzz targets (fuzz/), and the resource-exhaustion cases — headers claiming huge counts,
 //! deeply nested glTF, coordinates near 1e±300, a screen size that would need 100 GB, 10⁶ tiny
 //! components, 10⁶ coincident vertices. Each must end in a clear answer (a result or a status)

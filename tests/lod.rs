@@ -220,9 +220,9 @@ fn brute_force_gap(a: &TriMesh, b: &TriMesh) -> f64 {
     best
 }
 
-/// Issue 12 part 3, analytic: the cage of a box and of a sphere keeps the requested clearance
-/// `c·d` (exact minimum distance, checked by brute force over all triangle pairs) and stays
-/// within the offset distance where it is closest: `c·d ≤ min_clearance ≤ d`. Without a
+/// Cages with a clearance, analytic: the cage of a box and of a sphere keeps the requested
+/// clearance `c·d` (exact minimum distance, checked by brute force over all triangle pairs) and
+/// stays within the offset distance where it is closest: `c·d ≤ min_clearance ≤ d`. Without a
 /// clearance the cage comes closer than any of them.
 #[cfg(feature = "cage")]
 #[test]
@@ -587,8 +587,8 @@ fn output_does_not_depend_on_thread_count() {
     }
 }
 
-/// Issue 12 part 1: on an open input (a tray: a box without its top, walls of zero thickness)
-/// the fit's placements and flips could pull the LOD off the input's rims (the corpus' teapot
+/// On an open input (a tray: a box without its top, walls of zero thickness) the input-plane
+/// fit's placements and flips could pull the LOD off the input's rims (the corpus' teapot
 /// and beetle were reverted for that). Every fit operation now keeps each input sample within
 /// `max(d, its distance before the fit)` of the LOD (`lowpoly/coverage.rs`), so the fit is kept
 /// and its input-to-output side stays within the loop's (or d).
@@ -681,7 +681,7 @@ fn square_sheet(n: u32, z: f64, up: bool) -> TriMesh {
     TriMesh::new(pos, tris).unwrap()
 }
 
-/// Issue 11/12: a double-sided sheet thinner than `2d` (two parallel quads `0.2 d` apart, one
+/// A double-sided sheet thinner than `2d` (two parallel quads `0.2 d` apart, one
 /// facing up, one down) is not fitted into a LOD folded onto itself: the input-plane fit keeps
 /// every pair of faces sharing no vertex and facing more than 90° apart (the sheet's two
 /// sides) at least `FIT_SELF_CLEARANCE · d` apart, or no closer
@@ -806,7 +806,7 @@ fn compare_cage(
     })
 }
 
-/// Issue 4's validity target on the public corpus: every mesh of at most 200k triangles at
+/// The validity target on the public corpus: every mesh of at most 200k triangles at
 /// n_p = 50, 100, 200 is watertight, manifold and intersection-free according to the CGAL
 /// `meshcheck` (`PLEAT_MESHCHECK`), and its cage at n_p = 50 encloses every input vertex
 /// (winding number) without touching the input (exact triangle tests; also CGAL `compare
@@ -942,7 +942,7 @@ fn mean_axis_deviation(m: &TriMesh) -> f64 {
     sum / area
 }
 
-/// Issue 12 part 1: the offset rounds a box's edges and corners with radius d; the final
+/// The offset rounds a box's edges and corners with radius d; the final
 /// input-plane fit puts the LOD back on the box's planes, so the normal deviation from the
 /// input drops (here by more than half) and so does the output-to-input distance, with every
 /// guarantee still verified and the fit's counters in the report.

@@ -1,4 +1,4 @@
-//! The measured admission of a LOD's memory budget (issue 12 part 4): where the up-front
+//! The measured admission of a LOD's memory budget: where the up-front
 //! estimate (`LodParams::memory_estimate_bytes`, every soup piece's offset counted whole)
 //! fits no voxel scale, the offset stage counts its surface before allocating it and the
 //! budget is checked against the peak estimated from those counts. Checked on a generated soup

@@ -1,4 +1,4 @@
-//! The start surface of a LOD (issue 12 part 1, `LodParams::start`): a clean input (closed,
+//! The start surface of a LOD (`LodParams::start`): a clean input (closed,
 //! manifold, oriented, intersection-free after exact welding) can be the start of the loop
 //! instead of its offset surface; `Input` on a dirty soup is refused with the failing
 //! property; `Auto` on a dirty soup is the offset start, byte for byte; the C field is checked.

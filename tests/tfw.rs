@@ -1,4 +1,4 @@
-//! TFW (issue 13, dissertation ch. 2): scene setup, material law and the base surface solve on
+//! TFW (dissertation ch. 2): scene setup, material law and the base surface solve on
 //! small meshes. Finite-difference checks per energy term, analytic solutions and invariants.
 #![cfg(feature = "tfw")]
 
@@ -246,7 +246,7 @@ fn every_energy_term_matches_finite_differences() {
     check_term(&problem, &x, obstacles, "obstacles");
 }
 
-/// Issue 13 "obstacles": a 0.6 × 0.6 m sheet (ρ 200 kg/m³, h 1 mm, Y 0.1 MPa, ν 0.3, the
+/// Obstacles: a 0.6 × 0.6 m sheet (ρ 200 kg/m³, h 1 mm, Y 0.1 MPa, ν 0.3, the
 /// sphere drape's material, S:676) laid flat on top of a sphere r 0.2 m, its centre vertex
 /// pinned at the top (a frictionless sphere's top is an unstable equilibrium: a free sheet
 /// slides off), drapes over it under gravity and ends outside the sphere up to the penalty's
@@ -1199,7 +1199,7 @@ mod wrinkle_energy {
         }
     }
 
-    /// The one-pass evaluation of the exact-Hessian CG refinement (issue 13, branch `tfw13`)
+    /// The one-pass evaluation of the exact-Hessian CG refinement (2026-11-27)
     /// returns exactly the two evaluations it replaces.
     #[test]
     fn projected_and_exact_in_one_pass_equal_the_two_evaluations() {
@@ -1651,7 +1651,7 @@ mod stretched_sheet_check {
         (c.waves, c.peak)
     }
 
-    /// Solves issue 13's stretched sheet (0.25 × 0.1 m, h 0.1 mm, ν 0.5, Y 1 MPa, 37 × 14 =
+    /// Solves the stretched sheet (0.25 × 0.1 m, h 0.1 mm, ν 0.5, Y 1 MPa, 37 × 14 =
     /// 518 vertices) at `stretch`, evaluates 3 Loop levels with the v2 term and returns
     /// (periods across the width on the mid line, peak |z| there, max a), all in m.
     fn sheet(stretch: f64) -> (f64, f64, f64) {
@@ -1683,7 +1683,7 @@ mod stretched_sheet_check {
         (periods, peak_z, max_a)
     }
 
-    /// Issue 13's check: 5 periods across the width and a peak amplitude in [0.28, 0.50] mm.
+    /// The expected result: 5 periods across the width and a peak amplitude in [0.28, 0.50] mm.
     /// The dissertation does not give the stretch; 5% is used (see the ignored sweep).
     #[test]
     fn stretched_sheet_has_five_periods_and_the_expected_amplitude() {
@@ -1828,7 +1828,7 @@ mod twisted_cylinder_check {
 
     /// Measurements (report only): `PLEAT_CYL_TARGET` (default 720) vertices, curvature
     /// method `PLEAT_CYL_KAPPA` (`normals` or `quadric`), `PLEAT_CYL_ITERS` SQP iterations,
-    /// thickness × `PLEAT_CYL_THICKNESS_SCALE` (default 1; issue 13's "thickness × 10⁻²"),
+    /// thickness × `PLEAT_CYL_THICKNESS_SCALE` (default 1; 10⁻² for the thin-shell case),
     /// initial amplitude `PLEAT_CYL_K` (m), only the stationarity test at `PLEAT_CYL_RTOL`,
     /// every `PLEAT_CYL_HISTORY`-th SQP iteration printed (default 50).
     #[test]
@@ -1861,8 +1861,8 @@ mod twisted_cylinder_check {
         report(&scene, &params);
     }
 
-    /// Issue 13's "thickness × 10⁻² (≈10× more waves on the cylinder; no loss of
-    /// convergence)" on a coarse irregular twisted cylinder (378 v; main before the valley
+    /// The thin-shell requirement, thickness × 10⁻² (≈10× more waves on the cylinder; no loss
+    /// of convergence), on a coarse irregular twisted cylinder (378 v; main before the valley
     /// search: 1000 iterations, r/r₀ 2.4e-4, the same failure as at 690 and 1289 v): the SQP
     /// meets an A.6.3 test within the default 1000 iterations, every iterate keeps curl ≤ 1e-10
     /// and E non-increasing, a ≥ 0 at the end, and ω's period around the mid ring is ≈10× the
@@ -1901,7 +1901,7 @@ mod twisted_cylinder_check {
         assert!((345.0..=575.0).contains(&turns), "{turns} turns");
     }
 
-    /// Issue 13's twisted cylinder (r 1 m, height 5 m, h 0.1 mm, ν 0.44, Y 10 MPa, 10°) on
+    /// The twisted cylinder (r 1 m, height 5 m, h 0.1 mm, ν 0.44, Y 10 MPa, 10°) on
     /// irregular Delaunay meshes of ~700 and ~1300 vertices: expected 46 ± 5 waves around the
     /// mid-height ring ([`mid_ring_waves`]). Slow (ignored): `cargo test --release --test tfw
     /// twisted_cylinder_waves -- --ignored --nocapture`.
@@ -1991,7 +1991,7 @@ mod sheared_rectangle_check {
     }
 
     /// The Wong–Pellegrino sheared rectangle ([`Scene::sheared_rectangle`]: 380 × 128 mm,
-    /// 25 µm Kapton, 3 mm shear, ~1k vertices): issue 13 expects 25 ± 6 wrinkles (experiment
+    /// 25 µm Kapton, 3 mm shear, ~1k vertices): expected 25 ± 6 wrinkles (experiment
     /// 19, the dissertation 25). Slow (ignored): `cargo test --release --test tfw
     /// sheared_rectangle_wrinkles -- --ignored --nocapture`.
     #[test]
@@ -2296,7 +2296,7 @@ mod balloon_check {
         eprintln!("SKIPPED: picture {name} (feature bake off)");
     }
 
-    /// Issue 13's Mylar balloon ([`Scene::disk_balloon`], 2 × `PLEAT_BALLOON_V` (default
+    /// The Mylar balloon ([`Scene::disk_balloon`], 2 × `PLEAT_BALLOON_V` (default
     /// 600) vertices, 600 Pa): wrinkles around the equator. Slow (ignored): `cargo test
     /// --release --test tfw disk_balloon_wrinkles -- --ignored --nocapture`; writes
     /// docs/tfw_disk_balloon.png.
@@ -2309,7 +2309,7 @@ mod balloon_check {
         assert!(waves > 0.0, "no wrinkles around the equator");
     }
 
-    /// Issue 13's torus balloon ([`Scene::torus_balloon`], 2 × `PLEAT_BALLOON_V` (default
+    /// The torus balloon ([`Scene::torus_balloon`], 2 × `PLEAT_BALLOON_V` (default
     /// 800) vertices, 600 Pa): wrinkles around the outer equator. Slow (ignored): `cargo
     /// test --release --test tfw torus_balloon_wrinkles -- --ignored --nocapture`; writes
     /// docs/tfw_torus_balloon.png.
@@ -2398,7 +2398,7 @@ mod balloon_check {
     }
 }
 
-/// Issue 13 "Speed": the clarabel QP against the projected Newton with the curl eliminated on
+/// Speed: the clarabel QP against the projected Newton with the curl eliminated on
 /// the sheet, the cylinder and the sheared rectangle in one run (report + invariants + the
 /// agreement the default switch depends on). Slow (ignored): `cargo test --release --test tfw
 /// solver_comparison -- --ignored --nocapture`.
@@ -2504,7 +2504,7 @@ mod solver_comparison {
     }
 }
 
-/// Issue 13 "Speed", per scene: wall time until the answer is stable, base solve included,
+/// Speed, per scene: wall time until the answer is stable, base solve included,
 /// against Table 2.1 / 5 (S:792–815; the dissertation's stable times exclude the base solve,
 /// ours include it). "Stable" = the first SQP iteration from which on the wave count equals the
 /// final one and the peak amplitude stays within 1 % of the final one at every later checked
@@ -2915,7 +2915,7 @@ mod scene_speed {
     }
 }
 
-/// Issue 13, the torus saddle (README "Tension-field wrinkles"): is the converged base of the
+/// The torus saddle (README "Tension-field wrinkles"): is the converged base of the
 /// torus balloon, bent out of its plane, a local minimum, and is the mirror-symmetric state the
 /// old projected-pressure iteration crawled along one? The exact base Hessian (pressure not
 /// projected) with six coordinates pinned against the rigid motions (a principal submatrix:
@@ -3131,7 +3131,7 @@ fn teabag_sqp_rescues_a_step_without_curvature() {
     }
 }
 
-/// Issue 13's "inverted or degenerate base triangles (reported, no panic)": the stretched sheet
+/// Inverted or degenerate base triangles must be reported, without a panic: the stretched sheet
 /// started with one interior vertex pushed across its neighbours (inverted triangles) and one
 /// moved onto the midpoint of its row neighbours (zero-area triangles). The solve returns (no panic); the base
 /// solve untangles the start (the membrane's energy is finite there) or, where faces stay

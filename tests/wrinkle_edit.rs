@@ -1,4 +1,4 @@
-//! Wrinkle design and editing (issue 14, dissertation §3.6; checks of `specs/cwf-design.md`):
+//! Wrinkle design and editing (dissertation §3.6; checks of `specs/cwf-design.md`):
 //! fixed bits, identity and global edits of plane waves, interface quality, amplitude bounds,
 //! bad input, design from sources, and edit → interpolate → evaluate end to end.
 
@@ -508,7 +508,7 @@ fn symmetric_sources_give_a_symmetric_amplitude() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// C10 / issue part 4: edit → interpolate → evaluate
+// C10: edit → interpolate → evaluate
 
 #[test]
 fn edited_keyframe_animates_and_evaluates() {
@@ -1027,7 +1027,7 @@ fn corpus_interfaces_are_smooth_and_singularities_pair() {
         };
         let (k0, k1, rep) = run_corpus_edit(&mesh, k, &regions, &exact);
         check_interface(name, &k0, &k1, &rep);
-        // with 5 interface rings (about half a wavelength of these waves) the issue's 0.3 rad
+        // with 5 interface rings (about half a wavelength of these waves) the required 0.3 rad
         // holds over edit + interface edges on spot and fertility (the torus's curl floor is
         // 0.28 there, its RMS 0.34)
         let wide: Vec<_> = regions
@@ -1053,7 +1053,7 @@ fn corpus_interfaces_are_smooth_and_singularities_pair() {
                 rep.interface_rings, rep.attempts
             );
             check_interface(&format!("{name}, adaptive width"), &k0, &k1, &rep);
-            // over edit + interface edges and over the interface alone (the issue's wording)
+            // over edit + interface edges and over the interface alone (as required)
             assert!(rep.compat_rms <= 0.3, "{name}: {}", rep.compat_rms);
             let band = rep.compat_rms_by_class[1];
             assert!(band <= 0.3, "{name}: interface-only {band}");
@@ -1075,7 +1075,7 @@ fn curved_generated_interfaces_are_smooth_and_singularities_pair() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// issue 14 "Bad input": each a clear status (exit 2 + message), nothing written — from the CLI
+// Bad input: each a clear status (exit 2 + message), nothing written — from the CLI
 
 /// Runs the `pleat` binary; returns (exit code, stderr).
 fn pleat_cli(args: &[&str]) -> (Option<i32>, String) {
@@ -1233,7 +1233,7 @@ fn cli_bad_input_is_refused_and_writes_nothing() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// issue part 4 / C10: edit → interpolate → evaluate → rendered frames (README pictures)
+// C10: edit → interpolate → evaluate → rendered frames (README pictures)
 
 #[cfg(feature = "bake")]
 #[path = "common/shaded.rs"]
@@ -1538,7 +1538,7 @@ fn two_region_animation(
     Some((frame_steps(&anim, amp), irep))
 }
 
-/// The two-region animation has no temporal pop (issue 14 leftover). Without locality the
+/// The two-region animation has no temporal pop (found 2026-11-27). Without locality the
 /// far fixed region's phase drifted and snapped back at t ≈ 0.56–0.6: one step of 0.21–0.23
 /// (RMS of `Δ Re(a z̃)` over the amplitude) at both 20 and 40 guide frames — a jump, since it
 /// does not shrink with the step. With [`InterpOptions::locality`] the largest step halves when

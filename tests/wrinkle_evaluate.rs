@@ -362,7 +362,7 @@ fn progress_reports_and_cancels() {
         })
         .unwrap();
     assert_eq!(e.mesh.triangle_count(), 32 * 64);
-    // per level: 5 parts (4 on the last) and the level; then the displacement (issue 15)
+    // per level: 5 parts (4 on the last) and the level; then the displacement
     assert_eq!(seen.len(), 3 * 6);
     assert!(seen.windows(2).all(|w| w[0].1 < w[1].1) && seen[17].1 == 1.0);
     assert_eq!(stats.levels[2].faces, 2048);

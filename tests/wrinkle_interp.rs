@@ -1,4 +1,4 @@
-//! Wrinkle animation (issue 6, dissertation §3.4): invariants of the interpolant between two CWF
+//! Wrinkle animation (dissertation §3.4): invariants of the interpolant between two CWF
 //! keyframes — exact keyframes, rigid rotation of a plane wave (Fig. 3.8) against plain linear
 //! interpolation, temporal coherence against per-frame Knöppel, and stability cases.
 //!

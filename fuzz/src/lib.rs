@@ -533,7 +533,7 @@ pub fn wrinkle_eval(data: &[u8]) -> bool {
 /// Vertices up to which an accepted TFW scene also gets its base solve.
 const SOLVE_MAX_VERTICES: usize = 64;
 
-/// TFW scene reader (issue 15 part 1: "TFW scene files once they exist"): the JSON bytes go
+/// TFW scene reader (scene files are untrusted input like the mesh files): the JSON bytes go
 /// through the Rust parser (`Scene::from_json_str`) and the C entry point
 /// (`pleat_tfw_scene_from_json`), which must agree on acceptance; no input may panic. An
 /// accepted scene writes back to JSON that reads again, assembles to a model or a clear error,

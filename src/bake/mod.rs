@@ -1,4 +1,4 @@
-//! Textured LODs (issue 11; feature `bake`): read a glTF asset's appearance, build LODs by
+//! Textured LODs (feature `bake`): read a glTF asset's appearance, build LODs by
 //! screen size, give each an atlas, bake the input's material onto it, and write one `.glb`
 //! holding the chain.
 //!

@@ -1,8 +1,8 @@
-//! A small deterministic software rasterizer that **measures** a bake (issue 11, "error against
-//! run time"): the input and a baked LOD level are rendered from the same views and compared
-//! pixel by pixel. It is for evaluation only and shares nothing with the baking code paths:
-//! the input is shaded by [`Appearance::sample`] at the rasterized input point; the level by
-//! its own UVs, textures, normals and tangents as a glTF viewer would read them from the
+//! A small deterministic software rasterizer that **measures** a bake (its error, for the
+//! error-against-run-time benchmark): the input and a baked LOD level are rendered from the same
+//! views and compared pixel by pixel. It is for evaluation only and shares nothing with the baking
+//! code paths: the input is shaded by [`Appearance::sample`] at the rasterized input point; the
+//! level by its own UVs, textures, normals and tangents as a glTF viewer would read them from the
 //! output (bilinear, clamp to edge, sRGB decoded before filtering, normal map decoded in the
 //! per-pixel MikkTSpace frame `normalize(x·T + y·B + z·N)`, `B = w · N × T`).
 //!

@@ -355,8 +355,8 @@ enum WrinkleCommand {
         #[arg(long)]
         labels: Option<PathBuf>,
         /// Adaptive interface width: widen every band by one ring while the compatibility RMS
-        /// over edit + interface edges exceeds RAD radians (default 0.3, issue 14's smoothness
-        /// target; 0 = off: the requested widths). The widths used are printed.
+        /// over edit + interface edges exceeds RAD radians (default 0.3, the required interface
+        /// smoothness; 0 = off: the requested widths). The widths used are printed.
         #[arg(
             long,
             value_name = "RAD",
@@ -465,8 +465,8 @@ fn bench(cmd: BenchCommand) -> ExitCode {
 #[cfg(any(feature = "lod", feature = "tfw"))]
 const EXIT_FAILED: u8 = 1;
 
-/// Placeholders of the output path replaced by the screen size: `{n}` (the issue's and the
-/// README's spelling) and `{np}` (the one `--help` can show).
+/// Placeholders of the output path replaced by the screen size: `{n}` (the README's
+/// spelling) and `{np}` (the one `--help` can show).
 #[cfg(feature = "lod")]
 const SIZE_PLACEHOLDERS: [&str; 2] = ["{n}", "{np}"];
 

@@ -1,4 +1,4 @@
-//! Textured LODs from C (issue 11): `pleat_lod_provenance`, `pleat_points_provenance`,
+//! Textured LODs from C: `pleat_lod_provenance`, `pleat_points_provenance`,
 //! `pleat_bake_lod` and the `PleatBake` getters.
 //!
 //! An engine passes its own decoded data: the input as a `PleatMesh`, its UVs, optional

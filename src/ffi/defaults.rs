@@ -287,8 +287,8 @@ fn wrinkle_interp_params_locality_field() {
     assert!(e.contains("params->locality"), "{e}");
 }
 
-/// `PleatLodParams::offset_voxel_scale` (issue 12 part 4): 0 and older struct sizes are
-/// automatic, (0, 2] is passed on, NaN/negative/> 2 are refused naming the field.
+/// `PleatLodParams::offset_voxel_scale`: 0 and older struct sizes are automatic, (0, 2] is passed
+/// on, NaN/negative/> 2 are refused naming the field.
 #[cfg(feature = "lod")]
 #[test]
 fn lod_params_offset_voxel_scale_is_checked() {

@@ -1,10 +1,10 @@
-//! Wrinkle design and region edits in the C ABI (capability `wrinkle`, issue 14, dissertation
-//! §3.6): [`pleat_cwf_design`] (sources → keyframe), [`pleat_cwf_edit`] (rotate / rescale
-//! regions of a keyframe) and [`pleat_mesh_grow_faces`] (a region from seeds grown by rings).
+//! Wrinkle design and region edits in the C ABI (capability `wrinkle`, dissertation §3.6):
+//! [`pleat_cwf_design`] (sources → keyframe), [`pleat_cwf_edit`] (rotate / rescale regions of a
+//! keyframe) and [`pleat_mesh_grow_faces`] (a region from seeds grown by rings).
 //! Outputs are ordinary immutable `PleatCwf` handles, so `pleat_cwf_interpolate` and
 //! `pleat_cwf_evaluate` take them unchanged. The calls take well under a second on meshes of a
 //! few thousand vertices; on large meshes, [`pleat_cwf_design_with_progress`] and
-//! [`pleat_cwf_edit_with_progress`] report progress and can be cancelled (issue 15).
+//! [`pleat_cwf_edit_with_progress`] report progress and can be cancelled.
 
 #![allow(clippy::too_many_arguments)]
 
@@ -116,7 +116,7 @@ pub struct PleatCwfEditParams {
     /// 2026-11-27: an older, shorter struct gets the default.
     pub edit_weight: f64,
     /// Adaptive interface width: target RMS compatibility residual over edit + interface edges,
-    /// radians, finite, ≥ 0; default 0.3 (issue 14's smoothness target; also what an older,
+    /// radians, finite, ≥ 0; default 0.3 (the smoothness asked of an interface; also what an older,
     /// shorter struct gets), 0 = off: the regions' `interface_rings` exactly. While the
     /// residual exceeds it, every band is widened by one ring (up to `max_interface_rings`) and
     /// the edit redone; the edit with the smallest residual is returned
@@ -254,7 +254,7 @@ pub unsafe extern "C" fn pleat_cwf_design(
     )
 }
 
-/// As `pleat_cwf_design`, with a progress callback that can cancel (issue 15).
+/// As `pleat_cwf_design`, with a progress callback that can cancel.
 ///
 /// - `progress`, `user_data`: optional callback (NULL for none), called on this thread with
 ///   stage `"design"` after each step (regions, each vector heat solve, ω, the amplitude) and
@@ -320,7 +320,7 @@ pub unsafe extern "C" fn pleat_cwf_edit(
     )
 }
 
-/// As `pleat_cwf_edit`, with a progress callback that can cancel (issue 15).
+/// As `pleat_cwf_edit`, with a progress callback that can cancel.
 ///
 /// - `progress`, `user_data`: optional callback (NULL for none), called on this thread with
 ///   stage `"edit"` after each step of every attempt (labels, the interface ω and amplitude

@@ -46,7 +46,8 @@ pub struct PleatLodParams {
     pub struct_size: u32,
     /// Maximum number of optimization rounds N (default 50; 0 returns the offset surface). A
     /// LOD without a face target stops earlier after 5 rounds without a new smallest face
-    /// count (README "Session 19").
+    /// count (since 2026-11-29: later rounds only moved vertices, and the 23-mesh benchmark
+    /// kept or improved every aggregate).
     pub max_rounds: u32,
     /// Screen size n_p in pixels covered by the input's bounding-box diagonal l (default 200).
     /// The offset distance and error bound is d = l / n_p. Finite and > 0.
@@ -69,7 +70,7 @@ pub struct PleatLodParams {
     /// Cages only: the distance the cage keeps from the input, as a fraction of d (default
     /// 0.05: a twentieth of a pixel at the cage's screen size, see README "Cages with clearance"), or
     /// in model units with `PLEAT_LOD_CLEARANCE_ABSOLUTE`. Must be >= 0 and below d; 0 keeps
-    /// only "no contact". Appended for issue 12; callers with an older `struct_size` get the
+    /// only "no contact". Appended 2026-11-25; callers with an older `struct_size` get the
     /// default.
     pub clearance: f64,
     /// LODs only: the surface the loop starts from: 0 = auto (the welded input when it is
@@ -77,7 +78,7 @@ pub struct PleatLodParams {
     /// self-intersection-free — else the offset surface), 1 = the offset surface at d,
     /// 2 = the welded input (`PLEAT_STATUS_INVALID_ARGUMENT` naming the failing property when
     /// it is not clean). Other values are `PLEAT_STATUS_INVALID_ARGUMENT`. Cages always start
-    /// from the offset surface. Appended for issue 12; callers with an older `struct_size`
+    /// from the offset surface. Appended 2026-11-27; callers with an older `struct_size`
     /// get 0 (auto).
     pub start: u32,
     /// Reserved, 0 (keeps the struct free of padding).
@@ -85,8 +86,8 @@ pub struct PleatLodParams {
     /// LODs only: the offset voxel the bake starts from, as a multiple of d/√3, in (0, 2];
     /// 0 (the default) = automatic (2 from n_p = 200 on, 1.25 from 100, 1 below; see README
     /// "A coarser first stage"). A coarser voxel is still taken when the memory estimate needs it. NaN,
-    /// negative or > 2 is `PLEAT_STATUS_INVALID_ARGUMENT`. Appended for issue 12 part 4;
-    /// callers with an older `struct_size` get automatic.
+    /// negative or > 2 is `PLEAT_STATUS_INVALID_ARGUMENT`. Appended 2026-11-27; callers with
+    /// an older `struct_size` get automatic.
     pub offset_voxel_scale: f64,
 }
 
@@ -168,10 +169,9 @@ pub struct PleatLodStats {
     /// 1 when the level's loop started from the welded input (`PleatLodParams::start`; in a
     /// chain only the finest level can), 0 when from the offset surface or a finer level.
     pub started_from_input: u32,
-    /// When the level was admitted by measurement (issue 12 part 4: its up-front memory
-    /// estimate fitted no offset voxel scale, so the offset stage counted its surface before
-    /// allocating it): the peak bytes estimated from those counts, which fitted the memory
-    /// budget. NaN otherwise.
+    /// When the level was admitted by measurement (its up-front memory estimate fitted no offset
+    /// voxel scale, so the offset stage counted its surface before allocating it): the peak bytes
+    /// estimated from those counts, which fitted the memory budget. NaN otherwise.
     pub measured_estimate_bytes: f64,
     /// In a chain: 1 when this coarser level started from the next finer level's loop output
     /// before its fit (its own offset surface had the finer level's topology), 0 when from its
@@ -574,7 +574,7 @@ mod tests {
     use crate::lowpoly::{LodReport, LodStage};
     use crate::mesh::test_shapes::grid;
 
-    /// The fields appended in session 20 carry the typed report's: the chain rank (-1 outside
+    /// The fields appended 2026-11-29 carry the typed report's: the chain rank (-1 outside
     /// a chain), the loop's end flags and the fit and measure stage seconds.
     #[test]
     fn chain_and_loop_fields_come_from_the_report() {

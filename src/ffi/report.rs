@@ -78,7 +78,7 @@ pub struct PleatMeshReport {
     /// 1 when `self_intersecting_pair_count` is a lower bound, not the exact count: counting
     /// stops once 2²² exact tests have found an intersection (a pile of near-copies of one
     /// triangle; stacked exact copies are counted per group without using it up).
-    /// `self_intersection_free` is exact (0) then. Appended 2026-11-27 (issue 15).
+    /// `self_intersection_free` is exact (0) then. Appended 2026-11-27.
     pub self_intersecting_pair_count_is_lower_bound: u32,
     /// Padding; written as 0.
     pub reserved: u32,
@@ -161,7 +161,7 @@ pub unsafe extern "C" fn pleat_mesh_check(
     })
 }
 
-/// As `pleat_mesh_check`, with a progress callback that can cancel (issue 15).
+/// As `pleat_mesh_check`, with a progress callback that can cancel.
 ///
 /// - `progress`, `user_data`: optional callback (NULL for none), called on this thread with
 ///   stage `"check"` after each topology phase and, in the self-intersection test, after each

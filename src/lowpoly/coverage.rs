@@ -1,4 +1,4 @@
-//! The input-plane fit's coverage check (issue 12 part 1): no fit operation may uncover input.
+//! The input-plane fit's coverage check: no fit operation may uncover input.
 //!
 //! The fit (`fit.rs`) pulls the LOD onto the input's planes, which lowers the output→input
 //! distance; on open or thin inputs (a sheet's rim, a beetle's leg) the QEM placement or a flip
@@ -14,17 +14,17 @@
 //!   `σ_s = clamp(x_s − `[`BURIED_DEPTH`]` · floor, 0, `[`BURIED_SLACK`]` · floor)`: input
 //!   already farther than `d` (hidden input, rims the offset rounded) may not get farther,
 //!   except input buried deeper than `2 d`, which may get up to one `d` farther, but never
-//!   farther than the farthest sample already is. Session 23: input buried a few `d` under a
-//!   flat face held that face off the input's plane — thingi10k 42722 at n_p = 200, whose
-//!   4093 of 20k samples the unchecked fit moved beyond their distance were 99.7 % buried
-//!   (median 5.7 d, moved by at most 1.08 d, the farthest not moved farther): 28.41 dB with the
-//!   strict budget, 29.82 dB with this slack, 39.97 dB unchecked. A slack from any depth
-//!   (`x_s > d`) gained more there (30.77 dB) but let the fit pull the bridge between two cubes
-//!   sharing an edge (input 1–2 `d` inside it) into a twist (dirty_synth_nonmanifold at
-//!   n_p = 100: 25.49 → 22.84 dB). Session 24, not taken either: samples deeper than `2 d`
-//!   free up to `X` (no one-`d` limit) — 42722 31.69 dB, the 23-mesh mean +0.08 dB, but the
-//!   tree's measured Hausdorff distance +0.0008 l (many samples at the cap, the measurement
-//!   sampling between them); README, "Buried input and the fit".
+//!   farther than the farthest sample already is. Measured 2026-12-06: input buried a few `d` under
+//!   a flat face held that face off the input's plane — thingi10k 42722 at n_p = 200, whose 4093 of
+//!   20k samples the unchecked fit moved beyond their distance were 99.7 % buried (median 5.7 d,
+//!   moved by at most 1.08 d, the farthest not moved farther): 28.41 dB with the strict budget,
+//!   29.82 dB with this slack, 39.97 dB unchecked. A slack from any depth (`x_s > d`) gained more
+//!   there (30.77 dB) but let the fit pull the bridge between two cubes sharing an edge (input 1–2
+//!   `d` inside it) into a twist (dirty_synth_nonmanifold at n_p = 100: 25.49 → 22.84 dB). Measured
+//!   2026-12-07 and not taken either: samples deeper than `2 d` free up to `X` (no one-`d` limit) —
+//!   42722 31.69 dB, the 23-mesh mean +0.08 dB, but the tree's measured Hausdorff distance
+//!   +0.0008 l (many samples at the cap, the measurement sampling between them); README, "Buried
+//!   input and the fit".
 //! - Invariant: every sample is within its budget of the LOD. A vertex move or a flip replaces
 //!   a patch of faces (the one-ring, the flip's two faces); a sample within its budget of the
 //!   *old* patch may rely on it, so it must be within its budget of the *new* patch, or the
@@ -48,28 +48,28 @@ use crate::verify::hausdorff::surface_samples;
 use super::guard::InputModel;
 
 /// Spacing of the input samples, in `d` (the Hausdorff measurement's is `l / 400`, `d / 2` at
-/// n_p = 200). 1 since 2026-11-29 (was 0.5; issue 12 part 2): a quarter of the samples, the
+/// n_p = 200). 1 since 2026-11-29 (was 0.5, changed for speed): a quarter of the samples, the
 /// fit 1.5–2.5× faster (fandisk at n_p = 200: bake 0.70 → 0.44 s wall); measured with the
 /// shared harness at n_p = 100 and 200 against QEM and meshoptimizer at equal faces (README,
-/// "LOD benchmark", "Session 19"): shading and Hausdorff distance unchanged within the
+/// "LOD benchmark"): shading and Hausdorff distance unchanged within the
 /// per-mesh noise. The final measurement (`verify::hausdorff`, at `l / 400`) and the fit's
 /// safety revert still judge the fitted LOD.
 pub const SPACING: f64 = 1.0;
 
-/// How much farther a sample buried deeper than [`BURIED_DEPTH`] floors may end, in floors
-/// (reached at `BURIED_DEPTH + BURIED_SLACK`), capped at the farthest sample's distance before
-/// the fit (module docs). Session 23 (was 0): the shared harness over the 23 corpus meshes,
-/// same session, changes only the four inputs with deeply buried parts at n_p = 200 (mean PSNR
-/// 25.43 → 25.52 dB, normal difference 0.0477 → 0.0474, Hausdorff unchanged) and two at
-/// n_p = 100 (22.57 → 22.62 dB); README, "Buried input and the fit".
+/// How much farther a sample buried deeper than [`BURIED_DEPTH`] floors may end, in floors (reached
+/// at `BURIED_DEPTH + BURIED_SLACK`), capped at the farthest sample's distance before the fit
+/// (module docs). 1 since 2026-12-06 (was 0): measured that day with the shared harness over the 23
+/// corpus meshes, it changes only the four inputs with deeply buried parts at n_p = 200 (mean PSNR
+/// 25.43 → 25.52 dB, normal difference 0.0477 → 0.0474, Hausdorff unchanged) and two at n_p = 100
+/// (22.57 → 22.62 dB); README, "Buried input and the fit".
 pub const BURIED_SLACK: f64 = 1.0;
 
 /// The depth, in floors, below which a sample gets no slack ([`BURIED_SLACK`]): input 1–2 `d`
 /// inside the LOD lies in the bridges and fillets the offset spans, whose shape it holds.
 pub const BURIED_DEPTH: f64 = 2.0;
 
-/// Fewer samples than this are checked on the calling thread: a fit operation's patch is
-/// small, and below this the thread pool's wake-ups cost more than the work (issue 12 part 2:
+/// Fewer samples than this are checked on the calling thread: a fit operation's patch is small, and
+/// below this the thread pool's wake-ups cost more than the work (measured 2026-11-29:
 /// `sched_yield` and futex calls were ≈ 20% of a chain's CPU). The answers do not depend on it.
 const PARALLEL_MIN: usize = 2048;
 
@@ -77,8 +77,8 @@ const PARALLEL_MIN: usize = 2048;
 const MAX_SUBDIVISIONS: usize = 32;
 
 /// The input samples, their budgets and the box tree over `s ± b_s` (module docs): 24 + 8 B a
-/// sample and the compact [`CubeTree`]'s ≈ 7.5 B (parry's BVH took ≈ 400 B a sample; issue 12
-/// part 4).
+/// sample and the compact [`CubeTree`]'s ≈ 7.5 B (parry's BVH took ≈ 400 B a sample, too much
+/// for the memory budget).
 pub(crate) struct Coverage {
     points: Vec<Vec3>,
     budget: Vec<f64>,
@@ -160,7 +160,7 @@ impl Coverage {
     /// uses; deterministic order (the box tree's), not sorted.
     ///
     /// Same answers as testing every sample whose cube `s ± b_s` meets the patch's box against
-    /// the faces in order ([`Patch::face_within`]), found faster (issue 12 part 2): one box
+    /// the faces in order ([`Patch::face_within`]), found faster: one box
     /// tree query with the patch's box, then face `k` is tried on a candidate only when its
     /// cube meets face `k`'s box grown by [`Coverage::grow`] — every sample the face's box
     /// test would not cull — so a high-valence ring does not test every candidate against
@@ -173,8 +173,8 @@ impl Coverage {
     /// [`Coverage::keeps_within`] keeps without a distance for any replacement of `old` whose
     /// points each move at most `δ` (`spare ≥ δ + box_cull_margin(s, b + δ)`, the margin
     /// increasing in `δ`): the answer of [`Coverage::keeps_within`] with any `moved ≤ δ` is
-    /// the same as over the full set (issue 12 part 2: most samples stay well inside their
-    /// budget, and are no longer listed and re-checked on every line-search trial).
+    /// the same as over the full set (faster: most samples stay well inside their budget, and
+    /// are no longer listed and re-checked on every line-search trial).
     fn relying_on_moved(&mut self, old: &[[Vec3; 3]], moved: Option<f64>) -> Vec<Relying> {
         let Some((lo, hi)) = corners_box(old) else {
             return Vec::new();
@@ -376,8 +376,8 @@ impl<'a> Patch<'a> {
     }
 }
 
-/// A lower bound on the distance from a point to a well-shaped triangle `abc` (issue 12
-/// part 2): the triangle lies in its plane (unit normal `n`) and, within the plane, on the
+/// A lower bound on the distance from a point to a well-shaped triangle `abc` (cheaper than the
+/// exact distance): the triangle lies in its plane (unit normal `n`) and, within the plane, on the
 /// inner side of each edge line (in-plane inward unit normals `m_e`, `n × (end − start)` for a
 /// counter-clockwise `n = ab × ac`). For any `q` of the triangle, `p − q` has the component
 /// `h = n · (p − a)` along `n` and, along the orthogonal `m_e`, a component at least

@@ -1,4 +1,4 @@
-//! Final input-plane fit (issue 12 part 1: shading fidelity at equal face count).
+//! Final input-plane fit (for shading fidelity at equal face count).
 //!
 //! The loop of Alg. 3 leaves a LOD that approximates the *offset* surface: convex features
 //! rounded with radius `d`, the whole surface 1–3 `d` outside the input. Shading follows the

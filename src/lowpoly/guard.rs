@@ -30,7 +30,7 @@
 //!    the closed mesh changes only through `M_e`, so for input vertices `q` in the box swept by
 //!    the operation, `Δw(q) = (Σ_{new M_e} Ω_f(q) − Σ_{old M_e} Ω_f(q)) / 4π` (solid angles) must
 //!    round to 0. Together with "no touching", every input point stays strictly inside.
-//! 5. **A cage with clearance** (cage mode with a clearance `c > 0`, issue 12 part 3) — the
+//! 5. **A cage with clearance** (cage mode with a clearance `c > 0`) — the
 //!    exact distance between `M_e` and the input (triangle–triangle distances of
 //!    `spatial::closest::disjoint_triangle_distance` on the candidates of the input's BVH within
 //!    `c` of each face) is at least `c`, or — where the start surface already was closer — at
@@ -78,7 +78,7 @@ pub(crate) struct InputModel {
 const HELPER_THREAD_FACES: usize = 1 << 17;
 
 /// How often [`InputModel::new_with_stop`] asks whether to go on while its helper thread builds
-/// the trees (issue 15: a cancel is answered within 0.5 s).
+/// the trees (a cancel must be answered within 0.5 s).
 const TREE_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 
 /// The trees of an [`InputModel`]: the face BVH and the optional vertex index.
@@ -149,7 +149,7 @@ impl InputModel {
     }
 
     /// As [`new`](Self::new), with `keep_going()` asked on the calling thread while the trees
-    /// are built; `None` as soon as it answers `false` (issue 15: the face BVH of parry is one
+    /// are built; `None` as soon as it answers `false` (the face BVH of parry is one
     /// sequential build, 1.4 s at 10⁶ faces on a loaded machine, which has no cancellation point
     /// inside). From [`HELPER_THREAD_FACES`] input faces on, the trees are built on a helper
     /// thread while this thread computes the degeneracy flags and then asks `keep_going` every
@@ -293,7 +293,7 @@ pub(crate) struct Guard<'a> {
     tris: FaceData<[u32; 3]>,
     /// The tree over the live faces' boxes (a compact [`sp::TriTree`]: parry's BVH cost
     /// ≈ 160 B a face plus a rebuild workspace of the same order, the first pass's peak on a
-    /// dense offset surface; issue 12 part 4). Its queries give the same face sets.
+    /// dense offset surface). Its queries give the same face sets.
     bvh: sp::TriTree,
     input: &'a InputModel,
     cage: bool,
@@ -897,8 +897,8 @@ fn rebuild_threshold(mesh: &HalfEdgeMesh) -> usize {
 }
 
 /// Rebuilds the guard's BVH over the live faces (dropping the dead leaves of removed faces).
-/// The old tree is freed first, so the rebuild never holds two trees (issue 12 part 4: on the
-/// first pass over a dense offset surface the old tree still has a leaf per offset face).
+/// The old tree is freed first, so the rebuild never holds two trees (to bound the peak memory:
+/// on the first pass over a dense offset surface the old tree still has a leaf per offset face).
 fn rebuild_bvh(
     mesh: &HalfEdgeMesh,
     tris: &FaceData<[u32; 3]>,

@@ -5,7 +5,7 @@
 //! topology (`mc33`), feature vertices (`features`), interior removal (`interior`).
 //!
 //! Stage 2, the mesh-optimization loop (§4.3.2–4.3.3, Alg. 3–7), then for LODs a final fit to
-//! the input's planes (`fit`, issue 12): [`generate`] bakes one LOD,
+//! the input's planes (`fit`): [`generate`] bakes one LOD,
 //! [`generate_chain`] several. Every local operation of the loop — edge collapses
 //! (`simplify`, Alg. 5), the flow (Alg. 3–4) and the feature alignment (Alg. 6, eq. 4.5) —
 //! goes through one guard (`guard.rs`) that keeps the mesh watertight, manifold, of the same

@@ -178,7 +178,7 @@ pub(crate) enum OffsetCount {
     },
 }
 
-/// A measured admission of the offset stage (issue 12 part 4), called with each
+/// A measured admission of the offset stage (the memory budget), called with each
 /// [`OffsetCount`] in turn: once the band's distances are known and the extraction's first
 /// pass has counted the surface's [`Crossings`], then before the interior removal and before
 /// the feature phases. Its `Err` (e.g. `LimitExceeded` naming the measured figure) ends the
@@ -548,7 +548,7 @@ fn verify(
     stats: &mut OffsetReport,
     progress: &mut ProgressFn<'_>,
 ) -> Result<()> {
-    // a progress call per phase and per batch of the self-intersection pass (issue 15)
+    // a progress call per phase and per batch of the self-intersection pass (cancellation points)
     let report = MeshReport::compute_with_progress(out, &ReportOptions::default(), &mut |f| {
         progress(Progress {
             stage: "verify",
@@ -565,7 +565,7 @@ fn verify(
     let cap = r.d + 4.0 * r.h;
     let positions = out.positions();
     let mut max_dev: f64 = 0.0;
-    // chunked so that a cancel is seen between chunks (issue 15); a maximum, so the same bytes
+    // chunked so that a cancel is seen between chunks; a maximum, so the same bytes
     for (i, chunk) in positions.chunks(DEVIATION_CHUNK).enumerate() {
         let m = chunk
             .par_iter()

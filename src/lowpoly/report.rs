@@ -138,7 +138,7 @@ pub struct FloorMeasure {
     pub cpu_seconds: f64,
 }
 
-/// A cage's clearance: required and measured (issue 12 part 3).
+/// A cage's clearance: required and measured.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClearanceMeasure {
     /// The clearance the guard kept, in model units (`LodParams::clearance` resolved).
@@ -175,10 +175,10 @@ pub struct LodReport {
     /// coarser scale of `lowpoly::LOD_VOXEL_SCALES` when the memory budget needs one; `None` for cages (always 1) and in a chain level started
     /// from the finer level.
     pub offset_voxel_scale: Option<f64>,
-    /// Set when the bake was admitted by measurement (issue 12 part 4): the up-front memory
-    /// estimate fitted no voxel scale, so the offset stage counted its surface before
-    /// allocating it and the budget was checked against the peak estimated from those counts
-    /// (the larger of the offset stage's and the loop's/fit's, in bytes). `None` otherwise.
+    /// Set when the bake was admitted by measurement: the up-front memory estimate fitted no voxel
+    /// scale, so the offset stage counted its surface before allocating it and the budget was
+    /// checked against the peak estimated from those counts (the larger of the offset stage's and
+    /// the loop's/fit's, in bytes). `None` otherwise.
     pub measured_estimate_bytes: Option<f64>,
     /// Faces of the start surface (offset surface, the welded input, or the finer level in a
     /// chain).
@@ -242,7 +242,7 @@ pub struct LodReport {
     pub vertices: u64,
     /// Rank of this level in a chain, 0 = finest (baked first); `None` outside a chain.
     pub chain_level: Option<u64>,
-    /// The loop started from the welded input (`LodParams::start`, issue 12 part 1) instead of
+    /// The loop started from the welded input (`LodParams::start`) instead of
     /// the offset surface (in a chain: this level is the finest and started from the input).
     pub started_from_input: bool,
     /// In a chain, a coarser level that started from the next finer level's loop output before

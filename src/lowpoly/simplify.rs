@@ -553,7 +553,7 @@ impl<'g, 'a> Pass<'g, 'a> {
     /// Fills the queue with every edge: costs computed in parallel (each depends only on its
     /// edge), then one bottom-up heap build. The edges go through in chunks of
     /// [`QUEUE_FILL_CHUNK`], so the transient buffers are bounded instead of 36 B per edge of
-    /// the dense offset surface (issue 12 part 4); the entries are the same, in the same order,
+    /// the dense offset surface; the entries are the same, in the same order,
     /// whatever the chunk or thread count.
     fn queue_all_edges(&mut self) {
         let mut entries = Vec::with_capacity(self.g.mesh().edge_count());
@@ -591,7 +591,7 @@ impl<'g, 'a> Pass<'g, 'a> {
 
     /// The quadric optimum and cost of collapsing `e` ([`collapse_target`] of its endpoints'
     /// summed quadrics). Recomputed where needed instead of stored per edge (24 B per edge of
-    /// the dense offset surface; issue 12 part 4): within a pass only a commit changes a
+    /// the dense offset surface, a memory peak): within a pass only a commit changes a
     /// quadric or a position, and it re-queues every edge at the surviving vertex, so the
     /// value when an edge is popped is the one its queue cost was computed with.
     fn edge_target(&self, e: EdgeId) -> (Vec3, f64) {

@@ -24,10 +24,10 @@ use faer::{Conj, Mat, MatMut, Par, Side};
 use crate::{Error, Result};
 
 /// Factor entries from which a numeric factorization is run by [`run_stoppable`] on a helper
-/// thread (issue 15). Measured 2026-11-27 on the wrinkle design's systems: Knöppel's factor on
-/// a 53k-face base has 4.4·10⁶ entries and takes 0.19 CPU s, so one of 2¹⁹ entries takes a few
-/// hundredths of a second: the factorizations left on the calling thread stay far below the
-/// 0.5 s cancellation bound, and small ones pay no thread start.
+/// thread, so that a cancel is seen within 0.5 s. Measured 2026-11-27 on the wrinkle design's
+/// systems: Knöppel's factor on a 53k-face base has 4.4·10⁶ entries and takes 0.19 CPU s, so one of
+/// 2¹⁹ entries takes a few hundredths of a second: the factorizations left on the calling thread
+/// stay far below the 0.5 s cancellation bound, and small ones pay no thread start.
 pub const STOPPABLE_FACTOR_LEN: usize = 1 << 19;
 
 /// Stored matrix entries from which [`CholeskyAnalysis::new_stoppable`] runs the analysis (the
@@ -39,15 +39,15 @@ pub const STOPPABLE_MATRIX_NNZ: usize = 1 << 19;
 /// How often [`run_stoppable`] asks its `tick` while the work runs.
 const STOPPABLE_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 
-/// Runs `work` and returns its value, with a cancellation point every 0.1 s while it runs
-/// (issue 15: one sparse Cholesky factorization has no cancellation point inside, 1.1 CPU s on
-/// a 213k-face wrinkle base). When `heavy`, `work` runs on a helper thread, inside a rayon pool
-/// of as many threads as the caller's (so faer's `Par::rayon(0)` there is the caller's
-/// parallelism and the result is bit for bit the one of a call on this thread), while this
-/// thread calls `tick()` every 0.1 s; its first error is returned at once, and the
-/// helper then finishes `work` and drops its value (nothing is returned or kept: the thread
-/// owns everything `work` captured). Otherwise `work` runs right here, without a `tick`.
-/// A panic in `work` is re-raised on this thread.
+/// Runs `work` and returns its value, with a cancellation point every 0.1 s while it runs (one
+/// sparse Cholesky factorization has no cancellation point inside: 1.1 CPU s on a 213k-face wrinkle
+/// base, more than the 0.5 s a cancel may wait). When `heavy`, `work` runs on a helper thread,
+/// inside a rayon pool of as many threads as the caller's (so faer's `Par::rayon(0)` there is the
+/// caller's parallelism and the result is bit for bit the one of a call on this thread), while this
+/// thread calls `tick()` every 0.1 s; its first error is returned at once, and the helper then
+/// finishes `work` and drops its value (nothing is returned or kept: the thread owns everything
+/// `work` captured). Otherwise `work` runs right here, without a `tick`. A panic in `work` is
+/// re-raised on this thread.
 pub fn run_stoppable<T: Send + 'static>(
     heavy: bool,
     work: impl FnOnce() -> T + Send + 'static,

@@ -327,7 +327,7 @@ fn inverse(tri_of_leaf: &[u32]) -> HashMap<u32, u32> {
 
 /// A parry tree whose leaf `k` has the `k`-th box of `boxes`. The boxes stream into parry's
 /// build (the tree `Bvh::from_leaves` builds from the same boxes, without a 48 B-a-leaf copy of
-/// them alive during the build: issue 12 part 4, the guard's rebuilds on a dense offset).
+/// them alive during the build: a memory peak of the guard's rebuilds on a dense offset).
 fn build_tree(boxes: impl ExactSizeIterator<Item = Aabb>) -> Bvh {
     if boxes.len() <= 2 {
         // parry's bulk build special-cases one and two leaves; insertion is just as good.

@@ -1,6 +1,6 @@
 //! [`CubeTree`]: a compact static tree over axis-aligned cubes `p ± b` (a point and a
 //! half-width each), for millions of small boxes where parry's BVH costs ≈ 400 B a box (the
-//! input-plane fit's coverage samples, issue 12 part 4). It keeps no copy of the points: the
+//! input-plane fit's coverage samples). It keeps no copy of the points: the
 //! caller passes the same slices to every query.
 //!
 //! Layout: the cube indices in Morton order of their points (4 B a cube), and a pyramid of
@@ -97,7 +97,7 @@ pub fn cube_meets(p: Vec3, b: f64, lo: Vec3, hi: Vec3) -> bool {
 
 /// Reorders `points` in place into the order a [`CubeTree`] over them visits its cubes (Morton
 /// order in their bounding box, ties by index), so that a tree built afterwards has its leaves
-/// over consecutive points and queries read memory in sequence (issue 12 part 2). Only the
+/// over consecutive points and queries read memory in sequence (faster). Only the
 /// indices change: a tree over the reordered points answers the same cubes, in the same order,
 /// under their new indices. Deterministic; in place (one byte a point beyond the order).
 pub fn sort_in_tree_order(points: &mut [Vec3]) {

@@ -21,13 +21,13 @@
 //! of threads. [`has_self_intersection`] runs the same traversal but stops testing at the first
 //! hit.
 //!
-//! Stacked copies (issue 15): the counting pass behind `verify::MeshReport`
+//! Stacked copies: the counting pass behind `verify::MeshReport`
 //! (`count_self_intersections_welded`) and [`has_self_intersection`] group exact duplicates
 //! (the same welded vertex set) first and traverse one face per group, so `k` copies of a face
 //! cost one test, not `k(k−1)/2`. The listing functions return every pair, so their output (and
 //! time) stays quadratic in the copies.
 //!
-//! Piles of near-copies (issue 15): faces that overlap without being exact copies need one
+//! Piles of near-copies: faces that overlap without being exact copies need one
 //! exact test per pair (330 ns each on a jittered pile, against 19 ns of traversal). The
 //! counting pass therefore estimates each chunk pair's candidates from 64 sampled faces,
 //! counts a large chunk pair face by face in rounds of about 2¹⁹ candidates with a progress
@@ -131,7 +131,7 @@ pub(crate) struct SelfIntersectionCounts {
 }
 
 /// Exact tests that found an intersection after which [`count_self_intersections_welded`]
-/// stops counting (issue 15): a pile of near-copies of one face (20 000 copies with corners
+/// stops counting: a pile of near-copies of one face (20 000 copies with corners
 /// jittered by ±10⁻⁹: 1.5·10⁸ intersecting pairs, one exact test each, 63 CPU s) is then
 /// answered with a lower bound in about a second; the largest corpus count is 342 834
 /// (large_cycloidal_mid16), 12 times below the cap. Pairs of stacked exact copies are counted
@@ -139,7 +139,7 @@ pub(crate) struct SelfIntersectionCounts {
 pub(crate) const MAX_COUNTED_HITS: u64 = 1 << 22;
 
 /// The counts of [`find_self_intersections_welded`], in time linear in the number of stacked
-/// copies of a face rather than quadratic (issue 15): the non-degenerate faces are grouped by
+/// copies of a face rather than quadratic: the non-degenerate faces are grouped by
 /// their welded vertex set (exact duplicates, in any corner order or orientation); the `k(k−1)/2`
 /// pairs inside a group of `k` are classified once, by the exact test of its first two faces
 /// (two faces on the same three welded vertices always intersect: CGAL counts duplicate faces),
@@ -269,7 +269,7 @@ pub fn has_self_intersection_in(positions: &[[f64; 3]], triangles: &[[u32; 3]]) 
     if !degenerate.is_empty() {
         return true;
     }
-    // Stacked copies of a face are decided once per group (issue 15: not pair by pair).
+    // Stacked copies of a face are decided once per group, not pair by pair.
     let groups = DuplicateGroups::of(&welded, &faces);
     let narrow = Narrow {
         positions,
@@ -401,7 +401,7 @@ impl<'a> ChunkedBvh<'a> {
 
     /// As [`new`](Self::new), building the chunk trees in parallel batches of
     /// [`TREES_PER_BATCH`] with `keep_going(fraction)` on the calling thread after the Morton
-    /// order and after each batch (issue 15: a cancellation point every few 10⁵ faces instead
+    /// order and after each batch (a cancellation point every few 10⁵ faces instead
     /// of one piece of 0.5 CPU s at 10⁶ faces); `None` as soon as it returns `false`. The trees
     /// are those of one parallel build: each chunk's tree depends on its faces only.
     fn new_with_stop(
@@ -466,7 +466,7 @@ impl<'a> ChunkedBvh<'a> {
     /// `round_candidates` candidate pairs per thread; `None` as soon as it returns `false`.
     /// A chunk pair estimated at most `2 · round_candidates` candidates is traversed as one piece
     /// (tree against tree, consecutive such pairs in parallel); a larger one (a pile of
-    /// overlapping faces: issue 15) by one box query per face of its first chunk, in rounds
+    /// overlapping faces) by one box query per face of its first chunk, in rounds
     /// of about `round_candidates` candidates ([`count_round`](Self::count_round)).
     ///
     /// Counting stops at the first chunk pair (or, inside a large one, query face) in that

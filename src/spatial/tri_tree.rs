@@ -1,6 +1,6 @@
 //! [`TriTree`]: a compact tree over a subset of a mesh's triangles with in-place leaf updates,
 //! for the LOD guard's self-intersection queries on dense offset surfaces, where parry's BVH
-//! costs ≈ 160 B a triangle and its rebuild a workspace of the same order (issue 12 part 4).
+//! costs ≈ 160 B a triangle and its rebuild a workspace of the same order (a memory peak).
 //! It keeps no boxes of its own triangles: a leaf is tested with the triangle's current `f64`
 //! box, computed from the positions and triangles the caller passes to every call.
 //!

@@ -23,7 +23,7 @@
 //! to about 1 (multiplying by a power of two is exact, so the values are those of the unscaled
 //! evaluation wherever it did not overflow, up to the last bit of `atan2`). Its second moments grow as the fourth power of the extent and its far field
 //! divides by `|y|⁷`, so without the scaling a mesh of extent ~10⁴⁴ or more gave `∞ / ∞ = NaN`
-//! (found by fuzzing, issue 15: a cage of extent 10⁵⁵ "did not enclose" its input).
+//! (found by fuzzing: a cage of extent 10⁵⁵ "did not enclose" its input).
 
 use rayon::prelude::*;
 
@@ -600,7 +600,7 @@ pub(crate) mod tests {
 
     /// Scaling the torus and the queries together by 2^k gives the same winding numbers, for
     /// extents from 2^-120 to 2^180 (before the extent scaling, the far field's `y³ S / |y|⁷`
-    /// was `∞ / ∞ = NaN` from extents of about 10^44 on: issue 15's cage at 10^55).
+    /// was `∞ / ∞ = NaN` from extents of about 10^44 on: the fuzzed cage at 10^55).
     #[test]
     fn fast_winding_numbers_do_not_depend_on_scale() {
         let t = torus(96, 48);

@@ -33,7 +33,7 @@
 //! unconverged iterations → 85, converged). Scenes without pressure take the plain shifted
 //! step, as before (same iterates).
 //!
-//! Sheared rectangle (no pressure; measured 2026-11-29, branch `rectbase`): the plain
+//! Sheared rectangle (no pressure; measured 2026-11-29): the plain
 //! Armijo Newton iteration stopped at its 200-iteration limit at a relative gradient of 4.4e-8.
 //! Not the out-of-plane directions (the sheet starts flat and the load is in plane, so the z
 //! gradient and the x–z, y–z Hessian blocks are exactly 0 at every iterate) and not the shift:

@@ -1,4 +1,4 @@
-//! Wave counting on an evaluated wrinkle field (issue 13 item 6, spec "Measurements": "cross-
+//! Wave counting on an evaluated wrinkle field (spec "Measurements": "cross-
 //! checked by zero crossings of `Re z` on the evaluated mesh").
 //!
 //! A [`Section`] is a plane; where a mesh crosses it, a per-vertex value (`Re z`, or a

@@ -1,5 +1,5 @@
 //! Wrinkles from physics: tension-field wrinkle statics (TFW, dissertation ch. 2, appendix A;
-//! implementable spec `shared/specs/tfw.md`, issue 13). Feature `tfw`.
+//! implementable spec `shared/specs/tfw.md`). Feature `tfw`.
 //!
 //! **Implemented (this first part):**
 //! - [`scene`]: problem setup — flat panels with initial 3D positions, sewn by merging vertices

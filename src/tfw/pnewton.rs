@@ -29,7 +29,7 @@
 //! on the **exact** `Bᵀ H B` preconditioned by that factorization ([`CgRefinement`],
 //! 2026-11-27): the projected matrix alone made the cylinders converge linearly (r × 0.985–0.994
 //! per full step, 526 iterations; now 77, README "Tension-field wrinkles").
-//! **Valley search** (2026-11-29, issue 13's thin shell): after a full step with σ ≤
+//! **Valley search** (2026-11-29, for the cylinder at thickness × 10⁻²): after a full step with σ ≤
 //! [`CgRefinement::max_shift`] (the refinement's gate), `E` is minimized over the scalar `μ`
 //! along `(a, ω) → (a/μ, μω)` ([`SqpOptions::valley_search`]). The membrane term sees the
 //! wrinkles only through `½a²ωωᵀ` (eq. 2.21), stiff ∝ h, while the split between amplitude

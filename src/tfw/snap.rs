@@ -1,4 +1,4 @@
-//! **Period snapping** (spec `tfw.md` step 8's optional pre-step and Risk 9; issue 13): between
+//! **Period snapping** (spec `tfw.md` step 8's optional pre-step and Risk 9): between
 //! the wrinkle SQP and the Knöppel phase, the periods `∮ω` of the SQP's one-form around the
 //! base surface's non-contractible loops (the cylinder's ring, the torus's two generators) are
 //! moved to the nearest multiple of 2π by the smallest closed correction.

@@ -75,12 +75,13 @@ pub struct SqpOptions {
     pub valley_search: bool,
 }
 
-/// The exact-Hessian refinement of the projected Newton step (README "Tension-field wrinkles",
-/// issue 13's slow SQP): Steihaug–Toint CG on the exact reduced Hessian `Bᵀ H B` (held
-/// amplitudes fixed), preconditioned by the factorization of `Bᵀ(H_proj + σW)B`, in the region
-/// `‖s‖_M ≤ radius · ‖s₀‖_M` (s₀ the projected step), stopped at `‖Hs + g‖ ≤ tolerance ‖g‖`.
-/// The analogue of the base solve's CG (`tfw::base`), whose pressure projection made Newton
-/// linear the same way the per-face PSD projection of `E^wf` (S:2302–2307) does here.
+/// The exact-Hessian refinement of the projected Newton step (README "Tension-field wrinkles": the
+/// projected step alone converged only linearly): Steihaug–Toint CG on the exact reduced Hessian
+/// `Bᵀ H B` (held amplitudes fixed), preconditioned by the factorization of `Bᵀ(H_proj + σW)B`, in
+/// the region `‖s‖_M ≤ radius · ‖s₀‖_M` (s₀ the projected step), stopped at
+/// `‖Hs + g‖ ≤ tolerance ‖g‖`. The analogue of the base solve's CG (`tfw::base`), whose pressure
+/// projection made Newton linear the same way the per-face PSD projection of `E^wf` (S:2302–2307)
+/// does here.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CgRefinement {
     /// CG iterations per step (0 = the projected step alone).
@@ -108,7 +109,7 @@ impl CgRefinement {
         max_shift: f64::INFINITY,
     };
 
-    /// The default since 2026-11-27 (branch `tfw13`): 50 CG iterations, region 10 ‖s₀‖_M,
+    /// The default since 2026-11-27: 50 CG iterations, region 10 ‖s₀‖_M,
     /// tolerance 1e-3, after full steps with σ ≤ 1e-8 only (README "Tension-field wrinkles":
     /// the cylinders' SQP from 526 / 487 to 77 / 76 iterations, the torus's from 396 to 136,
     /// the same or a lower final energy on every scene).

@@ -81,7 +81,7 @@ impl<'a> CageInput<'a> {
     /// [`CageInput::check`] with a progress callback, called on the calling thread between
     /// chunks of [`super::hausdorff::FACES_PER_CHUNK`] cage triangles (contact) and of
     /// `16 ×` that many input vertices (enclosure) with the fraction done; `None` as soon as it
-    /// returns `false` (issue 15). The result is the same as [`CageInput::check`]'s: each
+    /// returns `false`. The result is the same as [`CageInput::check`]'s: each
     /// property is an "any" / "all" over independent tests, which the chunking does not change.
     pub fn check_with_progress(
         &self,

@@ -10,7 +10,7 @@
 //! diagonal. Each sample's exact distance to the other surface comes from a BVH closest-point
 //! query — skipped for a face sample whose 1-Lipschitz upper bound (from its face's corners
 //! and the last sample queried) cannot raise the maximum already found, which leaves the
-//! maximum's bytes unchanged (issue 12 part 2). The two-sided distance is the larger of the
+//! maximum's bytes unchanged. The two-sided distance is the larger of the
 //! two one-sided maxima.
 //!
 //! The sampler is this module's own (it shares no code with the LOD loop's convergence test).
@@ -147,7 +147,7 @@ enum Scan {
 /// sample). Without a stop, the maximum is the same bytes as [`one_sided_with`]'s (the same
 /// samples, the same exact `max`).
 ///
-/// Faster than a query per sample (issue 12 part 2): the vertices are measured first, then a
+/// Faster than a query per sample: the vertices are measured first, then a
 /// face sample is queried only when an upper bound on its distance could exceed the maximum
 /// found before its chunk of faces ([`face_max`]) — a sample it skips is at most that maximum,
 /// so the scan's maximum is the same bytes, and (for a monotone `reach`) its stop the same.
@@ -309,8 +309,8 @@ fn interior_sample_count(k: usize) -> usize {
 /// The distance to a surface is 1-Lipschitz, so a sample `p` is within `dist(q) + |p − q|` of
 /// `to` for each corner `q` of `t` and the last sample queried; a sample whose bound (plus a
 /// margin of 10⁻⁹ of its size, far beyond the rounding of the distances) is at most
-/// `max(floor, the face's maximum so far)` cannot raise the maximum and is not queried (issue
-/// 12 part 2: a LOD's samples lie mostly much closer to the input than the Hausdorff distance,
+/// `max(floor, the face's maximum so far)` cannot raise the maximum and is not queried (most
+/// are skipped: a LOD's samples lie mostly much closer to the input than the Hausdorff distance,
 /// a dense input's faces are smaller than the spacing).
 fn face_max(
     t: &[u32; 3],

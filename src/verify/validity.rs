@@ -157,8 +157,8 @@ pub struct MeshReport {
     /// 124 999 500 000 pairs, counted in about a second).
     pub n_self_intersecting_pairs: Option<usize>,
     /// True when [`Self::n_self_intersecting_pairs`] is a lower bound rather than the exact
-    /// count: the pass stops counting once 2²² exact tests have found an intersection (issue
-    /// 15: a pile of 20 000 near-copies of one face has 1.5·10⁸ intersecting pairs, each
+    /// count: the pass stops counting once 2²² exact tests have found an intersection (a
+    /// pile of 20 000 near-copies of one face has 1.5·10⁸ intersecting pairs, each
     /// needing its own test; stacked exact copies are counted per group and do not use the
     /// cap). The count is then at least that large and [`Self::self_intersection_free`] is
     /// still exact (`false`). Deterministic: the same for any number of threads. `None` when
@@ -243,7 +243,7 @@ impl MeshReport {
     /// The report with the given options and a progress callback (a cancellation point),
     /// called on the calling thread with the fraction done after each phase and, in the
     /// self-intersection pass, after each batch of chunk trees and of about 2¹⁹ candidate
-    /// pairs per thread, also inside one pile of overlapping faces (issue 15); `None` as soon
+    /// pairs per thread, also inside one pile of overlapping faces; `None` as soon
     /// as it returns `false`. When not cancelled, the same report as [`Self::compute_with`].
     pub fn compute_with_progress(
         mesh: &TriMesh,

@@ -104,9 +104,9 @@ impl Cwf {
     }
 
     /// As [`Cwf::from_one_form`], with a cancellation point: `tick` runs after the validation,
-    /// after Knöppel's factorization and before each of its inverse iterations after the first
-    /// (issue 15); its error is returned as is. When it never fails, the result is that of
-    /// [`Cwf::from_one_form`], bit for bit.
+    /// after Knöppel's factorization and before each of its inverse iterations after the first (so
+    /// a cancel is seen within 0.5 s); its error is returned as is. When it never fails, the result
+    /// is that of [`Cwf::from_one_form`], bit for bit.
     pub fn from_one_form_with_progress(
         base: TriMesh,
         omega: Vec<f64>,

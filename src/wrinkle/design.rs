@@ -117,7 +117,7 @@ pub fn design(
 /// As [`design`], calling `progress` (stage `"design"`, on the calling thread) after each step
 /// of the [module docs](self) and inside the long ones: after the topology, every 64 sources'
 /// regions, the vector heat method's vector solve and scalar solves, the amplitude solve,
-/// and in Knöppel's phase solve after its factorization and each inverse iteration (issue 15).
+/// and in Knöppel's phase solve after its factorization and each inverse iteration.
 /// The callback returning `false` stops with [`Error::Cancelled`](crate::Error::Cancelled).
 /// When not cancelled, the result is that of [`design`], bit for bit.
 pub fn design_with_progress(
@@ -417,7 +417,7 @@ fn vector_heat(
 }
 
 /// Eq. 3.25 (step 4): the amplitude, its solve's residual and the number clamped. `tick` is a
-/// cancellation point every 0.1 s of a large factorization (issue 15; the same result).
+/// cancellation point every 0.1 s of a large factorization (the same result).
 #[allow(clippy::too_many_arguments)]
 fn design_amplitude(
     topo: &Topology,

@@ -49,7 +49,7 @@ use crate::solve::{
 use crate::{Error, Result};
 
 /// Default [`EditOptions::compat_target`]: the RMS compatibility residual (radians) over edit and
-/// interface edges that issue 14 asks of a smooth interface.
+/// interface edges required of a smooth interface.
 pub const DEFAULT_COMPAT_TARGET: f64 = 0.3;
 
 /// One edited region: its faces and the operation applied to the wrinkles in it.
@@ -136,7 +136,7 @@ pub struct EditOptions {
     /// widths). A widening that would leave no fixed vertex or make the layout invalid stops it.
     /// The residual is forced by the curl of the eq. 3.26 blend, which only a wider band
     /// spreads (README, "Interface smoothness"); the corpus torus needs 7 rings for 0.3.
-    /// Default [`DEFAULT_COMPAT_TARGET`] = 0.3 rad, issue 14's smoothness target, so a default
+    /// Default [`DEFAULT_COMPAT_TARGET`] = 0.3 rad, the required interface smoothness, so a default
     /// edit has a smooth interface wherever a band of at most `max_interface_rings` rings can
     /// give one (the widening takes rings from the fixed region, which stays bit-for-bit
     /// copied; [`EditReport::interface_rings`] says how wide). 0 gives the requested widths
@@ -241,7 +241,7 @@ pub fn edit(cwf: &Cwf, regions: &[RegionEdit], opts: &EditOptions) -> Result<(Cw
 
 /// As [`edit`], calling `progress` (stage `"edit"`, on the calling thread) after each step of
 /// every attempt (labels and ω, the interface ω and amplitude solves, the phase solve's
-/// factorization and each of its inverse iterations, the compatibility measures; issue 15).
+/// factorization and each of its inverse iterations, the compatibility measures).
 /// The callback returning `false` stops with [`Error::Cancelled`]. When not cancelled, the
 /// result is that of [`edit`], bit for bit.
 pub fn edit_with_progress(
@@ -289,8 +289,8 @@ pub fn edit_with_progress(
 }
 
 /// What the adaptive width ([`EditOptions::compat_target`]) drives below its target: the larger
-/// of the compatibility RMS over edit + interface edges and over the interface-only edges (issue
-/// 14 asks the interface itself to be smooth; the mean over both classes can hide a rough band
+/// of the compatibility RMS over edit + interface edges and over the interface-only edges (the
+/// interface itself must be smooth; the mean over both classes can hide a rough band
 /// behind a smooth edited region).
 fn roughness(r: &EditReport) -> f64 {
     r.compat_rms.max(r.compat_rms_by_class[1])
@@ -794,7 +794,7 @@ fn solve_phase(
         growth: 100.0,
         max_attempts: 5,
     };
-    // a large factorization runs with `tick` every 0.1 s (issue 15; the same factor)
+    // a large factorization runs with `tick` every 0.1 s (the same factor)
     if an.is_heavy() {
         tick()?;
     }
@@ -936,7 +936,7 @@ fn compat_rms(cwf: &Cwf, labels: &Labels, which: &[FaceClass]) -> f64 {
 /// [`EditReport::compat_floor`]: `min ‖δ‖²` over non-fixed edges subject to `D δ = D ω` on the
 /// non-fixed faces (`D` the face curl, fixed edges held at 0), by the normal equations
 /// `D Dᵀ y = D ω`, `δ = Dᵀ y`; returns `‖δ‖ / √(non-fixed edges)`. `tick` is a cancellation
-/// point every 0.1 s of a large factorization (issue 15: 0.8 CPU s on a 213k-face global edit).
+/// point every 0.1 s of a large factorization (0.8 CPU s on a 213k-face global edit).
 fn compat_floor(
     topo: &Topology,
     omega: &[f64],

@@ -150,7 +150,7 @@ impl Cwf {
             let stage = format!("level {}", l + 1);
             let (f0, f1) = (work_done(l, levels), work_done(l + 1, levels));
             let mut part = 0.0;
-            // a progress call (and cancellation point) between the parts of a level (issue 15),
+            // a progress call (and cancellation point) between the parts of a level,
             // at increasing fractions below the level's own report
             let mut keep_going = || {
                 part += 1.0;
@@ -312,7 +312,7 @@ fn empty_topology() -> Topology {
 
 /// Normals, displacement and the optional outputs; `Numerical` when a displaced position is not
 /// finite (finite but huge amplitudes, scales or coordinates overflow `f64` in the upsampling
-/// or the displacement: found by fuzzing `wrinkle_eval`, issue 15).
+/// or the displacement: found by fuzzing `wrinkle_eval`).
 fn finish(level: Level<'_>, faces: Vec<[u32; 3]>, opts: &EvalOptions) -> crate::Result<Evaluated> {
     let normals = vertex_normals(&level.x, &faces);
     let s = opts.displacement_scale;

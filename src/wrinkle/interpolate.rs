@@ -282,7 +282,7 @@ pub fn interpolate(a: &Cwf, b: &Cwf, opts: &InterpOptions) -> Result<(CwfAnimati
 
 /// As [`interpolate`], reporting progress after each iteration (stage `"interpolate"`) and,
 /// as cancellation points, inside it (trust region: every 4 CG iterations, between batches of
-/// 8 frames of a preconditioner refactor, after each trial evaluation; issue 15); the callback
+/// 8 frames of a preconditioner refactor, after each trial evaluation); the callback
 /// returning `false` stops with [`Error::Cancelled`]. When not cancelled, the result is that of
 /// [`interpolate`], bit for bit.
 pub fn interpolate_with_progress(
@@ -296,7 +296,7 @@ pub fn interpolate_with_progress(
     check_same_base(a, b)?;
     let mut stats = StageTimes::default();
     let setup = stats.time(InterpStage::Setup, || Setup::new(a, b, opts));
-    // cancellation points around the solve's own per-iteration ones (issue 15)
+    // cancellation points around the solve's own per-iteration ones
     checkpoint(progress, "setup", 0.0)?;
     let n = opts.guide_frames;
     let omega_com: Vec<Vec<f64>> = (0..=n)
@@ -826,7 +826,7 @@ impl Problem {
             if let Some(stop) = log.record(iterations, parts.total(), &grad, opts, progress)? {
                 break stop;
             }
-            // a cancellation point per damping trial: a stalling last step can try ~24 (issue 15)
+            // a cancellation point per damping trial: a stalling last step can try ~24
             let mut tick = || log.tick(progress);
             match self.step(
                 &mut hess,
@@ -944,7 +944,7 @@ impl Problem {
         // measured on the knight and the torus (50 frames): refactoring every iteration,
         // every 5 and every 20 gave 6.4 / 4.5 / 5.8 s and 16.6 / 9.2 / 8.9 s
         const REFACTOR_EVERY: usize = 5;
-        // CG iterations between two cancellation points (issue 15): one took 22–30 ms at load
+        // CG iterations between two cancellation points: one took 22–30 ms at load
         // 7 on spot 1k × 50 frames, so 16 left gaps of 0.5 s; 4 keep them near 0.1 s
         const CG_PER_TICK: usize = 4;
         let blocks = self.frame_blocks()?;
@@ -1021,7 +1021,7 @@ impl Problem {
             let tol = gnorm * gnorm.sqrt().min(0.5);
             let mut first_trial = true;
             loop {
-                // a cancellation point per shrunk trial radius (issue 15)
+                // a cancellation point per shrunk trial radius
                 if !std::mem::take(&mut first_trial) {
                     log.tick(progress)?;
                 }
@@ -1041,7 +1041,7 @@ impl Problem {
                     .map(|(&xi, d)| xi + Complex::new(d[0], d[1]))
                     .collect();
                 let f1 = self.evaluate(&trial, false).0.total();
-                // after the trial's evaluation: the next one (with gradient) follows (issue 15)
+                // after the trial's evaluation: the next one (with gradient) follows
                 log.tick(progress)?;
                 let rho = if predicted > 0.0 {
                     (f0 - f1) / predicted

@@ -109,7 +109,7 @@ impl KnoppelReport {
 /// Knöppel et al. 2015 phase `z̃` (unit per vertex) for the one-form `omega` (EdgeList
 /// orientation) on the mesh of `topo` with positions `x`. See the [module docs](self).
 ///
-/// `tick` is a cancellation point (issue 15), run after the factorization and before each
+/// `tick` is a cancellation point, run after the factorization and before each
 /// inverse iteration after the first; its error is returned as is. It does not change the
 /// result.
 pub(crate) fn knoppel_phase_with_tick(

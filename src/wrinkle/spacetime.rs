@@ -151,7 +151,7 @@ impl FrameBlocks {
     /// `(h00, h10, h11)` of frame `n` (1-based), which must keep `B_n` positive definite.
     ///
     /// The frames are factored in parallel, [`FACTOR_BATCH`] at a time, and `tick` (a
-    /// cancellation point, issue 15) runs between two batches; its error is returned as is.
+    /// cancellation point) runs between two batches; its error is returned as is.
     /// The factors do not depend on the batching.
     pub(super) fn factor(
         &self,
@@ -207,7 +207,7 @@ impl FrameBlocks {
 }
 
 /// Frames factored between two cancellation points of [`FrameBlocks::factor`]: a refactor of
-/// 50 frames of 1000 vertices took 0.35 s at load 7 on 2 cores in one piece (issue 15).
+/// 50 frames of 1000 vertices took 0.35 s at load 7 on 2 cores in one piece.
 const FACTOR_BATCH: usize = 8;
 
 /// The symmetric block Gauss–Seidel preconditioner `M = (D + L) D⁻¹ (D + Lᵀ)` (module docs).

@@ -41,7 +41,7 @@ pub(crate) fn solve_spd(
 }
 
 /// [`solve_spd`] with `tick` as a cancellation point (its error returned as is) every 0.1 s
-/// of a large factorization (issue 15, [`run_stoppable`]); the same result.
+/// of a large factorization ([`run_stoppable`]); the same result.
 pub(crate) fn solve_spd_with_tick(
     dim: usize,
     entries: &[Entry],
@@ -55,8 +55,8 @@ pub(crate) fn solve_spd_with_tick(
 
 /// [`solve_spd`] for several right-hand sides on one factorization (each result as
 /// [`solve_spd`] would give it, bit for bit), with `tick` as a cancellation point (its error
-/// returned as is) after the analysis and every 0.1 s of a large factorization (issue 15,
-/// [`run_stoppable`]); the same results.
+/// returned as is) after the analysis and every 0.1 s of a large factorization
+/// ([`run_stoppable`]); the same results.
 pub(crate) fn solve_spd_many_with_tick(
     dim: usize,
     entries: &[Entry],

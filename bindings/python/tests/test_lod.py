@@ -30,7 +30,7 @@ def test_lod_of_a_soup_and_parameters():
     with pytest.raises(pleat.PleatError) as e:
         soup.lod(screen_size=-1)
     assert e.value.status == "INVALID_ARGUMENT"
-    # the offset voxel (issue 12 part 4): 0 = automatic, (0, 2] passed on, else refused
+    # the offset voxel (the memory budget's knob): 0 = automatic, (0, 2] passed on, else refused
     assert soup.lod(screen_size=10, max_rounds=2, offset_voxel_scale=1.5).check()["is_watertight"]
     with pytest.raises(pleat.PleatError) as e:
         soup.lod(screen_size=10, offset_voxel_scale=3)

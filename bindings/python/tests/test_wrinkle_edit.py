@@ -1,4 +1,4 @@
-"""Wrinkle design and region edits through the Python package (issue 14): grow a region,
+"""Wrinkle design and region edits through the Python package: grow a region,
 rotate it, fixed part copied bit for bit, identity edit, design from a source, errors."""
 import math
 

@@ -1,5 +1,5 @@
-//! `pleat bench chain`: what a LOD chain costs against its finest level alone (issue 12
-//! part 2: "a chain {50, 100, 200} costs ≤ 1.3× the n_p = 200 bake alone").
+//! `pleat bench chain`: what a LOD chain costs against its finest level alone (target: a
+//! chain {50, 100, 200} costs ≤ 1.3× the n_p = 200 bake alone).
 //!
 //! For every mesh of a folder, in this process: the finest level alone
 //! ([`pleat::lowpoly::generate`] at the largest screen size) and the chain

@@ -1,4 +1,4 @@
-//! `pleat bench lod`: error against run time (issue 4, item 8).
+//! `pleat bench lod`: error against run time.
 //!
 //! Bakes every mesh of a folder at every screen size `n_p` with [`pleat::lowpoly::generate`]
 //! (or [`pleat::cage::generate`] with `--cage`), checks each output independently with

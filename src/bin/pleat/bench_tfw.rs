@@ -1,5 +1,4 @@
-//! `pleat bench tfw`: error against run time of the tension-field wrinkle solve (issue 13,
-//! item 6).
+//! `pleat bench tfw`: error against run time of the tension-field wrinkle solve.
 //!
 //! Solves each scene (JSON files given, and/or built-ins by name) with [`pleat::tfw::solve`]
 //! and writes into `--out-dir`:

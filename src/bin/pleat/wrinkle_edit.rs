@@ -1,4 +1,4 @@
-//! `pleat wrinkle design` and `pleat wrinkle edit` (issue 14, dissertation §3.6): parse sources
+//! `pleat wrinkle design` and `pleat wrinkle edit` (dissertation §3.6): parse sources
 //! and region specs, run [`pleat::wrinkle::design`] / [`pleat::wrinkle::edit`], print each
 //! solve's seconds and residual, write the keyframe.
 
