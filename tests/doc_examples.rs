@@ -217,6 +217,17 @@ fn documentation_examples_run() {
         cxx: have("c++"),
         python: None,
     };
+    let needs_library =
+        |b: &Block| (b.lang == "c" && env.cc) || (b.lang == "cpp" && env.cxx) || b.lang == "python";
+    if all.iter().filter(runnable).any(needs_library) {
+        let t = std::time::Instant::now();
+        let dir = env.libdir();
+        println!(
+            "built the library in {} in {:.1} s",
+            dir.display(),
+            t.elapsed().as_secs_f64()
+        );
+    }
     let mut failures = Vec::new();
     let mut ran = 0;
     for b in all.iter().filter(runnable) {
