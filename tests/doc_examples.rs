@@ -13,6 +13,8 @@
 //!   `text`, `console` and other languages are output or listings, never run.
 //!
 //! Each block prints `ran FILE:LINE (LANG)`; failures are listed with their file and line.
+//! The test needs the `pleat` binary, so it is built only with the `cli` feature (a default).
+#![cfg(feature = "cli")]
 
 #[path = "common/clib.rs"]
 mod clib;
