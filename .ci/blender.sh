@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Headless test of the Blender add-on (bindings/blender/pleat_lod), README "Blender add-on".
+# Headless test of the Blender add-on (bindings/blender/pleat_lod), docs/guide/getting-started.md, "Blender add-on".
 # Not part of .ci/run: Debian's Blender with its dependencies is too large for CI's budget.
 #
 #   bash .ci/blender.sh        # installs blender + python3-numpy with apt when missing (root)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Packaging checks (README "Install" and "Python"): installs pleat into a temporary prefix with
+# Packaging checks (docs/guide/getting-started.md, "C and C++" and "Python"): installs pleat into a temporary prefix with
 # packaging/install.sh, builds the separate C consumer (examples_c/consumer) against it three
 # ways — CMake find_package(pleat) with pleat::pleat, the same with pleat::pleat_static, and
 # pkg-config through its Makefile — and runs each; compiles the C++ RAII test against the

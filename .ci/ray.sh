@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The Ray recipe (examples/ray/bake_lods.py, README "Beyond one machine"): one Ray task per
+# The Ray recipe (examples/ray/bake_lods.py, docs/guide/remote.md): one Ray task per
 # asset on a local Ray cluster, through the pleat Python package. Not part of .ci/run: Ray is
 # a ~70 MB wheel with many dependencies, too much for CI's budget.
 #

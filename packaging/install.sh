@@ -12,7 +12,7 @@
 #
 # It builds the library with `cargo build --release --lib` first (a no-op when `cargo build
 # --release` already ran), then copies cargo's artifacts; it needs only a POSIX shell and
-# coreutils. Why not cargo-c's `cargo cinstall`: see README "Install".
+# coreutils. Why not cargo-c's `cargo cinstall`: see docs/design-notes-lod.md, "Packaging".
 #
 # Options:
 #   --prefix DIR       installation prefix (default /usr/local)
