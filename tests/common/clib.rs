@@ -32,6 +32,11 @@ pub fn features() -> Vec<&'static str> {
     if cfg!(feature = "tfw") {
         f.push("tfw");
     }
+    // `cli` too: with any feature missing, the nested build below would compile the library and
+    // every test target a second time instead of copying what `cargo test` already built.
+    if cfg!(feature = "cli") {
+        f.push("cli");
+    }
     f
 }
 
