@@ -1,7 +1,7 @@
 /* Tension-field wrinkles through the C API (capability "tfw"): solves the shipped stretched
    sheet (examples/tfw/stretched_sheet.json, about 3 s natively) once, checks the status and
-   that the wrinkles are real (peak amplitude in [0.28, 0.50] mm, README "Tension-field
-   wrinkles"), copies out the base mesh, the field, the stats and the SQP history, writes the
+   that the wrinkles are real (peak amplitude in [0.28, 0.50] mm, docs/benchmarks/tfw.md,
+   "Answers"), copies out the base mesh, the field, the stats and the SQP history, writes the
    wrinkled mesh as OBJ; then a small sheet built from arrays, and misuse: NULLs, bad JSON,
    NaN in arrays, wrong struct sizes, cancel from the progress callback. Without "tfw" every
    call must answer UNSUPPORTED. Run from the repository root. */

@@ -2,7 +2,7 @@
 # The dissertation's example edits (ch. 3.6) on the coarse corpus meshes with the pleat CLI:
 # design from sources, local rotation, coupled frequency scaling, two regions at once, then
 # edit -> interpolate -> evaluate end to end. Prints each solve's seconds and residual (the
-# figures in the README's "Wrinkle design and editing" section).
+# figures in docs/guide/wrinkle-design.md).
 #
 #   examples_c/wrinkle_edit_demo.sh [MESH_DIR [OUT_DIR]]
 #

@@ -716,7 +716,7 @@ typedef struct PleatWrinkleInterpParams {
   // 1 (default): vertices whose star (amplitude, z̃ and ω on the incident edges) is the
   // same bit for bit in both keyframes (the fixed part of an edit) are held at their
   // keyframe phase on every frame, so an edit's animation moves only where it changed
-  // (README, "Wrinkle animation", C10); 0: every vertex is solved (the dissertation's
+  // (docs/guide/wrinkle-animation.md); 0: every vertex is solved (the dissertation's
   // literal problem). Appended 2026-11-27: an older, shorter struct gets 1.
   uint32_t locality;
   // Reserved, set to 0.
@@ -788,7 +788,7 @@ typedef struct PleatLodParams {
   // with `PLEAT_STATUS_LIMIT_EXCEEDED` before the expensive work.
   uint64_t memory_budget_bytes;
   // Cages only: the distance the cage keeps from the input, as a fraction of d (default
-  // 0.05: a twentieth of a pixel at the cage's screen size, see README "Cages with clearance"), or
+  // 0.05: a twentieth of a pixel at the cage's screen size, see docs/benchmarks/cage.md), or
   // in model units with `PLEAT_LOD_CLEARANCE_ABSOLUTE`. Must be >= 0 and below d; 0 keeps
   // only "no contact". Appended 2026-11-25; callers with an older `struct_size` get the
   // default.
@@ -804,10 +804,10 @@ typedef struct PleatLodParams {
   // Reserved, 0 (keeps the struct free of padding).
   uint32_t reserved;
   // LODs only: the offset voxel the bake starts from, as a multiple of d/√3, in (0, 2];
-  // 0 (the default) = automatic (2 from n_p = 200 on, 1.25 from 100, 1 below; see README
-  // "A coarser first stage"). A coarser voxel is still taken when the memory estimate needs it. NaN,
-  // negative or > 2 is `PLEAT_STATUS_INVALID_ARGUMENT`. Appended 2026-11-27; callers with
-  // an older `struct_size` get automatic.
+  // 0 (the default) = automatic (2 from n_p = 200 on, 1.25 from 100, 1 below; see
+  // docs/design-notes-lod.md, "Offset stage"). A coarser voxel is still taken when the memory
+  // estimate needs it. NaN, negative or > 2 is `PLEAT_STATUS_INVALID_ARGUMENT`. Appended
+  // 2026-11-27; callers with an older `struct_size` get automatic.
   double offset_voxel_scale;
 } PleatLodParams;
 
@@ -853,7 +853,7 @@ typedef struct PleatLodStats {
   // Cages: 1 when verified to enclose every input vertex without touching the input.
   // LODs: 0.
   uint32_t encloses_input;
-  // 1 when the result was recomputed with exact checks only (see README).
+  // 1 when the result was recomputed with exact checks only (see docs/guide/lod.md).
   uint32_t exact_rerun;
   // 1 when a target face count was given and met.
   uint32_t target_met;
@@ -940,7 +940,8 @@ typedef struct PleatOffsetParams {
 } PleatOffsetParams;
 
 // Validity report of a triangle soup, filled by `pleat_mesh_check`. Counts follow the
-// independent checker's definitions (see README). Yes/no fields are 0 or 1.
+// independent checker's definitions (see docs/guide/errors-and-limits.md). Yes/no fields are 0 or
+// 1.
 //
 // Set `struct_size = sizeof(PleatMeshReport)` before the call; pleat fills only that many
 // bytes, so a caller compiled against an older, shorter struct keeps working.
@@ -1779,8 +1780,8 @@ PleatStatus pleat_cwf_animation_copy_history(const struct PleatCwfAnimation *ani
                                              double *dst,
                                              size_t record_capacity);
 
-// Writes the animation as a `.cwfa` text file (lossless; format in README "Wrinkle
-// animation"). The base mesh is not written; store it separately.
+// Writes the animation as a `.cwfa` text file (lossless; format in
+// docs/guide/wrinkle-animation.md). The base mesh is not written; store it separately.
 //
 // - `anim`: non-NULL.
 // - `path`: NUL-terminated UTF-8 path; non-NULL. An existing file is replaced.
@@ -2399,7 +2400,7 @@ PleatStatus pleat_cwf_create_from_frequency(const struct PleatMesh *base,
                                             const struct PleatKnoppelParams *params,
                                             struct PleatCwf **out);
 
-// Reads a `.cwf` file (format: README "Wrinkle fields", `src/wrinkle/io.rs`) written for
+// Reads a `.cwf` file (format: docs/guide/wrinkle-evaluation.md, `src/wrinkle/io.rs`) written for
 // `base`, whose connectivity (vertex, edge and triangle counts and a hash of the triangles)
 // must match what the file records; positions may differ (a deformed base mesh).
 //

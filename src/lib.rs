@@ -24,7 +24,7 @@
 //! [`spatial`] (the only user of parry's types); [`verify`] (independent checks, never a
 //! pipeline); the pipelines `lowpoly` → `cage` → `bake`, `wrinkle` → `solve`, and `tfw` →
 //! `wrinkle`, `solve`; [`ffi`] and
-//! the CLI on top. The README's "Layout and layers" has the table.
+//! the CLI on top. docs/guide/architecture.md has the table.
 //!
 //! ```
 //! use pleat::mesh::TriMesh;

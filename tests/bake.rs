@@ -680,7 +680,8 @@ fn shared_assets_read_with_their_fields() {
         let mean = errs.iter().sum::<f64>() / errs.len() as f64;
         let p95 = errs[errs.len() * 95 / 100];
         eprintln!("{name}: field error at centroids mean {mean:.2} p95 {p95:.2} /255");
-        // README floor: textured mean 0.26 (tree soup 0.34), vertex colours mean 2.8.
+        // docs/benchmarks/bake.md floor: textured mean 0.26 (tree soup 0.34), vertex colours mean
+        // 2.8.
         let bound = if name.contains("vertexcolor") {
             4.0
         } else {

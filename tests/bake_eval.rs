@@ -5,7 +5,8 @@
 //! chart's or unowned colour).
 //!
 //! Ignored tests write the published numbers and files (run them with `--release`):
-//! - `publish_targets`: the README table, per shared asset and the generated sphere;
+//! - `publish_targets`: the docs/benchmarks/bake.md table, per shared asset and the generated
+//! sphere;
 //! - `write_sphere_100k`: `target/bake_eval/sphere_100k.glb`, the speed benchmark input;
 //! - `readme_picture`: `docs/bake_lods.png`.
 #![cfg(feature = "bake")]
@@ -213,9 +214,9 @@ fn shared_vertex_colour_teapot_meets_the_appearance_target() {
     check_seams("teapot", &level, 0.0);
 }
 
-/// The README table: every shared asset and the generated sphere at n_p = 200.
+/// The docs/benchmarks/bake.md table: every shared asset and the generated sphere at n_p = 200.
 #[test]
-#[ignore = "publishes the README numbers; run with --release"]
+#[ignore = "publishes the docs/benchmarks/bake.md numbers; run with --release"]
 fn publish_targets() {
     let mut cases: Vec<(String, Appearance)> =
         vec![("generated sphere 9k".into(), sphere(96, 512))];
@@ -762,9 +763,10 @@ fn cached_lod(name: &str, app: &Appearance) -> pleat::mesh::TriMesh {
 
 /// Sweep of the gutter levers (`PLEAT_ASSETS` picks assets, `PLEAT_LEVERS` the
 /// `padding:block_align` pairs, e.g. `15:0,8:0,8:1`): per asset and lever, the texture size,
-/// charts, padding used, mip-2 mixing and PSNR at n_p = 200 (the README's lever table).
+/// charts, padding used, mip-2 mixing and PSNR at n_p = 200 (docs/design-notes-lod.md, "Textured
+/// bakes").
 #[test]
-#[ignore = "parameter sweep for the README; run with --release"]
+#[ignore = "parameter sweep for the design notes; run with --release"]
 fn seam_levers() {
     let Some(dir) = assets() else { return };
     let names = std::env::var("PLEAT_ASSETS").unwrap_or("gen_teapot_vertexcolor.glb".into());

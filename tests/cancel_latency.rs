@@ -3,7 +3,7 @@
 //!
 //! Ignored tests (timings are not asserted; run in the release test profile):
 //! `cargo test --release --test cancel_latency -- --ignored --nocapture --test-threads 1`.
-//! Each prints one row of the README table ("Security and robustness"):
+//! Each prints one row of the docs/benchmarks/wrinkle.md table ("Cancellation latency"):
 //!
 //! 1. one uncancelled run records the time of every progress call: the longest gap between two
 //!    calls (from the start to the first call, and from the last call to the return, included)

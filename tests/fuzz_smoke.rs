@@ -15,8 +15,9 @@
 //!
 //! A finding fails the target's test, naming the input (`seed-…`, `regression-…`,
 //! `mutant-<n>`) and writing its bytes to `target/tmp/fuzz-smoke/<target>-<input>.bin` (keep it
-//! as `fuzz/regressions/<target>-<what>.bin`, which `tests/hardening.rs` replays too). `PLEAT_FUZZ_SMOKE_SCALE=k` runs k times the executions (longer local
-//! runs; the inputs of the default run are a prefix of the longer one's).
+//! as `fuzz/regressions/<target>-<what>.bin`, which `tests/hardening.rs` replays too).
+//! `PLEAT_FUZZ_SMOKE_SCALE=k` runs k times the executions (longer local runs; the inputs of the
+//! default run are a prefix of the longer one's).
 #![cfg(all(
     feature = "lod",
     feature = "cage",
@@ -261,7 +262,8 @@ fn smoke(name: &str, execs: usize) {
 
 // Executions per target: sized to about 4 CPU s each in the test profile (measured 2026-11-27:
 // 46 CPU s for all 11, user + sys; 124 s of wall time with 2 test threads at load 17–20 on the
-// shared 2 cores, so about 25 s on 2 free cores). README "How it is tested".
+// shared 2 cores, so about 25 s on 2 free cores). docs/guide/errors-and-limits.md, "How it is
+// tested".
 
 #[test]
 fn fuzz_smoke_obj() {

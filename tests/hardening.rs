@@ -228,8 +228,8 @@ fn deeply_nested_gltf_json_is_an_error_not_a_stack_overflow() {
 #[cfg(feature = "wrinkle")]
 #[test]
 fn cwfa_substeps_that_overflow_the_frame_count_are_rejected() {
-    // found while writing fuzz/fuzz_targets/cwfa.rs: `substeps 18446744073709551615` made frame_count()
-    // overflow (a panic in debug builds, a wrong count in release)
+    // found while writing fuzz/fuzz_targets/cwfa.rs: `substeps 18446744073709551615` made
+    // frame_count() overflow (a panic in debug builds, a wrong count in release)
     use pleat::wrinkle::{parse_animation, Complex, Cwf, CwfAnimation};
     let base = TriMesh::new(
         vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
@@ -569,7 +569,7 @@ fn report_both(m: &TriMesh, what: &str, si: bool) -> (MeshReport, MeshReport) {
 }
 
 #[test]
-#[ignore = "10^6 components: 26 s in release (reports 3 s each, LOD 19 s); README: Security and robustness"]
+#[ignore = "10^6 components: 26 s in release (reports 3 s each, LOD 19 s); docs/guide/errors-and-limits.md"]
 fn a_million_tiny_components_are_reported_and_baked() {
     let m = tiny_components(100);
     let (plain, welded) = report_both(&m, "10^6 tiny components", true);
@@ -602,9 +602,9 @@ fn a_million_coincident_vertices_are_reported_and_baked() {
     lod_limits::bake_or_limit(&m, "10^6 coincident vertices");
 }
 
-/// README "Not guaranteed": the self-intersection pass tests a pile of near-duplicate faces pair
-/// by pair. Measures, for a 20k-face jittered pile, the full report's time and the latency of a
-/// cancel requested 0.2 s into it (from the first `false` to the return).
+/// docs/guide/errors-and-limits.md, "Not guaranteed": the self-intersection pass tests a pile of
+/// near-duplicate faces pair by pair. Measures, for a 20k-face jittered pile, the full report's
+/// time and the latency of a cancel requested 0.2 s into it (from the first `false` to the return).
 #[test]
 #[ignore = "measurement: cargo test --release --test hardening jittered -- --ignored --nocapture"]
 fn jittered_pile_report_time_and_cancel_latency() {

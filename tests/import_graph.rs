@@ -582,7 +582,7 @@ fn cycles_are_found() {
     );
 }
 
-/// The layer map of the crate (README "Layout and layers"): which top-level modules each
+/// The layer map of the crate (docs/guide/architecture.md): which top-level modules each
 /// top-level module may import. Lower layers never import higher ones; `ffi` and the crate root
 /// (`lib.rs`, which only declares modules and re-exports) sit on top. A new top-level module
 /// must be added here, with the layers it may use.

@@ -2066,7 +2066,7 @@ mod balloon_check {
     /// Fast: both balloons build, are sewn into a closed oriented surface (the twin boundary
     /// vertices merged, the interior ones not), enclose a positive volume and the base solve
     /// inflates them (volume grows at least ×2; the Newton status is printed, not asserted:
-    /// the coarse torus does not reach 1e-8 in 200 iterations, see the README).
+    /// the coarse torus does not reach 1e-8 in 200 iterations, see docs/design-notes.md).
     #[test]
     fn balloons_are_sewn_closed_and_inflate() {
         for (scene, rims) in [
@@ -2915,7 +2915,7 @@ mod scene_speed {
     }
 }
 
-/// The torus saddle (README "Tension-field wrinkles"): is the converged base of the
+/// The torus saddle (docs/design-notes.md, "Base solve"): is the converged base of the
 /// torus balloon, bent out of its plane, a local minimum, and is the mirror-symmetric state the
 /// old projected-pressure iteration crawled along one? The exact base Hessian (pressure not
 /// projected) with six coordinates pinned against the rigid motions (a principal submatrix:
@@ -3133,10 +3133,10 @@ fn teabag_sqp_rescues_a_step_without_curvature() {
 
 /// Inverted or degenerate base triangles must be reported, without a panic: the stretched sheet
 /// started with one interior vertex pushed across its neighbours (inverted triangles) and one
-/// moved onto the midpoint of its row neighbours (zero-area triangles). The solve returns (no panic); the base
-/// solve untangles the start (the membrane's energy is finite there) or, where faces stay
-/// collapsed, reports them in `strain.degenerate_faces` with a warning; the SQP keeps its
-/// invariants.
+/// moved onto the midpoint of its row neighbours (zero-area triangles). The solve returns (no
+/// panic); the base solve untangles the start (the membrane's energy is finite there) or, where
+/// faces stay collapsed, reports them in `strain.degenerate_faces` with a warning; the SQP keeps
+/// its invariants.
 #[test]
 fn inverted_and_collapsed_start_triangles_are_solved_or_reported() {
     use pleat::tfw::{solve, TfwParams};

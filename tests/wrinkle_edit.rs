@@ -1233,7 +1233,7 @@ fn cli_bad_input_is_refused_and_writes_nothing() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// C10: edit → interpolate → evaluate → rendered frames (README pictures)
+// C10: edit → interpolate → evaluate → rendered frames (docs/wrinkle_edit_*.png)
 
 #[cfg(feature = "bake")]
 #[path = "common/shaded.rs"]
@@ -1277,11 +1277,12 @@ fn far_fixed_vertices(c: &Cwf, face_class: &[FaceClass], rings: usize) -> Vec<us
 }
 
 /// The dissertation's three edits (Figs. 3.7, 3.6, 3.19) on corpus meshes: edit → interpolate
-/// (40 guide frames, 41 frames; `GUIDE=n` changes it) → evaluate (3 levels, displacement ×2.5) → one PNG strip of 7 shaded frames per edit under `docs/`,
-/// from one fixed camera facing the edited area. Prints per frame step the RMS change of the
-/// displacement `Re z` (a temporal discontinuity shows as a spike) and, C10, the largest drift
-/// `|z̃(t) − z̃⁰|` over the fixed vertices ≥ 2 rings from the interface (no locality weights).
-/// `cargo test --release --test wrinkle_edit readme_frames -- --ignored --nocapture`
+/// (40 guide frames, 41 frames; `GUIDE=n` changes it) → evaluate (3 levels, displacement ×2.5) →
+/// one PNG strip of 7 shaded frames per edit under `docs/`, from one fixed camera facing the edited
+/// area. Prints per frame step the RMS change of the displacement `Re z` (a temporal discontinuity
+/// shows as a spike) and, C10, the largest drift `|z̃(t) − z̃⁰|` over the fixed vertices ≥ 2 rings
+/// from the interface (no locality weights). `cargo test --release --test wrinkle_edit
+/// readme_frames -- --ignored --nocapture`
 #[cfg(feature = "bake")]
 #[test]
 #[ignore]
@@ -1503,8 +1504,9 @@ fn frame_steps(anim: &pleat::wrinkle::CwfAnimation, amp: f64) -> Vec<f64> {
         .collect()
 }
 
-/// The two-region spot edit of the README (head 90°, body ×2.5 coupled; |k| = 12, 4 rings, 4
-/// interface rings) animated with `guide` guide frames: per-step changes and the keyframes.
+/// The two-region spot edit of docs/guide/wrinkle-design.md (head 90°, body ×2.5 coupled; |k| = 12,
+/// 4 rings, 4 interface rings) animated with `guide` guide frames: per-step changes and the
+/// keyframes.
 fn two_region_animation(
     guide: usize,
     locality: bool,
@@ -1520,7 +1522,7 @@ fn two_region_animation(
         r.frequency_scale = sigma;
         edits.push(if sigma != 1.0 { r.coupled() } else { r });
     }
-    // the README's 4 interface rings exactly; with the default adaptive width (both bands
+    // the documented 4 interface rings exactly; with the default adaptive width (both bands
     // widened to 8 rings, RMS 0.347) the largest step is 0.265 / 0.184 / 0.099 at 20 / 40 / 80
     // guide frames (2026-11-27 b): it shrinks with the step too, no pop
     let exact = EditOptions {

@@ -176,7 +176,8 @@ struct BakeArgs {
     /// batch: the pattern for the manifest rows that name no output (optional when all do).
     #[arg(short, long, required_unless_present = "manifest")]
     output: Option<PathBuf>,
-    /// Maximum optimization rounds N (a LOD without --faces also stops after 5 rounds without a new smallest face count).
+    /// Maximum optimization rounds N (a LOD without --faces also stops after 5 rounds without a new
+    /// smallest face count).
     #[arg(long, default_value_t = 50)]
     rounds: u32,
     /// Skip the feature-alignment step.
@@ -197,8 +198,8 @@ struct BakeArgs {
     #[arg(long, value_parser = parse_start, default_value = "auto")]
     start: pleat::lowpoly::LodStart,
     /// LODs: the offset voxel to start from, a multiple of d/√3 in (0, 2] (`1` = the
-    /// dissertation's voxel) [default: 2 from n_p = 200 on, 1.25 from 100, 1 below]; a coarser one is taken
-    /// when the memory estimate needs it. Ignored for cages.
+    /// dissertation's voxel) [default: 2 from n_p = 200 on, 1.25 from 100, 1 below]; a coarser one
+    /// is taken when the memory estimate needs it. Ignored for cages.
     #[arg(long)]
     voxel_scale: Option<f64>,
     /// No progress bar and no summary.
@@ -465,7 +466,7 @@ fn bench(cmd: BenchCommand) -> ExitCode {
 #[cfg(any(feature = "lod", feature = "tfw"))]
 const EXIT_FAILED: u8 = 1;
 
-/// Placeholders of the output path replaced by the screen size: `{n}` (the README's
+/// Placeholders of the output path replaced by the screen size: `{n}` (the older
 /// spelling) and `{np}` (the one `--help` can show).
 #[cfg(feature = "lod")]
 const SIZE_PLACEHOLDERS: [&str; 2] = ["{n}", "{np}"];

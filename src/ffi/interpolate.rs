@@ -87,7 +87,7 @@ pub struct PleatWrinkleInterpParams {
     /// 1 (default): vertices whose star (amplitude, z̃ and ω on the incident edges) is the
     /// same bit for bit in both keyframes (the fixed part of an edit) are held at their
     /// keyframe phase on every frame, so an edit's animation moves only where it changed
-    /// (README, "Wrinkle animation", C10); 0: every vertex is solved (the dissertation's
+    /// (docs/guide/wrinkle-animation.md); 0: every vertex is solved (the dissertation's
     /// literal problem). Appended 2026-11-27: an older, shorter struct gets 1.
     pub locality: u32,
     /// Reserved, set to 0.
@@ -315,8 +315,8 @@ pub unsafe extern "C" fn pleat_cwf_animation_copy_history(
     }))
 }
 
-/// Writes the animation as a `.cwfa` text file (lossless; format in README "Wrinkle
-/// animation"). The base mesh is not written; store it separately.
+/// Writes the animation as a `.cwfa` text file (lossless; format in
+/// docs/guide/wrinkle-animation.md). The base mesh is not written; store it separately.
 ///
 /// - `anim`: non-NULL.
 /// - `path`: NUL-terminated UTF-8 path; non-NULL. An existing file is replaced.

@@ -68,7 +68,7 @@ pub struct PleatLodParams {
     /// with `PLEAT_STATUS_LIMIT_EXCEEDED` before the expensive work.
     pub memory_budget_bytes: u64,
     /// Cages only: the distance the cage keeps from the input, as a fraction of d (default
-    /// 0.05: a twentieth of a pixel at the cage's screen size, see README "Cages with clearance"), or
+    /// 0.05: a twentieth of a pixel at the cage's screen size, see docs/benchmarks/cage.md), or
     /// in model units with `PLEAT_LOD_CLEARANCE_ABSOLUTE`. Must be >= 0 and below d; 0 keeps
     /// only "no contact". Appended 2026-11-25; callers with an older `struct_size` get the
     /// default.
@@ -84,10 +84,10 @@ pub struct PleatLodParams {
     /// Reserved, 0 (keeps the struct free of padding).
     pub reserved: u32,
     /// LODs only: the offset voxel the bake starts from, as a multiple of d/√3, in (0, 2];
-    /// 0 (the default) = automatic (2 from n_p = 200 on, 1.25 from 100, 1 below; see README
-    /// "A coarser first stage"). A coarser voxel is still taken when the memory estimate needs it. NaN,
-    /// negative or > 2 is `PLEAT_STATUS_INVALID_ARGUMENT`. Appended 2026-11-27; callers with
-    /// an older `struct_size` get automatic.
+    /// 0 (the default) = automatic (2 from n_p = 200 on, 1.25 from 100, 1 below; see
+    /// docs/design-notes-lod.md, "Offset stage"). A coarser voxel is still taken when the memory
+    /// estimate needs it. NaN, negative or > 2 is `PLEAT_STATUS_INVALID_ARGUMENT`. Appended
+    /// 2026-11-27; callers with an older `struct_size` get automatic.
     pub offset_voxel_scale: f64,
 }
 
@@ -142,7 +142,7 @@ pub struct PleatLodStats {
     /// Cages: 1 when verified to enclose every input vertex without touching the input.
     /// LODs: 0.
     pub encloses_input: u32,
-    /// 1 when the result was recomputed with exact checks only (see README).
+    /// 1 when the result was recomputed with exact checks only (see docs/guide/lod.md).
     pub exact_rerun: u32,
     /// 1 when a target face count was given and met.
     pub target_met: u32,

@@ -1,6 +1,6 @@
 //! The C ABI: the only place with `extern "C"`. Thin wrappers over the safe Rust API.
 //!
-//! Conventions (see README "C API"):
+//! Conventions (see docs/guide/c-abi.md):
 //! - Every fallible function returns [`PleatStatus`]; outputs are written only on success; the
 //!   reason of the last failure on the calling thread is available from
 //!   [`pleat_last_error`] / [`pleat_last_error_message`].

@@ -13,7 +13,8 @@ pub const PLEAT_CHECK_SKIP_SELF_INTERSECTIONS: u32 = 1;
 pub const PLEAT_CHECK_WELD: u32 = 2;
 
 /// Validity report of a triangle soup, filled by `pleat_mesh_check`. Counts follow the
-/// independent checker's definitions (see README). Yes/no fields are 0 or 1.
+/// independent checker's definitions (see docs/guide/errors-and-limits.md). Yes/no fields are 0 or
+/// 1.
 ///
 /// Set `struct_size = sizeof(PleatMeshReport)` before the call; pleat fills only that many
 /// bytes, so a caller compiled against an older, shorter struct keeps working.

@@ -420,7 +420,7 @@ pub unsafe extern "C" fn pleat_cwf_create_from_frequency(
     )))
 }
 
-/// Reads a `.cwf` file (format: README "Wrinkle fields", `src/wrinkle/io.rs`) written for
+/// Reads a `.cwf` file (format: docs/guide/wrinkle-evaluation.md, `src/wrinkle/io.rs`) written for
 /// `base`, whose connectivity (vertex, edge and triangle counts and a hash of the triangles)
 /// must match what the file records; positions may differ (a deformed base mesh).
 ///

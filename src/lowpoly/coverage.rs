@@ -23,8 +23,8 @@
 //!   `d` inside it) into a twist (dirty_synth_nonmanifold at n_p = 100: 25.49 → 22.84 dB). Measured
 //!   2026-12-07 and not taken either: samples deeper than `2 d` free up to `X` (no one-`d` limit) —
 //!   42722 31.69 dB, the 23-mesh mean +0.08 dB, but the tree's measured Hausdorff distance
-//!   +0.0008 l (many samples at the cap, the measurement sampling between them); README, "Buried
-//!   input and the fit".
+//!   +0.0008 l (many samples at the cap, the measurement sampling between them);
+//! docs/design-notes-lod.md,   "LOD loop and fit".
 //! - Invariant: every sample is within its budget of the LOD. A vertex move or a flip replaces
 //!   a patch of faces (the one-ring, the flip's two faces); a sample within its budget of the
 //!   *old* patch may rely on it, so it must be within its budget of the *new* patch, or the
@@ -50,8 +50,8 @@ use super::guard::InputModel;
 /// Spacing of the input samples, in `d` (the Hausdorff measurement's is `l / 400`, `d / 2` at
 /// n_p = 200). 1 since 2026-11-29 (was 0.5, changed for speed): a quarter of the samples, the
 /// fit 1.5–2.5× faster (fandisk at n_p = 200: bake 0.70 → 0.44 s wall); measured with the
-/// shared harness at n_p = 100 and 200 against QEM and meshoptimizer at equal faces (README,
-/// "LOD benchmark"): shading and Hausdorff distance unchanged within the
+/// shared harness at n_p = 100 and 200 against QEM and meshoptimizer at equal faces
+/// (docs/benchmarks/ lod.md): shading and Hausdorff distance unchanged within the
 /// per-mesh noise. The final measurement (`verify::hausdorff`, at `l / 400`) and the fit's
 /// safety revert still judge the fitted LOD.
 pub const SPACING: f64 = 1.0;
@@ -61,7 +61,7 @@ pub const SPACING: f64 = 1.0;
 /// (module docs). 1 since 2026-12-06 (was 0): measured that day with the shared harness over the 23
 /// corpus meshes, it changes only the four inputs with deeply buried parts at n_p = 200 (mean PSNR
 /// 25.43 → 25.52 dB, normal difference 0.0477 → 0.0474, Hausdorff unchanged) and two at n_p = 100
-/// (22.57 → 22.62 dB); README, "Buried input and the fit".
+/// (22.57 → 22.62 dB); docs/design-notes-lod.md, "LOD loop and fit".
 pub const BURIED_SLACK: f64 = 1.0;
 
 /// The depth, in floors, below which a sample gets no slack ([`BURIED_SLACK`]): input 1–2 `d`

@@ -31,10 +31,10 @@
 //! the guard, so the mesh stays watertight, manifold, self-intersection-free and of the same
 //! topology; the guard also keeps the LOD's sheets [`SELF_CLEARANCE`]`·d` apart (its check 6:
 //! no operation brings a face within that distance of a face sharing no vertex with it and
-//! facing more than 90° away, or closer than it was), so the two sides of an input sheet thinner than `2d`, which both
-//! project onto the sheet's plane, stop that far apart instead of collapsing onto each other;
-//! and the coverage check (`coverage.rs`): no line-search trial or flip may leave an
-//! input sample farther from the LOD than `max(`[`COVERAGE_FLOOR`]`·d, its distance before the
+//! facing more than 90° away, or closer than it was), so the two sides of an input sheet thinner
+//! than `2d`, which both project onto the sheet's plane, stop that far apart instead of collapsing
+//! onto each other; and the coverage check (`coverage.rs`): no line-search trial or flip may leave
+//! an input sample farther from the LOD than `max(`[`COVERAGE_FLOOR`]`·d, its distance before the
 //! fit)` (input buried deeper than `2 d`: up to one `d` more, never beyond the farthest), so
 //! the fit cannot pull the surface off a rim or a thin part of the input. The pipeline skips
 //! the fit for cages (a cage must stay outside the input) and reverts it when the measured
@@ -78,8 +78,8 @@ pub const COVERAGE_FLOOR: f64 = 1.0;
 /// `SELF_CLEARANCE · d` to a face sharing no vertex with it whose normal points more than 90°
 /// away from its own (the other side of a sheet), or closer than it already was
 /// (the guard's check 6). Without it, both sides of a double-sided sheet fit onto the same
-/// plane and the LOD folds onto itself, 10⁻⁶ apart (README, "The texture-coordinate test after
-/// the fit").
+/// plane and the LOD folds onto itself, 10⁻⁶ apart (docs/design-notes-lod.md,
+/// "Textured bakes").
 pub const SELF_CLEARANCE: f64 = 0.25;
 
 /// Tikhonov weight `μ / tr A` of the placement (keeps unconstrained directions in place).

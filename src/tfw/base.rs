@@ -51,8 +51,8 @@
 //! as `EnergyStalled` (its small E change says nothing about the rounding floor). Rectangle:
 //! **Converged in 89 iterations at 2.3e-9** (E 0.24518000641622 J, below the 200-iteration
 //! 0.24518000645213), 27.5 wrinkles, peak 1.299 mm (unchanged). The sheet (8 iterations) and
-//! the cylinders take it too (other iterates, same answers: README); with pressure the
-//! Newton matrix is not the Hessian and the CG path above is unchanged.
+//! the cylinders take it too (other iterates, same answers: docs/design-notes.md, "Base solve");
+//! with pressure the Newton matrix is not the Hessian and the CG path above is unchanged.
 //!
 //! Termination (spec step 2): `‖g‖∞ ≤ tol · ‖g₀‖∞` ([`BaseStatus::Converged`]); an accepted step
 //! changing E by less than `energy_tolerance · |E|` ([`BaseStatus::EnergyStalled`], the

@@ -10,10 +10,11 @@
 //!   (`dn(e_i) = n_i − n_0`), and `κ_f = tᵀ II t / tᵀ I t`. Exact on a sampled cylinder or
 //!   sphere whose vertex normals are exact; local (no neighbourhood search).
 //!
-//! Sign irrelevant (κ enters squared). Note (measured on the twisted cylinder, README): on a
-//! converged tension-field base without pressure, `κ_f ≈ 0` wherever there is tension, by the
-//! membrane's normal equilibrium `σ : II = p` with the uniaxial stress `σ = T t tᵀ` (`T κ_t =
-//! p = 0`); both estimators find |κ| ≈ 0.02–0.03 m⁻¹ there, so W_s² is weak on such bases.
+//! Sign irrelevant (κ enters squared). Note (measured on the twisted cylinder,
+//! docs/design-notes.md): on a converged tension-field base without pressure, `κ_f ≈ 0` wherever
+//! there is tension, by the membrane's normal equilibrium `σ : II = p` with the uniaxial stress `σ
+//! = T t tᵀ` (`T κ_t = p = 0`); both estimators find |κ| ≈ 0.02–0.03 m⁻¹ there, so W_s² is weak on
+//! such bases.
 
 use super::dense::{cross, dot, sub};
 use crate::mesh::TriMesh;

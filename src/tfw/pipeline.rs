@@ -43,7 +43,7 @@ pub struct TfwParams {
     /// the Knöppel phase still winds an integer number of times around every loop (it spreads
     /// the fractional part; no phase defect on the twisted cylinders). On: ω agrees with the
     /// phase's winding, at the cost of leaving the SQP's stationary point (E^wf +1.25% on the
-    /// 690-v twisted cylinder; README "Period snapping").
+    /// 690-v twisted cylinder; docs/design-notes.md, "Wrinkle SQP").
     pub snap_periods: bool,
 }
 

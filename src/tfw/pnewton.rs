@@ -28,7 +28,7 @@
 //! Near the optimum (after a full step with σ ≤ 1e-8) the step is refined by Steihaug–Toint CG
 //! on the **exact** `Bᵀ H B` preconditioned by that factorization ([`CgRefinement`],
 //! 2026-11-27): the projected matrix alone made the cylinders converge linearly (r × 0.985–0.994
-//! per full step, 526 iterations; now 77, README "Tension-field wrinkles").
+//! per full step, 526 iterations; now 77, docs/design-notes.md, "Wrinkle SQP").
 //! **Valley search** (2026-11-29, for the cylinder at thickness × 10⁻²): after a full step with σ ≤
 //! [`CgRefinement::max_shift`] (the refinement's gate), `E` is minimized over the scalar `μ`
 //! along `(a, ω) → (a/μ, μω)` ([`SqpOptions::valley_search`]). The membrane term sees the
@@ -40,7 +40,7 @@
 //! period still climbing 349 → 451 turns at 3545). The scaling keeps `a ≥ 0` and
 //! `curl ω = 0`, costs a few energy evaluations, and moves that mode in one go: 13 / 14
 //! iterations there, 77 / 76 → 14 / 15 on the thick cylinders, the other scenes' answers
-//! unchanged (README "Thickness × 10⁻² on the twisted cylinder").
+//! unchanged (docs/design-notes.md, "Wrinkle SQP").
 //! `Bᵀ H B` keeps one sparsity pattern (held entries are stored as zeros), so faer's symbolic
 //! analysis is done once. Every iterate is `x = B y`, curl-free to rounding by construction.
 //! The stationarity residual is the projected gradient in `y` (`∇_y E`, with `min(g, 0)` for
@@ -479,8 +479,8 @@ fn projected_gradient_norm(g: &[f64], y: &[f64], na: usize) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Runs the SQP by projected Newton (module docs, [`crate::tfw::QpMethod::ProjectedNewton`]) from `x0 =
-/// [a | ω]` (made feasible first), whatever `options.qp` says; otherwise as
+/// Runs the SQP by projected Newton (module docs, [`crate::tfw::QpMethod::ProjectedNewton`]) from
+/// `x0 = [a | ω]` (made feasible first), whatever `options.qp` says; otherwise as
 /// [`crate::tfw::sqp::run_sqp`]. The step is refined on the exact Hessian as
 /// `options.cg_refinement` says ([`CgRefinement::DEFAULT`] unless set).
 pub fn run_sqp_projected_newton(
@@ -636,7 +636,7 @@ fn run(
         };
         // the valley search near the optimum only (the refinement's gate: a full step at
         // σ ≤ max_shift); from every full step it led the sheared rectangle and the torus to
-        // stationary points of higher energy (README "Thickness × 10⁻²")
+        // stationary points of higher energy (docs/design-notes.md, "Wrinkle SQP")
         let near = t >= 1.0 && state.shift <= cg.max_shift;
         let (yn, xn, en) = if options.valley_search && near {
             valley_search(&yn, xn, en, na, &energy_at)
@@ -749,9 +749,9 @@ fn next_shift(shift: f64, t: f64) -> f64 {
 /// strain `½a²ωωᵀ` of eq. 2.21 stay put while the curvature and bending terms W_s², W_b²,
 /// which set the wavelength, change), minimized by at most eight rounds around the current
 /// best `s`: samples at `s ± ε` (ε = 1e-3), then the minimum of the parabola through the three
-/// points (at most 0.5 away, halved at most thrice until it lowers `E`) or, where `E` is concave in `s`,
-/// doubling steps downhill while `E` falls; stops when a round does not lower `E`. Keeps `a ≥ 0` and `curl ω = 0` (a scaling of
-/// both), returns `(y, x, E)` with `E` never above `energy`.
+/// points (at most 0.5 away, halved at most thrice until it lowers `E`) or, where `E` is concave in
+/// `s`, doubling steps downhill while `E` falls; stops when a round does not lower `E`. Keeps `a ≥
+/// 0` and `curl ω = 0` (a scaling of both), returns `(y, x, E)` with `E` never above `energy`.
 fn valley_search(
     y: &[f64],
     x: Vec<f64>,
@@ -1042,7 +1042,7 @@ mod tests {
         };
         // the default (near the optimum only): refining every step from the start
         // (`..CgRefinement::OFF` with 50 iterations) jumped to a ≡ 0 here in one step, a
-        // stationary point with twice the energy (README)
+        // stationary point with twice the energy (docs/design-notes.md)
         let cg = CgRefinement::DEFAULT;
         let plain =
             run_sqp_projected_newton_with(&problem, &x0, &options, &CgRefinement::OFF, &mut |_| {

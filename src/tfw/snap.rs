@@ -6,8 +6,8 @@
 //! **Why.** The text rounds the phase with a MIP on a cut mesh (A.6.4–A.6.5, S:2309–2329);
 //! pleat takes Knöppel's phase ([`crate::wrinkle::Cwf::from_one_form`]), which can follow ω
 //! without a defect only where every period of ω is in 2πℤ. The SQP does not know that: on the
-//! twisted cylinder its ω goes 46.21 times around the ring. Measured (README, "Period
-//! snapping"): Knöppel spreads such a fraction smoothly (no phase defect on the cylinders, and
+//! twisted cylinder its ω goes 46.21 times around the ring. Measured (docs/design-notes.md,
+//! "Wrinkle SQP"): Knöppel spreads such a fraction smoothly (no phase defect on the cylinders, and
 //! the torus balloon's lines, first read as a seam, are amplitude bands that stay with
 //! snapping), while snapping moves ω off the SQP's stationary point (E^wf +1.25% on the 690-v
 //! cylinder). So it is an option, off by default ([`crate::tfw::TfwParams::snap_periods`]),

@@ -57,7 +57,7 @@ pub struct SqpOptions {
     pub time_limit_seconds: f64,
     /// How each step is computed (default [`QpMethod::ProjectedNewton`] since 2026-11-27: it
     /// passes the same checks as clarabel, Y × 10⁴ included, and reaches the stable answer
-    /// 2.5–9× sooner; README "Tension-field wrinkles").
+    /// 2.5–9× sooner; docs/design-notes.md, "Wrinkle SQP").
     pub qp: QpMethod,
     /// Keep a copy of `x` in [`SqpResult::snapshots`] at the start and every this many
     /// iterations (0 = none; the last iterate is always [`SqpResult::x`]). For wave counts
@@ -65,7 +65,7 @@ pub struct SqpOptions {
     pub snapshot_every: usize,
     /// Projected Newton only: the exact-Hessian CG refinement of the step near the optimum
     /// (default [`CgRefinement::DEFAULT`] since 2026-11-27; [`CgRefinement::OFF`] is the
-    /// projected step alone; README "Tension-field wrinkles").
+    /// projected step alone; docs/design-notes.md, "Wrinkle SQP").
     pub cg_refinement: CgRefinement,
     /// Projected Newton only: after a full step near the optimum (the gate of
     /// [`CgRefinement`]), minimize `E` along the amplitude ↔ frequency valley
@@ -75,10 +75,10 @@ pub struct SqpOptions {
     pub valley_search: bool,
 }
 
-/// The exact-Hessian refinement of the projected Newton step (README "Tension-field wrinkles": the
-/// projected step alone converged only linearly): Steihaug–Toint CG on the exact reduced Hessian
-/// `Bᵀ H B` (held amplitudes fixed), preconditioned by the factorization of `Bᵀ(H_proj + σW)B`, in
-/// the region `‖s‖_M ≤ radius · ‖s₀‖_M` (s₀ the projected step), stopped at
+/// The exact-Hessian refinement of the projected Newton step (docs/design-notes.md, "Wrinkle SQP":
+/// the projected step alone converged only linearly): Steihaug–Toint CG on the exact reduced
+/// Hessian `Bᵀ H B` (held amplitudes fixed), preconditioned by the factorization of `Bᵀ(H_proj +
+/// σW)B`, in the region `‖s‖_M ≤ radius · ‖s₀‖_M` (s₀ the projected step), stopped at
 /// `‖Hs + g‖ ≤ tolerance ‖g‖`. The analogue of the base solve's CG (`tfw::base`), whose pressure
 /// projection made Newton linear the same way the per-face PSD projection of `E^wf` (S:2302–2307)
 /// does here.
@@ -93,7 +93,7 @@ pub struct CgRefinement {
     /// Refine only after a full step (`t = 1`) of the line search and while the relative
     /// shift σ is at most [`Self::max_shift`]: near the optimum, where the spec switches to
     /// the true Hessian (A.6.3). Far from it the exact-Hessian steps took other paths (the
-    /// sheared rectangle: a higher stationary energy, README).
+    /// sheared rectangle: a higher stationary energy, docs/design-notes.md).
     pub after_full_step: bool,
     /// With `after_full_step`: the largest relative shift σ at which to refine.
     pub max_shift: f64,
@@ -110,7 +110,7 @@ impl CgRefinement {
     };
 
     /// The default since 2026-11-27: 50 CG iterations, region 10 ‖s₀‖_M,
-    /// tolerance 1e-3, after full steps with σ ≤ 1e-8 only (README "Tension-field wrinkles":
+    /// tolerance 1e-3, after full steps with σ ≤ 1e-8 only (docs/design-notes.md, "Wrinkle SQP":
     /// the cylinders' SQP from 526 / 487 to 77 / 76 iterations, the torus's from 396 to 136,
     /// the same or a lower final energy on every scene).
     pub const DEFAULT: CgRefinement = CgRefinement {

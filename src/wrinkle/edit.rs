@@ -120,8 +120,8 @@ pub struct EditOptions {
     /// the interface edges' (≥ 1). The text asks for `z̃` consistent with `ω¹` on the edit
     /// edges; a weight above 1 keeps the interface's mismatch (the curl of the blended `ω`) in
     /// the interface, where singularities can absorb it, instead of spreading it into the
-    /// edited region at the cost of a larger interface residual (measured in the README). Default 1
-    /// (the literal eq. 3.28, as the reference).
+    /// edited region at the cost of a larger interface residual (measured in
+    /// docs/benchmarks/wrinkle.md). Default 1 (the literal eq. 3.28, as the reference).
     pub edit_weight: f64,
     /// Inverse-iteration steps of the phase solve; default 200.
     pub max_iterations: usize,
@@ -132,15 +132,15 @@ pub struct EditOptions {
     /// ([`EditReport::compat_rms`]) or over the interface-only edges
     /// ([`EditReport::compat_rms_by_class`]`[1]`) exceeds this target, every region's band is
     /// widened by one ring (up to [`max_interface_rings`](Self::max_interface_rings)) and the
-    /// edit redone; the edit with the smallest of these two maxima is returned ([`EditReport::interface_rings`] says which
-    /// widths). A widening that would leave no fixed vertex or make the layout invalid stops it.
-    /// The residual is forced by the curl of the eq. 3.26 blend, which only a wider band
-    /// spreads (README, "Interface smoothness"); the corpus torus needs 7 rings for 0.3.
-    /// Default [`DEFAULT_COMPAT_TARGET`] = 0.3 rad, the required interface smoothness, so a default
-    /// edit has a smooth interface wherever a band of at most `max_interface_rings` rings can
-    /// give one (the widening takes rings from the fixed region, which stays bit-for-bit
-    /// copied; [`EditReport::interface_rings`] says how wide). 0 gives the requested widths
-    /// exactly, as the reference code does.
+    /// edit redone; the edit with the smallest of these two maxima is returned
+    /// ([`EditReport::interface_rings`] says which widths). A widening that would leave no fixed
+    /// vertex or make the layout invalid stops it. The residual is forced by the curl of the eq.
+    /// 3.26 blend, which only a wider band spreads (docs/benchmarks/wrinkle.md, "Interface
+    /// smoothness"); the corpus torus needs 7 rings for 0.3. Default [`DEFAULT_COMPAT_TARGET`] =
+    /// 0.3 rad, the required interface smoothness, so a default edit has a smooth interface
+    /// wherever a band of at most `max_interface_rings` rings can give one (the widening takes
+    /// rings from the fixed region, which stays bit-for-bit copied; [`EditReport::interface_rings`]
+    /// says how wide). 0 gives the requested widths exactly, as the reference code does.
     pub compat_target: f64,
     /// Widest band the adaptive width may reach; default 8.
     pub max_interface_rings: usize,

@@ -1,5 +1,5 @@
-//! A white, smoothly shaded surface for `pleat::bake::render` (README pictures): area-weighted
-//! vertex normals. Shared by the tests that render pictures (`wrinkle_edit`, `tfw`).
+//! A white, smoothly shaded surface for `pleat::bake::render` (documentation pictures):
+//! area-weighted vertex normals. Shared by the tests that render pictures (`wrinkle_edit`, `tfw`).
 
 use pleat::mesh::TriMesh;
 

@@ -51,8 +51,8 @@ pub struct TfwBenchArgs {
     pub scenes: Vec<PathBuf>,
     /// Built-in scenes, comma separated: `sheet` (the shipped stretched sheet, 37 × 14
     /// vertices, 5 % stretch), `sheet-small` (13 × 6), `cylinder` (twisted cylinder, 43 × 16,
-    /// 10°), and the README's speed-table scenes: `sheared-rectangle` (1000 v, 3 mm shear),
-    /// `disk-balloon` (2 × 600 v, 600 Pa), `torus-balloon` (2 × 800 v, 600 Pa), `teabag`
+    /// 10°), and the speed-table scenes of docs/benchmarks/tfw.md: `sheared-rectangle` (1000 v, 3
+    /// mm shear), `disk-balloon` (2 × 600 v, 600 Pa), `torus-balloon` (2 × 800 v, 600 Pa), `teabag`
     /// (2 × 468 v, 10 Pa), `sphere-drape` (S:676: 1 m cloth on a 0.2 m sphere, 41 × 41 v) and
     /// `sphere-drape-delaunay` (the same cloth on an irregular Delaunay mesh of ~1681 v).
     #[arg(long, value_delimiter = ',')]

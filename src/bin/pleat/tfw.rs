@@ -14,7 +14,7 @@ use super::{failure_code, progress_bar, show_progress, EXIT_FAILED, EXIT_INPUT};
 /// Arguments of `pleat tfw`.
 #[derive(clap::Args)]
 pub struct TfwArgs {
-    /// The scene file (JSON; see the README "Tension-field wrinkles" section).
+    /// The scene file (JSON; format in docs/guide/tfw.md).
     pub scene: PathBuf,
     /// The wrinkled mesh (obj, ply, off, stl, glb, gltf).
     #[arg(short = 'o', long = "output")]
@@ -39,11 +39,11 @@ pub struct TfwArgs {
     #[arg(long, default_value = "default")]
     pub qp: String,
     /// Snap ω's periods around the base's non-contractible loops to multiples of 2π before
-    /// the phase (default: as the SQP leaves them; see the README's "Period snapping").
+    /// the phase (default: as the SQP leaves them; see docs/design-notes.md).
     #[arg(long)]
     pub snap: bool,
     /// Turn off the projected Newton's valley search near the optimum (on by default; see
-    /// the README's "Thickness × 10⁻²").
+    /// docs/design-notes.md).
     #[arg(long)]
     pub no_valley_search: bool,
     /// No progress bar.
@@ -143,7 +143,7 @@ fn print_summary(r: &TfwResult, qp: QpMethod) {
             s.initial_energy, r.energy, s.initial_stationarity, last_r
         );
         if let Some(i) = s.rescued_at {
-            println!("SQP rescue    at iteration {i} (step weights raised; README \"SQP rescue\")");
+            println!("SQP rescue    at iteration {i} (step weights raised; docs/design-notes.md)");
         }
     }
     if let Some(s) = &r.snap {
