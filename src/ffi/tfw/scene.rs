@@ -5,7 +5,7 @@ use super::types::*;
 use crate::ffi::boundary::{destroy, requires};
 use crate::ffi::common::{guard, PleatStatus};
 
-/// Reads and validates a scene file (JSON; format in README "Tension-field wrinkles").
+/// Reads and validates a scene file (JSON; format in docs/guide/tfw.md).
 ///
 /// - `path`: NUL-terminated UTF-8 path; non-NULL.
 /// - `out`: receives the new scene (destroy with `pleat_tfw_scene_destroy`); non-NULL.

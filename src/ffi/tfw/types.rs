@@ -128,9 +128,9 @@ pub struct PleatTfwParams {
     /// Reserved, set to 0.
     pub reserved4: u32,
     /// 1 (default): the projected-Newton SQP's valley search near the optimum (a 1-D search
-    /// along (a, ω) → (a/μ, μω), README "Thickness × 10⁻²"; what makes thin shells converge);
-    /// 0: off, the plain projected Newton. Appended 2026-11-29: a shorter struct (without it)
-    /// gets the default.
+    /// along (a, ω) → (a/μ, μω), docs/design-notes.md, "Wrinkle SQP"; what makes thin shells
+    /// converge); 0: off, the plain projected Newton. Appended 2026-11-29: a shorter struct
+    /// (without it) gets the default.
     pub valley_search: u32,
     /// Reserved, set to 0.
     pub reserved5: u32,
@@ -222,7 +222,7 @@ pub struct PleatTfwStats {
     /// when none.
     pub snap_relative_correction: f64,
     /// The SQP iteration at which a step without decrease was retried with raised weights
-    /// and kept them (README "SQP rescue"); −1 when no rescue was needed.
+    /// and kept them (docs/design-notes.md, "Wrinkle SQP"); −1 when no rescue was needed.
     pub sqp_rescue_iteration: i64,
 }
 

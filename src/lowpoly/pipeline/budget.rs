@@ -27,7 +27,7 @@ pub(super) const MAX_LOD_VOXEL_SCALE: f64 = LOD_VOXEL_SCALES[LOD_VOXEL_SCALES.le
 /// [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] starts from, as a multiple of `d/√3` (for speed,
 /// 2026-11-27); below it LODs start from scale 1. The first simplification pass works through
 /// every face of the offset surface (∝ 1/scale²) and was ≈ 80% of a bake. Measured against
-/// scale 1 (README, "LOD benchmark", "A coarser first stage"): at n_p = 200 on 8 corpus meshes
+/// scale 1 (docs/design-notes-lod.md, "Offset stage"): at n_p = 200 on 8 corpus meshes
 /// the median CPU time of a bake falls by 49% while LOD faces (−0.3%), Hausdorff distance and
 /// shading (normal difference +0.0003 ± 0.001, PSNR +0.03 dB) stay within the per-mesh noise;
 /// at n_p = 100 on the whole corpus it falls by 40% but the normal difference grows by
@@ -43,7 +43,7 @@ pub const LOD_COARSE_VOXEL_MIN_SCREEN_SIZE: f64 = 200.0;
 /// The offset voxel a LOD at a screen size in [`LOD_MEDIUM_VOXEL_MIN_SCREEN_SIZE`]`..`
 /// [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] starts from (for speed, 2026-11-29): 0.64× the
 /// offset faces of scale 1, the first simplification pass in proportion. Measured at n_p = 100
-/// on the 23 corpus meshes (README, "LOD benchmark", 2026-11-29): with the coarser coverage
+/// on the 23 corpus meshes (docs/benchmarks/lod.md, 2026-11-29): with the coarser coverage
 /// spacing of the fit (`coverage::SPACING`), median wall 1.09 → 0.69 s (scale 1.5: 0.63 s,
 /// scale 2: 0.56 s, with larger per-mesh Hausdorff changes); `run_suite.py --target-from
 /// pleat` with MeshLab QEM and meshoptimizer: mean normal difference 0.0807 → 0.0804, PSNR
@@ -189,8 +189,8 @@ impl LodParams {
 
     /// The estimated peak bytes of a LOD of `input` that starts from the (welded) input itself
     /// ([`LodStart`]) — the figure compared with `memory_budget_bytes` when that start is
-    /// taken; meant to be an upper bound of the measured peak (README, "Large screen sizes").
-    /// It does not depend on the offset voxel (no offset surface is built).
+    /// taken; meant to be an upper bound of the measured peak (docs/design-notes-lod.md, "Memory
+    /// budget"). It does not depend on the offset voxel (no offset surface is built).
     pub fn input_start_memory_estimate_bytes(&self, input: &TriMesh) -> f64 {
         self.input_start_estimate(input)
     }
@@ -210,7 +210,7 @@ impl LodParams {
 
     /// The estimated peak bytes of a LOD bake of `input` at offset voxel `voxel_scale` — the
     /// figure compared with `memory_budget_bytes` (see the private `memory_estimate`); meant to
-    /// be an upper bound of the measured peak (README, "Large screen sizes").
+    /// be an upper bound of the measured peak (docs/design-notes-lod.md, "Memory budget").
     pub fn memory_estimate_bytes(&self, input: &TriMesh, voxel_scale: f64) -> f64 {
         self.memory_estimate(input, voxel_scale)
     }
@@ -312,7 +312,8 @@ impl LodParams {
 
     /// Whether a LOD of `input` from the offset surface is decided by the measured admission
     /// ([`measured_start`]): the up-front estimate fits no voxel scale (so no bake admitted up
-    /// front changes), but some scale's a-priori part does ([`measured_scales`](Self::measured_scales)).
+    /// front changes), but some scale's a-priori part does
+    /// ([`measured_scales`](Self::measured_scales)).
     pub(super) fn measured_admission_may_fit(&self, input: &TriMesh) -> bool {
         self.offset_voxel_scale(input, Mode::Lod).is_none()
             && !self.measured_scales(input).is_empty()

@@ -139,7 +139,7 @@ fn initial_surface(
         // A LOD's own output is verified independently at the end (`verify_level`), and the
         // guard only keeps what the start surface has (a bad start ends in `Internal` there):
         // verifying the dense intermediate surface too cost ≈ 5% of a LOD bake's CPU at scale
-        // 2, with the same output bytes (README "A coarser first stage").
+        // 2, with the same output bytes (docs/design-notes-lod.md, "Offset stage").
         // Cages keep it, with the enclosure check below.
         verify: level.mode == Mode::Cage,
         ..OffsetParams::default()

@@ -111,7 +111,7 @@ impl LoopStats {
 /// alignment) — on the corpus most rounds after about 10 changed the count by 0–2 around a
 /// plateau, and a chain's coarser levels ran all 50 at one count. Measured with the shared
 /// harness against MeshLab QEM and meshoptimizer at equal faces on the 23 corpus meshes
-/// (README, "LOD benchmark", 2026-11-29): n_p = 100 faces +1.7%, normal difference
+/// (docs/benchmarks/lod.md, 2026-11-29): n_p = 100 faces +1.7%, normal difference
 /// 0.0804 → 0.0793, PSNR 22.39 → 22.57 dB, Hausdorff 3.43 → 3.35 % of l; n_p = 200 faces
 /// +0.4%, 0.0479 → 0.0477, 25.37 → 25.43 dB, 2.64 → 2.59 %; median wall at n_p = 100
 /// 0.67 → 0.62 s. With a face target the loop goes on relaxing its bound instead; cages keep
@@ -139,7 +139,7 @@ pub(super) fn has_stalled(faces_per_round: &[u64]) -> bool {
 /// faces and suzanne 122 → 108 but thingi10k 42722 28 → 44 (34 without clearance); from the
 /// second round on 72, 106 and 30, all within the +20% faces a cage's clearance may cost over
 /// the cage without clearance
-/// (README, "Cages with clearance", for all 69 corpus cages). LODs and cages without a
+/// (docs/benchmarks/cage.md, for all 69 corpus cages). LODs and cages without a
 /// clearance never retry, and their outputs do not change.
 pub(super) fn retries_guard_refusals(cfg: &LoopConfig, i: u32) -> bool {
     cfg.mode == Mode::Cage && cfg.clearance > 0.0 && i >= 1

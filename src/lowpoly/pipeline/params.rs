@@ -23,7 +23,7 @@ pub const DEFAULT_CLEARANCE_FRACTION: f64 = 0.05;
 /// cost a median +12% faces against a cage without clearance and 10 cages more than +20% (the
 /// bound a cage's clearance may cost in faces); a twentieth costs a median +6%, 2 cages above
 /// +20% (62 → 76 and 100 → 122 faces at n_p = 25), none once collapses refused by the guard are
-/// retried (`retries_guard_refusals`; README cage table).
+/// retried (`retries_guard_refusals`; docs/benchmarks/cage.md).
 /// Both are far below a pixel and far above rounding. It must stay below
 /// `d`: the cage starts from the offset surface at distance `d`, whose faces dip a few percent
 /// of `d` closer (chords of its rounded parts).
@@ -137,7 +137,7 @@ pub enum LodStart {
     /// offset stage's interior removal, kept by Input); every clean corpus mesh is connected,
     /// so clean multi-component inputs are not measured.
     ///
-    /// Measured 2026-11-27 (README "LOD benchmark", "Clean inputs start from the input") on
+    /// Measured 2026-11-27 (docs/design-notes-lod.md, "LOD loop and fit") on
     /// the 11 clean corpus meshes ≤ 40k faces at n_p = 200, Input against Offset: 24% fewer
     /// faces on average (412 against 545), two-sided Hausdorff 0.99% of l against 1.47%, less
     /// CPU on 10 of 11 (median 4.8 against 7.3 s), every output CGAL-valid; at pleat's face
