@@ -36,10 +36,10 @@ use super::atlas::{
     AtlasParams, Gutter, BLOCK_SHARED,
 };
 use super::level::{BakeReport, BakedLevel, BakedMaterial, Image8};
-use super::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 use crate::geom::{normalized, Vec3};
 use crate::mesh::TriMesh;
 use crate::report::{Progress, ProgressFn};
+use crate::transfer::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 use crate::{Error, Result};
 
 /// Texels baked between two progress reports (and cancellation checks): about 10 ms of work
