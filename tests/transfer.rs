@@ -203,8 +203,8 @@ fn skin_weights_are_top_k_normalised_and_carry_input_joints() {
             let s: f64 = w.iter().map(|&x| x as f64).sum();
             assert!((s - 1.0).abs() <= 1e-6, "vertex {i}: sum {s}");
             assert!(w.windows(2).all(|p| p[0] >= p[1]), "sorted: {w:?}");
-            for s in 0..k {
-                if w[s] > 0.0 {
+            for (s, &ws) in w.iter().enumerate() {
+                if ws > 0.0 {
                     assert!(c.skin_joints.contains(&sw.joints[i * k + s]));
                 }
             }

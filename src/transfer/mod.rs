@@ -269,7 +269,7 @@ impl Correspondence {
             })
             .collect();
         let far = far_vertex(found.iter().map(|f| f.1));
-        if let Some((i, dist)) = far.filter(|&(_, dist)| !(dist <= bound)) {
+        if let Some((i, dist)) = far.filter(|&(_, dist)| dist > bound) {
             return Err(wrong_input("LOD vertex", i, dist, bound, params));
         }
         // The other side: the input's bounding box within the bound of the LOD's (a LOD or
@@ -282,7 +282,7 @@ impl Correspondence {
                 ("min", (llo[a] - ilo[a]).abs()),
                 ("max", (lhi[a] - ihi[a]).abs()),
             ] {
-                if !(gap <= bound) {
+                if gap.is_nan() || gap > bound {
                     return Err(Error::InvalidArgument(format!(
                         "the bounding boxes differ by {gap:.6} at the {side} of axis {a}, more \
                          than {} d = {bound:.6} (d = l_lod / n_p, n_p = {}): the input is not \
@@ -434,7 +434,8 @@ impl Correspondence {
         self.check_rows(joints.len(), m, "joints")?;
         self.check_rows(weights.len(), m, "weights")?;
         let k = params.max_influences;
-        if !(1..=4).contains(&k) && !((5..=8).contains(&k) && k <= m) {
+        let allowed = (1..=4).contains(&k) || ((5..=8).contains(&k) && k <= m);
+        if !allowed {
             return Err(Error::InvalidArgument(format!(
                 "max_influences is {k}; allowed 1 to 4, or up to 8 when the input has as many \
                  influences per vertex (it has {m})"

@@ -6,7 +6,7 @@
 //!
 //! Skinning is linear blend skinning (Magnenat-Thalmann et al. 1988; Kavan et al. 2008, eq. 1):
 //! `v' = Σ_j w_j · G_j · v` with `G_j` the joint's world transform relative to the bind pose.
-#![allow(dead_code, clippy::needless_range_loop)]
+#![allow(dead_code, clippy::needless_range_loop, clippy::type_complexity)]
 
 use pleat::mesh::TriMesh;
 
