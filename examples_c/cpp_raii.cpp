@@ -192,6 +192,43 @@ static void lods() {
     lod.copy_positions(interleaved.data(), lod.vertex_count(), 16);
     EXPECT(interleaved[3] == 7.0f && interleaved[0] == lod.positions_f32()[0]);
 
+    // pleat::Transfer: the cube's per-vertex UVs, ids and skin weights on the LOD
+    {
+        pleat::Transfer tr(cube, lod, pleat::transfer_params(10.0));
+        std::vector<float> uv(16), w(16, 0.0f);
+        std::vector<uint32_t> ids(8), joints(16);
+        for (uint32_t v = 0; v < 8; v++) {
+            uv[2 * v] = p[3 * v], uv[2 * v + 1] = p[3 * v + 1], ids[v] = 100 + v;
+            joints[2 * v] = v % 2, joints[2 * v + 1] = 2, w[2 * v] = 0.75f, w[2 * v + 1] = 0.25f;
+        }
+        std::vector<float> luv = tr.f32(uv, 2);
+        std::vector<uint32_t> lid = tr.u32(ids, 1);
+        pleat::SkinWeights sw = tr.skin(joints, w, 2);
+        EXPECT(luv.size() == 2 * lod.vertex_count() && lid.size() == lod.vertex_count());
+        EXPECT(lid[0] >= 100 && lid[0] < 108 && luv[0] >= -1e-6f && luv[0] <= 1.0f + 1e-6f);
+        EXPECT(sw.weights.size() == 4 * lod.vertex_count());
+        EXPECT(std::fabs(sw.weights[0] + sw.weights[1] + sw.weights[2] + sw.weights[3] - 1.0f) <=
+               1e-6f);
+        pleat::Transfer moved_tr = std::move(tr);
+        EXPECT(!tr.get() && moved_tr.lod_vertex_count() == lod.vertex_count());
+        try {
+            float big[24];
+            for (int i = 0; i < 24; i++) big[i] = 3.0f * p[i];
+            pleat::Mesh other = pleat::Mesh::from_arrays(big, 8, t, 36);
+            tr = pleat::Transfer(other, lod, pleat::transfer_params(10.0));
+            EXPECT(false);
+        } catch (const pleat::Error &err) {
+            EXPECT(err.status() == PLEAT_STATUS_INVALID_ARGUMENT && !tr.get());
+            std::printf("  ok: not the LOD's input -> %s\n", err.what());
+        }
+        try {
+            moved_tr.f32(std::vector<float>(15), 2);
+            EXPECT(false);
+        } catch (const pleat::Error &err) {
+            EXPECT(err.status() == PLEAT_STATUS_INVALID_ARGUMENT);
+        }
+    }
+
     std::vector<PleatLodStats> chain_stats;
     std::vector<pleat::Mesh> chain = cube.lod_chain({10.0, 5.0}, pleat::lod_params(), &chain_stats);
     EXPECT(chain.size() == 2 && chain_stats.size() == 2 && chain[1].report().is_watertight);

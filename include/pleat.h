@@ -206,6 +206,25 @@
 // residual (absolute), step `‖Δx‖∞`, wall seconds since the SQP started.
 #define PLEAT_TFW_HISTORY_COLUMNS 4
 
+// `pleat_transfer_f32` mode: interpolated with the barycentric coordinates of the LOD
+// vertex's corresponding input point (UVs, colours, morph deltas).
+#define PLEAT_TRANSFER_BARYCENTRIC 0
+
+// `pleat_transfer_f32` mode: the value of the input triangle's corner nearest to the
+// corresponding point (values that must not be mixed).
+#define PLEAT_TRANSFER_NEAREST 1
+
+// `PleatTransferParams::lookup`: cast along the LOD vertex normal within the envelope,
+// nearest hit, the closest input point when nothing is hit (the default).
+#define PLEAT_TRANSFER_LOOKUP_CAST 0
+
+// `PleatTransferParams::lookup`: the closest input point.
+#define PLEAT_TRANSFER_LOOKUP_CLOSEST 1
+
+// Most components per vertex `k` (and influences per input vertex `m`) the transfer calls
+// take.
+#define PLEAT_TRANSFER_MAX_COMPONENTS (1 << 16)
+
 // Per-vertex field of an evaluation: the Loop-subdivided amplitude `a` (1 double per vertex).
 #define PLEAT_WRINKLE_FIELD_AMPLITUDE 1
 
@@ -348,6 +367,10 @@ typedef struct PleatTfwResult PleatTfwResult;
 // `pleat_tfw_scene_read_file`, `pleat_tfw_scene_from_json` or `pleat_tfw_scene_from_arrays`;
 // destroyed by `pleat_tfw_scene_destroy`. Immutable: may be solved from several threads.
 typedef struct PleatTfwScene PleatTfwScene;
+
+// A LOD→input correspondence (opaque), made by `pleat_transfer_create`, freed by
+// `pleat_transfer_destroy`. Immutable, so it may be used from several threads at once.
+typedef struct PleatTransfer PleatTransfer;
 
 // Optional per-vertex (and per-edge) fields of one evaluation (opaque), requested with
 // `PLEAT_WRINKLE_FIELD_*` bits in `PleatWrinkleEvalParams::flags` and returned by
@@ -1240,6 +1263,28 @@ typedef struct PleatTfwWaveCount {
   // equator; 0 keeps all. Out: the value used.
   double min_radius;
 } PleatTfwWaveCount;
+
+// Parameters of `pleat_transfer_create`. Get the defaults from
+// `pleat_transfer_params_default()`.
+typedef struct PleatTransferParams {
+  // `sizeof(PleatTransferParams)`.
+  uint32_t struct_size;
+  // `PLEAT_TRANSFER_LOOKUP_CAST` (default) or `PLEAT_TRANSFER_LOOKUP_CLOSEST`.
+  uint32_t lookup;
+  // Screen size n_p the LOD was made at (default 200; finite, > 0): d = l / n_p.
+  double screen_size;
+  // Half-length of the cast along the normal, in d (default 3; finite, > 0).
+  double envelope_d;
+  // Wrong-input bound, in d = l_lod / n_p (default 4; finite, > 0): every LOD vertex must
+  // lie within it of the input, and each side of the input's bounding box within it of
+  // the LOD's.
+  double max_distance_d;
+  // Jacobi smoothing iterations of skin weights over the LOD's one-ring before the top-k
+  // (default 0, the measured rule; at most 64).
+  uint32_t skin_smoothing;
+  // Reserved, 0.
+  uint32_t reserved;
+} PleatTransferParams;
 
 // Outcome of the Knöppel phase solve of a `PleatCwf` (`pleat_cwf_get_knoppel_report`).
 typedef struct PleatKnoppelReport {
@@ -2300,6 +2345,113 @@ size_t pleat_tfw_result_history_count(const struct PleatTfwResult *result);
 PleatStatus pleat_tfw_result_copy_history(const struct PleatTfwResult *result,
                                           double *dst,
                                           size_t iteration_capacity);
+
+// The transfer defaults (`pleat::transfer::TransferParams::default()`: n_p = 200, envelope
+// 3 d, wrong-input bound 4 d, cast lookup, no skin smoothing), with `struct_size` set.
+struct PleatTransferParams pleat_transfer_params_default(void);
+
+// Computes the correspondence of every vertex of `lod` on `input`, once, for any number of
+// `pleat_transfer_*` calls: per LOD vertex an input triangle and barycentric coordinates,
+// by a cast along the LOD's vertex normal within `envelope_d · d` (nearest hit), else the
+// closest input point. Deterministic, whatever the thread count.
+//
+// - `input`: the mesh the LOD was made from; `lod`: a LOD or cage of it
+//   (`pleat_lod_generate*`, `pleat_cage_generate`); non-NULL, with triangles.
+// - `params`: NULL for the defaults, else from `pleat_transfer_params_default()` with
+//   `screen_size` set to the LOD's.
+// - `out`: non-NULL; receives the handle (destroy with `pleat_transfer_destroy`).
+//
+// Returns `PLEAT_STATUS_INVALID_ARGUMENT` when `input` is not the mesh this LOD was made
+// from: some LOD vertex farther than `max_distance_d · l_lod / n_p` from the input, or a
+// side of the bounding boxes that far apart (the message names the vertex or the side);
+// or when `screen_size` is much larger than the LOD's.
+//
+// # Safety
+// Handles are NULL or live; `params` is NULL or valid for `params->struct_size` bytes.
+PleatStatus pleat_transfer_create(const struct PleatMesh *input,
+                                  const struct PleatMesh *lod,
+                                  const struct PleatTransferParams *params,
+                                  struct PleatTransfer **out);
+
+// Destroys a transfer handle. NULL is accepted and ignored.
+//
+// # Safety
+// `transfer` is NULL or a handle from `pleat_transfer_create` not yet destroyed.
+void pleat_transfer_destroy(struct PleatTransfer *transfer);
+
+// Number of LOD vertices of `transfer` (the rows of every output; 0 when NULL or in a build
+// without `lod`).
+//
+// # Safety
+// `transfer` is NULL or a live handle.
+size_t pleat_transfer_lod_vertex_count(const struct PleatTransfer *transfer);
+
+// Number of input vertices of `transfer` (the rows every input array has; 0 when NULL or
+// in a build without `lod`).
+//
+// # Safety
+// `transfer` is NULL or a live handle.
+size_t pleat_transfer_input_vertex_count(const struct PleatTransfer *transfer);
+
+// Real per-vertex attributes of the input on the LOD's vertices.
+//
+// - `mode`: `PLEAT_TRANSFER_BARYCENTRIC` (interpolated on the corresponding input triangle:
+//   each output is a convex combination of three input rows) or `PLEAT_TRANSFER_NEAREST`
+//   (the row of the nearest corner).
+// - `values`: `n_input × k` floats, row per input vertex, all finite; non-NULL.
+// - `n_input`: the input's vertex count; `k`: components per vertex, 1 to 65536.
+// - `out_values`: `n_lod × k` floats, non-NULL; `n_lod` the LOD's vertex count.
+//
+// `PLEAT_STATUS_INVALID_ARGUMENT` for NULL pointers, a count that is not the handle's, a
+// NaN or infinite value (named), an unknown mode. Nothing is written on failure.
+// Deterministic, whatever the thread count.
+//
+// # Safety
+// `transfer` is NULL or live; arrays are NULL or hold the counts stated.
+PleatStatus pleat_transfer_f32(const struct PleatTransfer *transfer,
+                               uint32_t mode,
+                               const float *values,
+                               size_t n_input,
+                               size_t k,
+                               float *out_values,
+                               size_t n_lod);
+
+// Integer per-vertex attributes of the input (ids, flags, material or group indices) on the
+// LOD's vertices: each LOD vertex gets the row of the nearest corner of its input triangle.
+// Arguments as `pleat_transfer_f32` (no mode).
+//
+// # Safety
+// As `pleat_transfer_f32`.
+PleatStatus pleat_transfer_u32(const struct PleatTransfer *transfer,
+                               const uint32_t *values,
+                               size_t n_input,
+                               size_t k,
+                               uint32_t *out_values,
+                               size_t n_lod);
+
+// Skin weights of the input on the LOD's vertices: per LOD vertex, the influences of its
+// input triangle's corners (each normalised) blended per joint with the barycentric
+// coordinates, the `max_influences` largest kept (ties: lower joint first), sorted by weight
+// descending and renormalised so they sum to 1 within 1e-6; unused slots are joint 0,
+// weight 0. (The rule was chosen by measuring posed LODs of a skinned character; see the
+// `pleat::transfer` module docs.)
+//
+// - `joints`, `weights`: `n_input × m` joint indices and weights (finite, >= 0; 0 marks an
+//   unused slot; every input vertex used by a triangle needs a positive one); non-NULL.
+// - `max_influences`: 1 to 4, or up to 8 when `m` >= it.
+// - `out_joints`, `out_weights`: `n_lod × max_influences` values each; non-NULL.
+//
+// # Safety
+// As `pleat_transfer_f32`.
+PleatStatus pleat_transfer_skin(const struct PleatTransfer *transfer,
+                                const uint32_t *joints,
+                                const float *weights,
+                                size_t n_input,
+                                size_t m,
+                                uint32_t max_influences,
+                                uint32_t *out_joints,
+                                float *out_weights,
+                                size_t n_lod);
 
 // The default evaluation parameters (levels 3, no fields, fixed boundary, corner angle π/6,
 // displacement scale 1, at most 2^26 output triangles), with `struct_size` set. Available in

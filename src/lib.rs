@@ -5,6 +5,8 @@
 //! Capabilities (each a cargo feature; `default` enables all):
 //! - `lod`: any triangle soup in, a watertight, manifold, self-intersection-free low-poly mesh
 //!   out that is indistinguishable from the input at a given screen size (dissertation ch. 4).
+//!   With it, [`transfer`]: the input's per-vertex attributes (UVs, colours, skin weights, morph
+//!   deltas, ids) on a LOD's or cage's vertices.
 //! - `cage`: the same, strictly enclosing the input without touching it (ch. 4.5.2).
 //! - `wrinkle`: complex wrinkle fields — evaluation, interpolation, design (ch. 3); brings the
 //!   numerics module [`solve`] (sparse Cholesky, inverse iteration, Krylov; faer).
@@ -22,7 +24,7 @@
 //! Each module imports only the layers below it (checked by `tests/import_graph.rs`):
 //! [`geom`] (the one vector type), `error` and [`report`] at the bottom; then [`mesh`];
 //! [`spatial`] (the only user of parry's types); [`verify`] (independent checks, never a
-//! pipeline); the pipelines `lowpoly` → `cage` → `bake`, `wrinkle` → `solve`, and `tfw` →
+//! pipeline); the pipelines `lowpoly` → `cage` → `bake` (`bake` also uses `transfer`), `wrinkle` → `solve`, and `tfw` →
 //! `wrinkle`, `solve`; [`ffi`] and
 //! the CLI on top. docs/guide/architecture.md has the table.
 //!
@@ -47,6 +49,9 @@ pub mod verify;
 
 #[cfg(feature = "lod")]
 pub mod lowpoly;
+
+#[cfg(feature = "lod")]
+pub mod transfer;
 
 #[cfg(feature = "cage")]
 pub mod cage;

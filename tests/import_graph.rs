@@ -610,9 +610,13 @@ const LAYERS: &[(&str, &[&str])] = &[
         &["geom", "error", "report", "mesh", "solve", "wrinkle"],
     ),
     (
+        "transfer",
+        &["geom", "error", "report", "mesh", "spatial", "verify"],
+    ),
+    (
         "bake",
         &[
-            "geom", "error", "report", "mesh", "spatial", "verify", "lowpoly", "cage",
+            "geom", "error", "report", "mesh", "spatial", "verify", "lowpoly", "cage", "transfer",
         ],
     ),
     ("ffi", &["*"]),

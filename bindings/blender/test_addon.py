@@ -6,7 +6,9 @@
    checks every new object through pleat's own check (watertight, self-intersection-free);
 2. feeds degenerate meshes (all vertices at one point, a NaN vertex, no faces): each must give
    an error report (RuntimeError from bpy.ops carrying the message), not a crash;
-3. cancels a bake from its progress callback (what Esc does) and checks nothing is added.
+3. cancels a bake from its progress callback (what Esc does) and checks nothing is added;
+4. bakes a rigged object (vertex groups, a shape key, an armature modifier) and checks the LOD
+   keeps all three, transferred by pleat.Transfer.
 
 Mesh: $PLEAT_BLENDER_MESH, else shared/meshes/coarse_spot_1k.obj beside the repository (as CI lays
 it out), else the repository's assets/dirty_two_boxes.obj.
@@ -130,8 +132,57 @@ def cancel_from_the_progress_callback():
     print(f"  cancelled after {len(calls)} progress report(s), nothing kept")
 
 
+def rigged_object_keeps_groups_keys_and_armature():
+    """Two touching boxes rigged to a two-bone armature, with a shape key: the LOD has the same
+    vertex groups (weights summing to 1), shape key and armature modifier."""
+    import numpy as np
+    cube = [(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)]
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    verts = cube + [(x + 1.0, y, z) for x, y, z in cube]
+    faces = quads + [tuple(i + 8 for i in q) for q in quads]
+    me = bpy.data.meshes.new("rigged")
+    me.from_pydata(verts, [], faces)
+    obj = bpy.data.objects.new("rigged", me)
+    bpy.context.scene.collection.objects.link(obj)
+    arm = bpy.data.objects.new("rig", bpy.data.armatures.new("rig"))
+    bpy.context.scene.collection.objects.link(arm)
+    select_only(arm)
+    bpy.ops.object.mode_set(mode="EDIT")
+    for name, x in (("left", 0.5), ("right", 1.5)):
+        bone = arm.data.edit_bones.new(name)
+        bone.head, bone.tail = (x, 0.5, 0.0), (x, 0.5, 1.0)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    for name, ids in (("left", range(8)), ("right", range(8, 16))):
+        obj.vertex_groups.new(name=name).add(list(ids), 1.0, "REPLACE")
+    obj.shape_key_add(name="Basis", from_mix=False)
+    lift = obj.shape_key_add(name="lift", from_mix=False)
+    for v in lift.data:
+        v.co.z += 0.25
+    obj.modifiers.new("Armature", "ARMATURE").object = arm
+    select_only(obj)
+    result = bpy.ops.object.pleat_bake_lods(screen_sizes="20", max_rounds=10)
+    assert result == {"FINISHED"}, result
+    lod = bpy.data.objects["rigged_LOD20"]
+    assert sorted(g.name for g in lod.vertex_groups) == ["left", "right"]
+    sums = np.zeros(len(lod.data.vertices))
+    for v in lod.data.vertices:
+        sums[v.index] = sum(g.weight for g in v.groups)
+    assert np.all(np.abs(sums - 1.0) < 1e-4), sums
+    keys = lod.data.shape_keys.key_blocks
+    assert [k.name for k in keys] == ["Basis", "lift"]
+    n = len(lod.data.vertices)
+    base, up = np.empty(3 * n), np.empty(3 * n)
+    keys["Basis"].data.foreach_get("co", base)
+    keys["lift"].data.foreach_get("co", up)
+    assert np.allclose((up - base).reshape(n, 3), [0.0, 0.0, 0.25], atol=1e-4)
+    mods = [m for m in lod.modifiers if m.type == "ARMATURE"]
+    assert len(mods) == 1 and mods[0].object == arm
+    print(f"  rigged: {n} LOD vertices with groups left/right, shape key lift, armature rig")
+
+
 def main():
     case(bake_corpus_mesh)
+    case(rigged_object_keeps_groups_keys_and_armature)
     case(degenerate_meshes_give_error_reports)
     case(cancel_from_the_progress_callback)
     failed = [n for n, err in results if err]

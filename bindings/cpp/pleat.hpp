@@ -1,7 +1,7 @@
 // pleat.hpp — header-only C++17 RAII wrappers over the C API in pleat.h.
 //
 // Covers the whole C API: meshes (arrays, files, validity report), LODs, LOD chains, cages,
-// offset surfaces with their stats, wrinkle fields (creation, copy-out, Knoppel report,
+// offset surfaces with their stats, attribute transfer to LODs (Transfer), wrinkle fields (creation, copy-out, Knoppel report,
 // evaluation with fields), wrinkle animations (interpolation, frames, history, files) and
 // tension-field wrinkles (TfwScene, TfwResult).
 // Every failing call throws pleat::Error carrying the PleatStatus and pleat's message.
@@ -652,6 +652,90 @@ inline Provenance points_provenance(const Mesh &input, const std::vector<double>
                                   n));
     return p;
 }
+
+/// Default transfer parameters with `screen_size` (the LOD's n_p) set.
+inline PleatTransferParams transfer_params(double screen_size = 200.0) noexcept {
+    PleatTransferParams p = pleat_transfer_params_default();
+    p.screen_size = screen_size;
+    return p;
+}
+
+/// Skin influences on a LOD's vertices (`Transfer::skin`): `influences` slots per vertex,
+/// sorted by weight descending, each vertex's weights summing to 1 within 1e-6.
+struct SkinWeights {
+    size_t influences = 0;
+    std::vector<uint32_t> joints;
+    std::vector<float> weights;
+};
+
+/// The correspondence of a LOD's vertices on the input it was made from (wraps
+/// PleatTransfer*), computed once and applied to any number of per-vertex arrays of the
+/// input. Move-only. Construction throws pleat::Error (PLEAT_STATUS_INVALID_ARGUMENT) when
+/// `input` is not the mesh `lod` was made from at `params.screen_size`.
+class Transfer {
+  public:
+    Transfer() = default;
+    Transfer(const Mesh &input, const Mesh &lod,
+             const PleatTransferParams &params = pleat_transfer_params_default()) {
+        check(pleat_transfer_create(input.get(), lod.get(), &params, &raw_));
+    }
+    Transfer(const Transfer &) = delete;
+    Transfer &operator=(const Transfer &) = delete;
+    Transfer(Transfer &&o) noexcept : raw_(std::exchange(o.raw_, nullptr)) {}
+    Transfer &operator=(Transfer &&o) noexcept {
+        if (this != &o) {
+            pleat_transfer_destroy(raw_);
+            raw_ = std::exchange(o.raw_, nullptr);
+        }
+        return *this;
+    }
+    ~Transfer() { pleat_transfer_destroy(raw_); }
+
+    size_t lod_vertex_count() const noexcept { return pleat_transfer_lod_vertex_count(raw_); }
+    size_t input_vertex_count() const noexcept {
+        return pleat_transfer_input_vertex_count(raw_);
+    }
+
+    /// `values` (input vertex count × k) on the LOD's vertices (LOD vertex count × k), by
+    /// `mode` (PLEAT_TRANSFER_BARYCENTRIC or PLEAT_TRANSFER_NEAREST).
+    std::vector<float> f32(const std::vector<float> &values, size_t k,
+                           uint32_t mode = PLEAT_TRANSFER_BARYCENTRIC) const {
+        std::vector<float> out(k * lod_vertex_count());
+        check(pleat_transfer_f32(raw_, mode, values.data(), rows(values.size(), k), k,
+                                 out.data(), lod_vertex_count()));
+        return out;
+    }
+    /// Integer attributes (ids, flags): the nearest corner's row.
+    std::vector<uint32_t> u32(const std::vector<uint32_t> &values, size_t k) const {
+        std::vector<uint32_t> out(k * lod_vertex_count());
+        check(pleat_transfer_u32(raw_, values.data(), rows(values.size(), k), k, out.data(),
+                                 lod_vertex_count()));
+        return out;
+    }
+    /// Skin weights (input vertex count × m joints and weights) on the LOD's vertices, at
+    /// most `max_influences` per vertex.
+    SkinWeights skin(const std::vector<uint32_t> &joints, const std::vector<float> &weights,
+                     size_t m, uint32_t max_influences = 4) const {
+        if (joints.size() != weights.size())
+            throw Error(PLEAT_STATUS_INVALID_ARGUMENT, "joints and weights differ in length");
+        size_t n = lod_vertex_count();
+        SkinWeights s{max_influences, std::vector<uint32_t>(max_influences * n),
+                      std::vector<float>(max_influences * n)};
+        check(pleat_transfer_skin(raw_, joints.data(), weights.data(), rows(joints.size(), m),
+                                  m, max_influences, s.joints.data(), s.weights.data(), n));
+        return s;
+    }
+
+    PleatTransfer *get() const noexcept { return raw_; }
+
+  private:
+    /// Rows of an array of `size` values with `k` per row (a size that is not a multiple
+    /// gives a count pleat refuses).
+    static size_t rows(size_t size, size_t k) noexcept {
+        return k == 0 || size % k != 0 ? SIZE_MAX : size / k;
+    }
+    PleatTransfer *raw_ = nullptr;
+};
 
 /// Default bake parameters with `screen_size` (the LOD's n_p) set.
 inline PleatBakeParams bake_params(double screen_size = 200.0) noexcept {

@@ -638,7 +638,7 @@ impl Appearance {
                 .iter()
                 .map(|&v| normalized(Vec3::from(v)).unwrap_or(Vec3::ZERO).to_array())
                 .collect(),
-            None => super::provenance::vertex_normals(b.mesh),
+            None => crate::transfer::provenance::vertex_normals(b.mesh),
         };
         // Per-corner UVs: vertex 3t + k copies corner k of triangle t.
         let corners: Option<Vec<u32>> = match b.uvs {

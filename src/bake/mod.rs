@@ -6,7 +6,9 @@
 //!   vertex colours, normals and tangents, in world space.
 //! - [`obj`]: the same from a Wavefront OBJ + MTL (`Kd`, `map_Kd`, `vt`, several materials).
 //! - [`provenance`](mod@provenance): LOD point → input triangle and barycentric coordinates (cast along the
-//!   LOD normal within an envelope of a few `d`, closest point as fallback).
+//!   LOD normal within an envelope of a few `d`, closest point as fallback); it lives in
+//!   [`crate::transfer::provenance`] (feature `lod`, shared with attribute transfer) and is
+//!   re-exported here.
 //! - [`atlas`]: xatlas charts and packing with a texel density rule from the screen size.
 //! - [`bake`](mod@bake): per-texel sampling, MikkTSpace normal map, dilation; vertex colours
 //!   for untextured inputs.
@@ -25,7 +27,7 @@ pub mod bake;
 pub mod level;
 pub mod obj;
 pub mod output;
-pub mod provenance;
+pub use crate::transfer::provenance;
 pub mod render;
 
 pub use appearance::{

@@ -34,9 +34,9 @@ use rayon::prelude::*;
 
 use super::appearance::{linear_to_srgb, srgb_to_linear, Appearance};
 use super::level::{BakedLevel, Image8};
-use super::provenance::barycentric;
 use crate::geom::{normalized, Vec3};
 use crate::spatial::TriangleBvh;
+use crate::transfer::provenance::barycentric;
 
 /// A pinhole camera with a square image.
 #[derive(Debug, Clone, Copy, PartialEq)]

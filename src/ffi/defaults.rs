@@ -31,6 +31,22 @@ fn lod_params_default_is_rust_default() {
 
 #[cfg(feature = "lod")]
 #[test]
+fn transfer_params_default_is_rust_default() {
+    let c = pleat_transfer_params_default();
+    assert_eq!(
+        c.struct_size as usize,
+        std::mem::size_of::<PleatTransferParams>()
+    );
+    let rust = transfer::imp::to_rust(&c).expect("the C default is valid");
+    assert_eq!(rust, crate::transfer::TransferParams::default());
+    assert_eq!(
+        c.skin_smoothing,
+        crate::transfer::SkinParams::default().smoothing_iterations
+    );
+}
+
+#[cfg(feature = "lod")]
+#[test]
 fn offset_params_default_is_rust_default() {
     let c = pleat_offset_params_default();
     assert_eq!(

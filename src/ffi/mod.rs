@@ -30,6 +30,7 @@ mod offset;
 mod report;
 mod stats;
 mod tfw;
+mod transfer;
 mod wrinkle;
 
 pub use bake::*;
@@ -43,6 +44,7 @@ pub use offset::*;
 pub use report::*;
 pub use stats::*;
 pub use tfw::*;
+pub use transfer::*;
 pub use wrinkle::*;
 
 #[cfg(test)]

@@ -6,6 +6,13 @@ through its Python package (ctypes), and adds each level as a new object ``<name
 (plus ``<name>_cage<n_p>`` when "Cage" is on) next to the source, with the bake's statistics as
 custom properties (``pleat_faces``, ``pleat_hausdorff_relative``, ``pleat_verified``).
 
+Rigged and morphed sources: a LOD (or cage) of an object with vertex groups, shape keys or an
+armature modifier keeps them: the vertex groups (same names; weights interpolated at each LOD
+vertex's corresponding point on the source, ``pleat.Transfer``), the shape keys (same names;
+their deltas interpolated the same way) and the armature modifiers (same armature object), so
+the LOD deforms with the rig. Such objects are baked from their base mesh (no modifiers, the
+rest pose) so that the attributes line up with the vertices they belong to.
+
 Guarantees (pleat's): every level is watertight, manifold and self-intersection-free, each
 verified by the library; a cage encloses the source without touching it. Meshes are baked in
 world space (screen size is about what is seen), so the new objects have an identity transform.
@@ -91,9 +98,96 @@ def object_arrays(obj, depsgraph):
     return np.ascontiguousarray(co), tri.reshape(m, 3).astype(np.uint32)
 
 
-def new_object(name, positions, triangles, like, stats):
+def has_rig(obj):
+    """True when ``obj`` has vertex groups, shape keys or an armature modifier (attributes a
+    LOD keeps, through ``pleat.Transfer``)."""
+    return bool(obj.vertex_groups) or obj.data.shape_keys is not None or any(
+        m.type == "ARMATURE" for m in obj.modifiers)
+
+
+def base_arrays(obj):
+    """World-space (positions float64 (n, 3), triangles uint32 (m, 3)) of the object's own
+    mesh, without modifiers (the rest pose): vertex i is the mesh's vertex i."""
+    import numpy as np
+    me = obj.data
+    me.calc_loop_triangles()
+    n, m = len(me.vertices), len(me.loop_triangles)
+    co = np.empty(3 * n, dtype=np.float64)
+    me.vertices.foreach_get("co", co)
+    tri = np.empty(3 * m, dtype=np.int32)
+    me.loop_triangles.foreach_get("vertices", tri)
+    world = np.array(obj.matrix_world, dtype=np.float64)
+    co = co.reshape(n, 3) @ world[:3, :3].T + world[:3, 3]
+    return np.ascontiguousarray(co), tri.reshape(m, 3).astype(np.uint32)
+
+
+def object_attributes(obj):
+    """The per-vertex attributes a LOD keeps, as plain arrays (no bpy): ``groups`` (names,
+    weights float32 (n, G)), ``shape_keys`` [(name, world-space deltas float32 (n, 3))]."""
+    import numpy as np
+    me = obj.data
+    n = len(me.vertices)
+    names = [g.name for g in obj.vertex_groups]
+    weights = np.zeros((n, len(names)), dtype=np.float32)
+    for v in me.vertices:
+        for g in v.groups:
+            if g.group < len(names):
+                weights[v.index, g.group] = g.weight
+    keys = []
+    if me.shape_keys is not None:
+        basis = me.shape_keys.reference_key
+        base = np.empty(3 * n, dtype=np.float64)
+        basis.data.foreach_get("co", base)
+        rot = np.array(obj.matrix_world, dtype=np.float64)[:3, :3]
+        for kb in me.shape_keys.key_blocks:
+            if kb.name == basis.name:
+                continue
+            co = np.empty(3 * n, dtype=np.float64)
+            kb.data.foreach_get("co", co)
+            keys.append((kb.name, ((co - base).reshape(n, 3) @ rot.T).astype(np.float32)))
+    return {"groups": (names, weights), "shape_keys": keys}
+
+
+def transfer_attributes(pleat, source, level, screen_size, attrs):
+    """``attrs`` (from ``object_attributes``) on the vertices of ``level``, a LOD or cage of
+    ``source`` (pleat Meshes) at ``screen_size``: the same structure, LOD rows. No bpy."""
+    import numpy as np
+    names, weights = attrs["groups"]
+    with pleat.Transfer(source, level, screen_size=screen_size) as t:
+        lod_weights = (t.f32(weights) if names else
+                       np.zeros((level.vertex_count, 0), dtype=np.float32))
+        keys = [(name, t.f32(deltas)) for name, deltas in attrs["shape_keys"]]
+    return {"groups": (names, lod_weights), "shape_keys": keys}
+
+
+def apply_attributes(obj, positions, like, attrs):
+    """Gives ``obj`` (made from ``positions``) the transferred vertex groups and shape keys and
+    ``like``'s armature modifiers."""
+    import numpy as np
+    names, weights = attrs["groups"]
+    for g, name in enumerate(names):
+        vg = obj.vertex_groups.new(name=name)
+        column = weights[:, g]
+        for i in np.flatnonzero(column > 0.0):
+            vg.add([int(i)], float(column[i]), "REPLACE")
+    if attrs["shape_keys"]:
+        obj.shape_key_add(name="Basis", from_mix=False)
+        base = np.asarray(positions, dtype=np.float64)
+        for name, deltas in attrs["shape_keys"]:
+            kb = obj.shape_key_add(name=name, from_mix=False)
+            kb.data.foreach_set("co", (base + deltas).astype(np.float32).ravel())
+    for m in like.modifiers:
+        if m.type == "ARMATURE":
+            new = obj.modifiers.new(m.name, "ARMATURE")
+            new.object = m.object
+            new.use_vertex_groups = m.use_vertex_groups
+            new.use_bone_envelopes = m.use_bone_envelopes
+
+
+def new_object(name, positions, triangles, like, stats, attrs=None):
     """A new mesh object from arrays, linked to ``like``'s first collection, with ``stats``
-    (a dict of numbers/bools) copied to ``pleat_*`` custom properties."""
+    (a dict of numbers/bools) copied to ``pleat_*`` custom properties, and the transferred
+    attributes ``attrs`` (``transfer_attributes``) with ``like``'s armature modifiers."""
     import numpy as np
     m = len(triangles)
     me = bpy.data.meshes.new(name)
@@ -117,6 +211,8 @@ def new_object(name, positions, triangles, like, stats):
             obj["pleat_" + key] = bool(value) if isinstance(value, bool) else float(value)
     obj["pleat_verified"] = bool(stats.get("watertight") and stats.get("manifold")
                                  and stats.get("self_intersection_free"))
+    if attrs is not None:
+        apply_attributes(obj, positions, like, attrs)
     return obj
 
 
@@ -134,13 +230,17 @@ class Job:
     """Bakes LOD chains (and cages) of a list of (name, positions, triangles). Thread-safe
     progress (``fraction``, ``stage``) and cancellation (``cancel()``); results in ``done``
     as (name, kind, n_p, positions, triangles, stats), errors in ``errors`` as (name, message).
-    One failing object does not stop the others; a cancel stops the job."""
+    One failing object does not stop the others; a cancel stops the job. ``attributes`` maps a
+    source name to its ``object_attributes``; each of its levels then gets them transferred,
+    in ``transferred[(name, kind, n_p)]``."""
 
-    def __init__(self, pleat, sources, sizes, params, cage_size=None):
+    def __init__(self, pleat, sources, sizes, params, cage_size=None, attributes=None):
         self.pleat, self.sources, self.sizes = pleat, sources, sizes
         self.params, self.cage_size = params, cage_size
+        self.attributes = attributes or {}
         self.fraction, self.stage = 0.0, ""
         self.done, self.errors = [], []
+        self.transferred = {}
         self._cancel = threading.Event()
         self.finished = threading.Event()
 
@@ -181,17 +281,25 @@ class Job:
                                        **self.params)
                 for n_p, level in zip(self.sizes, chain):
                     with level:
-                        self.done.append((name, "LOD", n_p, level.positions(),
-                                          level.triangles(), dict(level.stats)))
+                        self._keep(name, "LOD", n_p, mesh, level)
                 if self.cage_size:
                     with mesh.cage(self.cage_size, progress=self._progress(index, 1, parts),
                                    **self.params) as cage:
-                        self.done.append((name, "cage", self.cage_size, cage.positions(),
-                                          cage.triangles(), dict(cage.stats)))
+                        self._keep(name, "cage", self.cage_size, mesh, cage)
         except pleat.PleatError as e:
             if e.status == "CANCELLED" or self._cancel.is_set():
                 raise Cancelled() from e
             self.errors.append((name, f"{e}"))
+
+
+    def _keep(self, name, kind, n_p, source, level):
+        """Records a baked level, with the source's attributes transferred onto it."""
+        self.done.append((name, kind, n_p, level.positions(), level.triangles(),
+                          dict(level.stats)))
+        attrs = self.attributes.get(name)
+        if attrs is not None:
+            self.transferred[(name, kind, n_p)] = transfer_attributes(
+                self.pleat, source, level, n_p, attrs)
 
 
 def parse_sizes(text):
@@ -243,10 +351,12 @@ class OBJECT_OT_pleat_bake_lods(bpy.types.Operator):
             self.report({"ERROR"}, "pleat: select at least one mesh object")
             return None
         depsgraph = context.evaluated_depsgraph_get()
-        sources = [(o.name, *object_arrays(o, depsgraph)) for o in objects]
+        sources = [(o.name, *(base_arrays(o) if has_rig(o) else object_arrays(o, depsgraph)))
+                   for o in objects]
+        attributes = {o.name: object_attributes(o) for o in objects if has_rig(o)}
         params = {"max_rounds": self.max_rounds, "align": self.align}
         job = Job(pleat, sources, sizes, params,
-                  self.cage_screen_size if self.cage else None)
+                  self.cage_screen_size if self.cage else None, attributes)
         return job, {o.name: o for o in objects}
 
     def _finish(self, context, job, by_name):
@@ -262,7 +372,8 @@ class OBJECT_OT_pleat_bake_lods(bpy.types.Operator):
         added = []
         for name, kind, n_p, positions, triangles, stats in job.done:
             label = f"{name}_{kind}{n_p:g}"
-            added.append(new_object(label, positions, triangles, by_name[name], stats))
+            added.append(new_object(label, positions, triangles, by_name[name], stats,
+                                    job.transferred.get((name, kind, n_p))))
         for obj in added:
             obj.select_set(True)
         cancelled = any(msg == "cancelled" for _, msg in job.errors)

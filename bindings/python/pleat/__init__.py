@@ -1664,3 +1664,119 @@ class TfwResult(_Handle):
         s = self.stats
         return (f"<pleat.TfwResult {s['status']}, {s['vertex_count']} vertices, "
                 f"{s['sqp_iterations']} SQP iterations>")
+
+
+# --- attribute transfer to LODs (capability "lod") -----------------------------------------
+
+_TransferParams = _struct("PleatTransferParams", _u32s("struct_size", "lookup")
+                          + _f64s("screen_size", "envelope_d", "max_distance_d")
+                          + _u32s("skin_smoothing", "reserved"))
+for _name, _res, _args in [
+    ("pleat_transfer_params_default", _TransferParams, ()),
+    ("pleat_transfer_create", _st, (_P, _P, _c.POINTER(_TransferParams), _PP)),
+    ("pleat_transfer_destroy", None, (_P,)),
+    ("pleat_transfer_lod_vertex_count", _sz, (_P,)),
+    ("pleat_transfer_input_vertex_count", _sz, (_P,)),
+    ("pleat_transfer_f32", _st, (_P, _u32, _F, _sz, _sz, _F, _sz)),
+    ("pleat_transfer_u32", _st, (_P, _U, _sz, _sz, _U, _sz)),
+    ("pleat_transfer_skin", _st, (_P, _U, _F, _sz, _sz, _u32, _U, _F, _sz)),
+]:
+    _sig(_name, _res, *_args)
+if _lib.pleat_transfer_params_default().struct_size != _c.sizeof(_TransferParams):
+    raise ImportError(f"{_path}: PleatTransferParams is "
+                      f"{_lib.pleat_transfer_params_default().struct_size} bytes in the library, "
+                      f"{_c.sizeof(_TransferParams)} in this module")
+_TRANSFER_MODES = {"barycentric": 0, "nearest": 1}
+_LOOKUPS = {"cast": 0, "closest": 1}
+
+
+def _rows(values, n, dtype, what):
+    """``values`` as a contiguous 2-D (n, k) array of ``dtype``: (n,) is taken as (n, 1)."""
+    a = _np.asarray(values)
+    if a.ndim == 1:
+        a = a.reshape(-1, 1)
+    if a.ndim != 2 or a.shape[0] != n:
+        raise PleatError(1, f"{what}: shape {_np.shape(values)}; ({n}, k) needed (one row per "
+                            f"input vertex)")
+    return _np.ascontiguousarray(a, dtype=dtype)
+
+
+class Transfer(_Handle):
+    """The correspondence of a LOD's vertices on the input it was made from, computed once
+    (``pleat_transfer_create``) and applied to any number of per-vertex arrays of the input:
+    ``f32`` (UVs, colours, morph deltas; barycentric or nearest), ``u32`` (ids, groups) and
+    ``skin`` (joints + weights, top-k, renormalised). Raises PleatError (INVALID_ARGUMENT)
+    when ``input`` is not the mesh ``lod`` was made from at ``screen_size``. Deterministic,
+    whatever the thread count."""
+
+    _destroy = "pleat_transfer_destroy"
+
+    def __init__(self, input, lod, screen_size=200.0, lookup="cast", envelope_d=3.0,
+                 max_distance_d=4.0, skin_smoothing=0):
+        if lookup not in _LOOKUPS:
+            raise ValueError(f"lookup must be one of {sorted(_LOOKUPS)}, got {lookup!r}")
+        p = _lib.pleat_transfer_params_default()
+        p.screen_size, p.envelope_d, p.max_distance_d = (float(screen_size), float(envelope_d),
+                                                         float(max_distance_d))
+        p.lookup, p.skin_smoothing = _LOOKUPS[lookup], int(skin_smoothing)
+        h = _P()
+        _check(_lib.pleat_transfer_create(input._h, lod._h, _c.byref(p), _c.byref(h)))
+        super().__init__(h)
+
+    @property
+    def lod_vertex_count(self):
+        return int(_lib.pleat_transfer_lod_vertex_count(self._h))
+
+    @property
+    def input_vertex_count(self):
+        return int(_lib.pleat_transfer_input_vertex_count(self._h))
+
+    def f32(self, values, mode="barycentric"):
+        """``values`` (n_input, k) (or (n_input,)) on the LOD's vertices: float32 (n_lod, k)."""
+        if mode not in _TRANSFER_MODES:
+            raise ValueError(f"mode must be one of {sorted(_TRANSFER_MODES)}, got {mode!r}")
+        n = self.input_vertex_count
+        a = _rows(values, n, _np.float32, "values")
+        k, m = a.shape[1], self.lod_vertex_count
+        out = _np.empty((max(m, 1), max(k, 1)), dtype=_np.float32)
+        _check(_lib.pleat_transfer_f32(self._h, _TRANSFER_MODES[mode],
+                                       _ptr(a if a.size else _np.zeros(1, _np.float32),
+                                            _c.c_float), n, k, _ptr(out, _c.c_float), m))
+        return out[:m, :k]
+
+    def u32(self, values):
+        """Integer ``values`` (n_input, k): the nearest corner's row, uint32 (n_lod, k)."""
+        n = self.input_vertex_count
+        a = _np.asarray(values)
+        if a.size and a.dtype.kind not in "iu":
+            raise PleatError(1, f"values: integers needed, got {a.dtype}")
+        if a.size and (a.min() < 0 or a.max() > 0xFFFFFFFF):
+            raise PleatError(1, "values must be in [0, 2^32)")
+        a = _rows(a, n, _np.uint32, "values")
+        k, m = a.shape[1], self.lod_vertex_count
+        out = _np.empty((max(m, 1), max(k, 1)), dtype=_np.uint32)
+        _check(_lib.pleat_transfer_u32(self._h, _ptr(a if a.size else _np.zeros(1, _np.uint32),
+                                                     _c.c_uint32), n, k,
+                                       _ptr(out, _c.c_uint32), m))
+        return out[:m, :k]
+
+    def skin(self, joints, weights, max_influences=4):
+        """Skin weights: ``joints`` (n_input, m) integers and ``weights`` (n_input, m) on the
+        LOD's vertices, ``(joints uint32 (n_lod, k), weights float32 (n_lod, k))`` with
+        k = ``max_influences``, sorted by weight, each row summing to 1 within 1e-6."""
+        n = self.input_vertex_count
+        j = _rows(_indices(joints, "joints").reshape(_np.shape(joints)), n, _np.uint32,
+                  "joints")
+        w = _rows(weights, n, _np.float32, "weights")
+        if j.shape != w.shape:
+            raise PleatError(1, f"joints {j.shape} and weights {w.shape} differ in shape")
+        k, lm = int(max_influences), self.lod_vertex_count
+        oj = _np.zeros((max(lm, 1), max(k, 1)), dtype=_np.uint32)
+        ow = _np.zeros((max(lm, 1), max(k, 1)), dtype=_np.float32)
+        _check(_lib.pleat_transfer_skin(self._h, _ptr(j, _c.c_uint32), _ptr(w, _c.c_float), n,
+                                        j.shape[1], k, _ptr(oj, _c.c_uint32),
+                                        _ptr(ow, _c.c_float), lm))
+        return oj[:lm, :k], ow[:lm, :k]
+
+
+__all__.append("Transfer")

@@ -10,9 +10,9 @@ use super::textured::bake_textured;
 use super::vertex_colors::bake_vertex_colors;
 use crate::bake::appearance::Appearance;
 use crate::bake::level::BakedLevel;
-use crate::bake::provenance::{InputIndex, ProvenanceParams};
 use crate::mesh::TriMesh;
 use crate::report::ProgressFn;
+use crate::transfer::provenance::{InputIndex, ProvenanceParams};
 use crate::{Error, Result};
 
 /// Bakes `app`'s appearance onto `lod`, a LOD of `app.mesh` made for screen size `screen_size`.

@@ -7,8 +7,8 @@ use rayon::prelude::*;
 use super::sample::TexelCtx;
 use crate::bake::appearance::{linear_to_srgb, Appearance};
 use crate::bake::level::{BakeReport, Image8};
-use crate::bake::provenance::InputIndex;
 use crate::geom::Vec3;
+use crate::transfer::provenance::InputIndex;
 
 /// |baked − input at the closest input point|, max over RGB, in sRGB 1/255 (`baked` linear).
 pub(super) fn color_error(

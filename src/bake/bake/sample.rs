@@ -7,8 +7,8 @@ use super::rasterize::Coverage;
 use super::tangents::tangent_coords;
 use crate::bake::appearance::{linear_to_srgb, Appearance, MaterialSample};
 use crate::bake::atlas::Atlas;
-use crate::bake::provenance::{InputIndex, ProvenanceParams};
 use crate::geom::{normalized, Vec3};
+use crate::transfer::provenance::{InputIndex, ProvenanceParams};
 
 /// Texels baked between two progress reports (and cancellation checks): about 10 ms of work
 /// on one core, so a cancel takes effect well within 0.1 s.

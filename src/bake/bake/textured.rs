@@ -20,8 +20,8 @@ use crate::bake::atlas::{
     build_atlas_growing, deepest_mip, footprint_owners, triangle_charts, Gutter,
 };
 use crate::bake::level::{BakeReport, BakedLevel, Image8};
-use crate::bake::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 use crate::mesh::TriMesh;
+use crate::transfer::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 use crate::Result;
 
 #[allow(clippy::too_many_arguments)]

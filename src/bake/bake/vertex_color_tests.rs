@@ -8,10 +8,10 @@ use super::vertex_colors::*;
 use crate::bake::appearance::Appearance;
 use crate::bake::appearance::{AppearanceBuffers, BufferMaterial};
 use crate::bake::atlas::Atlas;
-use crate::bake::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 use crate::geom::Vec3;
 use crate::mesh::test_shapes::grid;
 use crate::mesh::TriMesh;
+use crate::transfer::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 
 /// `grid(n, n)` scaled to the unit square, lifted to height `z`.
 fn square(n: u32, z: f64) -> TriMesh {

@@ -13,9 +13,9 @@ use super::params::{BakeParams, VertexColors};
 use super::progress::Steps;
 use crate::bake::appearance::{linear_to_srgb, Appearance};
 use crate::bake::level::{BakeReport, BakedLevel};
-use crate::bake::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 use crate::geom::{normalized, Vec3};
 use crate::mesh::TriMesh;
+use crate::transfer::provenance::{vertex_normals, InputIndex, ProvenanceParams};
 use crate::Result;
 
 /// Surface samples the [`VertexColors::Auto`] decision compares at most.

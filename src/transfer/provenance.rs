@@ -9,6 +9,9 @@
 //! back to the closest point of the input. Ties are broken by the lower triangle index, and the
 //! queries run in parallel with rayon but each is independent, so the result does not depend
 //! on the thread count.
+//!
+//! Used by [`Correspondence`](super::Correspondence) (attribute transfer, feature `lod`) and
+//! by textured bakes (`crate::bake`, which re-exports this module).
 
 use rayon::prelude::*;
 
