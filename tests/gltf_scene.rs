@@ -410,8 +410,17 @@ fn assert_valid(file: &Path) {
         .iter()
         .filter(|m| m["severity"] == 0)
         .collect();
+    let mut warnings: Vec<&str> = issues["messages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["severity"] == 1)
+        .filter_map(|m| m["code"].as_str())
+        .collect();
+    warnings.sort_unstable();
+    warnings.dedup();
     eprintln!(
-        "glTF-Validator {}: {} errors, {} warnings, {} infos",
+        "glTF-Validator {}: {} errors, {} warnings {warnings:?}, {} infos",
         file.display(),
         issues["numErrors"],
         issues["numWarnings"],

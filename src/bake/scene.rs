@@ -274,6 +274,8 @@ pub enum Kept {
         /// Triangles of the LOD that was discarded.
         lod_faces: usize,
     },
+    /// The mesh has at most 4 triangles: no closed LOD (a tetrahedron at least) has fewer.
+    Minimal,
     /// The mesh is skinned or has morph targets and [`transfer_deformation`] gave nothing.
     Deformable,
     /// The LOD pipeline or the bake failed on this mesh (the message).
@@ -287,6 +289,7 @@ impl std::fmt::Display for Kept {
             Kept::NotSmaller { lod_faces } => {
                 write!(f, "unchanged (the LOD had {lod_faces} faces, not fewer)")
             }
+            Kept::Minimal => write!(f, "unchanged (no closed LOD has fewer faces)"),
             Kept::Deformable => write!(
                 f,
                 "unchanged (skinned/morphed: kept, weight transfer not applied)"
@@ -329,6 +332,10 @@ pub struct MeshChain {
     /// Wall seconds spent on this mesh (geometry and bake).
     pub seconds: f64,
 }
+
+/// Triangles of the smallest closed mesh (a tetrahedron): a mesh with at most this many is
+/// kept without running the pipeline, whose output is always closed.
+const MIN_CLOSED_FACES: usize = 4;
 
 /// Per-vertex deformation attributes of a LOD: what a skinned or morphed mesh's level needs.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -427,6 +434,8 @@ pub fn lod_scene(
         };
         let levels = if scene.is_deformable(m) && !DEFORMATION_TRANSFER {
             kept_all(Kept::Deformable)
+        } else if faces <= MIN_CLOSED_FACES {
+            kept_all(Kept::Minimal)
         } else if let Some(budget) = params.lod.target_faces.filter(|&f| faces <= f) {
             kept_all(Kept::AtBudget { budget })
         } else {
@@ -652,7 +661,7 @@ pub fn scene_glb(scene: &GltfScene, chains: &[MeshChain], opts: &WriteOptions) -
     let wanted = |s: f64| {
         opts.only_sizes
             .as_ref()
-            .is_none_or(|o| o.iter().any(|&x| x == s))
+            .is_none_or(|o| o.contains(&s))
     };
     // Baked images, encoded in the order the levels are written.
     let baked: Vec<&BakedLevel> = chains
