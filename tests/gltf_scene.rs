@@ -190,13 +190,15 @@ fn rich_scene() -> Vec<u8> {
         "attributes": {"POSITION": b.positions(&tp)}, "indices": b.indices(&tt), "material": 1}]});
     // Skinned column: two joints, weights by height.
     let (sp, st) = grid_box(3, 0.3, 3.0);
-    let joints: Vec<u8> = sp.iter().flat_map(|_| [0u8, 1, 0, 0]).collect();
+    let height = |p: &[f32; 3]| ((p[1] + 0.9) / 1.8).clamp(0.0, 1.0);
+    // Joint 1 only where it has weight (a non-zero joint index with zero weight is flagged).
+    let joints: Vec<u8> = sp
+        .iter()
+        .flat_map(|p| [0u8, u8::from(height(p) > 0.0), 0, 0])
+        .collect();
     let weights: Vec<f32> = sp
         .iter()
-        .flat_map(|p| {
-            let w = ((p[1] + 0.9) / 1.8).clamp(0.0, 1.0);
-            [1.0 - w, w, 0.0, 0.0]
-        })
+        .flat_map(|p| [1.0 - height(p), height(p), 0.0, 0.0])
         .collect();
     let jv = b.view(&joints, Some(34962));
     b.accessors.push(
@@ -612,6 +614,32 @@ fn scene_survives_with_one_chain_per_mesh() {
         .starts_with("Box_LOD"));
     assert!(mesh_faces(&bdoc, m) < box_faces);
 
+    // JSON glTF with an external buffer: the same document, embedded into one GLB.
+    let (mut jdoc, bin) = parse_glb(&std::fs::read(&input).unwrap());
+    jdoc["buffers"][0]["uri"] = json!("scene data.bin");
+    std::fs::write(dir.join("scene data.bin"), &bin).unwrap();
+    let gltf_in = dir.join("scene.gltf");
+    std::fs::write(&gltf_in, serde_json::to_vec(&jdoc).unwrap()).unwrap();
+    let from_json = dir.join("from_json.glb");
+    lod(&gltf_in, &from_json, &["--screen-size", "100,50", "-q"], 1);
+    let (jout, _) = parse_glb(&std::fs::read(&from_json).unwrap());
+    assert_eq!(jout["nodes"], doc["nodes"]);
+    assert!(jout["buffers"][0]["uri"].is_null());
+    assert_valid(&from_json);
+
+    // Cages of each mesh, written the same way.
+    let cages = dir.join("cages.glb");
+    let o = Command::new(env!("CARGO_BIN_EXE_pleat"))
+        .args(["cage", input.to_str().unwrap(), "--screen-size", "50", "-o"])
+        .arg(&cages)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (cdoc, _) = parse_glb(&std::fs::read(&cages).unwrap());
+    assert_eq!(names(&cdoc, "skins"), names(&src, "skins"));
+    assert!(!cdoc["nodes"][1]["extensions"]["MSFT_lod"].is_null());
+    assert_valid(&cages);
+
     // --merge: today's one fused proxy.
     let merged = dir.join("merged.glb");
     lod(
@@ -726,6 +754,23 @@ fn shared_textured_assets_give_valid_scenes() {
                     assert!(mesh_faces(&doc, m as usize) <= own, "{stem}");
                 }
             }
+            assert_valid(&out);
+        }
+    }
+    // --merge never returns more faces than the input soup (10 triangles here, whose closed
+    // proxy needs more).
+    let tiny = assets.join("khronos_texture_coordinate_test.glb");
+    if tiny.is_file() {
+        for extra in [None, Some("--bake")] {
+            let out = dir.join("merged_tc.glb");
+            let mut args = vec!["--screen-size", "100", "--merge", "-q"];
+            args.extend(extra);
+            lod(&tiny, &out, &args, 2);
+            let (doc, _) = parse_glb(&std::fs::read(&out).unwrap());
+            let faces: usize = (0..doc["meshes"].as_array().unwrap().len())
+                .map(|m| mesh_faces(&doc, m))
+                .sum();
+            assert!(faces <= 10, "--merge {extra:?}: {faces} faces for 10");
             assert_valid(&out);
         }
     }

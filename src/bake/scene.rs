@@ -658,11 +658,7 @@ pub fn scene_glb(scene: &GltfScene, chains: &[MeshChain], opts: &WriteOptions) -
     };
     let mut samplers = take(root, "samplers");
     let mut nodes = take(root, "nodes");
-    let wanted = |s: f64| {
-        opts.only_sizes
-            .as_ref()
-            .is_none_or(|o| o.contains(&s))
-    };
+    let wanted = |s: f64| opts.only_sizes.as_ref().is_none_or(|o| o.contains(&s));
     // Baked images, encoded in the order the levels are written.
     let baked: Vec<&BakedLevel> = chains
         .iter()
