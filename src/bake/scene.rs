@@ -679,11 +679,12 @@ pub fn scene_glb(scene: &GltfScene, chains: &[MeshChain], opts: &WriteOptions) -
     for chain in chains {
         // (screen size, mesh of the level) of the written levels, finest first.
         let mut levels: Vec<(f64, usize)> = Vec::new();
-        for (k, l) in chain.levels.iter().enumerate() {
+        for l in &chain.levels {
             if !wanted(l.screen_size) {
                 continue;
             }
-            let name = format!("{}_LOD{}", chain.name, k + 1);
+            // Level k (1 = finest written) of the mesh; its level nodes carry the same k.
+            let name = format!("{}_LOD{}", chain.name, levels.len() + 1);
             let mesh = match (&l.lod, &l.baked) {
                 (_, Some(b)) => push_level(b, &name, &mut encoded, sampler, &mut bin, &mut arrays)?,
                 (Some(lod), None) => {
