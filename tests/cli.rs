@@ -446,7 +446,7 @@ fn wrinkle_demo_script_runs() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// `pleat lod IN.glb --bake` writes one GLB holding the chain, readable as glTF.
+/// `pleat lod IN.glb --bake --merge` writes one GLB holding the merged chain, readable as glTF.
 #[cfg(feature = "bake")]
 #[test]
 fn lod_bake_writes_one_glb_chain() {
@@ -472,6 +472,7 @@ fn lod_bake_writes_one_glb_chain() {
             "--screen-size",
             "25,50",
             "--bake",
+            "--merge",
             "-q",
             "-o",
         ])
@@ -487,7 +488,7 @@ fn lod_bake_writes_one_glb_chain() {
     let one = dir.join("one.glb");
     let status = std::process::Command::new(env!("CARGO_BIN_EXE_pleat"))
         .args(["lod", asset.to_str().unwrap(), "--screen-size", "50"])
-        .args(["--faces", "60", "--bake", "-q", "-o"])
+        .args(["--faces", "60", "--bake", "--merge", "-q", "-o"])
         .arg(&one)
         .status()
         .unwrap();

@@ -779,8 +779,51 @@ pub fn read_appearance_bytes(
     reader.finish()
 }
 
+/// Reads the appearance of one glTF mesh (index `mesh`) alone, in the mesh's local space: its
+/// triangle primitives in order with no node transform, materials, textures, UV sets, colours,
+/// normals and tangents read exactly as [`read_appearance_bytes`] reads them for one instance
+/// under an identity transform. This is the appearance a per-mesh LOD chain is baked from
+/// (`bake::scene`). Errors as [`read_appearance_bytes`], plus `Parse` for a mesh index out of
+/// range or a mesh without triangles.
+pub fn read_mesh_appearance_bytes(
+    data: &[u8],
+    base_dir: Option<&Path>,
+    name: &str,
+    mesh: usize,
+) -> Result<Appearance> {
+    let loaded = io::load_document(data, base_dir, name)?;
+    let raw = raw_json(data);
+    mesh_appearance(&loaded, raw.as_ref(), base_dir, name, mesh)
+}
+
+/// [`read_mesh_appearance_bytes`] on a document already loaded (`raw`: its JSON, for
+/// `KHR_texture_transform`).
+pub(crate) fn mesh_appearance(
+    loaded: &io::LoadedDocument,
+    raw: Option<&serde_json::Value>,
+    base_dir: Option<&Path>,
+    name: &str,
+    mesh: usize,
+) -> Result<Appearance> {
+    let mut reader = Reader {
+        doc: &loaded.document,
+        buffers: &loaded.buffers,
+        raw,
+        name,
+        base: base_dir,
+        out: Builder::default(),
+        texture_slots: HashMap::new(),
+        material_slots: HashMap::new(),
+    };
+    let doc = reader.doc;
+    io::for_each_mesh_primitive(doc, mesh, name, &mut |prim, pos, world, what| {
+        reader.add_primitive(prim, pos, world, what)
+    })?;
+    reader.finish()
+}
+
 /// The document's JSON as a `serde_json` value (for extensions the `gltf` crate drops).
-fn raw_json(data: &[u8]) -> Option<serde_json::Value> {
+pub(crate) fn raw_json(data: &[u8]) -> Option<serde_json::Value> {
     let json = if data.starts_with(b"glTF") {
         let len = u32::from_le_bytes(data.get(12..16)?.try_into().ok()?) as usize;
         if data.get(16..20)? != b"JSON" {

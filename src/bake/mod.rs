@@ -14,6 +14,8 @@
 //!   for untextured inputs.
 //! - [`level`]: the baked result (mesh, material, images, report), plain data.
 //! - [`output`]: a `.glb` with every level (`MSFT_lod`, `MSFT_screencoverage`).
+//! - [`scene`]: a glTF document kept whole, one LOD chain per mesh in local space (`MSFT_lod`
+//!   on every instancing node), written back as one GLB.
 //! - [`render`]: an independent software rasterizer measuring a bake (PSNR of renders of the
 //!   input and a level, normal-map gain); evaluation only.
 //!
@@ -29,10 +31,11 @@ pub mod obj;
 pub mod output;
 pub use crate::transfer::provenance;
 pub mod render;
+pub mod scene;
 
 pub use appearance::{
-    read_appearance_bytes, read_gltf_appearance, Appearance, AppearanceBuffers, BufferMaterial,
-    ImageBuffer, MaterialSample, UvBuffer,
+    read_appearance_bytes, read_gltf_appearance, read_mesh_appearance_bytes, Appearance,
+    AppearanceBuffers, BufferMaterial, ImageBuffer, MaterialSample, UvBuffer,
 };
 pub use atlas::{build_atlas, build_atlas_growing, Atlas, AtlasParams, Gutter};
 pub use bake::{bake_level, bake_level_with_progress, BakeParams, VertexColors};
@@ -40,6 +43,9 @@ pub use level::{BakeReport, BakedLevel, BakedMaterial, Image8};
 pub use obj::read_obj_appearance;
 pub use output::{chain_glb, chain_glb_with_progress, screen_coverage};
 pub use provenance::{provenance, InputIndex, Provenance, ProvenanceParams};
+pub use scene::{
+    lod_scene, scene_glb, GltfScene, Kept, MeshChain, SceneLevel, SceneParams, WriteOptions,
+};
 
 use crate::lowpoly::LodParams;
 use crate::report::{Progress, ProgressFn};

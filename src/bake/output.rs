@@ -27,18 +27,21 @@ pub fn screen_coverage(screen_size: f64) -> f64 {
     (screen_size / REFERENCE_VIEWPORT).powi(2).min(1.0)
 }
 
-struct Bin {
-    data: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
+/// A GLB's binary chunk under construction with its buffer views and accessors (all in buffer
+/// 0); shared with the scene writer (`super::scene`), which starts it from the input's repacked
+/// views.
+pub(crate) struct Bin {
+    pub(crate) data: Vec<u8>,
+    pub(crate) views: Vec<Value>,
+    pub(crate) accessors: Vec<Value>,
 }
 
 impl Bin {
-    fn align(&mut self) {
+    pub(crate) fn align(&mut self) {
         self.data.resize(self.data.len().next_multiple_of(4), 0);
     }
 
-    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+    pub(crate) fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
         self.align();
         let mut v = json!({"buffer": 0, "byteOffset": self.data.len(), "byteLength": bytes.len()});
         if let Some(t) = target {
@@ -49,7 +52,12 @@ impl Bin {
         self.views.len() - 1
     }
 
-    fn floats<const N: usize>(&mut self, values: &[[f32; N]], ty: &str, bounds: bool) -> usize {
+    pub(crate) fn floats<const N: usize>(
+        &mut self,
+        values: &[[f32; N]],
+        ty: &str,
+        bounds: bool,
+    ) -> usize {
         let bytes: Vec<u8> = values
             .iter()
             .flatten()
@@ -77,7 +85,7 @@ impl Bin {
         self.accessors.len() - 1
     }
 
-    fn indices(&mut self, tris: &[[u32; 3]]) -> usize {
+    pub(crate) fn indices(&mut self, tris: &[[u32; 3]]) -> usize {
         let bytes: Vec<u8> = tris
             .iter()
             .flatten()
@@ -174,89 +182,21 @@ pub fn chain_glb_with_progress(
         views: Vec::new(),
         accessors: Vec::new(),
     };
-    let (mut meshes, mut materials, mut nodes) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut images, mut textures) = (Vec::new(), Vec::new());
+    let mut arrays = Arrays::default();
+    let mut nodes = Vec::new();
     for (rank, &li) in order.iter().enumerate() {
         let level = levels[li];
-        let positions: Vec<[f32; 3]> = level
-            .positions
-            .iter()
-            .map(|p| p.map(|c| c as f32))
-            .collect();
-        if let Some(p) = positions.iter().find(|p| !p.iter().all(|c| c.is_finite())) {
-            return Err(Error::InvalidArgument(format!(
-                "vertex {p:?} exceeds the f32 range of glTF positions"
-            )));
-        }
-        let mut attributes = serde_json::Map::new();
-        attributes.insert(
-            "POSITION".into(),
-            json!(bin.floats(&positions, "VEC3", true)),
-        );
-        attributes.insert(
-            "NORMAL".into(),
-            json!(bin.floats(&level.normals, "VEC3", false)),
-        );
-        if let Some(t) = &level.tangents {
-            attributes.insert("TANGENT".into(), json!(bin.floats(t, "VEC4", false)));
-        }
-        if let Some(uv) = &level.uvs {
-            attributes.insert("TEXCOORD_0".into(), json!(bin.floats(uv, "VEC2", false)));
-        }
-        if let Some(c) = &level.colors {
-            attributes.insert("COLOR_0".into(), json!(bin.floats(c, "VEC4", false)));
-        }
-        let indices = bin.indices(&level.triangles);
-        meshes.push(json!({"name": format!("LOD{rank}"), "primitives": [{
-            "attributes": attributes, "indices": indices, "mode": 4, "material": rank}]}));
-        let mut tex = |img: &Option<Image8>, bin: &mut Bin| -> Result<Option<usize>> {
-            if img.is_none() {
-                return Ok(None);
-            }
-            let png = encoded
-                .next()
-                .ok_or_else(|| Error::Internal("PNG missing for an image".into()))?;
-            let view = bin.view(&png, None);
-            images.push(json!({"bufferView": view, "mimeType": "image/png"}));
-            textures.push(json!({"sampler": 0, "source": images.len() - 1}));
-            Ok(Some(textures.len() - 1))
-        };
-        let m = &level.material;
-        let mut pbr = json!({
-            "baseColorFactor": m.base_color_factor,
-            "metallicFactor": m.metallic_factor,
-            "roughnessFactor": m.roughness_factor,
-        });
-        if let Some(t) = tex(&m.base_color, &mut bin)? {
-            pbr["baseColorTexture"] = json!({"index": t});
-        }
-        if let Some(t) = tex(&m.metallic_roughness, &mut bin)? {
-            pbr["metallicRoughnessTexture"] = json!({"index": t});
-        }
-        let mut mat = json!({"name": format!("LOD{rank}"), "pbrMetallicRoughness": pbr,
-                             "emissiveFactor": m.emissive_factor,
-                             "doubleSided": m.double_sided});
-        if let Some(t) = tex(&m.normal, &mut bin)? {
-            mat["normalTexture"] = json!({"index": t});
-        }
-        if let Some(t) = tex(&m.occlusion, &mut bin)? {
-            mat["occlusionTexture"] = json!({"index": t});
-        }
-        if let Some(t) = tex(&m.emissive, &mut bin)? {
-            mat["emissiveTexture"] = json!({"index": t});
-        }
-        match m.alpha_mode {
-            super::appearance::AlphaMode::Opaque => {}
-            super::appearance::AlphaMode::Mask => {
-                mat["alphaMode"] = json!("MASK");
-                mat["alphaCutoff"] = json!(m.alpha_cutoff);
-            }
-            super::appearance::AlphaMode::Blend => mat["alphaMode"] = json!("BLEND"),
-        }
-        materials.push(mat);
-        nodes.push(json!({"name": format!("LOD{rank}"), "mesh": rank,
+        let name = format!("LOD{rank}");
+        let mesh = push_level(level, &name, &mut encoded, 0, &mut bin, &mut arrays)?;
+        nodes.push(json!({"name": name, "mesh": mesh,
                           "extras": {"pleat_screen_size": level.screen_size}}));
     }
+    let Arrays {
+        meshes,
+        materials,
+        images,
+        textures,
+    } = arrays;
     if order.len() > 1 {
         let coverage: Vec<f64> = (0..order.len())
             .map(|r| {
@@ -289,12 +229,134 @@ pub fn chain_glb_with_progress(
     if order.len() > 1 {
         doc["extensionsUsed"] = json!(["MSFT_lod"]);
     }
-    let mut json_bytes = serde_json::to_vec(&doc)
+    let out = glb_container(&doc, &bin.data)?;
+    Ok((out, png_seconds))
+}
+
+/// The mesh, material, image and texture arrays of a document under construction.
+#[derive(Default)]
+pub(crate) struct Arrays {
+    pub(crate) meshes: Vec<Value>,
+    pub(crate) materials: Vec<Value>,
+    pub(crate) images: Vec<Value>,
+    pub(crate) textures: Vec<Value>,
+}
+
+/// The PNG bytes of every image of `levels`, in the order [`push_level`] consumes them (level
+/// by level, each material's images in the writer's order), encoded in parallel.
+pub(crate) fn encode_images(levels: &[&BakedLevel]) -> Result<Vec<Vec<u8>>> {
+    use rayon::prelude::*;
+    let all: Vec<&Image8> = levels
+        .iter()
+        .flat_map(|l| material_images(&l.material))
+        .flatten()
+        .collect();
+    all.par_iter().map(|img| png_bytes(img)).collect()
+}
+
+/// Appends one baked level as a mesh (one indexed `TRIANGLES` primitive) named `name` with its
+/// own material named `name` and its images (taken from `encoded`, see [`encode_images`]) as
+/// PNG buffer views whose textures use sampler `sampler`. Returns the mesh index.
+pub(crate) fn push_level(
+    level: &BakedLevel,
+    name: &str,
+    encoded: &mut dyn Iterator<Item = Vec<u8>>,
+    sampler: usize,
+    bin: &mut Bin,
+    out: &mut Arrays,
+) -> Result<usize> {
+    let positions: Vec<[f32; 3]> = level
+        .positions
+        .iter()
+        .map(|p| p.map(|c| c as f32))
+        .collect();
+    if let Some(p) = positions.iter().find(|p| !p.iter().all(|c| c.is_finite())) {
+        return Err(Error::InvalidArgument(format!(
+            "vertex {p:?} exceeds the f32 range of glTF positions"
+        )));
+    }
+    let mut attributes = serde_json::Map::new();
+    attributes.insert(
+        "POSITION".into(),
+        json!(bin.floats(&positions, "VEC3", true)),
+    );
+    attributes.insert(
+        "NORMAL".into(),
+        json!(bin.floats(&level.normals, "VEC3", false)),
+    );
+    if let Some(t) = &level.tangents {
+        attributes.insert("TANGENT".into(), json!(bin.floats(t, "VEC4", false)));
+    }
+    if let Some(uv) = &level.uvs {
+        attributes.insert("TEXCOORD_0".into(), json!(bin.floats(uv, "VEC2", false)));
+    }
+    if let Some(c) = &level.colors {
+        attributes.insert("COLOR_0".into(), json!(bin.floats(c, "VEC4", false)));
+    }
+    let indices = bin.indices(&level.triangles);
+    let material = out.materials.len();
+    out.meshes.push(json!({"name": name, "primitives": [{
+        "attributes": attributes, "indices": indices, "mode": 4, "material": material}]}));
+    let (images, textures) = (&mut out.images, &mut out.textures);
+    let mut tex = |img: &Option<Image8>, bin: &mut Bin| -> Result<Option<usize>> {
+        if img.is_none() {
+            return Ok(None);
+        }
+        let png = encoded
+            .next()
+            .ok_or_else(|| Error::Internal("PNG missing for an image".into()))?;
+        let view = bin.view(&png, None);
+        images.push(json!({"bufferView": view, "mimeType": "image/png"}));
+        textures.push(json!({"sampler": sampler, "source": images.len() - 1}));
+        Ok(Some(textures.len() - 1))
+    };
+    let m = &level.material;
+    let mut pbr = json!({
+        "baseColorFactor": m.base_color_factor,
+        "metallicFactor": m.metallic_factor,
+        "roughnessFactor": m.roughness_factor,
+    });
+    if let Some(t) = tex(&m.base_color, bin)? {
+        pbr["baseColorTexture"] = json!({"index": t});
+    }
+    if let Some(t) = tex(&m.metallic_roughness, bin)? {
+        pbr["metallicRoughnessTexture"] = json!({"index": t});
+    }
+    let mut mat = json!({"name": name, "pbrMetallicRoughness": pbr,
+                         "emissiveFactor": m.emissive_factor,
+                         "doubleSided": m.double_sided});
+    if let Some(t) = tex(&m.normal, bin)? {
+        mat["normalTexture"] = json!({"index": t});
+    }
+    if let Some(t) = tex(&m.occlusion, bin)? {
+        mat["occlusionTexture"] = json!({"index": t});
+    }
+    if let Some(t) = tex(&m.emissive, bin)? {
+        mat["emissiveTexture"] = json!({"index": t});
+    }
+    match m.alpha_mode {
+        super::appearance::AlphaMode::Opaque => {}
+        super::appearance::AlphaMode::Mask => {
+            mat["alphaMode"] = json!("MASK");
+            mat["alphaCutoff"] = json!(m.alpha_cutoff);
+        }
+        super::appearance::AlphaMode::Blend => mat["alphaMode"] = json!("BLEND"),
+    }
+    out.materials.push(mat);
+    Ok(out.meshes.len() - 1)
+}
+
+/// A GLB container (header, JSON chunk padded with spaces, BIN chunk padded with zeros when
+/// `bin` is not empty). `InvalidArgument` beyond GLB's 4 GiB.
+pub(crate) fn glb_container(doc: &Value, bin: &[u8]) -> Result<Vec<u8>> {
+    let mut json_bytes = serde_json::to_vec(doc)
         .map_err(|e| Error::Internal(format!("glTF JSON encoding failed: {e}")))?;
     json_bytes.resize(json_bytes.len().next_multiple_of(4), b' ');
-    let total = 12 + 8 + json_bytes.len() + 8 + bin.data.len();
+    let bin_len = bin.len().next_multiple_of(4);
+    let chunk = if bin.is_empty() { 0 } else { 8 + bin_len };
+    let total = 12 + 8 + json_bytes.len() + chunk;
     let total32 = u32::try_from(total)
-        .map_err(|_| Error::InvalidArgument("the LOD chain exceeds GLB's 4 GiB limit".into()))?;
+        .map_err(|_| Error::InvalidArgument("the document exceeds GLB's 4 GiB limit".into()))?;
     let mut out = Vec::with_capacity(total);
     out.extend_from_slice(b"glTF");
     out.extend_from_slice(&2u32.to_le_bytes());
@@ -302,8 +364,11 @@ pub fn chain_glb_with_progress(
     out.extend_from_slice(&(json_bytes.len() as u32).to_le_bytes());
     out.extend_from_slice(b"JSON");
     out.extend_from_slice(&json_bytes);
-    out.extend_from_slice(&(bin.data.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin.data);
-    Ok((out, png_seconds))
+    if !bin.is_empty() {
+        out.extend_from_slice(&(bin_len as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(bin);
+        out.resize(total, 0);
+    }
+    Ok(out)
 }

@@ -31,6 +31,10 @@ mod wrinkle_edit;
 #[path = "pleat/bake.rs"]
 mod bake_cmd;
 
+#[cfg(feature = "bake")]
+#[path = "pleat/scene.rs"]
+mod scene_cmd;
+
 #[cfg(feature = "lod")]
 #[path = "pleat/batch.rs"]
 mod batch;
@@ -94,6 +98,12 @@ enum Command {
     #[cfg(feature = "lod")]
     /// Bake LODs by screen size: watertight, manifold, self-intersection-free meshes that look
     /// like the input when its bounding-box diagonal covers N pixels.
+    ///
+    /// glTF input with a .glb output keeps the whole document (nodes, skins, animations,
+    /// cameras, lights, materials, extras) and gives every mesh its own chain, baked once in
+    /// the mesh's local space and linked to each instancing node with MSFT_lod; a mesh whose
+    /// LOD would not have fewer faces, or that is skinned or morphed, is kept unchanged.
+    /// `--merge` fuses everything into one proxy instead.
     Lod {
         /// The input mesh (any triangle soup); several files, folders or --manifest bake a batch.
         #[arg(required_unless_present = "manifest")]
@@ -211,6 +221,9 @@ struct BakeArgs {
     #[cfg(feature = "bake")]
     #[command(flatten)]
     textures: bake_cmd::TextureArgs,
+    #[cfg(feature = "bake")]
+    #[command(flatten)]
+    scene: scene_cmd::SceneArgs,
 }
 
 /// `pleat wrinkle ...` (needs the `wrinkle` feature; otherwise exits 2 with a message).
@@ -496,6 +509,10 @@ fn output_path(pattern: &std::path::Path, n_p: f64) -> PathBuf {
 fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
     let cmd = if cage { "cage" } else { "lod" };
     #[cfg(feature = "bake")]
+    if scene_cmd::applies(input, args) {
+        return scene_cmd::run(input, args, cage);
+    }
+    #[cfg(feature = "bake")]
     if args.textures.bake {
         return bake_cmd::run(input, args, cmd);
     }
@@ -539,6 +556,23 @@ fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
     };
     for ((out, stats), &n_p) in levels.iter().zip(sizes) {
         let path = output_path(output, n_p);
+        // Never larger than the input: a LOD with more faces than the input soup is replaced
+        // by the input itself.
+        if out.triangle_count() > mesh.triangle_count() {
+            if let Err(e) = write_mesh(&path, &mesh) {
+                eprintln!("pleat {cmd}: {e}");
+                return ExitCode::from(EXIT_FAILED);
+            }
+            if !args.quiet {
+                println!(
+                    "{}: n_p={n_p} unchanged: the input ({} triangles) is written, its LOD had {}",
+                    path.display(),
+                    mesh.triangle_count(),
+                    out.triangle_count()
+                );
+            }
+            continue;
+        }
         if let Err(e) = write_mesh(&path, out) {
             eprintln!("pleat {cmd}: {e}");
             return ExitCode::from(EXIT_FAILED);

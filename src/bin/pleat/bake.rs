@@ -95,7 +95,7 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
     let bar = progress_bar(args.quiet);
     let mut prog = |p: pleat::Progress<'_>| show_progress(&bar, p);
     let result = bake_chain(&app, &args.screen_size, &lod_params, &params, &mut prog);
-    let chain = match result {
+    let mut chain = match result {
         Ok(l) => l,
         Err(e) => {
             if let Some(b) = &bar {
@@ -105,6 +105,27 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
             return ExitCode::from(failure_code(&e));
         }
     };
+    // Never larger than the input: a level whose LOD has more faces than the input soup is
+    // the input geometry itself, baked the same way.
+    let input_faces = app.mesh.triangle_count();
+    let mut kept = Vec::new();
+    for l in &mut chain.levels {
+        if l.lod.triangle_count() <= input_faces {
+            continue;
+        }
+        let index = pleat::bake::InputIndex::new(&app.mesh);
+        let n_p = l.baked.screen_size;
+        match pleat::bake::bake_level(&app, &index, &app.mesh, n_p, &params) {
+            Ok(b) => {
+                kept.push((n_p, l.lod.triangle_count()));
+                l.baked = b;
+            }
+            Err(e) => {
+                eprintln!("pleat {cmd}: {e}");
+                return ExitCode::from(failure_code(&e));
+            }
+        }
+    }
     let levels = &chain.levels;
     let refs: Vec<&BakedLevel> = levels.iter().map(|l| &l.baked).collect();
     // `-o OUT.glb`: one file holding the chain; `-o 'OUT_{np}.glb'`: one file per level.
@@ -187,6 +208,12 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
                     r.overlapping_texels
                 );
             }
+        }
+        for (n_p, lod_faces) in &kept {
+            println!(
+                "n_p {n_p:>5}: unchanged geometry: the input's {input_faces} faces are written \
+                 (its LOD had {lod_faces})"
+            );
         }
         let names: Vec<String> = files.iter().map(|(p, _)| p.display().to_string()).collect();
         println!(

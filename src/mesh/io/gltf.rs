@@ -328,23 +328,7 @@ pub(crate) fn for_each_primitive(
     visit: &mut dyn FnMut(&::gltf::Primitive, &Accessor, &Mat4, &str) -> Result<()>,
 ) -> Result<()> {
     let mut mesh_primitives = |mesh: &::gltf::Mesh, world: &Mat4| -> Result<()> {
-        for prim in mesh.primitives() {
-            let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
-            let Some(pos) = prim.get(&Semantic::Positions) else {
-                continue;
-            };
-            if !matches!(
-                prim.mode(),
-                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-            ) {
-                continue;
-            }
-            if pos.dimensions() != Dimensions::Vec3 {
-                return Err(parse_error(name, format!("{what}: POSITION is not VEC3")));
-            }
-            visit(&prim, &pos, world, &what)?;
-        }
-        Ok(())
+        visit_mesh(mesh, world, name, &mut *visit)
     };
     let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
         for mesh in doc.meshes() {
@@ -375,6 +359,68 @@ pub(crate) fn for_each_primitive(
         stack[first_child..].reverse();
     }
     Ok(())
+}
+
+/// The primitives of one mesh that [`for_each_primitive`] visits (triangle modes with a `VEC3`
+/// `POSITION`), in order, each with `world`.
+fn visit_mesh(
+    mesh: &::gltf::Mesh,
+    world: &Mat4,
+    name: &str,
+    visit: &mut dyn FnMut(&::gltf::Primitive, &Accessor, &Mat4, &str) -> Result<()>,
+) -> Result<()> {
+    for prim in mesh.primitives() {
+        let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+        let Some(pos) = prim.get(&Semantic::Positions) else {
+            continue;
+        };
+        if !matches!(
+            prim.mode(),
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            continue;
+        }
+        if pos.dimensions() != Dimensions::Vec3 {
+            return Err(parse_error(name, format!("{what}: POSITION is not VEC3")));
+        }
+        visit(&prim, &pos, world, &what)?;
+    }
+    Ok(())
+}
+
+/// Visits the triangle primitives of glTF mesh `mesh` alone, untransformed (its local space),
+/// with the same filter and labels as [`for_each_primitive`].
+#[cfg(feature = "bake")]
+pub(crate) fn for_each_mesh_primitive(
+    doc: &Document,
+    mesh: usize,
+    name: &str,
+    visit: &mut dyn FnMut(&::gltf::Primitive, &Accessor, &Mat4, &str) -> Result<()>,
+) -> Result<()> {
+    let m = doc
+        .meshes()
+        .nth(mesh)
+        .ok_or_else(|| parse_error(name, format!("mesh {mesh} does not exist")))?;
+    visit_mesh(&m, &IDENTITY, name, visit)
+}
+
+/// The triangles of glTF mesh `mesh` in its local space: its triangle primitives in order,
+/// unwelded, exactly the triangles [`read_gltf_bytes`] gives for one instance under an identity
+/// transform. `Err(Parse)` when the mesh has no triangle.
+#[cfg(feature = "bake")]
+pub(crate) fn mesh_geometry(loaded: &LoadedDocument, mesh: usize, name: &str) -> Result<TriMesh> {
+    let mut soup = Soup::default();
+    let ctx = Ctx {
+        buffers: &loaded.buffers,
+        name,
+    };
+    for_each_mesh_primitive(
+        &loaded.document,
+        mesh,
+        name,
+        &mut |prim, pos, world, what| add_primitive(prim, pos, world, what, &ctx, &mut soup),
+    )?;
+    build_mesh(name, soup.positions, soup.triangles)
 }
 
 /// Appends one primitive (world transform applied) to the soup.

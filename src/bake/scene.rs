@@ -1,0 +1,885 @@
+//! glTF scenes in, glTF scenes out: one LOD chain per mesh, with the whole document kept.
+//!
+//! [`GltfScene`] reads a `.glb`/`.gltf` once: the raw JSON (a `serde_json` value, so every
+//! property survives, known or not) and the buffers (validated and loaded as the geometry
+//! reader does). [`lod_scene`] bakes one chain per glTF mesh that some node instantiates, in
+//! the mesh's **local space** and **once**, however many nodes instance it. [`scene_glb`] writes
+//! the document back as one GLB with the levels added.
+//!
+//! # What is kept
+//!
+//! Everything in the input JSON is written back unchanged except buffers, buffer views and
+//! images, which are repacked: every buffer view is copied into the one `BIN` chunk (4-byte
+//! aligned, same index, `buffer` 0), external and `data:` images are embedded as buffer views,
+//! and the buffer list becomes one buffer (the first buffer's `name`/`extras` kept). Accessor,
+//! buffer view, mesh, material, texture, image, sampler, node, skin, animation and camera
+//! indices of the input stay valid: new objects are appended at the end of their arrays, so
+//! scene roots, children, skin joints and skeletons, animation channel targets and
+//! `KHR_lights_punctual` references need no remapping. Names, `extras` and extensions pleat
+//! does not know are copied where they are. Required extensions the reader cannot honour
+//! (Draco, meshopt, GPU instancing, ...) make reading fail (ignoring them would give wrong
+//! geometry); the readable ones are listed in `mesh::io::gltf`. A `EXT_meshopt_compression`
+//! that is only *used* (with a fallback) is not supported: its buffer references are not
+//! remapped.
+//!
+//! # Levels
+//!
+//! The levels of a chain are sorted finest first (largest `n_p`). The screen size `n_p` maps
+//! to the mesh's own local bounding-box diagonal `l` (`d = l / n_p`); a node with scale `s`
+//! shows the mesh at `s · l` world units, and `MSFT_screencoverage` is relative to the size of
+//! each instance on screen, so the same chain serves every instance at any scale: a level made
+//! for `n_p` is indistinguishable from the mesh whenever that instance's diagonal covers at
+//! most `n_p` pixels.
+//!
+//! A level is **kept** (the input mesh is used for it, textures untouched; [`Kept`] says why)
+//! when the mesh has at most `target_faces` triangles, when its LOD has at least as many
+//! triangles as the mesh, when the mesh is skinned or has morph targets (see
+//! [`transfer_deformation`]), or when the LOD pipeline failed on it. So no level is ever
+//! larger than its input.
+//!
+//! # Written nodes
+//!
+//! Each node instancing a mesh whose chain has at least one new level gets the extension
+//! `MSFT_lod` with `ids` = new nodes, one per coarser level (finest first), appended at the end
+//! of `nodes`, each with the instancing node's `translation`/`rotation`/`scale`/`matrix`, a
+//! name `<node>_LOD<k>` and `extras.pleat_screen_size`; and `extras.MSFT_screencoverage`
+//! ([`screen_coverage`] of each next level's `n_p`, 0 for the coarsest). The level nodes are
+//! not children of any node: a viewer implementing `MSFT_lod` puts them in place of the
+//! instancing node (same parent, same transform), and a viewer that does not shows the input
+//! mesh alone instead of every level on top of each other. A chain whose levels are all kept
+//! adds nothing. With [`WriteOptions::drop_original`] the instancing node shows the finest
+//! level instead of the input mesh (which stays in `meshes`, unused).
+//!
+//! A new level is a mesh `<mesh>_LOD<k>` with one indexed `TRIANGLES` primitive. Baked
+//! ([`SceneParams::bake`]), it has its own material and images, as [`super::chain_glb`]
+//! writes them. Not baked, it has `POSITION` only (viewers compute flat normals) and the
+//! material of the mesh's first triangle primitive, or, when that material samples a texture
+//! (a texture needs `TEXCOORD`s the LOD does not have), a copy of it named
+//! `<material> (untextured)` without its texture references (factors kept).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde_json::{json, Value};
+
+use super::appearance::{mesh_appearance, raw_json, Appearance};
+use super::bake::{bake_level_with_progress, BakeParams};
+use super::level::BakedLevel;
+use super::output::{encode_images, glb_container, push_level, screen_coverage, Arrays, Bin};
+use super::provenance::InputIndex;
+use crate::lowpoly::{LodParams, LodReport};
+use crate::mesh::io::gltf::{self as io, LoadedDocument};
+use crate::mesh::io::parse_error;
+use crate::mesh::TriMesh;
+use crate::report::{Progress, ProgressFn};
+use crate::{Error, Result};
+
+/// A glTF document read for per-mesh LODs: its raw JSON and its loaded buffers.
+pub struct GltfScene {
+    json: Value,
+    loaded: LoadedDocument,
+    name: String,
+    base: Option<PathBuf>,
+}
+
+impl GltfScene {
+    /// Reads a `.glb` or `.gltf` file (external buffers and images relative to its folder).
+    /// Errors: `Io` when the file cannot be read, `Parse` when it is not valid glTF for
+    /// pleat's reader (including a required extension it cannot read).
+    pub fn read(path: &Path) -> Result<GltfScene> {
+        let name = path.display().to_string();
+        let data = std::fs::read(path).map_err(|e| crate::mesh::io::io_error(&name, &e))?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        GltfScene::from_bytes(&data, Some(base), &name)
+    }
+
+    /// Reads binary or JSON glTF from memory; `name` stands for the file in messages and
+    /// external files resolve against `base_dir` (`None`: embedded data only).
+    pub fn from_bytes(data: &[u8], base_dir: Option<&Path>, name: &str) -> Result<GltfScene> {
+        let loaded = io::load_document(data, base_dir, name)?;
+        let json = raw_json(data)
+            .ok_or_else(|| parse_error(name, "the glTF JSON cannot be parsed as JSON"))?;
+        Ok(GltfScene {
+            json,
+            loaded,
+            name: name.to_string(),
+            base: base_dir.map(Path::to_path_buf),
+        })
+    }
+
+    /// The document's JSON as read.
+    pub fn json(&self) -> &Value {
+        &self.json
+    }
+
+    /// Number of meshes of the document.
+    pub fn mesh_count(&self) -> usize {
+        self.array("meshes").len()
+    }
+
+    fn array(&self, key: &str) -> &[Value] {
+        self.json
+            .get(key)
+            .and_then(Value::as_array)
+            .map_or(&[], Vec::as_slice)
+    }
+
+    /// The name of mesh `mesh`, or `mesh <index>` when it has none.
+    pub fn mesh_name(&self, mesh: usize) -> String {
+        self.array("meshes")
+            .get(mesh)
+            .and_then(|m| m.get("name"))
+            .and_then(Value::as_str)
+            .map_or_else(|| format!("mesh {mesh}"), str::to_string)
+    }
+
+    /// How many nodes reference mesh `mesh` (in any scene or none).
+    pub fn instances(&self, mesh: usize) -> usize {
+        self.array("nodes")
+            .iter()
+            .filter(|n| n.get("mesh").and_then(Value::as_u64) == Some(mesh as u64))
+            .count()
+    }
+
+    /// Whether mesh `mesh` deforms: a primitive with `JOINTS_0`/`WEIGHTS_0` or morph
+    /// `targets`, or a node instancing it with a `skin` or `weights`.
+    pub fn is_deformable(&self, mesh: usize) -> bool {
+        let prims = self
+            .array("meshes")
+            .get(mesh)
+            .and_then(|m| m.get("primitives"))
+            .and_then(Value::as_array);
+        let in_prims = prims.is_some_and(|ps| {
+            ps.iter().any(|p| {
+                let a = p.get("attributes");
+                a.is_some_and(|a| a.get("JOINTS_0").is_some() || a.get("WEIGHTS_0").is_some())
+                    || p.get("targets")
+                        .and_then(Value::as_array)
+                        .is_some_and(|t| !t.is_empty())
+            })
+        });
+        in_prims
+            || self.array("nodes").iter().any(|n| {
+                n.get("mesh").and_then(Value::as_u64) == Some(mesh as u64)
+                    && (n.get("skin").is_some() || n.get("weights").is_some())
+            })
+    }
+
+    /// The triangles of mesh `mesh` in its local space (its triangle primitives in order,
+    /// unwelded). `Parse` when it has none.
+    pub fn mesh_geometry(&self, mesh: usize) -> Result<TriMesh> {
+        io::mesh_geometry(&self.loaded, mesh, &self.name)
+    }
+
+    /// The appearance of mesh `mesh` in its local space
+    /// ([`super::appearance::read_mesh_appearance_bytes`] on this document); its `mesh` equals
+    /// [`mesh_geometry`](Self::mesh_geometry).
+    pub fn mesh_appearance(&self, mesh: usize) -> Result<Appearance> {
+        mesh_appearance(
+            &self.loaded,
+            Some(&self.json),
+            self.base.as_deref(),
+            &self.name,
+            mesh,
+        )
+    }
+
+    /// The deformation attributes of mesh `mesh` per vertex of
+    /// [`mesh_geometry`](Self::mesh_geometry) (same vertex order): `JOINTS_0`, `WEIGHTS_0` and
+    /// `TARGET<i>_POSITION` (morph target `i`'s displacement), each a row of components per
+    /// vertex, zeros where a primitive lacks the attribute. Only semantics some primitive has
+    /// are present.
+    pub fn vertex_attributes(&self, mesh: usize) -> Result<BTreeMap<String, Vec<Vec<f64>>>> {
+        let mut out: BTreeMap<String, Vec<Vec<f64>>> = BTreeMap::new();
+        let mut count = 0usize;
+        let (buffers, name) = (&self.loaded.buffers, self.name.as_str());
+        io::for_each_mesh_primitive(
+            &self.loaded.document,
+            mesh,
+            name,
+            &mut |prim, pos, _, what| {
+                let n = pos.count();
+                let mut accessors = Vec::new();
+                if let Some(a) = prim.get(&::gltf::Semantic::Joints(0)) {
+                    accessors.push(("JOINTS_0".to_string(), a));
+                }
+                if let Some(a) = prim.get(&::gltf::Semantic::Weights(0)) {
+                    accessors.push(("WEIGHTS_0".to_string(), a));
+                }
+                for (i, t) in prim.morph_targets().enumerate() {
+                    if let Some(a) = t.positions() {
+                        accessors.push((format!("TARGET{i}_POSITION"), a));
+                    }
+                }
+                for (key, acc) in accessors {
+                    let k = acc.dimensions().multiplicity();
+                    let v = io::accessor_values(&acc, buffers, name, what)?;
+                    if acc.count() != n {
+                        return Err(parse_error(name, format!("{what}: {key} count is wrong")));
+                    }
+                    let rows = out.entry(key).or_insert_with(|| vec![vec![0.0; k]; count]);
+                    rows.resize(count, vec![0.0; k]);
+                    rows.extend(v.chunks_exact(k).map(<[f64]>::to_vec));
+                }
+                count += n;
+                Ok(())
+            },
+        )?;
+        for rows in out.values_mut() {
+            let k = rows.first().map_or(0, Vec::len);
+            rows.resize(count, vec![0.0; k]);
+        }
+        Ok(out)
+    }
+
+    /// The material index of mesh `mesh`'s first triangle primitive (`None`: default material).
+    fn first_material(&self, mesh: usize) -> Option<usize> {
+        let prims = self
+            .array("meshes")
+            .get(mesh)?
+            .get("primitives")?
+            .as_array()?;
+        let p = prims
+            .iter()
+            .find(|p| p.get("mode").and_then(Value::as_u64).unwrap_or(4) >= 4)?;
+        p.get("material")?.as_u64().map(|m| m as usize)
+    }
+}
+
+/// Parameters of [`lod_scene`].
+#[derive(Debug, Clone)]
+pub struct SceneParams {
+    /// Screen sizes `n_p` of the levels (any order; levels come out finest first, duplicates
+    /// removed).
+    pub screen_sizes: Vec<f64>,
+    /// LOD parameters (`screen_size` is replaced per level; `target_faces` applies to a
+    /// single screen size only, as in [`super::bake_chain`]).
+    pub lod: LodParams,
+    /// Cages instead of LODs (`crate::cage`); cages are never baked.
+    pub cage: bool,
+    /// Bake the mesh's materials onto each new level.
+    pub bake: Option<BakeParams>,
+}
+
+/// Why a level is the input mesh itself.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Kept {
+    /// The mesh has at most the level's face target.
+    AtBudget {
+        /// The face target.
+        budget: usize,
+    },
+    /// The LOD has at least as many triangles as the mesh.
+    NotSmaller {
+        /// Triangles of the LOD that was discarded.
+        lod_faces: usize,
+    },
+    /// The mesh has at most 4 triangles: no closed LOD (a tetrahedron at least) has fewer.
+    Minimal,
+    /// The mesh is skinned or has morph targets and [`transfer_deformation`] gave nothing.
+    Deformable,
+    /// The LOD pipeline or the bake failed on this mesh (the message).
+    Failed(String),
+}
+
+impl std::fmt::Display for Kept {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Kept::AtBudget { budget } => write!(f, "unchanged (at or below {budget} faces)"),
+            Kept::NotSmaller { lod_faces } => {
+                write!(f, "unchanged (the LOD had {lod_faces} faces, not fewer)")
+            }
+            Kept::Minimal => write!(f, "unchanged (no closed LOD has fewer faces)"),
+            Kept::Deformable => write!(
+                f,
+                "unchanged (skinned/morphed: kept, weight transfer not applied)"
+            ),
+            Kept::Failed(e) => write!(f, "unchanged (LOD failed: {e})"),
+        }
+    }
+}
+
+/// One level of a mesh's chain.
+#[derive(Debug, Clone)]
+pub struct SceneLevel {
+    /// Screen size `n_p`.
+    pub screen_size: f64,
+    /// Triangles of the level (the mesh's own when kept).
+    pub faces: usize,
+    /// `Some` when the level is the input mesh itself.
+    pub kept: Option<Kept>,
+    /// The new geometry (`None` when kept).
+    pub lod: Option<TriMesh>,
+    /// The pipeline's report of the new geometry.
+    pub stats: Option<LodReport>,
+    /// The baked level when baking (`None` when kept or not baking).
+    pub baked: Option<BakedLevel>,
+}
+
+/// The chain of one glTF mesh.
+#[derive(Debug, Clone)]
+pub struct MeshChain {
+    /// Index of the mesh in the document.
+    pub mesh: usize,
+    /// Its name (or `mesh <index>`).
+    pub name: String,
+    /// Nodes instancing it.
+    pub instances: usize,
+    /// Triangles of the mesh (its triangle primitives together).
+    pub faces: usize,
+    /// Levels, finest first.
+    pub levels: Vec<SceneLevel>,
+    /// Wall seconds spent on this mesh (geometry and bake).
+    pub seconds: f64,
+}
+
+/// Triangles of the smallest closed mesh (a tetrahedron): a mesh with at most this many is
+/// kept without running the pipeline, whose output is always closed.
+const MIN_CLOSED_FACES: usize = 4;
+
+/// Per-vertex deformation attributes of a LOD: what a skinned or morphed mesh's level needs.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Deformation {
+    /// `JOINTS_0` per LOD vertex.
+    pub joints: Vec<[u16; 4]>,
+    /// `WEIGHTS_0` per LOD vertex (each summing to 1).
+    pub weights: Vec<[f32; 4]>,
+    /// Morph target `POSITION` displacements, one list per target, one entry per LOD vertex.
+    pub targets: Vec<Vec<[f32; 3]>>,
+}
+
+/// Whether [`transfer_deformation`] is implemented; while it is not, a skinned or morphed mesh
+/// is kept unchanged at every level without baking a LOD for it.
+pub const DEFORMATION_TRANSFER: bool = false;
+
+/// The one place where skin weights and morph targets are carried from a mesh to its LOD:
+/// `input` is the mesh in local space ([`GltfScene::mesh_geometry`]), `attributes` its
+/// per-vertex attributes by glTF semantic (`JOINTS_0`, `WEIGHTS_0`, `TARGET<i>_POSITION`, one
+/// row of components per input vertex), `lod` the level. Returns `None` when no transfer is
+/// available, and the level is then kept unchanged. Today it always returns `None`.
+pub fn transfer_deformation(
+    input: &TriMesh,
+    attributes: &BTreeMap<String, Vec<Vec<f64>>>,
+    lod: &TriMesh,
+) -> Option<Deformation> {
+    let _ = (input, attributes, lod);
+    None
+}
+
+/// The chains of every mesh that some node instantiates, in mesh order. Each is baked once in
+/// the mesh's local space (see the [module docs](self)); `progress` sees `mesh i/n: <stage>`
+/// with the fraction over all meshes; returning `false` cancels with `Error::Cancelled`. A
+/// failure of the pipeline on one mesh keeps that mesh ([`Kept::Failed`]); reading errors and
+/// cancellation are returned. Deterministic: meshes run one after the other, each level being
+/// the pipeline's deterministic output.
+pub fn lod_scene(
+    scene: &GltfScene,
+    params: &SceneParams,
+    progress: &mut ProgressFn<'_>,
+) -> Result<Vec<MeshChain>> {
+    let mut sizes = params.screen_sizes.clone();
+    if sizes.is_empty() || sizes.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+        return Err(Error::InvalidArgument(
+            "screen sizes must be finite and > 0 (at least one)".into(),
+        ));
+    }
+    sizes.sort_by(|a, b| b.total_cmp(a));
+    sizes.dedup();
+    let meshes: Vec<usize> = (0..scene.mesh_count())
+        .filter(|&m| scene.instances(m) > 0)
+        .collect();
+    let n = meshes.len().max(1) as f64;
+    let mut chains = Vec::new();
+    for (i, &m) in meshes.iter().enumerate() {
+        let t = std::time::Instant::now();
+        let label = format!("mesh {}/{}", i + 1, meshes.len());
+        let mut prog = |p: Progress<'_>| {
+            progress(Progress {
+                stage: &format!("{label}: {}", p.stage),
+                fraction: (i as f64 + p.fraction.clamp(0.0, 1.0)) / n,
+            })
+        };
+        if !prog(Progress {
+            stage: "read",
+            fraction: 0.0,
+        }) {
+            return Err(Error::Cancelled);
+        }
+        let app = match &params.bake {
+            Some(_) if !params.cage => Some(scene.mesh_appearance(m)?),
+            _ => None,
+        };
+        let geometry = match &app {
+            Some(a) => a.mesh.clone(),
+            None => match scene.mesh_geometry(m) {
+                Ok(g) => g,
+                // A mesh without triangles (points, lines) has no chain.
+                Err(Error::Parse { .. }) if no_triangles(scene, m) => continue,
+                Err(e) => return Err(e),
+            },
+        };
+        let faces = geometry.triangle_count();
+        let kept_all = |k: Kept| -> Vec<SceneLevel> {
+            sizes
+                .iter()
+                .map(|&s| SceneLevel {
+                    screen_size: s,
+                    faces,
+                    kept: Some(k.clone()),
+                    lod: None,
+                    stats: None,
+                    baked: None,
+                })
+                .collect()
+        };
+        let levels = if scene.is_deformable(m) && !DEFORMATION_TRANSFER {
+            kept_all(Kept::Deformable)
+        } else if faces <= MIN_CLOSED_FACES {
+            kept_all(Kept::Minimal)
+        } else if let Some(budget) = params.lod.target_faces.filter(|&f| faces <= f) {
+            kept_all(Kept::AtBudget { budget })
+        } else {
+            match mesh_levels(scene, m, &geometry, app.as_ref(), &sizes, params, &mut prog) {
+                Ok(l) => l,
+                Err(Error::Cancelled) => return Err(Error::Cancelled),
+                Err(e) => kept_all(Kept::Failed(e.to_string())),
+            }
+        };
+        chains.push(MeshChain {
+            mesh: m,
+            name: scene.mesh_name(m),
+            instances: scene.instances(m),
+            faces,
+            levels,
+            seconds: t.elapsed().as_secs_f64(),
+        });
+    }
+    Ok(chains)
+}
+
+/// Whether mesh `m` has no triangle primitive at all (so reading its geometry fails by
+/// design, not because the file is broken).
+fn no_triangles(scene: &GltfScene, m: usize) -> bool {
+    let prims = scene
+        .array("meshes")
+        .get(m)
+        .and_then(|x| x.get("primitives"))
+        .and_then(Value::as_array);
+    prims.is_none_or(|ps| {
+        ps.iter()
+            .all(|p| p.get("mode").and_then(Value::as_u64).unwrap_or(4) < 4)
+    })
+}
+
+/// The levels of one mesh: the pipeline's chain, each level kept when not smaller, baked when
+/// asked.
+fn mesh_levels(
+    scene: &GltfScene,
+    m: usize,
+    geometry: &TriMesh,
+    app: Option<&Appearance>,
+    sizes: &[f64],
+    params: &SceneParams,
+    prog: &mut ProgressFn<'_>,
+) -> Result<Vec<SceneLevel>> {
+    let share = if app.is_some() {
+        super::GEOMETRY_SHARE
+    } else {
+        1.0
+    };
+    let lods = {
+        let mut geo = |p: Progress<'_>| {
+            prog(Progress {
+                stage: p.stage,
+                fraction: share * p.fraction,
+            })
+        };
+        let single = sizes.len() == 1 && params.lod.target_faces.is_some();
+        let p = LodParams {
+            screen_size: sizes[0],
+            ..params.lod.clone()
+        };
+        match (single, params.cage) {
+            (true, false) => vec![crate::lowpoly::generate(geometry, &p, &mut geo)?],
+            (false, false) => crate::lowpoly::generate_chain(geometry, sizes, &p, &mut geo)?,
+            #[cfg(feature = "cage")]
+            (true, true) => vec![crate::cage::generate(geometry, &p, &mut geo)?],
+            #[cfg(feature = "cage")]
+            (false, true) => crate::cage::generate_chain(geometry, sizes, &p, &mut geo)?,
+            #[cfg(not(feature = "cage"))]
+            (_, true) => {
+                return Err(Error::InvalidArgument(
+                    "cages need pleat's `cage` feature".into(),
+                ))
+            }
+        }
+    };
+    let faces = geometry.triangle_count();
+    let index = app.map(|a| InputIndex::new(&a.mesh));
+    let per = (1.0 - share) / sizes.len() as f64;
+    let mut levels = Vec::new();
+    for (k, ((lod, stats), &n_p)) in lods.into_iter().zip(sizes).enumerate() {
+        let lod_faces = lod.triangle_count();
+        if lod_faces >= faces {
+            levels.push(SceneLevel {
+                screen_size: n_p,
+                faces,
+                kept: Some(Kept::NotSmaller { lod_faces }),
+                lod: None,
+                stats: Some(stats),
+                baked: None,
+            });
+            continue;
+        }
+        if scene.is_deformable(m) {
+            // Reached only once DEFORMATION_TRANSFER is set: the level is kept unless the
+            // transfer gives its attributes (writing them is the transfer's companion change).
+            let attributes = scene.vertex_attributes(m)?;
+            if transfer_deformation(geometry, &attributes, &lod).is_none() {
+                levels.push(SceneLevel {
+                    screen_size: n_p,
+                    faces,
+                    kept: Some(Kept::Deformable),
+                    lod: None,
+                    stats: Some(stats),
+                    baked: None,
+                });
+                continue;
+            }
+        }
+        let baked = match (app, &index, &params.bake) {
+            (Some(app), Some(index), Some(bp)) => {
+                let base = share + per * k as f64;
+                let mut lp = |p: Progress<'_>| {
+                    prog(Progress {
+                        stage: p.stage,
+                        fraction: base + per * p.fraction,
+                    })
+                };
+                Some(bake_level_with_progress(
+                    app, index, &lod, n_p, bp, &mut lp,
+                )?)
+            }
+            _ => None,
+        };
+        levels.push(SceneLevel {
+            screen_size: n_p,
+            faces: lod_faces,
+            kept: None,
+            lod: Some(lod),
+            stats: Some(stats),
+            baked,
+        });
+    }
+    Ok(levels)
+}
+
+/// Options of [`scene_glb`].
+#[derive(Debug, Clone, Default)]
+pub struct WriteOptions {
+    /// The instancing nodes show the finest level instead of the input mesh.
+    pub drop_original: bool,
+    /// Write only the levels of these screen sizes (`None`: every level).
+    pub only_sizes: Option<Vec<f64>>,
+}
+
+/// The document with the chains' levels added, as one GLB (see the [module docs](self)).
+/// Deterministic: the bytes depend only on the input and the chains.
+///
+/// Errors: `Parse` for a buffer view outside its buffer or an image that cannot be read;
+/// `InvalidArgument` for a coordinate beyond `f32` or a file over GLB's 4 GiB.
+pub fn scene_glb(scene: &GltfScene, chains: &[MeshChain], opts: &WriteOptions) -> Result<Vec<u8>> {
+    let mut doc = scene.json.clone();
+    let root = doc
+        .as_object_mut()
+        .ok_or_else(|| parse_error(&scene.name, "the glTF JSON is not an object"))?;
+    let take = |root: &mut serde_json::Map<String, Value>, key: &str| -> Vec<Value> {
+        match root.remove(key) {
+            Some(Value::Array(a)) => a,
+            _ => Vec::new(),
+        }
+    };
+    // Buffer views repacked into one buffer.
+    let mut bin = Bin {
+        data: Vec::new(),
+        views: take(root, "bufferViews"),
+        accessors: take(root, "accessors"),
+    };
+    for (i, v) in bin.views.iter_mut().enumerate() {
+        let get = |k: &str| v.get(k).and_then(Value::as_u64).map(|x| x as usize);
+        let (buf, off, len) = (
+            get("buffer").unwrap_or(0),
+            get("byteOffset").unwrap_or(0),
+            get("byteLength").unwrap_or(0),
+        );
+        let bytes = scene
+            .loaded
+            .buffers
+            .get(buf)
+            .and_then(|b| b.get(off..off.checked_add(len)?))
+            .ok_or_else(|| {
+                parse_error(
+                    &scene.name,
+                    format!("buffer view {i} lies outside buffer {buf}"),
+                )
+            })?;
+        bin.data.resize(bin.data.len().next_multiple_of(4), 0);
+        v["buffer"] = json!(0);
+        v["byteOffset"] = json!(bin.data.len());
+        bin.data.extend_from_slice(bytes);
+    }
+    // Images by URI embedded.
+    let mut images = take(root, "images");
+    for (i, img) in images.iter_mut().enumerate() {
+        let Some(uri) = img.get("uri").and_then(Value::as_str).map(str::to_string) else {
+            continue;
+        };
+        let bytes = if uri.starts_with("data:") {
+            io::data_uri_bytes(&uri)
+                .ok_or_else(|| parse_error(&scene.name, format!("image {i}: malformed data URI")))?
+        } else {
+            io::external_bytes(&uri, 1 << 30, scene.base.as_deref(), &scene.name)?
+        };
+        let view = bin.view(&bytes, None);
+        let obj = img
+            .as_object_mut()
+            .expect("an image with a uri is an object");
+        obj.remove("uri");
+        obj.insert("bufferView".into(), json!(view));
+        if !obj.contains_key("mimeType") {
+            obj.insert("mimeType".into(), json!(mime_type(&bytes)));
+        }
+    }
+    let mut arrays = Arrays {
+        meshes: take(root, "meshes"),
+        materials: take(root, "materials"),
+        images,
+        textures: take(root, "textures"),
+    };
+    let mut samplers = take(root, "samplers");
+    let mut nodes = take(root, "nodes");
+    let wanted = |s: f64| opts.only_sizes.as_ref().is_none_or(|o| o.contains(&s));
+    // Baked images, encoded in the order the levels are written.
+    let baked: Vec<&BakedLevel> = chains
+        .iter()
+        .flat_map(|c| &c.levels)
+        .filter(|l| wanted(l.screen_size))
+        .filter_map(|l| l.baked.as_ref())
+        .collect();
+    let encoded = encode_images(&baked)?;
+    let sampler = samplers.len();
+    if !encoded.is_empty() {
+        samplers.push(json!({"magFilter": 9729, "minFilter": 9987,
+                             "wrapS": 33071, "wrapT": 33071}));
+    }
+    let mut encoded = encoded.into_iter();
+    let mut untextured: BTreeMap<Option<usize>, Option<usize>> = BTreeMap::new();
+    let mut any_lod = false;
+    let n_nodes = nodes.len();
+    for chain in chains {
+        // (screen size, mesh of the level) of the written levels, finest first.
+        let mut levels: Vec<(f64, usize)> = Vec::new();
+        for l in &chain.levels {
+            if !wanted(l.screen_size) {
+                continue;
+            }
+            // Level k (1 = finest written) of the mesh; its level nodes carry the same k.
+            let name = format!("{}_LOD{}", chain.name, levels.len() + 1);
+            let mesh = match (&l.lod, &l.baked) {
+                (_, Some(b)) => push_level(b, &name, &mut encoded, sampler, &mut bin, &mut arrays)?,
+                (Some(lod), None) => {
+                    let src = scene.first_material(chain.mesh);
+                    let material = *untextured
+                        .entry(src)
+                        .or_insert_with(|| untextured_material(src, &mut arrays.materials));
+                    push_plain(lod, &name, material, &mut bin, &mut arrays)?
+                }
+                (None, None) => chain.mesh,
+            };
+            levels.push((l.screen_size, mesh));
+        }
+        if levels.iter().all(|&(_, m)| m == chain.mesh) {
+            continue;
+        }
+        for i in 0..n_nodes {
+            if nodes[i].get("mesh").and_then(Value::as_u64) != Some(chain.mesh as u64) {
+                continue;
+            }
+            let node_name = nodes[i]
+                .get("name")
+                .and_then(Value::as_str)
+                .map_or_else(|| format!("node {i}"), str::to_string);
+            let rest = if opts.drop_original {
+                nodes[i]["mesh"] = json!(levels[0].1);
+                &levels[1..]
+            } else {
+                &levels[..]
+            };
+            if rest.is_empty() {
+                continue;
+            }
+            let first = if opts.drop_original { 2 } else { 1 };
+            let mut ids = Vec::new();
+            for (k, &(n_p, mesh)) in rest.iter().enumerate() {
+                let mut lod = json!({"name": format!("{node_name}_LOD{}", k + first),
+                                     "mesh": mesh, "extras": {"pleat_screen_size": n_p}});
+                for key in ["matrix", "translation", "rotation", "scale"] {
+                    if let Some(v) = nodes[i].get(key) {
+                        lod[key] = v.clone();
+                    }
+                }
+                ids.push(nodes.len());
+                nodes.push(lod);
+            }
+            let mut coverage: Vec<f64> = rest.iter().map(|&(s, _)| screen_coverage(s)).collect();
+            coverage.push(0.0);
+            let node = nodes[i].as_object_mut().expect("a node is an object");
+            let ext = node.entry("extensions").or_insert_with(|| json!({}));
+            if let Some(e) = ext.as_object_mut() {
+                e.insert("MSFT_lod".into(), json!({ "ids": ids }));
+            }
+            let extras = node.entry("extras").or_insert_with(|| json!({}));
+            if let Some(e) = extras.as_object_mut() {
+                e.insert("MSFT_screencoverage".into(), json!(coverage));
+            }
+            any_lod = true;
+        }
+    }
+    let Arrays {
+        meshes,
+        materials,
+        images,
+        textures,
+    } = arrays;
+    for (key, v) in [
+        ("nodes", nodes),
+        ("meshes", meshes),
+        ("materials", materials),
+        ("images", images),
+        ("textures", textures),
+        ("samplers", samplers),
+        ("accessors", std::mem::take(&mut bin.accessors)),
+        ("bufferViews", std::mem::take(&mut bin.views)),
+    ] {
+        if !v.is_empty() {
+            root.insert(key.into(), Value::Array(v));
+        }
+    }
+    bin.align();
+    let old = take(root, "buffers");
+    if !bin.data.is_empty() {
+        let mut buffer = json!({"byteLength": bin.data.len()});
+        for key in ["name", "extras"] {
+            if let Some(v) = old.first().and_then(|b| b.get(key)) {
+                buffer[key] = v.clone();
+            }
+        }
+        root.insert("buffers".into(), json!([buffer]));
+    }
+    if any_lod {
+        let used = root
+            .entry("extensionsUsed")
+            .or_insert_with(|| json!([]))
+            .as_array_mut();
+        if let Some(used) = used {
+            if !used.iter().any(|e| e == "MSFT_lod") {
+                used.push(json!("MSFT_lod"));
+            }
+        }
+    }
+    if let Some(asset) = root.get_mut("asset").and_then(Value::as_object_mut) {
+        let generator = match asset.get("generator").and_then(Value::as_str) {
+            Some(g) if !g.starts_with("pleat") => format!("pleat (LODs); input by {g}"),
+            Some(g) => g.to_string(),
+            None => "pleat (LODs)".to_string(),
+        };
+        asset.insert("generator".into(), json!(generator));
+    }
+    glb_container(&doc, &bin.data)
+}
+
+/// The IANA type of embedded image bytes by their signature (PNG, JPEG, WebP, KTX2), PNG when
+/// unknown.
+fn mime_type(bytes: &[u8]) -> &'static str {
+    if bytes.starts_with(&[0xFF, 0xD8, 0xFF]) {
+        "image/jpeg"
+    } else if bytes.len() >= 12 && &bytes[0..4] == b"RIFF" && &bytes[8..12] == b"WEBP" {
+        "image/webp"
+    } else if bytes.starts_with(&[0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30]) {
+        "image/ktx2"
+    } else {
+        "image/png"
+    }
+}
+
+/// Whether a JSON value references a texture (a key ending in `Texture` anywhere inside).
+fn samples_texture(v: &Value) -> bool {
+    match v {
+        Value::Object(o) => o
+            .iter()
+            .any(|(k, x)| k.ends_with("Texture") || samples_texture(x)),
+        Value::Array(a) => a.iter().any(samples_texture),
+        _ => false,
+    }
+}
+
+/// `v` without any texture reference (keys ending in `Texture` removed at every depth).
+fn strip_textures(v: &mut Value) {
+    match v {
+        Value::Object(o) => {
+            o.retain(|k, _| !k.ends_with("Texture"));
+            o.values_mut().for_each(strip_textures);
+        }
+        Value::Array(a) => a.iter_mut().for_each(strip_textures),
+        _ => {}
+    }
+}
+
+/// The material an unbaked level uses for source material `src`: `src` itself when it samples
+/// no texture, else a new untextured copy appended to `materials` (`None`: the default).
+fn untextured_material(src: Option<usize>, materials: &mut Vec<Value>) -> Option<usize> {
+    let i = src?;
+    let m = materials.get(i)?;
+    if !samples_texture(m) {
+        return Some(i);
+    }
+    let mut copy = m.clone();
+    strip_textures(&mut copy);
+    let name = m
+        .get("name")
+        .and_then(Value::as_str)
+        .map_or_else(|| format!("material {i}"), str::to_string);
+    copy["name"] = json!(format!("{name} (untextured)"));
+    materials.push(copy);
+    Some(materials.len() - 1)
+}
+
+/// Appends an unbaked level: `POSITION` (f32, min/max) and `u32` indices, `material`.
+fn push_plain(
+    lod: &TriMesh,
+    name: &str,
+    material: Option<usize>,
+    bin: &mut Bin,
+    arrays: &mut Arrays,
+) -> Result<usize> {
+    let positions: Vec<[f32; 3]> = lod
+        .positions()
+        .iter()
+        .map(|p| p.map(|c| c as f32))
+        .collect();
+    if positions.iter().any(|p| !p.iter().all(|c| c.is_finite())) {
+        return Err(Error::InvalidArgument(format!(
+            "a vertex of {name} exceeds the f32 range of glTF positions"
+        )));
+    }
+    let pos = bin.floats(&positions, "VEC3", true);
+    let indices = bin.indices(lod.triangles());
+    let mut prim = json!({"attributes": {"POSITION": pos}, "indices": indices, "mode": 4});
+    if let Some(m) = material {
+        prim["material"] = json!(m);
+    }
+    arrays
+        .meshes
+        .push(json!({"name": name, "primitives": [prim]}));
+    Ok(arrays.meshes.len() - 1)
+}

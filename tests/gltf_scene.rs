@@ -1,0 +1,778 @@
+//! glTF scenes through `pleat lod`: the document survives (names, hierarchy, skins,
+//! animations, cameras, lights, extras, unknown extensions), every mesh gets one chain baked
+//! once in its local space however many nodes instance it, no level has more faces than its
+//! mesh, skinned and morphed meshes are kept, the bytes do not depend on the thread count, and
+//! the Khronos glTF-Validator finds no error in any output (when installed).
+//!
+//! The test scenes are generated here (JSON with `serde_json`, buffers by hand).
+#![cfg(feature = "bake")]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use serde_json::{json, Value};
+
+/// A GLB from a document and its binary chunk.
+fn glb(doc: &Value, bin: &[u8]) -> Vec<u8> {
+    let mut j = serde_json::to_vec(doc).unwrap();
+    j.resize(j.len().next_multiple_of(4), b' ');
+    let mut b = bin.to_vec();
+    b.resize(b.len().next_multiple_of(4), 0);
+    let total = 12 + 8 + j.len() + 8 + b.len();
+    let mut out = Vec::new();
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&j);
+    out.extend_from_slice(&(b.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&b);
+    out
+}
+
+/// The JSON chunk and BIN chunk of a GLB.
+fn parse_glb(data: &[u8]) -> (Value, Vec<u8>) {
+    assert_eq!(&data[0..4], b"glTF");
+    let jl = u32::from_le_bytes(data[12..16].try_into().unwrap()) as usize;
+    let doc: Value = serde_json::from_slice(&data[20..20 + jl]).unwrap();
+    let rest = &data[20 + jl..];
+    let bin = if rest.len() >= 8 {
+        let bl = u32::from_le_bytes(rest[0..4].try_into().unwrap()) as usize;
+        rest[8..8 + bl].to_vec()
+    } else {
+        Vec::new()
+    };
+    (doc, bin)
+}
+
+/// Buffer, buffer views and accessors under construction.
+#[derive(Default)]
+struct Builder {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Builder {
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        self.bin.resize(self.bin.len().next_multiple_of(4), 0);
+        let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
+        if let Some(t) = target {
+            v["target"] = json!(t);
+        }
+        self.bin.extend_from_slice(bytes);
+        self.views.push(v);
+        self.views.len() - 1
+    }
+
+    fn floats(
+        &mut self,
+        v: &[f32],
+        ty: &str,
+        n: usize,
+        target: Option<u32>,
+        bounds: bool,
+    ) -> usize {
+        let bytes: Vec<u8> = v.iter().flat_map(|f| f.to_le_bytes()).collect();
+        let view = self.view(&bytes, target);
+        let mut a = json!({"bufferView": view, "componentType": 5126, "count": v.len() / n,
+                           "type": ty});
+        if bounds {
+            let lo: Vec<f32> = (0..n)
+                .map(|k| {
+                    v.iter()
+                        .skip(k)
+                        .step_by(n)
+                        .copied()
+                        .fold(f32::MAX, f32::min)
+                })
+                .collect();
+            let hi: Vec<f32> = (0..n)
+                .map(|k| {
+                    v.iter()
+                        .skip(k)
+                        .step_by(n)
+                        .copied()
+                        .fold(f32::MIN, f32::max)
+                })
+                .collect();
+            a["min"] = json!(lo);
+            a["max"] = json!(hi);
+        }
+        self.accessors.push(a);
+        self.accessors.len() - 1
+    }
+
+    fn indices(&mut self, t: &[[u32; 3]]) -> usize {
+        let bytes: Vec<u8> = t.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+        let view = self.view(&bytes, Some(34963));
+        self.accessors
+            .push(json!({"bufferView": view, "componentType": 5125,
+                                   "count": 3 * t.len(), "type": "SCALAR"}));
+        self.accessors.len() - 1
+    }
+
+    fn positions(&mut self, p: &[[f32; 3]]) -> usize {
+        let flat: Vec<f32> = p.iter().flatten().copied().collect();
+        self.floats(&flat, "VEC3", 3, Some(34962), true)
+    }
+}
+
+/// A closed box `[−s, s]³` (stretched by `stretch` along y), each face an `n × n` grid, welded.
+fn grid_box(n: usize, s: f32, stretch: f32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
+    let mut pos: Vec<[f32; 3]> = Vec::new();
+    let mut tris = Vec::new();
+    let mut index = std::collections::HashMap::new();
+    let mut vid = |p: [f32; 3], pos: &mut Vec<[f32; 3]>| -> u32 {
+        let key = p.map(|c| (c * 1000.0).round() as i64);
+        *index.entry(key).or_insert_with(|| {
+            pos.push(p);
+            pos.len() as u32 - 1
+        })
+    };
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let mut ids = vec![vec![0u32; n + 1]; n + 1];
+            for (i, row) in ids.iter_mut().enumerate() {
+                for (j, id) in row.iter_mut().enumerate() {
+                    let mut p = [0.0f32; 3];
+                    p[axis] = sign * s;
+                    p[u] = s * (2.0 * i as f32 / n as f32 - 1.0);
+                    p[v] = s * (2.0 * j as f32 / n as f32 - 1.0);
+                    p[1] *= stretch;
+                    *id = vid(p, &mut pos);
+                }
+            }
+            for i in 0..n {
+                for j in 0..n {
+                    let (a, b, c, d) = (ids[i][j], ids[i + 1][j], ids[i + 1][j + 1], ids[i][j + 1]);
+                    if sign > 0.0 {
+                        tris.push([a, b, c]);
+                        tris.push([a, c, d]);
+                    } else {
+                        tris.push([a, c, b]);
+                        tris.push([a, d, c]);
+                    }
+                }
+            }
+        }
+    }
+    (pos, tris)
+}
+
+/// A pentagonal bipyramid: 7 vertices, 10 triangles, closed.
+fn bipyramid(r: f32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
+    let mut pos = vec![[0.0, r, 0.0], [0.0, -r, 0.0]];
+    for k in 0..5 {
+        let a = k as f32 * std::f32::consts::TAU / 5.0;
+        pos.push([r * a.cos(), 0.0, r * a.sin()]);
+    }
+    let mut tris = Vec::new();
+    for k in 0..5u32 {
+        let (a, b) = (2 + k, 2 + (k + 1) % 5);
+        tris.push([0, b, a]);
+        tris.push([1, a, b]);
+    }
+    (pos, tris)
+}
+
+/// The rich test scene (see the module docs) as GLB bytes.
+fn rich_scene() -> Vec<u8> {
+    let mut b = Builder::default();
+    let (bp, bt) = grid_box(6, 1.0, 1.0);
+    let box_mesh = json!({"name": "Box", "extras": {"kind": "box"}, "primitives": [{
+        "attributes": {"POSITION": b.positions(&bp)}, "indices": b.indices(&bt), "material": 0}]});
+    let (tp, tt) = bipyramid(0.5);
+    let tiny = json!({"name": "Tiny", "extras": {"kind": "tiny"}, "primitives": [{
+        "attributes": {"POSITION": b.positions(&tp)}, "indices": b.indices(&tt), "material": 1}]});
+    // Skinned column: two joints, weights by height.
+    let (sp, st) = grid_box(3, 0.3, 3.0);
+    let height = |p: &[f32; 3]| ((p[1] + 0.9) / 1.8).clamp(0.0, 1.0);
+    // Joint 1 only where it has weight (a non-zero joint index with zero weight is flagged).
+    let joints: Vec<u8> = sp
+        .iter()
+        .flat_map(|p| [0u8, u8::from(height(p) > 0.0), 0, 0])
+        .collect();
+    let weights: Vec<f32> = sp
+        .iter()
+        .flat_map(|p| [1.0 - height(p), height(p), 0.0, 0.0])
+        .collect();
+    let jv = b.view(&joints, Some(34962));
+    b.accessors.push(
+        json!({"bufferView": jv, "componentType": 5121, "count": sp.len(),
+                            "type": "VEC4"}),
+    );
+    let joints_acc = b.accessors.len() - 1;
+    let weights_acc = b.floats(&weights, "VEC4", 4, Some(34962), false);
+    let skinned = json!({"name": "Column", "primitives": [{
+        "attributes": {"POSITION": b.positions(&sp), "JOINTS_0": joints_acc,
+                       "WEIGHTS_0": weights_acc},
+        "indices": b.indices(&st), "material": 0}]});
+    let ibm: Vec<f32> = [0.0f32, -0.9]
+        .iter()
+        .flat_map(|&y| {
+            [
+                1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, -y, 0.0, 1.0,
+            ]
+        })
+        .collect();
+    let ibm_acc = b.floats(&ibm, "MAT4", 16, None, false);
+    // Morphed box: one target pulling +y up.
+    let (mp, mt) = grid_box(3, 0.4, 1.0);
+    let deltas: Vec<[f32; 3]> = mp
+        .iter()
+        .map(|p| [0.0, if p[1] > 0.0 { 0.3 } else { 0.0 }, 0.0])
+        .collect();
+    let morph_pos = b.positions(&mp);
+    let morph_idx = b.indices(&mt);
+    let target = b.positions(&deltas);
+    let morphed = json!({"name": "Morph", "weights": [0.5], "extras": {"targetNames": ["up"]},
+        "primitives": [{"attributes": {"POSITION": morph_pos}, "indices": morph_idx,
+                        "targets": [{"POSITION": target}], "material": 1}]});
+    // Animation of Joint1's rotation.
+    let times = b.floats(&[0.0, 1.0], "SCALAR", 1, None, true);
+    let (s, c) = (0.5f32.sin(), 0.5f32.cos());
+    let rots = b.floats(
+        &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, s, c],
+        "VEC4",
+        4,
+        None,
+        false,
+    );
+    let doc = json!({
+        "asset": {"version": "2.0", "generator": "pleat test", "extras": {"who": "test"}},
+        "extensionsUsed": ["KHR_lights_punctual", "EXT_pleat_test_unknown"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "name": "Lamp", "color": [1.0, 0.9, 0.8], "intensity": 3.0}]}},
+        "scene": 0,
+        "scenes": [{"name": "Main", "nodes": [0, 3, 4, 5, 6, 7, 8, 10], "extras": {"s": 1}}],
+        "nodes": [
+            {"name": "Root", "children": [1, 2], "extras": {"id": "root"},
+             "extensions": {"EXT_pleat_test_unknown": {"keep": true}}},
+            {"name": "ChildA", "mesh": 0, "extras": {"id": "a"}},
+            {"name": "ChildB", "mesh": 0, "translation": [3.0, 0.0, 0.0],
+             "scale": [2.0, 2.0, 2.0], "extras": {"id": "b"}},
+            {"name": "Far", "mesh": 0, "translation": [-4.0, 0.0, 0.0],
+             "scale": [0.5, 0.5, 0.5]},
+            {"name": "TinyNode", "mesh": 1, "translation": [0.0, 3.0, 0.0]},
+            {"name": "CameraNode", "camera": 0, "translation": [0.0, 0.0, 10.0]},
+            {"name": "LampNode", "translation": [0.0, 5.0, 0.0],
+             "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"name": "SkinnedNode", "mesh": 2, "skin": 0},
+            {"name": "Joint0", "children": [9]},
+            {"name": "Joint1", "translation": [0.0, 0.9, 0.0]},
+            {"name": "MorphNode", "mesh": 3, "translation": [0.0, -3.0, 0.0]}
+        ],
+        "meshes": [box_mesh, tiny, skinned, morphed],
+        "materials": [
+            {"name": "BoxMaterial", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.2, 0.2, 1.0]},
+             "extras": {"m": 0}, "extensions": {"EXT_pleat_test_unknown": {"x": 1}}},
+            {"name": "TinyMaterial", "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.8, 0.2, 1.0]}}
+        ],
+        "skins": [{"name": "ColumnSkin", "joints": [8, 9], "skeleton": 8,
+                   "inverseBindMatrices": ibm_acc}],
+        "animations": [{"name": "Bend", "channels": [
+            {"sampler": 0, "target": {"node": 9, "path": "rotation"}}],
+            "samplers": [{"input": times, "output": rots, "interpolation": "LINEAR"}]}],
+        "cameras": [{"name": "Cam", "type": "perspective",
+                     "perspective": {"yfov": 0.8, "znear": 0.1, "zfar": 100.0, "aspectRatio": 1.5}}],
+        "accessors": b.accessors,
+        "bufferViews": b.views,
+        "buffers": [{"byteLength": b.bin.len().next_multiple_of(4)}],
+    });
+    glb(&doc, &b.bin)
+}
+
+/// A scene of `meshes` distinct closed meshes and `instances` nodes cycling through them.
+fn instanced_scene(meshes: usize, instances: usize) -> Vec<u8> {
+    let mut b = Builder::default();
+    let mut ms = Vec::new();
+    for m in 0..meshes {
+        let (p, t) = grid_box(4 + m, 1.0, 1.0 + 0.3 * m as f32);
+        ms.push(json!({"name": format!("M{m}"), "primitives": [{
+            "attributes": {"POSITION": b.positions(&p)}, "indices": b.indices(&t)}]}));
+    }
+    let nodes: Vec<Value> = (0..instances)
+        .map(|i| {
+            let s = 1.0 + 0.01 * i as f32;
+            json!({"name": format!("N{i}"), "mesh": i % meshes,
+                   "translation": [3.0 * (i % 20) as f32, 3.0 * (i / 20) as f32, 0.0],
+                   "scale": [s, s, s]})
+        })
+        .collect();
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": (0..instances).collect::<Vec<_>>()}],
+        "nodes": nodes, "meshes": ms,
+        "accessors": b.accessors, "bufferViews": b.views,
+        "buffers": [{"byteLength": b.bin.len().next_multiple_of(4)}],
+    });
+    glb(&doc, &b.bin)
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("pleat-scene-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs `pleat lod <input> <args> -o <out>` with `RAYON_NUM_THREADS=threads`; returns stdout.
+fn lod(input: &Path, out: &Path, args: &[&str], threads: usize) -> String {
+    let o = Command::new(env!("CARGO_BIN_EXE_pleat"))
+        .arg("lod")
+        .arg(input)
+        .args(args)
+        .arg("-o")
+        .arg(out)
+        .env("RAYON_NUM_THREADS", threads.to_string())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        o.status.success(),
+        "pleat lod {args:?} failed: {stdout}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    stdout
+}
+
+fn names(doc: &Value, key: &str) -> Vec<String> {
+    doc[key]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .filter_map(|x| x["name"].as_str().map(str::to_string))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Triangles of every triangle primitive of mesh `m` (index counts / 3, or POSITION count / 3).
+fn mesh_faces(doc: &Value, m: usize) -> usize {
+    doc["meshes"][m]["primitives"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| match p["indices"].as_u64() {
+            Some(i) => doc["accessors"][i as usize]["count"].as_u64().unwrap() as usize / 3,
+            None => {
+                let a = p["attributes"]["POSITION"].as_u64().unwrap() as usize;
+                doc["accessors"][a]["count"].as_u64().unwrap() as usize / 3
+            }
+        })
+        .sum()
+}
+
+/// The Khronos glTF-Validator (`PLEAT_GLTF_VALIDATOR`: its npm package folder) and node, or
+/// `None` with a message.
+fn validator() -> Option<PathBuf> {
+    let Some(dir) = std::env::var_os("PLEAT_GLTF_VALIDATOR").map(PathBuf::from) else {
+        eprintln!("SKIPPED glTF-Validator: PLEAT_GLTF_VALIDATOR is not set (.ci/run sets it)");
+        return None;
+    };
+    if !dir.join("package.json").is_file() {
+        eprintln!(
+            "SKIPPED glTF-Validator: {} is not the npm package",
+            dir.display()
+        );
+        return None;
+    }
+    if Command::new("node").arg("--version").output().is_err() {
+        eprintln!("SKIPPED glTF-Validator: node is not installed");
+        return None;
+    }
+    Some(dir)
+}
+
+/// Asserts that the glTF-Validator reports no error for `file` (no-op without validator).
+fn assert_valid(file: &Path) {
+    let Some(dir) = validator() else { return };
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/gltf_validate.mjs");
+    let o = Command::new("node")
+        .arg(script)
+        .arg(&dir)
+        .arg(file)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "validator failed on {}: {}",
+        file.display(),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let report: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let issues = &report["issues"];
+    let errors: Vec<&Value> = issues["messages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["severity"] == 0)
+        .collect();
+    let mut warnings: Vec<&str> = issues["messages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["severity"] == 1)
+        .filter_map(|m| m["code"].as_str())
+        .collect();
+    warnings.sort_unstable();
+    warnings.dedup();
+    eprintln!(
+        "glTF-Validator {}: {} errors, {} warnings {warnings:?}, {} infos",
+        file.display(),
+        issues["numErrors"],
+        issues["numWarnings"],
+        issues["numInfos"]
+    );
+    assert_eq!(issues["numErrors"], 0, "{}: {errors:#?}", file.display());
+}
+
+#[test]
+fn scene_survives_with_one_chain_per_mesh() {
+    let dir = scratch("rich");
+    let input = dir.join("scene.glb");
+    std::fs::write(&input, rich_scene()).unwrap();
+    let (src, _) = parse_glb(&std::fs::read(&input).unwrap());
+    let out = dir.join("out.glb");
+    let report = lod(&input, &out, &["--screen-size", "100,50"], 1);
+    eprintln!("{report}");
+    let data = std::fs::read(&out).unwrap();
+    gltf::import_slice(&data).expect("the gltf crate reads the output");
+    let (doc, _) = parse_glb(&data);
+    assert_valid(&out);
+
+    // Every name of the input is in the output.
+    for key in [
+        "nodes",
+        "meshes",
+        "skins",
+        "animations",
+        "cameras",
+        "materials",
+        "scenes",
+    ] {
+        let have = names(&doc, key);
+        for n in names(&src, key) {
+            assert!(have.contains(&n), "{key} '{n}' lost: {have:?}");
+        }
+    }
+    // Input objects keep their indices, extras and unknown extensions.
+    let n_in = src["nodes"].as_array().unwrap().len();
+    for i in 0..n_in {
+        let (a, b) = (&src["nodes"][i], &doc["nodes"][i]);
+        assert_eq!(a["name"], b["name"]);
+        assert_eq!(a["children"], b["children"]);
+        assert_eq!(a["skin"], b["skin"]);
+        assert_eq!(a["camera"], b["camera"]);
+        assert_eq!(a["mesh"], b["mesh"], "node {i} keeps its mesh");
+        for (k, v) in a["extras"].as_object().into_iter().flatten() {
+            assert_eq!(&b["extras"][k], v);
+        }
+    }
+    assert_eq!(src["scenes"], doc["scenes"]);
+    assert_eq!(src["skins"], doc["skins"]);
+    assert_eq!(src["cameras"], doc["cameras"]);
+    assert_eq!(src["extensions"], doc["extensions"]);
+    assert_eq!(
+        doc["nodes"][0]["extensions"]["EXT_pleat_test_unknown"]["keep"],
+        true
+    );
+    assert_eq!(
+        doc["materials"][0]["extensions"],
+        src["materials"][0]["extensions"]
+    );
+    let used: Vec<&str> = doc["extensionsUsed"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(Value::as_str)
+        .collect();
+    for e in ["KHR_lights_punctual", "EXT_pleat_test_unknown", "MSFT_lod"] {
+        assert!(used.contains(&e), "{used:?}");
+    }
+    // Animation channels target the same named nodes.
+    for (ca, cb) in src["animations"][0]["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(doc["animations"][0]["channels"].as_array().unwrap())
+    {
+        let (na, nb) = (
+            ca["target"]["node"].as_u64().unwrap() as usize,
+            cb["target"]["node"].as_u64().unwrap() as usize,
+        );
+        assert_eq!(src["nodes"][na]["name"], doc["nodes"][nb]["name"]);
+    }
+
+    // The Box chain: baked once, shared by its three instances, with their transforms.
+    let box_levels: Vec<usize> = (0..doc["meshes"].as_array().unwrap().len())
+        .filter(|&m| {
+            doc["meshes"][m]["name"]
+                .as_str()
+                .is_some_and(|n| n.starts_with("Box_LOD"))
+        })
+        .collect();
+    assert!(!box_levels.is_empty(), "the Box got no level: {report}");
+    assert!(box_levels.len() <= 2);
+    let box_faces = mesh_faces(&src, 0);
+    let mut lod_ids = None;
+    for i in [1usize, 2, 3] {
+        let node = &doc["nodes"][i];
+        let ids: Vec<usize> = node["extensions"]["MSFT_lod"]["ids"]
+            .as_array()
+            .unwrap_or_else(|| panic!("node {i} has no MSFT_lod"))
+            .iter()
+            .map(|x| x.as_u64().unwrap() as usize)
+            .collect();
+        assert_eq!(ids.len(), 2);
+        let coverage = node["extras"]["MSFT_screencoverage"].as_array().unwrap();
+        assert_eq!(coverage.len(), 3);
+        let meshes: Vec<u64> = ids
+            .iter()
+            .map(|&j| {
+                let lod = &doc["nodes"][j];
+                assert!(j >= n_in, "level nodes are appended");
+                for k in ["translation", "rotation", "scale", "matrix"] {
+                    assert_eq!(lod[k], node[k], "level node {j} has node {i}'s {k}");
+                }
+                let m = lod["mesh"].as_u64().unwrap();
+                assert!(mesh_faces(&doc, m as usize) <= box_faces);
+                m
+            })
+            .collect();
+        match &lod_ids {
+            None => lod_ids = Some(meshes),
+            Some(first) => assert_eq!(first, &meshes, "every instance shares the chain"),
+        }
+    }
+    // No level anywhere has more faces than the mesh it replaces.
+    for (i, node) in doc["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .take(n_in)
+    {
+        let Some(ids) = node["extensions"]["MSFT_lod"]["ids"].as_array() else {
+            continue;
+        };
+        let own = mesh_faces(&doc, node["mesh"].as_u64().unwrap() as usize);
+        for j in ids {
+            let m = doc["nodes"][j.as_u64().unwrap() as usize]["mesh"]
+                .as_u64()
+                .unwrap();
+            assert!(mesh_faces(&doc, m as usize) <= own, "node {i}");
+        }
+    }
+    // Tiny, skinned and morphed meshes come back unchanged, without LOD nodes.
+    for (i, m) in [(4usize, 1usize), (7, 2), (10, 3)] {
+        assert!(
+            doc["nodes"][i]["extensions"]["MSFT_lod"].is_null(),
+            "node {i}"
+        );
+        assert_eq!(doc["meshes"][m], src["meshes"][m], "mesh {m} unchanged");
+    }
+    assert!(
+        report.contains("Tiny") && report.contains("unchanged"),
+        "{report}"
+    );
+    assert!(
+        report.contains("skinned/morphed: kept, weight transfer not applied"),
+        "{report}"
+    );
+    assert_eq!(report.matches("Box (mesh 0").count(), 1, "{report}");
+
+    // Same bytes on 1 and 2 threads.
+    let out2 = dir.join("out2.glb");
+    lod(&input, &out2, &["--screen-size", "100,50", "-q"], 2);
+    assert_eq!(
+        data,
+        std::fs::read(&out2).unwrap(),
+        "thread count changed the bytes"
+    );
+
+    // Baked, with the original dropped: still valid, the Box nodes show the finest level.
+    let baked = dir.join("baked.glb");
+    lod(
+        &input,
+        &baked,
+        &["--screen-size", "50", "--bake", "--drop-original", "-q"],
+        2,
+    );
+    let bdata = std::fs::read(&baked).unwrap();
+    gltf::import_slice(&bdata).expect("the gltf crate reads the baked output");
+    assert_valid(&baked);
+    let (bdoc, _) = parse_glb(&bdata);
+    let m = bdoc["nodes"][1]["mesh"].as_u64().unwrap() as usize;
+    assert!(bdoc["meshes"][m]["name"]
+        .as_str()
+        .unwrap()
+        .starts_with("Box_LOD"));
+    assert!(mesh_faces(&bdoc, m) < box_faces);
+
+    // JSON glTF with an external buffer: the same document, embedded into one GLB.
+    let (mut jdoc, bin) = parse_glb(&std::fs::read(&input).unwrap());
+    jdoc["buffers"][0]["uri"] = json!("scene data.bin");
+    std::fs::write(dir.join("scene data.bin"), &bin).unwrap();
+    let gltf_in = dir.join("scene.gltf");
+    std::fs::write(&gltf_in, serde_json::to_vec(&jdoc).unwrap()).unwrap();
+    let from_json = dir.join("from_json.glb");
+    lod(&gltf_in, &from_json, &["--screen-size", "100,50", "-q"], 1);
+    let (jout, _) = parse_glb(&std::fs::read(&from_json).unwrap());
+    assert_eq!(jout["nodes"], doc["nodes"]);
+    assert!(jout["buffers"][0]["uri"].is_null());
+    assert_valid(&from_json);
+
+    // Cages of each mesh, written the same way.
+    let cages = dir.join("cages.glb");
+    let o = Command::new(env!("CARGO_BIN_EXE_pleat"))
+        .args(["cage", input.to_str().unwrap(), "--screen-size", "50", "-o"])
+        .arg(&cages)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (cdoc, _) = parse_glb(&std::fs::read(&cages).unwrap());
+    assert_eq!(names(&cdoc, "skins"), names(&src, "skins"));
+    assert!(!cdoc["nodes"][1]["extensions"]["MSFT_lod"].is_null());
+    assert_valid(&cages);
+
+    // --merge: today's one fused proxy.
+    let merged = dir.join("merged.glb");
+    lod(
+        &input,
+        &merged,
+        &["--screen-size", "50", "--merge", "-q"],
+        2,
+    );
+    let (mdoc, _) = parse_glb(&std::fs::read(&merged).unwrap());
+    assert_eq!(mdoc["meshes"].as_array().unwrap().len(), 1);
+    assert_valid(&merged);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// 200 instances of 5 meshes bake 5 chains, in about the time of the 5 meshes alone.
+#[test]
+fn instances_share_one_chain_per_mesh() {
+    let dir = scratch("inst");
+    let (few, many) = (dir.join("few.glb"), dir.join("many.glb"));
+    std::fs::write(&few, instanced_scene(5, 5)).unwrap();
+    std::fs::write(&many, instanced_scene(5, 200)).unwrap();
+    let t = std::time::Instant::now();
+    lod(
+        &few,
+        &dir.join("few_out.glb"),
+        &["--screen-size", "30", "-q"],
+        2,
+    );
+    let t_few = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+    let report = lod(
+        &many,
+        &dir.join("many_out.glb"),
+        &["--screen-size", "30"],
+        2,
+    );
+    let t_many = t.elapsed().as_secs_f64();
+    eprintln!(
+        "5 meshes alone {t_few:.2} s, 200 instances {t_many:.2} s (ratio {:.2})",
+        t_many / t_few
+    );
+    assert_eq!(report.matches(" instances, ").count(), 5, "{report}");
+    let (doc, _) = parse_glb(&std::fs::read(dir.join("many_out.glb")).unwrap());
+    let levels = doc["meshes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["name"].as_str().unwrap().contains("_LOD"))
+        .count();
+    assert!(levels <= 5, "{levels} level meshes for 5 meshes");
+    let lod_nodes = doc["nodes"].as_array().unwrap().len() - 200;
+    assert_eq!(
+        lod_nodes,
+        200 * levels / 5,
+        "one level node per instance and level"
+    );
+    assert!(
+        t_many < 3.0 * t_few + 2.0,
+        "instancing cost {t_many} s vs {t_few} s"
+    );
+    assert_valid(&dir.join("many_out.glb"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Every textured asset of the shared corpus at n_p = 100, with and without `--bake`: the
+/// output is valid glTF (glTF-Validator: 0 errors) and no level is larger than its mesh.
+#[test]
+fn shared_textured_assets_give_valid_scenes() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let Some(assets) = ["../shared", "../../shared", "/work/shared"]
+        .iter()
+        .map(|d| root.join(d).join("assets/textured"))
+        .find(|p| p.is_dir())
+    else {
+        eprintln!("SKIPPED: the shared assets (../shared/assets/textured) are absent");
+        return;
+    };
+    let dir = scratch("shared");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&assets)
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "glb"))
+        .collect();
+    files.sort();
+    for f in files {
+        let stem = f.file_stem().unwrap().to_string_lossy().to_string();
+        let (src, _) = parse_glb(&std::fs::read(&f).unwrap());
+        for bake in [false, true] {
+            let out = dir.join(format!("{stem}_{bake}.glb"));
+            let mut args = vec!["--screen-size", "100"];
+            if bake {
+                args.push("--bake");
+            }
+            let report = lod(&f, &out, &args, 2);
+            eprintln!("{stem} bake={bake}:\n{report}");
+            let data = std::fs::read(&out).unwrap();
+            gltf::import_slice(&data).expect("the gltf crate reads the output");
+            let (doc, _) = parse_glb(&data);
+            assert_eq!(
+                names(&doc, "nodes")[..names(&src, "nodes").len()],
+                names(&src, "nodes")[..]
+            );
+            for node in doc["nodes"].as_array().unwrap() {
+                let Some(ids) = node["extensions"]["MSFT_lod"]["ids"].as_array() else {
+                    continue;
+                };
+                let own = mesh_faces(&doc, node["mesh"].as_u64().unwrap() as usize);
+                for j in ids {
+                    let m = doc["nodes"][j.as_u64().unwrap() as usize]["mesh"]
+                        .as_u64()
+                        .unwrap();
+                    assert!(mesh_faces(&doc, m as usize) <= own, "{stem}");
+                }
+            }
+            assert_valid(&out);
+        }
+    }
+    // --merge never returns more faces than the input soup (10 triangles here, whose closed
+    // proxy needs more).
+    let tiny = assets.join("khronos_texture_coordinate_test.glb");
+    if tiny.is_file() {
+        for extra in [None, Some("--bake")] {
+            let out = dir.join("merged_tc.glb");
+            let mut args = vec!["--screen-size", "100", "--merge", "-q"];
+            args.extend(extra);
+            lod(&tiny, &out, &args, 2);
+            let (doc, _) = parse_glb(&std::fs::read(&out).unwrap());
+            let faces: usize = (0..doc["meshes"].as_array().unwrap().len())
+                .map(|m| mesh_faces(&doc, m))
+                .sum();
+            assert!(faces <= 10, "--merge {extra:?}: {faces} faces for 10");
+            assert_valid(&out);
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
