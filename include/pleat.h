@@ -1095,9 +1095,9 @@ typedef struct PleatTfwParams {
   // Reserved, set to 0.
   uint32_t reserved4;
   // 1 (default): the projected-Newton SQP's valley search near the optimum (a 1-D search
-  // along (a, ω) → (a/μ, μω), README "Thickness × 10⁻²"; what makes thin shells converge);
-  // 0: off, the plain projected Newton. Appended 2026-11-29: a shorter struct (without it)
-  // gets the default.
+  // along (a, ω) → (a/μ, μω), docs/design-notes.md, "Wrinkle SQP"; what makes thin shells
+  // converge); 0: off, the plain projected Newton. Appended 2026-11-29: a shorter struct
+  // (without it) gets the default.
   uint32_t valley_search;
   // Reserved, set to 0.
   uint32_t reserved5;
@@ -1235,7 +1235,7 @@ typedef struct PleatTfwStats {
   // when none.
   double snap_relative_correction;
   // The SQP iteration at which a step without decrease was retried with raised weights
-  // and kept them (README "SQP rescue"); −1 when no rescue was needed.
+  // and kept them (docs/design-notes.md, "Wrinkle SQP"); −1 when no rescue was needed.
   int64_t sqp_rescue_iteration;
 } PleatTfwStats;
 
@@ -2150,7 +2150,7 @@ struct PleatTfwMaterial pleat_tfw_material_default(void);
 // margin 0, radius 0, with `struct_size` set. Available in every build.
 struct PleatTfwObstacle pleat_tfw_obstacle_default(void);
 
-// Reads and validates a scene file (JSON; format in README "Tension-field wrinkles").
+// Reads and validates a scene file (JSON; format in docs/guide/tfw.md).
 //
 // - `path`: NUL-terminated UTF-8 path; non-NULL.
 // - `out`: receives the new scene (destroy with `pleat_tfw_scene_destroy`); non-NULL.

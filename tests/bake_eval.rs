@@ -6,7 +6,7 @@
 //!
 //! Ignored tests write the published numbers and files (run them with `--release`):
 //! - `publish_targets`: the docs/benchmarks/bake.md table, per shared asset and the generated
-//! sphere;
+//!   sphere;
 //! - `write_sphere_100k`: `target/bake_eval/sphere_100k.glb`, the speed benchmark input;
 //! - `readme_picture`: `docs/bake_lods.png`.
 #![cfg(feature = "bake")]

@@ -24,7 +24,7 @@
 //!   2026-12-07 and not taken either: samples deeper than `2 d` free up to `X` (no one-`d` limit) —
 //!   42722 31.69 dB, the 23-mesh mean +0.08 dB, but the tree's measured Hausdorff distance
 //!   +0.0008 l (many samples at the cap, the measurement sampling between them);
-//! docs/design-notes-lod.md,   "LOD loop and fit".
+//!   docs/design-notes-lod.md, "LOD loop and fit".
 //! - Invariant: every sample is within its budget of the LOD. A vertex move or a flip replaces
 //!   a patch of faces (the one-ring, the flip's two faces); a sample within its budget of the
 //!   *old* patch may rely on it, so it must be within its budget of the *new* patch, or the
