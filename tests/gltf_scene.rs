@@ -1272,3 +1272,49 @@ fn check_deformed_levels(doc: &Value, bin: &[u8]) {
         assert!(posed <= 1.5 * bind + 0.005, "mesh {m}: {posed} vs {bind}");
     }
 }
+
+/// `transfer_deformation` on a mesh and itself as its LOD: 8 influences (`JOINTS_1`/`WEIGHTS_1`)
+/// come out as 8 slots per vertex, each vertex's weights summing to 1 within 1e-6 with joints
+/// of the input; a morph target with `POSITION` and `NORMAL` keeps both, one row per vertex; a
+/// target without displacements gets `POSITION` zeros; a LOD far from the mesh is refused.
+#[test]
+fn deformation_transfer_carries_eight_influences_and_every_target() {
+    use pleat::bake::scene::transfer_deformation;
+    use std::collections::BTreeMap;
+    let (p, t) = grid_box(3, 1.0, 1.0);
+    let pos: Vec<[f64; 3]> = p.iter().map(|x| x.map(f64::from)).collect();
+    let mesh = pleat::mesh::TriMesh::new(pos.clone(), t.clone()).unwrap();
+    let n = pos.len();
+    let mut attributes: BTreeMap<String, Vec<Vec<f64>>> = BTreeMap::new();
+    let row = |v: usize, base: f64| (0..4).map(|s| ((v + s) % 9) as f64 + base).collect();
+    attributes.insert("JOINTS_0".into(), (0..n).map(|v| row(v, 0.0)).collect());
+    attributes.insert("JOINTS_1".into(), (0..n).map(|v| row(v, 9.0)).collect());
+    attributes.insert("WEIGHTS_0".into(), vec![vec![0.2, 0.15, 0.1, 0.05]; n]);
+    attributes.insert("WEIGHTS_1".into(), vec![vec![0.2, 0.15, 0.1, 0.05]; n]);
+    attributes.insert(
+        "TARGET0_POSITION".into(),
+        pos.iter().map(|x| vec![0.0, x[1].max(0.0), 0.0]).collect(),
+    );
+    attributes.insert("TARGET0_NORMAL".into(), vec![vec![0.0, 0.0, 0.1]; n]);
+    let d = transfer_deformation(&mesh, &attributes, 2, &mesh, 100.0).unwrap();
+    assert_eq!(d.influences, 8);
+    assert_eq!(d.joints.len(), 8 * n);
+    assert_eq!(d.weights.len(), 8 * n);
+    for (j, w) in d.joints.chunks_exact(8).zip(d.weights.chunks_exact(8)) {
+        let sum: f64 = w.iter().map(|&x| f64::from(x)).sum();
+        assert!((sum - 1.0).abs() <= 1e-6, "{w:?}");
+        assert!(j.iter().all(|&j| j < 18), "{j:?}");
+    }
+    assert_eq!(d.targets.len(), 2);
+    let sems: Vec<&str> = d.targets[0].iter().map(|(s, _)| s.as_str()).collect();
+    assert_eq!(sems, ["POSITION", "NORMAL"]);
+    assert!(d.targets[0].iter().all(|(_, v)| v.len() == n));
+    assert_eq!(
+        d.targets[1],
+        vec![("POSITION".to_string(), vec![[0.0; 3]; n])]
+    );
+    // The same mesh moved far away is not a LOD of it.
+    let moved: Vec<[f64; 3]> = pos.iter().map(|x| [x[0] + 10.0, x[1], x[2]]).collect();
+    let far = pleat::mesh::TriMesh::new(moved, t).unwrap();
+    assert!(transfer_deformation(&mesh, &attributes, 2, &far, 100.0).is_err());
+}
