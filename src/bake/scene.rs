@@ -33,15 +33,28 @@
 //!
 //! A level is **kept** (the input mesh is used for it, textures untouched; [`Kept`] says why)
 //! when the mesh has at most `target_faces` triangles, when its LOD has at least as many
-//! triangles as the mesh, when the mesh is skinned or has morph targets (see
-//! [`transfer_deformation`]), or when the LOD pipeline failed on it. So no level is ever
-//! larger than its input.
+//! triangles as the mesh, when the mesh is skinned or has morph targets and
+//! [`transfer_deformation`] refused the level, or when the LOD pipeline failed on it. So no
+//! level is ever larger than its input.
+//!
+//! # Skinned and morphed meshes
+//!
+//! A level of a skinned or morphed mesh is made in the bind pose (the mesh's local-space
+//! geometry) and carries the mesh's deformation, transferred by [`crate::transfer`]
+//! ([`transfer_deformation`]): `JOINTS_0`/`WEIGHTS_0` (and `JOINTS_1`/`WEIGHTS_1` when the
+//! mesh has 8 influences) per level vertex, joints as `UNSIGNED_SHORT` indices into the same
+//! skin, weights as `FLOAT` summing to 1 within `1e-6`; and every morph target of the mesh,
+//! in order, with its `POSITION` (and `NORMAL`/`TANGENT`) displacements interpolated
+//! barycentrically, the mesh's default `weights` and `extras.targetNames` copied. The level
+//! nodes carry the instancing node's `skin` and `weights`, so the skin's joints and weight
+//! animations of the instancing node drive every level.
 //!
 //! # Written nodes
 //!
 //! Each node instancing a mesh whose chain has at least one new level gets the extension
 //! `MSFT_lod` with `ids` = new nodes, one per coarser level (finest first), appended at the end
-//! of `nodes`, each with the instancing node's `translation`/`rotation`/`scale`/`matrix`, a
+//! of `nodes`, each with the instancing node's `translation`/`rotation`/`scale`/`matrix`,
+//! `skin` and `weights`, a
 //! name `<node>_LOD<k>` and `extras.pleat_screen_size`; and `extras.MSFT_screencoverage`
 //! ([`screen_coverage`] of each next level's `n_p`, 0 for the coarsest). The level nodes are
 //! not children of any node: a viewer implementing `MSFT_lod` puts them in place of the
@@ -185,10 +198,11 @@ impl GltfScene {
     }
 
     /// The deformation attributes of mesh `mesh` per vertex of
-    /// [`mesh_geometry`](Self::mesh_geometry) (same vertex order): `JOINTS_0`, `WEIGHTS_0` and
-    /// `TARGET<i>_POSITION` (morph target `i`'s displacement), each a row of components per
-    /// vertex, zeros where a primitive lacks the attribute. Only semantics some primitive has
-    /// are present.
+    /// [`mesh_geometry`](Self::mesh_geometry) (same vertex order): `JOINTS_0`, `WEIGHTS_0`,
+    /// `JOINTS_1`, `WEIGHTS_1` and `TARGET<i>_POSITION`, `TARGET<i>_NORMAL`,
+    /// `TARGET<i>_TANGENT` (morph target `i`'s displacements), each a row of components per
+    /// vertex (normalised integers read as reals), zeros where a primitive lacks the
+    /// attribute. Only semantics some primitive has are present.
     pub fn vertex_attributes(&self, mesh: usize) -> Result<BTreeMap<String, Vec<Vec<f64>>>> {
         let mut out: BTreeMap<String, Vec<Vec<f64>>> = BTreeMap::new();
         let mut count = 0usize;
@@ -200,15 +214,24 @@ impl GltfScene {
             &mut |prim, pos, _, what| {
                 let n = pos.count();
                 let mut accessors = Vec::new();
-                if let Some(a) = prim.get(&::gltf::Semantic::Joints(0)) {
-                    accessors.push(("JOINTS_0".to_string(), a));
-                }
-                if let Some(a) = prim.get(&::gltf::Semantic::Weights(0)) {
-                    accessors.push(("WEIGHTS_0".to_string(), a));
+                for set in 0..2 {
+                    if let Some(a) = prim.get(&::gltf::Semantic::Joints(set)) {
+                        accessors.push((format!("JOINTS_{set}"), a));
+                    }
+                    if let Some(a) = prim.get(&::gltf::Semantic::Weights(set)) {
+                        accessors.push((format!("WEIGHTS_{set}"), a));
+                    }
                 }
                 for (i, t) in prim.morph_targets().enumerate() {
-                    if let Some(a) = t.positions() {
-                        accessors.push((format!("TARGET{i}_POSITION"), a));
+                    let sems = [
+                        ("POSITION", t.positions()),
+                        ("NORMAL", t.normals()),
+                        ("TANGENT", t.tangents()),
+                    ];
+                    for (sem, a) in sems {
+                        if let Some(a) = a {
+                            accessors.push((format!("TARGET{i}_{sem}"), a));
+                        }
                     }
                 }
                 for (key, acc) in accessors {
@@ -230,6 +253,21 @@ impl GltfScene {
             rows.resize(count, vec![0.0; k]);
         }
         Ok(out)
+    }
+
+    /// The number of morph targets of mesh `mesh` (the most any of its primitives has).
+    pub fn morph_target_count(&self, mesh: usize) -> usize {
+        self.array("meshes")
+            .get(mesh)
+            .and_then(|m| m.get("primitives"))
+            .and_then(Value::as_array)
+            .map_or(0, |ps| {
+                ps.iter()
+                    .filter_map(|p| p.get("targets").and_then(Value::as_array))
+                    .map(Vec::len)
+                    .max()
+                    .unwrap_or(0)
+            })
     }
 
     /// The material index of mesh `mesh`'s first triangle primitive (`None`: default material).
@@ -276,8 +314,9 @@ pub enum Kept {
     },
     /// The mesh has at most 4 triangles: no closed LOD (a tetrahedron at least) has fewer.
     Minimal,
-    /// The mesh is skinned or has morph targets and [`transfer_deformation`] gave nothing.
-    Deformable,
+    /// The mesh is skinned or has morph targets and [`transfer_deformation`] refused this
+    /// level (the reason).
+    Deformable(String),
     /// The LOD pipeline or the bake failed on this mesh (the message).
     Failed(String),
 }
@@ -290,9 +329,9 @@ impl std::fmt::Display for Kept {
                 write!(f, "unchanged (the LOD had {lod_faces} faces, not fewer)")
             }
             Kept::Minimal => write!(f, "unchanged (no closed LOD has fewer faces)"),
-            Kept::Deformable => write!(
+            Kept::Deformable(e) => write!(
                 f,
-                "unchanged (skinned/morphed: kept, weight transfer not applied)"
+                "unchanged (skinned/morphed: deformation transfer refused: {e})"
             ),
             Kept::Failed(e) => write!(f, "unchanged (LOD failed: {e})"),
         }
@@ -314,6 +353,9 @@ pub struct SceneLevel {
     pub stats: Option<LodReport>,
     /// The baked level when baking (`None` when kept or not baking).
     pub baked: Option<BakedLevel>,
+    /// Skin influences and morph targets per vertex of the written level (of `baked` when
+    /// baked, else of `lod`); `None` when kept or when the mesh does not deform.
+    pub deformation: Option<Deformation>,
 }
 
 /// The chain of one glTF mesh.
@@ -337,33 +379,137 @@ pub struct MeshChain {
 /// kept without running the pipeline, whose output is always closed.
 const MIN_CLOSED_FACES: usize = 4;
 
-/// Per-vertex deformation attributes of a LOD: what a skinned or morphed mesh's level needs.
+/// Per-vertex deformation attributes of a level: what a skinned or morphed mesh's level needs.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Deformation {
-    /// `JOINTS_0` per LOD vertex.
-    pub joints: Vec<[u16; 4]>,
-    /// `WEIGHTS_0` per LOD vertex (each summing to 1).
-    pub weights: Vec<[f32; 4]>,
-    /// Morph target `POSITION` displacements, one list per target, one entry per LOD vertex.
-    pub targets: Vec<Vec<[f32; 3]>>,
+    /// Influences per vertex: 4 (`JOINTS_0`/`WEIGHTS_0`), 8 when the mesh also has
+    /// `JOINTS_1`/`WEIGHTS_1`, 0 when it is not skinned.
+    pub influences: usize,
+    /// Joint indices (into the skin's `joints`), `influences` per vertex, slots sorted by weight
+    /// descending; unused slots are joint 0 with weight 0.
+    pub joints: Vec<u16>,
+    /// Weights, `influences` per vertex, each vertex's summing to 1 within `1e-6`.
+    pub weights: Vec<f32>,
+    /// Morph targets in the mesh's order: per target, its displacements by semantic
+    /// (`POSITION`, `NORMAL`, `TANGENT`, those the mesh has; `POSITION` zeros when it has none),
+    /// one entry per vertex.
+    pub targets: Vec<Vec<(String, Vec<[f32; 3]>)>>,
 }
 
-/// Whether [`transfer_deformation`] is implemented; while it is not, a skinned or morphed mesh
-/// is kept unchanged at every level without baking a LOD for it.
-pub const DEFORMATION_TRANSFER: bool = false;
+impl Deformation {
+    /// The attributes of vertex `map[i]` on vertex `i` (a level whose vertices were split).
+    fn remap(&self, map: &[usize]) -> Deformation {
+        let k = self.influences;
+        Deformation {
+            influences: k,
+            joints: map
+                .iter()
+                .flat_map(|&i| &self.joints[i * k..(i + 1) * k])
+                .copied()
+                .collect(),
+            weights: map
+                .iter()
+                .flat_map(|&i| &self.weights[i * k..(i + 1) * k])
+                .copied()
+                .collect(),
+            targets: self
+                .targets
+                .iter()
+                .map(|t| {
+                    t.iter()
+                        .map(|(s, v)| (s.clone(), map.iter().map(|&i| v[i]).collect()))
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+}
 
-/// The one place where skin weights and morph targets are carried from a mesh to its LOD:
-/// `input` is the mesh in local space ([`GltfScene::mesh_geometry`]), `attributes` its
-/// per-vertex attributes by glTF semantic (`JOINTS_0`, `WEIGHTS_0`, `TARGET<i>_POSITION`, one
-/// row of components per input vertex), `lod` the level. Returns `None` when no transfer is
-/// available, and the level is then kept unchanged. Today it always returns `None`.
+/// The one place where skin weights and morph targets are carried from a mesh to its LOD, by
+/// [`crate::transfer`]: `input` is the mesh in local space (its bind pose,
+/// [`GltfScene::mesh_geometry`]), `attributes` its per-vertex attributes
+/// ([`GltfScene::vertex_attributes`]), `targets` the mesh's morph target count, `lod` the
+/// level made at screen size `screen_size`.
+///
+/// Skin: the influences of `JOINTS_0`/`WEIGHTS_0` (and `JOINTS_1`/`WEIGHTS_1`: up to 8) by
+/// [`crate::transfer::Correspondence::transfer_skin`] with the default rule, as many per vertex
+/// as the mesh has (4 or 8). Morph targets: each displacement interpolated barycentrically
+/// ([`crate::transfer::TransferMode::Barycentric`]).
+///
+/// Errors: `InvalidArgument` when the correspondence is refused (the LOD is not within the
+/// wrong-input bound of the mesh), when the attributes do not have one row per input vertex,
+/// when an input vertex used by the LOD has no positive skin weight, or when a joint index
+/// exceeds 65535.
 pub fn transfer_deformation(
     input: &TriMesh,
     attributes: &BTreeMap<String, Vec<Vec<f64>>>,
+    targets: usize,
     lod: &TriMesh,
-) -> Option<Deformation> {
-    let _ = (input, attributes, lod);
-    None
+    screen_size: f64,
+) -> Result<Deformation> {
+    use crate::transfer::{Correspondence, SkinParams, TransferMode, TransferParams};
+    let n = input.vertex_count();
+    if let Some((key, rows)) = attributes.iter().find(|(_, r)| r.len() != n) {
+        return Err(Error::InvalidArgument(format!(
+            "{key} has {} rows for {n} vertices",
+            rows.len()
+        )));
+    }
+    let corr = Correspondence::new(input, lod, &TransferParams::for_screen_size(screen_size))?;
+    let flat = |key: &str, k: usize| -> Option<Vec<f64>> {
+        attributes.get(key).map(|rows| {
+            rows.iter()
+                .flat_map(|r| (0..k).map(|j| r.get(j).copied().unwrap_or(0.0)))
+                .collect()
+        })
+    };
+    let mut out = Deformation::default();
+    if let (Some(j0), Some(w0)) = (flat("JOINTS_0", 4), flat("WEIGHTS_0", 4)) {
+        let second = flat("JOINTS_1", 4).zip(flat("WEIGHTS_1", 4));
+        let m = if second.is_some() { 8 } else { 4 };
+        let (mut joints, mut weights) = (Vec::with_capacity(n * m), Vec::with_capacity(n * m));
+        for v in 0..n {
+            let r = v * 4..v * 4 + 4;
+            joints.extend(j0[r.clone()].iter().map(|&j| j as u32));
+            weights.extend(w0[r.clone()].iter().map(|&w| w as f32));
+            if let Some((j1, w1)) = &second {
+                joints.extend(j1[r.clone()].iter().map(|&j| j as u32));
+                weights.extend(w1[r].iter().map(|&w| w as f32));
+            }
+        }
+        let params = SkinParams {
+            max_influences: m,
+            ..SkinParams::default()
+        };
+        let skin = corr.transfer_skin(&joints, &weights, m, &params)?;
+        out.influences = skin.influences;
+        out.joints = skin
+            .joints
+            .iter()
+            .map(|&j| {
+                u16::try_from(j)
+                    .map_err(|_| Error::InvalidArgument(format!("joint index {j} exceeds 65535")))
+            })
+            .collect::<Result<_>>()?;
+        out.weights = skin.weights;
+    }
+    for t in 0..targets {
+        let mut target = Vec::new();
+        for sem in ["POSITION", "NORMAL", "TANGENT"] {
+            let Some(values) = flat(&format!("TARGET{t}_{sem}"), 3) else {
+                continue;
+            };
+            let values: Vec<f32> = values.iter().map(|&x| x as f32).collect();
+            let moved = corr.transfer_f32(&values, 3, TransferMode::Barycentric)?;
+            let rows = moved.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            target.push((sem.to_string(), rows));
+        }
+        if target.is_empty() {
+            target.push(("POSITION".into(), vec![[0.0; 3]; lod.vertex_count()]));
+        }
+        out.targets.push(target);
+    }
+    Ok(out)
 }
 
 /// The chains of every mesh that some node instantiates, in mesh order. Each is baked once in
@@ -429,12 +575,11 @@ pub fn lod_scene(
                     lod: None,
                     stats: None,
                     baked: None,
+                    deformation: None,
                 })
                 .collect()
         };
-        let levels = if scene.is_deformable(m) && !DEFORMATION_TRANSFER {
-            kept_all(Kept::Deformable)
-        } else if faces <= MIN_CLOSED_FACES {
+        let levels = if faces <= MIN_CLOSED_FACES {
             kept_all(Kept::Minimal)
         } else if let Some(budget) = params.lod.target_faces.filter(|&f| faces <= f) {
             kept_all(Kept::AtBudget { budget })
@@ -528,25 +673,31 @@ fn mesh_levels(
                 lod: None,
                 stats: Some(stats),
                 baked: None,
+                deformation: None,
             });
             continue;
         }
-        if scene.is_deformable(m) {
-            // Reached only once DEFORMATION_TRANSFER is set: the level is kept unless the
-            // transfer gives its attributes (writing them is the transfer's companion change).
+        let deformation = if scene.is_deformable(m) {
             let attributes = scene.vertex_attributes(m)?;
-            if transfer_deformation(geometry, &attributes, &lod).is_none() {
-                levels.push(SceneLevel {
-                    screen_size: n_p,
-                    faces,
-                    kept: Some(Kept::Deformable),
-                    lod: None,
-                    stats: Some(stats),
-                    baked: None,
-                });
-                continue;
+            let targets = scene.morph_target_count(m);
+            match transfer_deformation(geometry, &attributes, targets, &lod, n_p) {
+                Ok(d) => Some(d),
+                Err(e) => {
+                    levels.push(SceneLevel {
+                        screen_size: n_p,
+                        faces,
+                        kept: Some(Kept::Deformable(e.to_string())),
+                        lod: None,
+                        stats: Some(stats),
+                        baked: None,
+                        deformation: None,
+                    });
+                    continue;
+                }
             }
-        }
+        } else {
+            None
+        };
         let baked = match (app, &index, &params.bake) {
             (Some(app), Some(index), Some(bp)) => {
                 let base = share + per * k as f64;
@@ -562,6 +713,11 @@ fn mesh_levels(
             }
             _ => None,
         };
+        // A baked level splits vertices at seams: each copy takes its LOD vertex's attributes.
+        let deformation = match (deformation, &baked) {
+            (Some(d), Some(b)) => Some(d.remap(&split_map(&lod, &b.positions)?)),
+            (d, _) => d,
+        };
         levels.push(SceneLevel {
             screen_size: n_p,
             faces: lod_faces,
@@ -569,9 +725,28 @@ fn mesh_levels(
             lod: Some(lod),
             stats: Some(stats),
             baked,
+            deformation,
         });
     }
     Ok(levels)
+}
+
+/// For each of `positions` (a baked level's vertices, copies of the LOD's split at seams),
+/// the LOD vertex at the same position. `InvalidArgument` when one has none.
+fn split_map(lod: &TriMesh, positions: &[[f64; 3]]) -> Result<Vec<usize>> {
+    let key = |p: &[f64; 3]| p.map(f64::to_bits);
+    let mut at = std::collections::HashMap::new();
+    for (i, p) in lod.positions().iter().enumerate() {
+        at.entry(key(p)).or_insert(i);
+    }
+    positions
+        .iter()
+        .map(|p| {
+            at.get(&key(p)).copied().ok_or_else(|| {
+                Error::InvalidArgument("a baked vertex is not a vertex of its LOD".into())
+            })
+        })
+        .collect()
 }
 
 /// Options of [`scene_glb`].
@@ -696,6 +871,14 @@ pub fn scene_glb(scene: &GltfScene, chains: &[MeshChain], opts: &WriteOptions) -
                 }
                 (None, None) => chain.mesh,
             };
+            if let (Some(d), true) = (&l.deformation, mesh != chain.mesh) {
+                let src = arrays
+                    .meshes
+                    .get(chain.mesh)
+                    .cloned()
+                    .unwrap_or(Value::Null);
+                push_deformation(d, &src, &mut arrays.meshes[mesh], &mut bin);
+            }
             levels.push((l.screen_size, mesh));
         }
         if levels.iter().all(|&(_, m)| m == chain.mesh) {
@@ -723,7 +906,14 @@ pub fn scene_glb(scene: &GltfScene, chains: &[MeshChain], opts: &WriteOptions) -
             for (k, &(n_p, mesh)) in rest.iter().enumerate() {
                 let mut lod = json!({"name": format!("{node_name}_LOD{}", k + first),
                                      "mesh": mesh, "extras": {"pleat_screen_size": n_p}});
-                for key in ["matrix", "translation", "rotation", "scale"] {
+                for key in [
+                    "matrix",
+                    "translation",
+                    "rotation",
+                    "scale",
+                    "skin",
+                    "weights",
+                ] {
                     if let Some(v) = nodes[i].get(key) {
                         lod[key] = v.clone();
                     }
@@ -852,6 +1042,53 @@ fn untextured_material(src: Option<usize>, materials: &mut Vec<Value>) -> Option
     copy["name"] = json!(format!("{name} (untextured)"));
     materials.push(copy);
     Some(materials.len() - 1)
+}
+
+/// Adds a level's skin and morph targets to its mesh `level` (one primitive): `JOINTS_<s>`
+/// (`UNSIGNED_SHORT`) and `WEIGHTS_<s>` (`FLOAT`) per 4 influences, the `targets` (`POSITION`
+/// with bounds), and the source mesh `src`'s default `weights` and `extras.targetNames`.
+fn push_deformation(d: &Deformation, src: &Value, level: &mut Value, bin: &mut Bin) {
+    let prim = &mut level["primitives"][0];
+    for set in 0..d.influences / 4 {
+        let rows = d.joints.len() / d.influences;
+        let (mut joints, mut weights) = (Vec::new(), Vec::with_capacity(rows));
+        for v in 0..rows {
+            let r = v * d.influences + 4 * set..v * d.influences + 4 * set + 4;
+            joints.extend(d.joints[r.clone()].iter().flat_map(|j| j.to_le_bytes()));
+            weights.push([
+                d.weights[r.start],
+                d.weights[r.start + 1],
+                d.weights[r.start + 2],
+                d.weights[r.start + 3],
+            ]);
+        }
+        let view = bin.view(&joints, Some(34962));
+        bin.accessors
+            .push(json!({"bufferView": view, "componentType": 5123,
+                                  "count": rows, "type": "VEC4"}));
+        prim["attributes"][format!("JOINTS_{set}")] = json!(bin.accessors.len() - 1);
+        prim["attributes"][format!("WEIGHTS_{set}")] = json!(bin.floats(&weights, "VEC4", false));
+    }
+    if !d.targets.is_empty() {
+        let targets: Vec<Value> = d
+            .targets
+            .iter()
+            .map(|t| {
+                let mut o = serde_json::Map::new();
+                for (sem, v) in t {
+                    o.insert(sem.clone(), json!(bin.floats(v, "VEC3", sem == "POSITION")));
+                }
+                Value::Object(o)
+            })
+            .collect();
+        prim["targets"] = json!(targets);
+        if let Some(w) = src.get("weights") {
+            level["weights"] = w.clone();
+        }
+        if let Some(names) = src.get("extras").and_then(|e| e.get("targetNames")) {
+            level["extras"]["targetNames"] = names.clone();
+        }
+    }
 }
 
 /// Appends an unbaked level: `POSITION` (f32, min/max) and `u32` indices, `material`.

@@ -102,7 +102,8 @@ enum Command {
     /// glTF input with a .glb output keeps the whole document (nodes, skins, animations,
     /// cameras, lights, materials, extras) and gives every mesh its own chain, baked once in
     /// the mesh's local space and linked to each instancing node with MSFT_lod; a mesh whose
-    /// LOD would not have fewer faces, or that is skinned or morphed, is kept unchanged.
+    /// LOD would not have fewer faces is kept unchanged; the levels of a skinned or morphed
+    /// mesh carry its joints, weights and morph targets (transferred from the input).
     /// `--merge` fuses everything into one proxy instead.
     Lod {
         /// The input mesh (any triangle soup); several files, folders or --manifest bake a batch.
