@@ -44,7 +44,7 @@ const STOPPABLE_POLL: std::time::Duration = std::time::Duration::from_millis(100
 /// base, more than the 0.5 s a cancel may wait). When `heavy`, `work` runs on a helper thread,
 /// inside a rayon pool of as many threads as the caller's (so faer's `Par::rayon(0)` there is the
 /// caller's parallelism and the result is bit for bit the one of a call on this thread), while this
-/// thread calls `tick()` every 0.1 s; its first error is returned at once, and the helper then
+/// thread calls `tick()` every 0.1 s; its first error is returned at once, and the worker then
 /// finishes `work` and drops its value (nothing is returned or kept: the thread owns everything
 /// `work` captured). Otherwise `work` runs right here, without a `tick`. A panic in `work` is
 /// re-raised on this thread.

@@ -1,6 +1,6 @@
 //! The built-in scenes of the dissertation and the examples: the stretched sheet, sphere drapes,
 //! twisted cylinders, the sheared rectangle, the disk and torus balloons and the teabag, with the
-//! pattern helpers they are made of (grids, outlines, balloon panels). Deterministic: a seed is
+//! pattern functions they are made of (grids, outlines, balloon panels). Deterministic: a seed is
 //! the only source of variation.
 
 use super::description::{

@@ -46,7 +46,7 @@
 //!
 //! ## Files
 //!
-//! `description.rs` (the data), `validate.rs` (field checks and the field-error helpers),
+//! `description.rs` (the data), `validate.rs` (field checks and the field-error functions),
 //! `assemble.rs` (panels stitched into the [`Model`]), `json.rs` (the format above, read and
 //! written) and `builtin.rs` (the built-in scenes); they import each other without cycles, in
 //! that order from the bottom. This module only declares them and re-exports their API.

@@ -1,6 +1,6 @@
 //! Validation of a [`Scene`]: every field is checked and an error (`InvalidArgument`, message
 //! `scene: <field path>: <what>`) names the bad one; questionable but valid values come back as
-//! warnings. The field-error helpers here are shared by the JSON reader and the assembly.
+//! warnings. The field-error functions here are shared by the JSON reader and the assembly.
 
 use super::description::{rest_form, Obstacle, ObstacleShape, Panel, Scene};
 use crate::{Error, Result};
