@@ -238,8 +238,8 @@ fn manifests_give_per_asset_screen_sizes_and_budgets() {
     write_assets(&dir, false);
     std::fs::write(
         dir.join("assets.csv"),
-        "# per-asset settings\ninput,screen_size,faces,output\n\
-         torus.obj,20;10,,out/torus_{n}.obj\nsphere.off,12,60,out/sphere.ply\nbox.ply,,,\n",
+        "# per-asset settings\ninput,screen_size,faces,output,memory_budget\n\
+         torus.obj,20;10,,out/torus_{n}.obj,\nsphere.off,12,60,out/sphere.ply,1GiB\nbox.ply,,,,\n",
     )
     .unwrap();
     let default_out = dir.join("out").join("{stem}_default.obj");
@@ -279,7 +279,9 @@ fn manifests_give_per_asset_screen_sizes_and_budgets() {
     std::fs::write(
         dir.join("assets.json"),
         r#"[{"input": "torus.obj", "screen_size": [20, 10], "output": "json/t_{np}.obj"},
-            {"input": "missing.obj", "screen_size": 9, "output": "json/m.obj"}]"#,
+            {"input": "missing.obj", "screen_size": 9, "output": "json/m.obj"},
+            {"input": "box.ply", "screen_size": 20, "output": "json/b.obj",
+             "memory_budget": "1K"}]"#,
     )
     .unwrap();
     let o = pleat(&[
@@ -296,6 +298,13 @@ fn manifests_give_per_asset_screen_sizes_and_budgets() {
     assert_eq!(row(&r, "torus")["status"], "baked");
     assert_eq!(row(&r, "missing")["status"], "failed");
     assert!(dir.join("json").join("t_10.obj").is_file());
+    // A row's memory budget is its own: 1 KiB refuses the box, naming how to allow it.
+    let boxed = row(&r, "box");
+    assert_eq!(boxed["status"], "failed");
+    assert!(
+        boxed["error"].as_str().unwrap().contains("--memory-budget"),
+        "{boxed}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

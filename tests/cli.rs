@@ -925,3 +925,41 @@ fn lod_start_option() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("started from the input"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--memory-budget` takes a size with a unit; a bake over it exits 1 with the figure it would
+/// need and how to allow it; a budget that fits bakes; a malformed one exits 2.
+#[cfg(feature = "lod")]
+#[test]
+fn memory_budget_option_refuses_and_allows() {
+    let dir = std::env::temp_dir().join(format!("pleat-cli-budget-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("lod.obj");
+    let lod = |budget: &str| {
+        pleat(&[
+            "lod",
+            "assets/dirty_two_boxes.obj",
+            "--screen-size",
+            "50",
+            "--memory-budget",
+            budget,
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    let refused = lod("1K");
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("MiB") && err.contains("--memory-budget"),
+        "the refusal names the need and the option: {err}"
+    );
+    assert!(!out.exists());
+    stdout_of_success(&lod("1GiB"));
+    assert!(out.exists());
+    for bad in ["lots", "3X", "0", "-1G"] {
+        let o = lod(bad);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {:?}", o);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

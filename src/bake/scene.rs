@@ -512,6 +512,63 @@ pub fn transfer_deformation(
     Ok(out)
 }
 
+/// A mesh's per-vertex deformation attributes ([`GltfScene::vertex_attributes`]) and its morph
+/// target count.
+type MeshDeformation = (BTreeMap<String, Vec<Vec<f64>>>, usize);
+
+/// The deformation the LOD of a skinned or morphed mesh follows (`LodParams::deformation`):
+/// its `JOINTS_0`/`WEIGHTS_0` (and `JOINTS_1`/`WEIGHTS_1`) influences and its morph targets'
+/// `POSITION` displacements, per vertex of `input` ([`GltfScene::vertex_attributes`] and the
+/// target count). `None` for a mesh without either.
+fn deformation_field(
+    input: &TriMesh,
+    deform: Option<&MeshDeformation>,
+) -> Result<Option<crate::lowpoly::DeformationField>> {
+    let Some((attributes, targets)) = deform else {
+        return Ok(None);
+    };
+    let n = input.vertex_count();
+    let rows = |key: &str| attributes.get(key).filter(|r| r.len() == n);
+    let mut field = crate::lowpoly::DeformationField::default();
+    for set in 0..2 {
+        let (Some(j), Some(w)) = (
+            rows(&format!("JOINTS_{set}")),
+            rows(&format!("WEIGHTS_{set}")),
+        ) else {
+            break;
+        };
+        field.influences += 4;
+        let (mut joints, mut weights) = (Vec::new(), Vec::new());
+        for v in 0..n {
+            for k in 0..4 {
+                joints.push(j[v].get(k).copied().unwrap_or(0.0) as u32);
+                weights.push(w[v].get(k).copied().unwrap_or(0.0) as f32);
+            }
+        }
+        field.joints = interleave(&field.joints, &joints, field.influences - 4, n);
+        field.weights = interleave(&field.weights, &weights, field.influences - 4, n);
+    }
+    for t in 0..*targets {
+        if let Some(d) = rows(&format!("TARGET{t}_POSITION")) {
+            let deltas = d
+                .iter()
+                .map(|r| [0, 1, 2].map(|i| r.get(i).copied().unwrap_or(0.0) as f32))
+                .collect();
+            field.morph_deltas.push(deltas);
+        }
+    }
+    field.validate(n)?;
+    Ok((!field.is_empty()).then_some(field))
+}
+
+/// Per vertex, the `k` entries of `a` then the 4 of `b` (`n` vertices).
+fn interleave<T: Copy>(a: &[T], b: &[T], k: usize, n: usize) -> Vec<T> {
+    (0..n)
+        .flat_map(|v| a[v * k..(v + 1) * k].iter().chain(&b[v * 4..v * 4 + 4]))
+        .copied()
+        .collect()
+}
+
 /// The chains of every mesh that some node instantiates, in mesh order. Each is baked once in
 /// the mesh's local space (see the [module docs](self)); `progress` sees `mesh i/n: <stage>`
 /// with the fraction over all meshes; returning `false` cancels with `Error::Cancelled`. A
@@ -627,6 +684,11 @@ fn mesh_levels(
     params: &SceneParams,
     prog: &mut ProgressFn<'_>,
 ) -> Result<Vec<SceneLevel>> {
+    let deform = if scene.is_deformable(m) {
+        Some((scene.vertex_attributes(m)?, scene.morph_target_count(m)))
+    } else {
+        None
+    };
     let share = if app.is_some() {
         super::GEOMETRY_SHARE
     } else {
@@ -642,6 +704,7 @@ fn mesh_levels(
         let single = sizes.len() == 1 && params.lod.target_faces.is_some();
         let p = LodParams {
             screen_size: sizes[0],
+            deformation: deformation_field(geometry, deform.as_ref())?.map(std::sync::Arc::new),
             ..params.lod.clone()
         };
         match (single, params.cage) {
@@ -677,10 +740,8 @@ fn mesh_levels(
             });
             continue;
         }
-        let deformation = if scene.is_deformable(m) {
-            let attributes = scene.vertex_attributes(m)?;
-            let targets = scene.morph_target_count(m);
-            match transfer_deformation(geometry, &attributes, targets, &lod, n_p) {
+        let deformation = if let Some((attributes, targets)) = &deform {
+            match transfer_deformation(geometry, attributes, *targets, &lod, n_p) {
                 Ok(d) => Some(d),
                 Err(e) => {
                     levels.push(SceneLevel {

@@ -213,6 +213,11 @@ struct BakeArgs {
     /// is taken when the memory estimate needs it. Ignored for cages.
     #[arg(long)]
     voxel_scale: Option<f64>,
+    /// Upper bound on the memory of each bake: bytes or a size with a unit (`4GiB`, `512MiB`,
+    /// `3G`, `800M`; K, M, G, T are powers of 1024) [default: 2GiB]. A bake whose estimate
+    /// exceeds it takes a coarser offset voxel, or is refused with the figure it would need.
+    #[arg(long, value_parser = parse_memory_budget)]
+    memory_budget: Option<u64>,
     /// No progress bar and no summary.
     #[arg(short, long)]
     quiet: bool,
@@ -601,6 +606,9 @@ fn lod_params(args: &BakeArgs, sizes: &[f64], faces: Option<usize>) -> LodParams
         clearance: args.clearance.unwrap_or_default(),
         start: args.start,
         offset_voxel_scale: args.voxel_scale,
+        memory_budget_bytes: args
+            .memory_budget
+            .unwrap_or(LodParams::default().memory_budget_bytes),
         ..LodParams::default()
     }
 }
@@ -638,6 +646,39 @@ fn parse_start(s: &str) -> Result<pleat::lowpoly::LodStart, String> {
         "input" => Ok(LodStart::Input),
         _ => Err(format!("expected auto, offset or input, got {s}")),
     }
+}
+
+/// `--memory-budget` (and the batch manifest's `memory_budget`): bytes, or a number with a unit
+/// K, M, G or T (powers of 1024; `KiB`, `MB`, … read the same); at least one byte.
+#[cfg(feature = "lod")]
+pub(crate) fn parse_memory_budget(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (num, unit) = t.split_at(split);
+    let v: f64 = num
+        .parse()
+        .map_err(|_| format!("`{s}` is not a size (e.g. 4GiB, 512MiB, 3G or bytes)"))?;
+    let power = match unit.trim().to_ascii_lowercase().as_str() {
+        "" | "b" => 0,
+        "k" | "kb" | "kib" => 1,
+        "m" | "mb" | "mib" => 2,
+        "g" | "gb" | "gib" => 3,
+        "t" | "tb" | "tib" => 4,
+        _ => {
+            return Err(format!(
+                "`{s}`: unknown unit `{unit}` (K, M, G, T, or none for bytes)"
+            ))
+        }
+    };
+    let bytes = v * 1024f64.powi(power);
+    if !(bytes.is_finite() && bytes >= 1.0 && bytes < u64::MAX as f64) {
+        return Err(format!(
+            "the memory budget must be at least one byte, got {s}"
+        ));
+    }
+    Ok(bytes as u64)
 }
 
 /// `--clearance`: `0.25d` (a fraction of d) or `0.002` (model units); finite and `>= 0`.

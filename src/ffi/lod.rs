@@ -327,6 +327,9 @@ pub(super) mod imp {
                 Clearance::FractionOfD(p.clearance)
             },
             offset_voxel_scale: voxel_scale_to_rust(p.offset_voxel_scale)?,
+            // Deformation-aware simplification is not in the C ABI yet: C callers simplify
+            // the bind pose and carry weights over with `pleat_transfer_*`.
+            deformation: None,
         })
     }
 

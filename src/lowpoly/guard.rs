@@ -71,6 +71,9 @@ pub(crate) struct InputModel {
     pub points: Option<(Vec<[u32; 3]>, TriangleBvh)>,
     /// Bounding-box diagonal `l`.
     pub diag: f64,
+    /// The deformation the simplification must keep vertices for (`LodParams::deformation`;
+    /// `super::deform`), when there is one.
+    pub deformation: Option<std::sync::Arc<super::deform::DeformationField>>,
 }
 
 /// Input faces from which [`InputModel::new_with_stop`] builds its trees on a helper thread
@@ -195,6 +198,7 @@ impl InputModel {
             bvh,
             degenerate,
             points,
+            deformation: None,
         })
     }
 

@@ -20,6 +20,7 @@
 
 mod align;
 mod coverage;
+mod deform;
 pub(crate) mod distance;
 mod extract;
 pub(crate) mod features;
@@ -36,6 +37,7 @@ mod pipeline;
 mod report;
 mod simplify;
 
+pub use deform::{DeformationField, MORPH_DEVIATION, SKIN_DEVIATION, SKIN_GAP};
 pub use fit::SELF_CLEARANCE as FIT_SELF_CLEARANCE;
 pub use guard::CONE_HALF_ANGLE;
 pub use offset::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};

@@ -64,6 +64,9 @@ pub struct SimplifyCounts {
     pub rejected_distance: u64,
     /// Rejected by the guard (topology, intersections, cage contact).
     pub rejected_guard: u64,
+    /// Rejected: an edge would span more change of the input's deformation (skin weights,
+    /// morph displacements) than `LodParams::deformation` allows.
+    pub rejected_deformation: u64,
     /// Collapses re-checked after a neighbour changed.
     pub rechecked: u64,
 }
@@ -77,6 +80,7 @@ impl SimplifyCounts {
         self.rejected_hausdorff += o.rejected_hausdorff;
         self.rejected_distance += o.rejected_distance;
         self.rejected_guard += o.rejected_guard;
+        self.rejected_deformation += o.rejected_deformation;
         self.rechecked += o.rechecked;
     }
 }
@@ -293,6 +297,9 @@ impl LodReport {
         e.count_entry("rejected_hausdorff", s.rejected_hausdorff);
         e.count_entry("rejected_distance", s.rejected_distance);
         e.count_entry("rejected_guard", s.rejected_guard);
+        if s.rejected_deformation > 0 {
+            e.count_entry("rejected_deformation", s.rejected_deformation);
+        }
         e.count_entry("collapses_rechecked", s.rechecked);
         let g = &self.guard;
         e.count_entry("guard_checks", g.checks);

@@ -45,6 +45,7 @@
 
 use rayon::prelude::*;
 
+use super::deform::{label_at, DeformationField, Label};
 use super::guard::{bbox, boxes_overlap, patches_intersect, Guard, GuardScratch};
 use super::report::{GuardCounts, SimplifyCounts};
 use crate::geom::{normalized, tri_normal, Vec3};
@@ -377,6 +378,9 @@ struct Pass<'g, 'a> {
     vert_dist: VertexData<f64>,
     scratch: GuardScratch,
     report: SimplifyCounts,
+    /// Per vertex, the input's deformation at its closest input point, when the input has one
+    /// (`super::deform`): collapses keep the vertices it needs.
+    labels: Option<VertexData<Label>>,
 }
 
 /// The collapse queue and the formation of batches from it (see [`Pass::run`]). Needs only
@@ -485,6 +489,8 @@ struct Accepted {
     dx: f64,
     new: Patch,
     new_face_dist: Vec<FaceDist>,
+    /// The deformation label of `x` (when the input has a deformation).
+    label: Option<Label>,
 }
 
 /// A face's sampled distance to the input: mean and largest of its samples (corners, and
@@ -527,8 +533,14 @@ pub(crate) fn simplify_pass(
 impl<'g, 'a> Pass<'g, 'a> {
     fn new(g: &'g mut Guard<'a>, opt: SimplifyOptions) -> Self {
         let quadrics = vertex_quadrics(g);
+        let labels = g
+            .input()
+            .deformation
+            .as_deref()
+            .map(|f| vertex_labels(g, f));
         let m = g.mesh();
         let mut pass = Pass {
+            labels,
             face_dist: FaceData::filled(m.face_capacity(), FaceDist::UNKNOWN),
             vert_dist: VertexData::filled(m.vertex_capacity(), f64::NAN),
             batcher: Batcher {
@@ -732,7 +744,9 @@ impl<'g, 'a> Pass<'g, 'a> {
                 // in a cage with a clearance a guard refusal (when the pass retries them); a
                 // too large change, or a guard refusal elsewhere, is rarely cured by moving
                 // along the edge, and retrying would double the cost of those rejections.
-                Err(r @ (Rejection::Fold | Rejection::Distance)) => ev.outcome = Err(r),
+                Err(r @ (Rejection::Fold | Rejection::Distance | Rejection::Deformation)) => {
+                    ev.outcome = Err(r)
+                }
                 Err(r @ Rejection::Guard) if retry_guard => ev.outcome = Err(r),
                 Err(r) => {
                     ev.outcome = Err(r);
@@ -757,6 +771,7 @@ impl<'g, 'a> Pass<'g, 'a> {
         if folds_over(&old, &new) {
             return Err(Rejection::Fold);
         }
+        let label = self.follows_deformation(a, b, x, &old, &new)?;
         if !self.within_hausdorff(a, b, x, &old, &new) {
             return Err(Rejection::Hausdorff);
         }
@@ -774,7 +789,58 @@ impl<'g, 'a> Pass<'g, 'a> {
             dx,
             new,
             new_face_dist,
+            label,
         })
+    }
+
+    /// The deformation check (`super::deform`): `x`'s label, when every edge of the new patch
+    /// from `x` to a neighbour `n` spans a skin gap of at most 1 (or no more than the edge from
+    /// `a` or `b` to `n` it replaces already did) and the input's deformation at a quarter,
+    /// half and three quarters of it is within the allowed deviation of the edge's linear
+    /// blend. `Ok(None)` without a deformation.
+    fn follows_deformation(
+        &self,
+        a: VertexId,
+        b: VertexId,
+        x: Vec3,
+        old: &Patch,
+        new: &Patch,
+    ) -> std::result::Result<Option<Label>, Rejection> {
+        let (Some(labels), Some(field)) = (&self.labels, self.g.input().deformation.as_deref())
+        else {
+            return Ok(None);
+        };
+        let model = self.g.input();
+        let m = self.g.mesh();
+        let lx = label_at(model, field, x.to_array()).unwrap_or_default();
+        let d = self.opt.d;
+        let mut seen: Vec<VertexId> = Vec::with_capacity(16);
+        for &n in new.verts.iter().flatten() {
+            if n == a || seen.contains(&n) {
+                continue;
+            }
+            seen.push(n);
+            let replaced = old
+                .verts
+                .iter()
+                .filter(|f| f.contains(&n))
+                .flatten()
+                .filter(|&&e| e == a || e == b)
+                .map(|&e| labels[e].skin_gap(&labels[n]))
+                .fold(1.0, f64::max);
+            if lx.skin_gap(&labels[n]) > replaced {
+                return Err(Rejection::Deformation);
+            }
+            let pn = Vec3::from(m.position(n));
+            for t in [0.25f32, 0.5, 0.75] {
+                let p = x + (pn - x) * f64::from(t);
+                let at = label_at(model, field, p.to_array()).unwrap_or_default();
+                if at.deviation(&lx, &labels[n], t, d) > 1.0 {
+                    return Err(Rejection::Deformation);
+                }
+            }
+        }
+        Ok(Some(lx))
     }
 
     /// Writes the distances an evaluation computed into the caches.
@@ -800,6 +866,7 @@ impl<'g, 'a> Pass<'g, 'a> {
             Err(Rejection::Hausdorff) => self.report.rejected_hausdorff += 1,
             Err(Rejection::Distance) => self.report.rejected_distance += 1,
             Err(Rejection::Guard) => self.report.rejected_guard += 1,
+            Err(Rejection::Deformation) => self.report.rejected_deformation += 1,
         }
     }
 
@@ -1040,6 +1107,9 @@ impl<'g, 'a> Pass<'g, 'a> {
         self.report.collapses += 1;
         self.quadrics[a] = self.quadrics[a].add(&self.quadrics[b]);
         self.vert_dist[a] = acc.dx;
+        if let (Some(labels), Some(l)) = (&mut self.labels, &acc.label) {
+            labels[a] = l.clone();
+        }
         for (i, &f) in new.ids.iter().enumerate() {
             self.face_dist[f] = acc.new_face_dist[i];
         }
@@ -1061,6 +1131,27 @@ enum Rejection {
     Hausdorff,
     Distance,
     Guard,
+    /// An edge would span too much change of the input's deformation (`super::deform`).
+    Deformation,
+}
+
+/// The label (`super::deform`) of every live vertex of the guard's mesh, in parallel (one
+/// closest-point query each); dead slots get the empty label.
+fn vertex_labels(g: &Guard<'_>, field: &DeformationField) -> VertexData<Label> {
+    let (m, model) = (g.mesh(), g.input());
+    let labels: Vec<Label> = (0..m.vertex_capacity())
+        .into_par_iter()
+        .with_min_len(256)
+        .map(|i| {
+            let v = VertexId::new(i as u32);
+            if m.is_vertex_live(v) {
+                label_at(model, field, m.position(v)).unwrap_or_default()
+            } else {
+                Label::default()
+            }
+        })
+        .collect();
+    VertexData::from_vec(labels)
 }
 
 /// Faces of a patch: ids, vertex ids and corner positions.

@@ -25,9 +25,12 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 
 use super::{
-    bake, bake_levels, lod_params, output_path, progress_bar, BakeArgs, EXIT_FAILED, EXIT_INPUT,
-    SIZE_PLACEHOLDERS,
+    bake, bake_levels, lod_params, output_path, parse_memory_budget, progress_bar, BakeArgs,
+    EXIT_FAILED, EXIT_INPUT, SIZE_PLACEHOLDERS,
 };
+
+/// The columns a CSV manifest may name.
+const COLUMNS: [&str; 5] = ["input", "screen_size", "faces", "output", "memory_budget"];
 
 /// Placeholder of the output path replaced by the input's file stem.
 const STEM_PLACEHOLDER: &str = "{stem}";
@@ -39,9 +42,10 @@ const CACHE_LAYOUT: &str = "pleat batch cache v1";
 #[derive(clap::Args)]
 pub struct BatchArgs {
     /// Manifest of inputs with per-asset settings: JSON (`.json`: an array of
-    /// {"input", "screen_size": n or [n, ...], "faces", "output"}) or CSV (header naming
-    /// `input` and optionally `screen_size` (sizes separated by `;`), `faces`, `output`; no
-    /// quoted fields). Paths are relative to the manifest's folder; missing settings come from
+    /// {"input", "screen_size": n or [n, ...], "faces", "output", "memory_budget"}) or CSV
+    /// (header naming `input` and optionally `screen_size` (sizes separated by `;`), `faces`,
+    /// `output`, `memory_budget`; no quoted fields). `memory_budget` is a size as for
+    /// --memory-budget (`"4GiB"`, or a number of bytes). Paths are relative to the manifest's folder; missing settings come from
     /// the command line.
     #[arg(long)]
     pub manifest: Option<PathBuf>,
@@ -86,6 +90,8 @@ struct Asset {
     sizes: Vec<f64>,
     faces: Option<usize>,
     outputs: Vec<PathBuf>,
+    /// The asset's memory budget in bytes when its manifest row gives one.
+    memory_budget: Option<u64>,
 }
 
 /// Outcome of one asset.
@@ -188,6 +194,7 @@ struct Spec {
     sizes: Option<Vec<f64>>,
     faces: Option<usize>,
     output: Option<PathBuf>,
+    memory_budget: Option<u64>,
 }
 
 impl Spec {
@@ -230,6 +237,7 @@ impl Spec {
             sizes,
             faces,
             outputs,
+            memory_budget: self.memory_budget,
         })
     }
 }
@@ -359,16 +367,26 @@ fn json_row(r: &Value) -> Result<Spec, String> {
         None | Some(Value::Null) => None,
         Some(x) => Some(PathBuf::from(x.as_str().ok_or("output must be a path")?)),
     };
+    let memory_budget = match r.get("memory_budget") {
+        None | Some(Value::Null) => None,
+        Some(Value::String(t)) => Some(parse_memory_budget(t)?),
+        Some(x) => Some(
+            x.as_u64()
+                .filter(|&b| b > 0)
+                .ok_or("memory_budget must be a size (\"4GiB\") or a positive number of bytes")?,
+        ),
+    };
     Ok(Spec {
         input: PathBuf::from(input),
         sizes,
         faces,
         output,
+        memory_budget,
     })
 }
 
 /// CSV manifest: a header naming the columns (`input` required; `screen_size`, `faces`,
-/// `output` optional), then one asset per line; empty cells take the command line's value.
+/// `output`, `memory_budget` optional), then one asset per line; empty cells take the command line's value.
 /// Blank lines and lines starting with `#` are skipped. No quoting.
 fn parse_csv_manifest(text: &str) -> Result<Vec<Spec>, String> {
     let mut lines = text
@@ -378,10 +396,8 @@ fn parse_csv_manifest(text: &str) -> Result<Vec<Spec>, String> {
     let (_, header) = lines.next().ok_or("empty manifest")?;
     let columns: Vec<String> = header.split(',').map(|c| c.trim().to_string()).collect();
     for c in &columns {
-        if !["input", "screen_size", "faces", "output"].contains(&c.as_str()) {
-            return Err(format!(
-                "unknown column '{c}' (input, screen_size, faces, output)"
-            ));
+        if !COLUMNS.contains(&c.as_str()) {
+            return Err(format!("unknown column '{c}' ({})", COLUMNS.join(", ")));
         }
     }
     if !columns.iter().any(|c| c == "input") {
@@ -419,6 +435,7 @@ fn csv_row(columns: &[String], line: &str) -> Result<Spec, String> {
             "faces" => {
                 spec.faces = Some(v.parse().map_err(|e| format!("faces '{v}': {e}"))?);
             }
+            "memory_budget" => spec.memory_budget = Some(parse_memory_budget(v)?),
             _ => spec.output = Some(PathBuf::from(v)),
         }
     }
@@ -580,10 +597,20 @@ fn bake_or_copy(
     Ok((Status::Baked, levels))
 }
 
+/// The LOD parameters of asset `a`: the command line's, with the asset's sizes, face target
+/// and (when its manifest row gives one) memory budget.
+fn asset_params(args: &BakeArgs, a: &Asset) -> pleat::lowpoly::LodParams {
+    let mut p = lod_params(args, &a.sizes, a.faces);
+    if let Some(b) = a.memory_budget {
+        p.memory_budget_bytes = b;
+    }
+    p
+}
+
 /// Reads, bakes and writes one asset's levels.
 fn bake_and_write(a: &Asset, args: &BakeArgs, cage: bool) -> AssetResult<Vec<Level>> {
     let mesh = read_mesh(&a.input).map_err(|e| e.to_string())?;
-    let params = lod_params(args, &a.sizes, a.faces);
+    let params = asset_params(args, a);
     let result = bake_levels(&mesh, &a.sizes, &params, cage, &mut |_| true);
     let baked = result.map_err(|e| e.to_string())?;
     let mut levels = Vec::with_capacity(baked.len());
@@ -650,7 +677,7 @@ fn cache_key(input: &[u8], a: &Asset, args: &BakeArgs, cmd: &str) -> String {
     }
     // Every LOD parameter the bake will use (its `Debug` form prints each field, f64s exactly),
     // so a parameter added to `lod_params` can never be left out of the key.
-    field(&format!("{:?}", lod_params(args, &a.sizes, a.faces)));
+    field(&format!("{:?}", asset_params(args, a)));
     for o in &a.outputs {
         field(&format!("format={}", extension(o)));
     }

@@ -11,6 +11,12 @@ use crate::lowpoly::offset::{band_estimate_bytes, OffsetCount};
 use crate::mesh::TriMesh;
 use crate::{Error, Result};
 
+/// How a refused bake may be allowed more memory, appended to every budget refusal.
+pub(crate) const RAISE_THE_BUDGET: &str =
+    "; to allow it, raise the budget (`--memory-budget` in the \
+    CLI and in batch manifests, `memory_budget_bytes` in C, Python and Rust) or lower the \
+    screen size";
+
 /// Voxel scales (multiples of the offset stage's voxel edge `d/√3`, `OffsetParams::voxel_scale`)
 /// a LOD's offset surface may use, finest first: from the scale its screen size starts from
 /// (1, or [`LOD_VOXEL_SCALE`] from [`LOD_COARSE_VOXEL_MIN_SCREEN_SIZE`] on), the finest whose
@@ -171,7 +177,7 @@ impl LodParams {
         };
         Error::LimitExceeded(format!(
             "the bake needs about {:.0} MiB at screen size {} (offset voxel {}× the default) \
-             but the memory budget is {:.0} MiB{input_start}",
+             but the memory budget is {:.0} MiB{input_start}{RAISE_THE_BUDGET}",
             mib(est),
             self.screen_size,
             MAX_LOD_VOXEL_SCALE,
@@ -373,7 +379,8 @@ impl LodParams {
         };
         Error::LimitExceeded(format!(
             "the offset surface at screen size {} (offset voxel {scale}× the default) measured \
-             {what}: the bake would need about {:.0} MiB but the memory budget is {:.0} MiB",
+             {what}: the bake would need about {:.0} MiB but the memory budget is {:.0} MiB\
+             {RAISE_THE_BUDGET}",
             self.screen_size,
             mib(peak),
             mib(self.memory_budget_bytes as f64)
@@ -402,7 +409,8 @@ pub(super) fn check_mode_budget(p: &LodParams, input: &TriMesh, mode: Mode) -> R
         return Ok(());
     }
     Err(Error::LimitExceeded(format!(
-        "the bake needs about {:.0} MiB at screen size {} but the memory budget is {:.0} MiB",
+        "the bake needs about {:.0} MiB at screen size {} but the memory budget is {:.0} MiB\
+         {RAISE_THE_BUDGET}",
         p.memory_estimate(input, 1.0) / (1u64 << 20) as f64,
         p.screen_size,
         p.memory_budget_bytes as f64 / (1u64 << 20) as f64

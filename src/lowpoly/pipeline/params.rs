@@ -3,6 +3,8 @@
 //! data and their documented defaults; the checks are in `validate.rs`, the memory budget in
 //! `budget.rs`.
 
+use crate::lowpoly::DeformationField;
+
 /// Default cage clearance as a fraction of `d` ([`Clearance::FractionOfD`]).
 pub const DEFAULT_CLEARANCE_FRACTION: f64 = 0.05;
 
@@ -119,6 +121,19 @@ pub struct LodParams {
     /// environment variable `PLEAT_LOD_VOXEL_SCALE`, so the output depends on
     /// the parameters only.
     pub offset_voxel_scale: Option<f64>,
+    /// The input's skin weights and morph targets, per input vertex, when the LOD will be
+    /// deformed by them (a skinned or morphed mesh; see [`DeformationField`]). The
+    /// simplification then keeps the vertices the deformation needs: no collapse creates an
+    /// edge across which the skin weights change by more than [`SKIN_GAP`] (total variation),
+    /// or along which the input's weights stray more than [`SKIN_DEVIATION`] (morph
+    /// displacements more than [`MORPH_DEVIATION`]` · d`) from the linear blend of the edge's
+    /// ends, so the posed LOD bends with its input (more faces where weights change). `None`
+    /// (default): a static mesh.
+    ///
+    /// [`SKIN_GAP`]: crate::lowpoly::SKIN_GAP
+    /// [`SKIN_DEVIATION`]: crate::lowpoly::SKIN_DEVIATION
+    /// [`MORPH_DEVIATION`]: crate::lowpoly::MORPH_DEVIATION
+    pub deformation: Option<std::sync::Arc<DeformationField>>,
 }
 
 /// The largest total genus of a clean input that [`LodStart::Auto`] starts from (see there):
@@ -182,6 +197,7 @@ impl Default for LodParams {
             fit_to_input: true,
             start: LodStart::Auto,
             offset_voxel_scale: None,
+            deformation: None,
         }
     }
 }

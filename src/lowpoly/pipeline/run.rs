@@ -78,9 +78,10 @@ pub(crate) fn run(
     let mut rep = Reporter::new(progress);
     // cancellation points between the setup's trees (each about 1 s on a 10⁶-face input)
     rep.check("setup", 0.0)?;
-    let model =
+    let mut model =
         InputModel::new_with_stop(input, mode == Mode::Cage, &mut || rep.report("setup", 0.0))
             .ok_or(Error::Cancelled)?;
+    model.deformation = followed_deformation(params);
     rep.check("setup", 0.0)?;
     let start = choose_start(input, params, mode, &mut rep)?;
     check_offset_budget(params, input, mode, start.is_some())?;
@@ -127,9 +128,10 @@ pub(crate) fn run_chain(
     let mut rep = Reporter::new(progress);
     // cancellation points between the setup's trees (each about 1 s on a 10⁶-face input)
     rep.check("setup", 0.0)?;
-    let model =
+    let mut model =
         InputModel::new_with_stop(input, mode == Mode::Cage, &mut || rep.report("setup", 0.0))
             .ok_or(Error::Cancelled)?;
+    model.deformation = followed_deformation(&level_params[0]);
     rep.check("setup", 0.0)?;
     let level = Level::new(&model, input, mode);
     // the finest level starts from the welded input when it is clean (`LodStart`)
@@ -158,4 +160,12 @@ pub(crate) fn run_chain(
         .into_iter()
         .map(|x| x.expect("every level baked"))
         .collect())
+}
+
+/// The deformation the simplification keeps vertices for: `params.deformation` unless it is
+/// empty (the same for every level of a chain).
+fn followed_deformation(
+    params: &LodParams,
+) -> Option<std::sync::Arc<crate::lowpoly::DeformationField>> {
+    params.deformation.clone().filter(|f| !f.is_empty())
 }

@@ -41,6 +41,9 @@ impl LodParams {
                 self.theta0_deg
             ));
         }
+        if let Some(field) = &self.deformation {
+            field.validate(input.vertex_count())?;
+        }
         if self.memory_budget_bytes == 0 {
             return bad("memory budget must be > 0".into());
         }
