@@ -255,6 +255,81 @@ impl GltfScene {
         Ok(out)
     }
 
+    /// The skin of the first node instancing mesh `mesh` with one.
+    fn skin_of(&self, mesh: usize) -> Option<usize> {
+        self.array("nodes").iter().find_map(|n| {
+            (n.get("mesh").and_then(Value::as_u64) == Some(mesh as u64))
+                .then(|| n.get("skin").and_then(Value::as_u64))
+                .flatten()
+                .map(|s| s as usize)
+        })
+    }
+
+    /// The bind-pose pivot of each joint of mesh `mesh`'s skin in the mesh's space, by joint
+    /// index: the origin of the joint's space, i.e. the inverse of its inverse bind matrix
+    /// applied to the origin (identity matrices when the skin has none). Empty without a skin;
+    /// a joint whose matrix is singular gets no pivot (the lever of a joint without one).
+    pub fn joint_pivots(&self, mesh: usize) -> Vec<[f64; 3]> {
+        let Some(skin) = self
+            .skin_of(mesh)
+            .and_then(|s| self.loaded.document.skins().nth(s))
+        else {
+            return Vec::new();
+        };
+        let buffers = &self.loaded.buffers;
+        let reader = skin.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+        let n = skin.joints().count();
+        let matrices: Vec<[[f32; 4]; 4]> = match reader.read_inverse_bind_matrices() {
+            Some(m) => m.collect(),
+            None => vec![glam::Mat4::IDENTITY.to_cols_array_2d(); n],
+        };
+        let mut pivots = Vec::with_capacity(n);
+        for m in matrices {
+            let m = glam::DMat4::from_cols_array_2d(&m.map(|c| c.map(f64::from)));
+            if m.determinant().abs() <= f64::EPSILON {
+                break;
+            }
+            pivots.push(m.inverse().transform_point3(glam::DVec3::ZERO).to_array());
+        }
+        pivots
+    }
+
+    /// The largest angle in radians by which an animation turns one of mesh `mesh`'s skin
+    /// joints from its rest rotation (its node's `rotation`), over every rotation keyframe;
+    /// 0 without a skin or rotation animation.
+    pub fn max_joint_rotation(&self, mesh: usize) -> f64 {
+        let Some(skin) = self
+            .skin_of(mesh)
+            .and_then(|s| self.loaded.document.skins().nth(s))
+        else {
+            return 0.0;
+        };
+        let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
+        let buffers = &self.loaded.buffers;
+        let mut max = 0.0f64;
+        for anim in self.loaded.document.animations() {
+            for ch in anim.channels() {
+                let node = ch.target().node();
+                if !joints.contains(&node.index()) {
+                    continue;
+                }
+                let reader = ch.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+                let Some(::gltf::animation::util::ReadOutputs::Rotations(r)) =
+                    reader.read_outputs()
+                else {
+                    continue;
+                };
+                let rest = glam::DQuat::from_array(node.transform().decomposed().1.map(f64::from));
+                for q in r.into_f32() {
+                    let q = glam::DQuat::from_array(q.map(f64::from)).normalize();
+                    let cos = q.dot(rest).abs().min(1.0);
+                    max = max.max(2.0 * cos.acos());
+                }
+            }
+        }
+        max
+    }
+
     /// The number of morph targets of mesh `mesh` (the most any of its primitives has).
     pub fn morph_target_count(&self, mesh: usize) -> usize {
         self.array("meshes")
@@ -297,6 +372,10 @@ pub struct SceneParams {
     pub cage: bool,
     /// Bake the mesh's materials onto each new level.
     pub bake: Option<BakeParams>,
+    /// The largest posed error the skin of a skinned mesh may add to its levels, in pixels at
+    /// each level's screen size (`DeformationField::max_skin_error`; 0: the default
+    /// [`crate::lowpoly::SKIN_ERROR`]).
+    pub skin_error: f64,
 }
 
 /// Why a level is the input mesh itself.
@@ -519,17 +598,29 @@ type MeshDeformation = (BTreeMap<String, Vec<Vec<f64>>>, usize);
 /// The deformation the LOD of a skinned or morphed mesh follows (`LodParams::deformation`):
 /// its `JOINTS_0`/`WEIGHTS_0` (and `JOINTS_1`/`WEIGHTS_1`) influences and its morph targets'
 /// `POSITION` displacements, per vertex of `input` ([`GltfScene::vertex_attributes`] and the
-/// target count). `None` for a mesh without either.
+/// target count), its skin's joint pivots and the largest joint turn of its animations (at
+/// least [`crate::lowpoly::DEFAULT_MAX_ROTATION`]). `None` for a mesh without either.
 fn deformation_field(
+    scene: &GltfScene,
+    mesh: usize,
     input: &TriMesh,
     deform: Option<&MeshDeformation>,
+    skin_error: f64,
 ) -> Result<Option<crate::lowpoly::DeformationField>> {
     let Some((attributes, targets)) = deform else {
         return Ok(None);
     };
     let n = input.vertex_count();
     let rows = |key: &str| attributes.get(key).filter(|r| r.len() == n);
-    let mut field = crate::lowpoly::DeformationField::default();
+    let mut field = crate::lowpoly::DeformationField {
+        joint_pivots: scene.joint_pivots(mesh),
+        // The animations' largest turn, and at least the default: an engine may play others.
+        max_rotation: scene
+            .max_joint_rotation(mesh)
+            .max(crate::lowpoly::DEFAULT_MAX_ROTATION),
+        max_skin_error: skin_error,
+        ..Default::default()
+    };
     for set in 0..2 {
         let (Some(j), Some(w)) = (
             rows(&format!("JOINTS_{set}")),
@@ -704,7 +795,8 @@ fn mesh_levels(
         let single = sizes.len() == 1 && params.lod.target_faces.is_some();
         let p = LodParams {
             screen_size: sizes[0],
-            deformation: deformation_field(geometry, deform.as_ref())?.map(std::sync::Arc::new),
+            deformation: deformation_field(scene, m, geometry, deform.as_ref(), params.skin_error)?
+                .map(std::sync::Arc::new),
             ..params.lod.clone()
         };
         match (single, params.cage) {

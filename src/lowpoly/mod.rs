@@ -37,7 +37,7 @@ mod pipeline;
 mod report;
 mod simplify;
 
-pub use deform::{DeformationField, MORPH_DEVIATION, SKIN_DEVIATION, SKIN_GAP};
+pub use deform::{DeformationField, DEFAULT_MAX_ROTATION, MORPH_DEVIATION, SKIN_ERROR};
 pub use fit::SELF_CLEARANCE as FIT_SELF_CLEARANCE;
 pub use guard::CONE_HALF_ANGLE;
 pub use offset::{offset_surface, offset_surface_with_progress, OffsetDistance, OffsetParams};

@@ -45,8 +45,8 @@
 
 use rayon::prelude::*;
 
-use super::deform::{label_at, DeformationField, Label};
-use super::guard::{bbox, boxes_overlap, patches_intersect, Guard, GuardScratch};
+use super::deform::{label_at, DeformationField, Label, LabelInput, Lever};
+use super::guard::{bbox, boxes_overlap, patches_intersect, Guard, GuardScratch, InputModel};
 use super::report::{GuardCounts, SimplifyCounts};
 use crate::geom::{normalized, tri_normal, Vec3};
 use crate::mesh::halfedge::{EdgeData, EdgeId, FaceData, FaceId, HalfedgeId, VertexData, VertexId};
@@ -794,10 +794,10 @@ impl<'g, 'a> Pass<'g, 'a> {
     }
 
     /// The deformation check (`super::deform`): `x`'s label, when every edge of the new patch
-    /// from `x` to a neighbour `n` spans a skin gap of at most 1 (or no more than the edge from
-    /// `a` or `b` to `n` it replaces already did) and the input's deformation at a quarter,
-    /// half and three quarters of it is within the allowed deviation of the edge's linear
-    /// blend. `Ok(None)` without a deformation.
+    /// from `x` to a neighbour `n` keeps the posed error of its middle within bounds (or no
+    /// larger than the edge from `a` or `b` to `n` it replaces) and the input's deformation at
+    /// a quarter, half and three quarters of it is within bounds of the edge's linear blend.
+    /// `Ok(None)` without a deformation.
     fn follows_deformation(
         &self,
         a: VertexId,
@@ -810,9 +810,12 @@ impl<'g, 'a> Pass<'g, 'a> {
         else {
             return Ok(None);
         };
-        let model = self.g.input();
+        let input = self.g.input();
+        let lever = Lever::new(field, input.diag);
+        let model = label_input(input);
         let m = self.g.mesh();
-        let lx = label_at(model, field, x.to_array()).unwrap_or_default();
+        let at = |v: VertexId| Vec3::from(m.position(v));
+        let lx = label_at(&model, field, x.to_array()).unwrap_or_default();
         let d = self.opt.d;
         let mut seen: Vec<VertexId> = Vec::with_capacity(16);
         for &n in new.verts.iter().flatten() {
@@ -820,22 +823,22 @@ impl<'g, 'a> Pass<'g, 'a> {
                 continue;
             }
             seen.push(n);
+            let pn = at(n);
             let replaced = old
                 .verts
                 .iter()
                 .filter(|f| f.contains(&n))
                 .flatten()
                 .filter(|&&e| e == a || e == b)
-                .map(|&e| labels[e].skin_gap(&labels[n]))
+                .map(|&e| labels[e].skin_gap(&labels[n], at(e).distance(pn), &lever, d))
                 .fold(1.0, f64::max);
-            if lx.skin_gap(&labels[n]) > replaced {
+            if lx.skin_gap(&labels[n], x.distance(pn), &lever, d) > replaced {
                 return Err(Rejection::Deformation);
             }
-            let pn = Vec3::from(m.position(n));
             for t in [0.25f32, 0.5, 0.75] {
                 let p = x + (pn - x) * f64::from(t);
-                let at = label_at(model, field, p.to_array()).unwrap_or_default();
-                if at.deviation(&lx, &labels[n], t, d) > 1.0 {
+                let there = label_at(&model, field, p.to_array()).unwrap_or_default();
+                if there.deviation(&lx, &labels[n], t, p, &lever, d) > 1.0 {
                     return Err(Rejection::Deformation);
                 }
             }
@@ -1135,17 +1138,26 @@ enum Rejection {
     Deformation,
 }
 
+/// The guard's input as the deformation labels query it.
+fn label_input(input: &InputModel) -> LabelInput<'_> {
+    LabelInput {
+        positions: &input.positions,
+        tris: &input.tris,
+        bvh: &input.bvh,
+    }
+}
+
 /// The label (`super::deform`) of every live vertex of the guard's mesh, in parallel (one
 /// closest-point query each); dead slots get the empty label.
 fn vertex_labels(g: &Guard<'_>, field: &DeformationField) -> VertexData<Label> {
-    let (m, model) = (g.mesh(), g.input());
+    let (m, model) = (g.mesh(), label_input(g.input()));
     let labels: Vec<Label> = (0..m.vertex_capacity())
         .into_par_iter()
         .with_min_len(256)
         .map(|i| {
             let v = VertexId::new(i as u32);
             if m.is_vertex_live(v) {
-                label_at(model, field, m.position(v)).unwrap_or_default()
+                label_at(&model, field, m.position(v)).unwrap_or_default()
             } else {
                 Label::default()
             }

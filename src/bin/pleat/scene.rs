@@ -26,6 +26,21 @@ pub struct SceneArgs {
     /// mesh (the input mesh stays in the file, unused).
     #[arg(long, conflicts_with = "merge")]
     pub drop_original: bool,
+    /// Per-mesh chains: the largest error, in pixels at each level's screen size, that the
+    /// skin of a skinned mesh may add when posed (joints turning by up to their animations'
+    /// largest angle, at least 1 rad). Smaller keeps more vertices where weights change
+    /// [default: 0.5].
+    #[arg(long, value_parser = parse_skin_error, conflicts_with = "merge")]
+    pub skin_error: Option<f64>,
+}
+
+fn parse_skin_error(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "the skin error must be a number of pixels > 0, got {s}"
+        )),
+    }
 }
 
 /// Whether `input` → `output` runs as a scene (glTF in, `.glb` out, no `--merge`).
@@ -82,6 +97,7 @@ pub fn run(input: &Path, args: &BakeArgs, cage: bool) -> ExitCode {
         lod: super::lod_params(args, &args.screen_size, args.faces),
         cage,
         bake,
+        skin_error: args.scene.skin_error.unwrap_or(0.0),
     };
     let t = std::time::Instant::now();
     let bar = progress_bar(args.quiet);

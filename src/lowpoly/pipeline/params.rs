@@ -124,14 +124,13 @@ pub struct LodParams {
     /// The input's skin weights and morph targets, per input vertex, when the LOD will be
     /// deformed by them (a skinned or morphed mesh; see [`DeformationField`]). The
     /// simplification then keeps the vertices the deformation needs: no collapse creates an
-    /// edge across which the skin weights change by more than [`SKIN_GAP`] (total variation),
-    /// or along which the input's weights stray more than [`SKIN_DEVIATION`] (morph
-    /// displacements more than [`MORPH_DEVIATION`]` · d`) from the linear blend of the edge's
-    /// ends, so the posed LOD bends with its input (more faces where weights change). `None`
-    /// (default): a static mesh.
+    /// edge whose posed shape would leave the posed input by more than [`SKIN_ERROR`]` · d`
+    /// (joints turning by up to the field's `max_rotation`), or along which the input's morph
+    /// displacements stray more than [`MORPH_DEVIATION`]` · d` from the linear blend of the
+    /// edge's ends, so the posed LOD bends with its input (more faces where weights change).
+    /// `None` (default): a static mesh.
     ///
-    /// [`SKIN_GAP`]: crate::lowpoly::SKIN_GAP
-    /// [`SKIN_DEVIATION`]: crate::lowpoly::SKIN_DEVIATION
+    /// [`SKIN_ERROR`]: crate::lowpoly::SKIN_ERROR
     /// [`MORPH_DEVIATION`]: crate::lowpoly::MORPH_DEVIATION
     pub deformation: Option<std::sync::Arc<DeformationField>>,
 }
