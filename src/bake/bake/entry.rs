@@ -16,7 +16,7 @@ use crate::transfer::provenance::{InputIndex, ProvenanceParams};
 use crate::{Error, Result};
 
 /// Bakes `app`'s appearance onto `lod`, a LOD of `app.mesh` made for screen size `screen_size`.
-/// `index` must index `app.mesh`. See the [module docs](self).
+/// `index` must index `app.mesh`. See the [module docs](crate::bake::bake).
 ///
 /// Errors: `InvalidArgument` for bad parameters; `Internal` when the atlas fails.
 pub fn bake_level(

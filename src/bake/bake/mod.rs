@@ -7,7 +7,7 @@
 //!    bilinear filtering at chart borders reads surface values, not gutter.
 //! 2. **Sample** (rayon over rows, each texel independent, so the bytes do not depend on the
 //!    thread count): point and interpolated normal on the LOD, provenance
-//!    ([`InputIndex::query`]), material evaluation ([`Appearance::sample`]). Base colour is
+//!    ([`InputIndex::query`](crate::bake::InputIndex::query)), material evaluation ([`Appearance::sample`](crate::bake::Appearance::sample)). Base colour is
 //!    interpolated in linear space by the input sampler and stored sRGB-encoded with linear
 //!    alpha; emissive likewise; metallic-roughness as glTF's (–, roughness, metallic);
 //!    occlusion in R (G = B = R).

@@ -3,7 +3,7 @@
 
 use crate::bake::atlas::AtlasParams;
 
-/// Parameters of [`bake_level`].
+/// Parameters of [`bake_level`](crate::bake::bake_level).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BakeParams {
     /// Atlas size rule and gutter.
@@ -35,7 +35,7 @@ pub enum VertexColors {
     /// that footprint, so an error of the colour change across half a pixel, `|∇c| · h/2`
     /// (`c` the input's sRGB base colour in 1/255, its gradient over the input triangle at the
     /// closest input point, max over R, G, B), plus one 8-bit step, is not visible at that
-    /// size. The vertex fit ([`bake_level`]'s L² fit) is kept when its mean error over the
+    /// size. The vertex fit ([`bake_level`](crate::bake::bake_level)'s L² fit) is kept when its mean error over the
     /// surface samples is at most the mean allowed error over the same samples; otherwise the
     /// level gets a texture at the atlas rule's density. Both numbers are reported
     /// (`BakeReport::vertex_fit_error`, `vertex_fit_allowed_error`).

@@ -207,8 +207,8 @@ impl LodParams {
     /// field `offset_voxel_scale` and [`LOD_VOXEL_SCALES`]), or `None`
     /// when even the coarsest scale's up-front estimate exceeds the budget: then the bake
     /// starts from the input if it may, else the measured admission decides during the bake
-    /// (its scale is [`LodReport::offset_voxel_scale`], its estimate
-    /// [`LodReport::measured_estimate_bytes`]), else `validate` refuses. The same choice
+    /// (its scale is [`LodReport::offset_voxel_scale`](crate::lowpoly::LodReport::offset_voxel_scale), its estimate
+    /// [`LodReport::measured_estimate_bytes`](crate::lowpoly::LodReport::measured_estimate_bytes)), else `validate` refuses. The same choice
     /// `generate` makes; for benchmarks and tools.
     pub fn lod_voxel_scale(&self, input: &TriMesh) -> Option<f64> {
         self.offset_voxel_scale(input, Mode::Lod)

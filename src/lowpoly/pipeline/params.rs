@@ -4,6 +4,13 @@
 //! `budget.rs`.
 
 use crate::lowpoly::DeformationField;
+// Targets of the doc links below (the items live in sibling files of this module).
+#[allow(unused_imports)]
+use crate::lowpoly::{
+    check_clean, generate, generate_chain, LodReport, LOD_COARSE_VOXEL_MIN_SCREEN_SIZE,
+    LOD_MEDIUM_VOXEL_MIN_SCREEN_SIZE, LOD_MEDIUM_VOXEL_SCALE, LOD_VOXEL_SCALE, LOD_VOXEL_SCALES,
+    STALL_ROUNDS,
+};
 
 /// Default cage clearance as a fraction of `d` ([`Clearance::FractionOfD`]).
 pub const DEFAULT_CLEARANCE_FRACTION: f64 = 0.05;
