@@ -93,7 +93,8 @@ impl DeformationField {
     pub fn validate(&self, vertices: usize) -> Result<()> {
         let bad = |m: String| Err(Error::InvalidArgument(format!("deformation: {m}")));
         let k = self.influences;
-        if self.joints.len() != vertices * k || self.weights.len() != vertices * k {
+        let expected = vertices.checked_mul(k);
+        if expected != Some(self.joints.len()) || expected != Some(self.weights.len()) {
             return bad(format!(
                 "{} joints and {} weights for {vertices} vertices × {k} influences",
                 self.joints.len(),
