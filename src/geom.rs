@@ -32,6 +32,33 @@ pub fn normalized(a: Vec3) -> Option<Vec3> {
     (l > 0.0 && l.is_finite()).then(|| a * (1.0 / l))
 }
 
+/// Barycentric coordinates of `q` (on or near the triangle's plane) with respect to `t`,
+/// clamped to the triangle (non-negative, summing to 1).
+pub fn barycentric(t: [Vec3; 3], q: Vec3) -> [f64; 3] {
+    let v0 = t[1] - t[0];
+    let v1 = t[2] - t[0];
+    let v2 = q - t[0];
+    let d00 = v0.dot(v0);
+    let d01 = v0.dot(v1);
+    let d11 = v1.dot(v1);
+    let d20 = v2.dot(v0);
+    let d21 = v2.dot(v1);
+    let den = d00 * d11 - d01 * d01;
+    if den == 0.0 || !den.is_finite() {
+        // Degenerate triangle: the nearest corner.
+        let d = t.map(|c| (c - q).length_squared());
+        let k = (0..3).min_by(|&a, &b| d[a].total_cmp(&d[b])).unwrap_or(0);
+        let mut b = [0.0; 3];
+        b[k] = 1.0;
+        return b;
+    }
+    let v = (d11 * d20 - d01 * d21) / den;
+    let w = (d00 * d21 - d01 * d20) / den;
+    let b = [1.0 - v - w, v, w].map(|x| x.max(0.0));
+    let s = b[0] + b[1] + b[2];
+    b.map(|x| x / s)
+}
+
 /// `(b − a) × (c − a)`: the normal of triangle `abc` scaled by twice its area.
 #[inline]
 pub fn tri_normal(a: Vec3, b: Vec3, c: Vec3) -> Vec3 {

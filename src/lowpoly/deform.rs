@@ -34,7 +34,7 @@
 //!
 //! May import what `lowpoly` may.
 
-use crate::geom::Vec3;
+use crate::geom::{barycentric, Vec3};
 use crate::spatial::bvh::TriangleBvh;
 use crate::{Error, Result};
 
@@ -308,7 +308,7 @@ pub(crate) fn label_at(
         .closest_point(model.positions, model.tris, p, f64::INFINITY)?;
     let t = model.tris[c.triangle as usize];
     let corners = t.map(|v| Vec3::from(model.positions[v as usize]));
-    let bary = barycentric(Vec3::from(c.point), &corners);
+    let bary = barycentric(corners, Vec3::from(c.point));
     let mut skin: Vec<(u32, f32)> = Vec::with_capacity(3 * field.influences);
     for (k, &v) in t.iter().enumerate() {
         if bary[k] > 0.0 {
@@ -339,29 +339,6 @@ pub(crate) fn label_at(
         })
         .collect();
     Some(Label { skin, morph })
-}
-
-/// Barycentric coordinates of `q` (a point of the triangle) in `t`, clamped to `[0, 1]` and
-/// summing to 1; the nearest corner's when `t` is degenerate.
-fn barycentric(q: Vec3, t: &[Vec3; 3]) -> [f64; 3] {
-    let (e0, e1, e2) = (t[1] - t[0], t[2] - t[0], q - t[0]);
-    let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
-    let (d20, d21) = (e2.dot(e0), e2.dot(e1));
-    let den = d00 * d11 - d01 * d01;
-    let degenerate = den.is_nan() || den <= 1e-30 * (d00 * d11).max(f64::MIN_POSITIVE);
-    if degenerate {
-        let nearest = (0..3)
-            .min_by(|&a, &b| q.distance(t[a]).total_cmp(&q.distance(t[b])))
-            .unwrap_or(0);
-        let mut w = [0.0; 3];
-        w[nearest] = 1.0;
-        return w;
-    }
-    let v = ((d11 * d20 - d01 * d21) / den).clamp(0.0, 1.0);
-    let w = ((d00 * d21 - d01 * d20) / den).clamp(0.0, 1.0);
-    let u = (1.0 - v - w).max(0.0);
-    let s = u + v + w;
-    [u / s, v / s, w / s]
 }
 
 #[cfg(test)]

@@ -254,32 +254,9 @@ fn ray_triangle(p: Vec3, n: Vec3, t: &[Vec3; 3]) -> Option<(f64, [f64; 3])> {
     Some((s, [1.0 - u - v, u, v]))
 }
 
-/// Barycentric coordinates of `q` (on or near the triangle's plane) with respect to `t`,
-/// clamped to the triangle (non-negative, summing to 1).
-pub fn barycentric(t: [Vec3; 3], q: Vec3) -> [f64; 3] {
-    let v0 = t[1] - t[0];
-    let v1 = t[2] - t[0];
-    let v2 = q - t[0];
-    let d00 = v0.dot(v0);
-    let d01 = v0.dot(v1);
-    let d11 = v1.dot(v1);
-    let d20 = v2.dot(v0);
-    let d21 = v2.dot(v1);
-    let den = d00 * d11 - d01 * d01;
-    if den == 0.0 || !den.is_finite() {
-        // Degenerate triangle: the nearest corner.
-        let d = t.map(|c| (c - q).length_squared());
-        let k = (0..3).min_by(|&a, &b| d[a].total_cmp(&d[b])).unwrap_or(0);
-        let mut b = [0.0; 3];
-        b[k] = 1.0;
-        return b;
-    }
-    let v = (d11 * d20 - d01 * d21) / den;
-    let w = (d00 * d21 - d01 * d20) / den;
-    let b = [1.0 - v - w, v, w].map(|x| x.max(0.0));
-    let s = b[0] + b[1] + b[2];
-    b.map(|x| x / s)
-}
+/// Barycentric coordinates of `q` with respect to `t`, clamped to the triangle
+/// ([`crate::geom::barycentric`], kept here for callers of this module).
+pub use crate::geom::barycentric;
 
 #[cfg(test)]
 mod tests {
