@@ -76,11 +76,11 @@ pub(crate) struct InputModel {
     pub deformation: Option<std::sync::Arc<super::deform::DeformationField>>,
 }
 
-/// Input faces from which [`InputModel::new_with_stop`] builds its trees on a helper thread
+/// Input faces from which [`InputModel::new_with_stop`] builds its trees on a background thread
 /// (below, on the calling thread: no extra thread for the small inputs of most calls).
 const HELPER_THREAD_FACES: usize = 1 << 17;
 
-/// How often [`InputModel::new_with_stop`] asks whether to go on while its helper thread builds
+/// How often [`InputModel::new_with_stop`] asks whether to go on while its background thread builds
 /// the trees (a cancel must be answered within 0.5 s).
 const TREE_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 
@@ -118,7 +118,7 @@ fn degeneracy_flags(positions: &[[f64; 3]], tris: &[[u32; 3]]) -> Vec<bool> {
         .collect()
 }
 
-/// The trees from the helper thread, asking `keep_going()` every [`TREE_POLL`] meanwhile;
+/// The trees from the background thread, asking `keep_going()` every [`TREE_POLL`] meanwhile;
 /// `None` when it answers `false`.
 fn wait_for_trees(
     rx: &std::sync::mpsc::Receiver<InputTrees>,
@@ -154,11 +154,12 @@ impl InputModel {
     /// As [`new`](Self::new), with `keep_going()` asked on the calling thread while the trees
     /// are built; `None` as soon as it answers `false` (the face BVH of parry is one
     /// sequential build, 1.4 s at 10⁶ faces on a loaded machine, which has no cancellation point
-    /// inside). From [`HELPER_THREAD_FACES`] input faces on, the trees are built on a helper
-    /// thread while this thread computes the degeneracy flags and then asks `keep_going` every
-    /// [`TREE_POLL`]; on a cancel it returns at once and the helper finishes its build and drops
-    /// it (its result has no receiver; nothing is kept). The trees are the same sequential
-    /// builds on either thread, so the model does not depend on the path taken.
+    /// inside). From [`HELPER_THREAD_FACES`] input faces on, the trees are built on a
+    /// background thread while this thread computes the degeneracy flags and then asks
+    /// `keep_going` every [`TREE_POLL`]; on a cancel it returns at once and the background
+    /// thread finishes its build and drops it (its result has no receiver; nothing is kept).
+    /// The trees are the same sequential builds on either thread, so the model does not depend
+    /// on the path taken.
     pub fn new_with_stop(
         mesh: &crate::mesh::TriMesh,
         with_points: bool,
@@ -167,7 +168,7 @@ impl InputModel {
         Self::build(mesh, with_points, keep_going, HELPER_THREAD_FACES)
     }
 
-    /// [`new_with_stop`](Self::new_with_stop) with the helper thread from `helper_from` faces.
+    /// [`new_with_stop`](Self::new_with_stop) with the background thread from `helper_from` faces.
     fn build(
         mesh: &crate::mesh::TriMesh,
         with_points: bool,

@@ -10,7 +10,7 @@
 //!
 //! Built with the features that need faer (currently `wrinkle`).
 //!
-//! May import: `faer`, `rayon` (a helper thread's pool, [`run_stoppable`]), `crate::error` (the crate's `Error`/`Result`). Nothing else of the crate.
+//! May import: `faer`, `rayon` (a background thread's pool, [`run_stoppable`]), `crate::error` (the crate's `Error`/`Result`). Nothing else of the crate.
 
 pub mod eigen;
 pub mod krylov;

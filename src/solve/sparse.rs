@@ -31,7 +31,7 @@ use crate::{Error, Result};
 pub const STOPPABLE_FACTOR_LEN: usize = 1 << 19;
 
 /// Stored matrix entries from which [`CholeskyAnalysis::new_stoppable`] runs the analysis (the
-/// fill-reducing ordering) on a helper thread: measured 2026-11-27, the analyses of the
+/// fill-reducing ordering) on a background thread: measured 2026-11-27, the analyses of the
 /// wrinkle design's systems on a 213k-face base took 0.17–0.56 CPU s (matrices of 0.7–1.7·10⁶
 /// entries), those of a 53k-face base a few hundredths.
 pub const STOPPABLE_MATRIX_NNZ: usize = 1 << 19;
@@ -41,7 +41,7 @@ const STOPPABLE_POLL: std::time::Duration = std::time::Duration::from_millis(100
 
 /// Runs `work` and returns its value, with a cancellation point every 0.1 s while it runs (one
 /// sparse Cholesky factorization has no cancellation point inside: 1.1 CPU s on a 213k-face wrinkle
-/// base, more than the 0.5 s a cancel may wait). When `heavy`, `work` runs on a helper thread,
+/// base, more than the 0.5 s a cancel may wait). When `heavy`, `work` runs on a background thread,
 /// inside a rayon pool of as many threads as the caller's (so faer's `Par::rayon(0)` there is the
 /// caller's parallelism and the result is bit for bit the one of a call on this thread), while this
 /// thread calls `tick()` every 0.1 s; its first error is returned at once, and the worker then
