@@ -749,6 +749,129 @@ fn instances_share_one_chain_per_mesh() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// `--nodes`: with `--merge` only the selected nodes are fused (the proxy lies around them);
+/// without it only the meshes they instance get chains; a pattern that matches nothing, or a
+/// node filter on a file that is not glTF, is refused with the names there are.
+#[test]
+fn node_filter_selects_what_is_merged_and_what_gets_chains() {
+    let dir = scratch("nodes");
+    let input = dir.join("six.glb");
+    // Meshes M0..M2; nodes N0..N5 at x = 0, 3, .., 15, node i instancing mesh i % 3.
+    std::fs::write(&input, instanced_scene(3, 6)).unwrap();
+    let merged = dir.join("n1.obj");
+    lod(
+        &input,
+        &merged,
+        &["--merge", "--nodes", "N1", "--screen-size", "50", "-q"],
+        2,
+    );
+    let m = pleat::mesh::io::read_mesh(&merged).unwrap();
+    let xs = m.positions().iter().map(|p| p[0]);
+    let (lo, hi) = xs.fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)));
+    assert!(
+        lo > 1.5 && hi < 4.5,
+        "the proxy of N1 (x near 3) spans x in [{lo}, {hi}]"
+    );
+    let report = lod(
+        &input,
+        &dir.join("chains.glb"),
+        &["--nodes", "N1, *2", "--screen-size", "50"],
+        2,
+    );
+    assert!(report.contains("2 mesh chains"), "{report}");
+    assert!(
+        report.contains("(mesh 1,") && report.contains("(mesh 2,"),
+        "{report}"
+    );
+    assert_valid(&dir.join("chains.glb"));
+    let refused = |args: &[&str], input: &Path| {
+        let o = Command::new(env!("CARGO_BIN_EXE_pleat"))
+            .arg("lod")
+            .arg(input)
+            .args(args)
+            .args(["--screen-size", "50", "-o"])
+            .arg(dir.join("refused.glb"))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?} was not refused");
+        String::from_utf8_lossy(&o.stderr).to_string()
+    };
+    let e = refused(&["--nodes", "Leg*"], &input);
+    assert!(
+        e.contains("no node matches Leg*") && e.contains("'N5'"),
+        "{e}"
+    );
+    let e = refused(&["--merge", "--nodes", "Leg*"], &input);
+    assert!(e.contains("no node matches Leg*"), "{e}");
+    pleat::mesh::io::write_mesh(&dir.join("m.obj"), &m).unwrap();
+    let e = refused(&["--merge", "--nodes", "N1"], &dir.join("m.obj"));
+    assert!(e.contains("not a .glb or .gltf"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A batch of glTF scenes with `.glb` outputs bakes each as the single command does (one chain
+/// per mesh, one file per level, the same bytes), reports the levels' faces, and caches them.
+#[test]
+fn batches_bake_gltf_scenes_per_mesh() {
+    let dir = scratch("batch");
+    let (a, b) = (dir.join("a.glb"), dir.join("b.glb"));
+    std::fs::write(&a, instanced_scene(3, 4)).unwrap();
+    std::fs::write(&b, instanced_scene(2, 2)).unwrap();
+    let pattern = dir.join("out").join("{stem}_{np}.glb");
+    let report = dir.join("report.json");
+    let batch = || {
+        let o = Command::new(env!("CARGO_BIN_EXE_pleat"))
+            .arg("lod")
+            .args([&a, &b])
+            .args(["--screen-size", "40,20", "--jobs", "2", "-o"])
+            .arg(&pattern)
+            .arg("--cache")
+            .arg(dir.join("cache"))
+            .arg("--report")
+            .arg(&report)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let r: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        r["assets"].as_array().unwrap().clone()
+    };
+    let rows = batch();
+    lod(
+        &a,
+        &dir.join("single_{np}.glb"),
+        &["--screen-size", "40,20", "-q"],
+        1,
+    );
+    for np in ["40", "20"] {
+        let got = std::fs::read(dir.join("out").join(format!("a_{np}.glb"))).unwrap();
+        let single = std::fs::read(dir.join(format!("single_{np}.glb"))).unwrap();
+        assert!(got == single, "a_{np}.glb differs from the single bake");
+        let (doc, _) = parse_glb(&got);
+        assert_eq!(
+            names(&doc, "nodes").len() - 4,
+            4,
+            "one level node per instance"
+        );
+        assert_valid(&dir.join("out").join(format!("a_{np}.glb")));
+    }
+    let row_a = rows
+        .iter()
+        .find(|r| r["input"].as_str().unwrap().ends_with("a.glb"))
+        .unwrap();
+    assert_eq!(row_a["status"], "baked", "{row_a}");
+    let (doc, _) = parse_glb(&std::fs::read(dir.join("out").join("a_40.glb")).unwrap());
+    let level_faces: usize = (3..doc["meshes"].as_array().unwrap().len())
+        .map(|m| mesh_faces(&doc, m))
+        .sum();
+    assert_eq!(
+        row_a["levels"][0]["faces"].as_u64().unwrap() as usize,
+        level_faces
+    );
+    let again = batch();
+    assert!(again.iter().all(|r| r["status"] == "cached"), "{again:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// Every textured asset of the shared corpus at n_p = 100, with and without `--bake`: the
 /// output is valid glTF (glTF-Validator: 0 errors) and no level is larger than its mesh.
 #[test]

@@ -25,7 +25,7 @@ use ::gltf::{Document, Semantic};
 
 use crate::geom::{normalized, Vec3};
 use crate::mesh::io::gltf::{self as io, Matrix4};
-use crate::mesh::io::parse_error;
+use crate::mesh::io::{parse_error, NodeFilter};
 use crate::mesh::TriMesh;
 use crate::{Error, Result};
 
@@ -750,10 +750,21 @@ fn buffer_material(
 /// folder). See the [module docs](self); [`super::read_appearance`] picks the reader by
 /// extension.
 pub fn read_gltf_appearance(path: &Path) -> Result<Appearance> {
+    read_gltf_appearance_selected(path, None)
+}
+
+/// [`read_gltf_appearance`] of the nodes `filter` selects (matched nodes with their subtrees,
+/// see [`NodeFilter`]); `None` reads every node. The geometry is what
+/// [`crate::mesh::io::gltf::read_gltf_selected`] returns with the same filter. Errors as
+/// [`read_gltf_appearance`], plus `InvalidArgument` when the filter matches no node.
+pub fn read_gltf_appearance_selected(
+    path: &Path,
+    filter: Option<&NodeFilter>,
+) -> Result<Appearance> {
     let name = path.display().to_string();
     let data = std::fs::read(path).map_err(|e| crate::mesh::io::io_error(&name, &e))?;
     let base = path.parent().unwrap_or(Path::new("."));
-    read_appearance_bytes(&data, Some(base), &name)
+    read_appearance_bytes_selected(&data, Some(base), &name, filter)
 }
 
 /// Reads a glTF/GLB's appearance from memory; `name` stands for the file in messages; external
@@ -763,9 +774,21 @@ pub fn read_appearance_bytes(
     base_dir: Option<&Path>,
     name: &str,
 ) -> Result<Appearance> {
+    read_appearance_bytes_selected(data, base_dir, name, None)
+}
+
+/// [`read_appearance_bytes`] of the nodes `filter` selects (see
+/// [`read_gltf_appearance_selected`]).
+pub fn read_appearance_bytes_selected(
+    data: &[u8],
+    base_dir: Option<&Path>,
+    name: &str,
+    filter: Option<&NodeFilter>,
+) -> Result<Appearance> {
     let loaded = io::load_document(data, base_dir, name)?;
     let raw = raw_json(data);
     let mut reader = Reader {
+        filter,
         doc: &loaded.document,
         buffers: &loaded.buffers,
         raw: raw.as_ref(),
@@ -806,6 +829,7 @@ pub(crate) fn mesh_appearance(
     mesh: usize,
 ) -> Result<Appearance> {
     let mut reader = Reader {
+        filter: None,
         doc: &loaded.document,
         buffers: &loaded.buffers,
         raw,
@@ -872,6 +896,8 @@ impl Builder {
 }
 
 struct Reader<'a> {
+    /// The nodes read (`None`: all).
+    filter: Option<&'a NodeFilter>,
     doc: &'a Document,
     buffers: &'a [Vec<u8>],
     raw: Option<&'a serde_json::Value>,
@@ -892,8 +918,8 @@ impl Reader<'_> {
     /// Every primitive the geometry reader instantiates, in its order (one walker:
     /// [`io::for_each_primitive`]).
     fn read_scene(&mut self) -> Result<()> {
-        let (doc, name) = (self.doc, self.name);
-        io::for_each_primitive(doc, name, &mut |prim, pos, world, what| {
+        let (doc, name, filter) = (self.doc, self.name, self.filter);
+        io::for_each_primitive(doc, name, filter, &mut |prim, pos, world, what| {
             self.add_primitive(prim, pos, world, what)
         })
     }

@@ -34,8 +34,9 @@ pub mod render;
 pub mod scene;
 
 pub use appearance::{
-    read_appearance_bytes, read_gltf_appearance, read_mesh_appearance_bytes, Appearance,
-    AppearanceBuffers, BufferMaterial, ImageBuffer, MaterialSample, UvBuffer,
+    read_appearance_bytes, read_appearance_bytes_selected, read_gltf_appearance,
+    read_gltf_appearance_selected, read_mesh_appearance_bytes, Appearance, AppearanceBuffers,
+    BufferMaterial, ImageBuffer, MaterialSample, UvBuffer,
 };
 pub use atlas::{build_atlas, build_atlas_growing, Atlas, AtlasParams, Gutter};
 pub use bake::{bake_level, bake_level_with_progress, BakeParams, VertexColors};

@@ -82,7 +82,7 @@ use super::output::{encode_images, glb_container, push_level, screen_coverage, A
 use super::provenance::InputIndex;
 use crate::lowpoly::{LodParams, LodReport};
 use crate::mesh::io::gltf::{self as io, LoadedDocument};
-use crate::mesh::io::parse_error;
+use crate::mesh::io::{parse_error, NodeFilter};
 use crate::mesh::TriMesh;
 use crate::report::{Progress, ProgressFn};
 use crate::{Error, Result};
@@ -152,6 +152,39 @@ impl GltfScene {
             .iter()
             .filter(|n| n.get("mesh").and_then(Value::as_u64) == Some(mesh as u64))
             .count()
+    }
+
+    /// Per mesh, whether a node that `filter` selects (by name or index, with its subtree,
+    /// in any scene or none) instances it. Errors (`InvalidArgument`) when no node matches.
+    pub fn meshes_of(&self, filter: &NodeFilter) -> Result<Vec<bool>> {
+        let nodes = self.array("nodes");
+        let names: Vec<Option<&str>> = nodes
+            .iter()
+            .map(|n| n.get("name").and_then(Value::as_str))
+            .collect();
+        let children: Vec<Vec<usize>> = nodes
+            .iter()
+            .map(|n| {
+                n.get("children")
+                    .and_then(Value::as_array)
+                    .map_or_else(Vec::new, |c| {
+                        c.iter()
+                            .filter_map(Value::as_u64)
+                            .map(|i| i as usize)
+                            .collect()
+                    })
+            })
+            .collect();
+        let selected = filter.select(&names, &children)?;
+        let mut meshes = vec![false; self.mesh_count()];
+        for (node, _) in nodes.iter().zip(&selected).filter(|(_, &s)| s) {
+            if let Some(m) = node.get("mesh").and_then(Value::as_u64) {
+                if let Some(x) = meshes.get_mut(m as usize) {
+                    *x = true;
+                }
+            }
+        }
+        Ok(meshes)
     }
 
     /// Whether mesh `mesh` deforms: a primitive with `JOINTS_0`/`WEIGHTS_0` or morph
@@ -376,6 +409,10 @@ pub struct SceneParams {
     /// each level's screen size (`DeformationField::max_skin_error`; 0: the default
     /// [`crate::lowpoly::SKIN_ERROR`]).
     pub skin_error: f64,
+    /// Chains only for the meshes that a node it selects instances (`None`: every instanced
+    /// mesh). A mesh also instanced by unselected nodes gets its chain there too: the chain
+    /// belongs to the mesh.
+    pub nodes: Option<NodeFilter>,
 }
 
 /// Why a level is the input mesh itself.
@@ -679,8 +716,12 @@ pub fn lod_scene(
     }
     sizes.sort_by(|a, b| b.total_cmp(a));
     sizes.dedup();
+    let chosen = match &params.nodes {
+        Some(f) => scene.meshes_of(f)?,
+        None => vec![true; scene.mesh_count()],
+    };
     let meshes: Vec<usize> = (0..scene.mesh_count())
-        .filter(|&m| scene.instances(m) > 0)
+        .filter(|&m| chosen[m] && scene.instances(m) > 0)
         .collect();
     let n = meshes.len().max(1) as f64;
     let mut chains = Vec::new();

@@ -380,7 +380,7 @@ enum WrinkleCommand {
         #[arg(
             long,
             value_name = "RAD",
-            default_value_t = pleat::wrinkle::DEFAULT_COMPAT_TARGET,
+            default_value_t = DEFAULT_COMPAT_TARGET,
             allow_hyphen_values = true
         )]
         compat_target: f64,
@@ -539,7 +539,11 @@ fn bake(input: &std::path::Path, args: &BakeArgs, cage: bool) -> ExitCode {
         eprintln!("pleat {cmd}: --faces needs a single screen size");
         return ExitCode::from(EXIT_INPUT);
     }
-    let mesh = match read_mesh(input) {
+    #[cfg(feature = "bake")]
+    let mesh = scene_cmd::read_merged(input, &args.scene);
+    #[cfg(not(feature = "bake"))]
+    let mesh = read_mesh(input).map_err(|e| e.to_string());
+    let mesh = match mesh {
         Ok(m) => m,
         Err(e) => {
             eprintln!("pleat {cmd}: {e}");
@@ -911,6 +915,13 @@ fn offset(
     }
     ExitCode::SUCCESS
 }
+
+/// The default of `pleat wrinkle edit --compat-target` (the library's, when it is built in).
+#[cfg(feature = "wrinkle")]
+const DEFAULT_COMPAT_TARGET: f64 = pleat::wrinkle::DEFAULT_COMPAT_TARGET;
+/// Without the `wrinkle` feature the option is parsed, then the command refuses to run.
+#[cfg(not(feature = "wrinkle"))]
+const DEFAULT_COMPAT_TARGET: f64 = 0.3;
 
 /// `pleat wrinkle ...`.
 #[cfg(feature = "wrinkle")]

@@ -6,8 +6,7 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use pleat::bake::{
-    bake_chain, chain_glb_with_progress, read_appearance, AtlasParams, BakeParams, BakedLevel,
-    VertexColors,
+    bake_chain, chain_glb_with_progress, AtlasParams, BakeParams, BakedLevel, VertexColors,
 };
 
 use super::{
@@ -76,7 +75,7 @@ pub fn run(input: &Path, args: &BakeArgs, cmd: &str) -> ExitCode {
             return ExitCode::from(EXIT_INPUT);
         }
     }
-    let app = match read_appearance(input) {
+    let app = match super::scene_cmd::read_merged_appearance(input, &args.scene) {
         Ok(a) => a,
         Err(e) => {
             eprintln!("pleat {cmd}: {e}");

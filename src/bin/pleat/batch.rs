@@ -3,7 +3,9 @@
 //!
 //! Guarantees:
 //! - every asset is baked exactly as `pleat lod ASSET` would bake it (same parameters, same
-//!   code path: [`super::bake_levels`]), so its outputs are byte-identical whatever `--jobs` is;
+//!   code path: [`super::bake_levels`], or for a glTF input with `.glb` outputs the per-mesh
+//!   scene bake of `pleat::bake::scene`, one file per level), so its outputs are
+//!   byte-identical whatever `--jobs` is;
 //! - an output file is written to a temporary file in its own folder and renamed over the
 //!   target, so a reader (or an interrupted build) never sees a half-written mesh;
 //! - with `--cache DIR`, an asset whose input bytes, parameters and pleat version were baked
@@ -20,7 +22,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use pleat::mesh::io::{read_mesh, write_mesh, MeshFormat};
+#[cfg(not(feature = "bake"))]
+use pleat::mesh::io::read_mesh;
+use pleat::mesh::io::{write_mesh, MeshFormat};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 
@@ -36,7 +40,7 @@ const COLUMNS: [&str; 5] = ["input", "screen_size", "faces", "output", "memory_b
 const STEM_PLACEHOLDER: &str = "{stem}";
 
 /// Version tag of the cache key layout; bump it when the key or the entry layout changes.
-const CACHE_LAYOUT: &str = "pleat batch cache v1";
+const CACHE_LAYOUT: &str = "pleat batch cache v2";
 
 /// Options that turn `pleat lod`/`pleat cage` into a batch bake.
 #[derive(clap::Args)]
@@ -607,8 +611,17 @@ fn asset_params(args: &BakeArgs, a: &Asset) -> pleat::lowpoly::LodParams {
     p
 }
 
-/// Reads, bakes and writes one asset's levels.
+/// Reads, bakes and writes one asset's levels: a glTF scene with `.glb` outputs as
+/// `pleat lod IN.glb -o OUT.glb` does (one chain per mesh, one file per level), anything else
+/// merged into one mesh.
 fn bake_and_write(a: &Asset, args: &BakeArgs, cage: bool) -> AssetResult<Vec<Level>> {
+    #[cfg(feature = "bake")]
+    if super::scene_cmd::applies_to_asset(&a.input, &a.outputs, args) {
+        return bake_scene(a, args, cage);
+    }
+    #[cfg(feature = "bake")]
+    let mesh = super::scene_cmd::read_merged(&a.input, &args.scene)?;
+    #[cfg(not(feature = "bake"))]
     let mesh = read_mesh(&a.input).map_err(|e| e.to_string())?;
     let params = asset_params(args, a);
     let result = bake_levels(&mesh, &a.sizes, &params, cage, &mut |_| true);
@@ -622,6 +635,48 @@ fn bake_and_write(a: &Asset, args: &BakeArgs, cage: bool) -> AssetResult<Vec<Lev
             hausdorff_rel: report.hausdorff_rel,
             verified: report.verified.all_hold(),
         });
+    }
+    Ok(levels)
+}
+
+/// A glTF scene asset: every mesh's chain (`pleat::bake::scene`), then one `.glb` per level
+/// holding the document with that level. A level's row sums the faces of every mesh at that
+/// level (kept meshes count their own), with the largest error and whether every new level
+/// verified.
+#[cfg(feature = "bake")]
+fn bake_scene(a: &Asset, args: &BakeArgs, cage: bool) -> AssetResult<Vec<Level>> {
+    use pleat::bake::scene::{lod_scene, scene_glb, GltfScene, WriteOptions};
+    let scene = GltfScene::read(&a.input).map_err(|e| e.to_string())?;
+    let params = super::scene_cmd::scene_params(args, &a.sizes, asset_params(args, a), cage);
+    let chains = lod_scene(&scene, &params, &mut |_| true).map_err(|e| e.to_string())?;
+    let mut levels = Vec::with_capacity(a.sizes.len());
+    for (&n_p, out) in a.sizes.iter().zip(&a.outputs) {
+        let opts = WriteOptions {
+            drop_original: args.scene.drop_original,
+            only_sizes: Some(vec![n_p]),
+        };
+        let bytes = scene_glb(&scene, &chains, &opts).map_err(|e| e.to_string())?;
+        write_atomically(out, |tmp| {
+            std::fs::write(tmp, &bytes)
+                .map_err(|e| format!("cannot write '{}': {e}", tmp.display()))
+        })?;
+        let at_size = chains
+            .iter()
+            .filter_map(|c| c.levels.iter().find(|l| l.screen_size == n_p));
+        let mut level = Level {
+            screen_size: n_p,
+            faces: 0,
+            hausdorff_rel: 0.0,
+            verified: true,
+        };
+        for l in at_size {
+            level.faces += l.faces;
+            if let Some(s) = &l.stats {
+                level.hausdorff_rel = level.hausdorff_rel.max(s.hausdorff_rel);
+                level.verified &= s.verified.all_hold();
+            }
+        }
+        levels.push(level);
     }
     Ok(levels)
 }
@@ -678,6 +733,8 @@ fn cache_key(input: &[u8], a: &Asset, args: &BakeArgs, cmd: &str) -> String {
     // Every LOD parameter the bake will use (its `Debug` form prints each field, f64s exactly),
     // so a parameter added to `lod_params` can never be left out of the key.
     field(&format!("{:?}", asset_params(args, a)));
+    #[cfg(feature = "bake")]
+    field(&super::scene_cmd::cache_fields(&args.scene));
     for o in &a.outputs {
         field(&format!("format={}", extension(o)));
     }

@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 use pleat::bake::scene::{lod_scene, scene_glb, GltfScene, SceneParams, WriteOptions};
 use pleat::bake::{AtlasParams, BakeParams};
+use pleat::mesh::io::NodeFilter;
 
 use super::{
     failure_code, output_path, progress_bar, show_progress, BakeArgs, EXIT_FAILED, EXIT_INPUT,
@@ -32,6 +33,59 @@ pub struct SceneArgs {
     /// [default: 0.5].
     #[arg(long, value_parser = parse_skin_error, conflicts_with = "merge")]
     pub skin_error: Option<f64>,
+    /// glTF input: only these nodes, each with everything below it: node names separated by
+    /// commas, `*` and `?` as wildcards, `#N` for node N. With --merge only they are fused into
+    /// the proxy; otherwise only the meshes they instance get chains.
+    #[arg(long, value_name = "NAMES", value_parser = parse_nodes)]
+    pub nodes: Option<NodeFilter>,
+}
+
+fn parse_nodes(s: &str) -> Result<NodeFilter, String> {
+    NodeFilter::parse(s).map_err(|e| e.to_string())
+}
+
+/// Whether `p` names a glTF file (`.glb`, `.gltf`, any case).
+fn is_gltf(p: &Path) -> bool {
+    let ext = p.extension().and_then(|e| e.to_str()).unwrap_or("");
+    ext.eq_ignore_ascii_case("glb") || ext.eq_ignore_ascii_case("gltf")
+}
+
+/// `--nodes` on an input that is not glTF: the message (nodes are glTF's).
+fn nodes_without_gltf(input: &Path, args: &SceneArgs) -> Option<String> {
+    (args.nodes.is_some() && !is_gltf(input)).then(|| {
+        format!(
+            "--nodes selects glTF nodes, and '{}' is not a .glb or .gltf file",
+            input.display()
+        )
+    })
+}
+
+/// The merged geometry of `input`: the nodes `--nodes` selects, or the whole file.
+pub fn read_merged(input: &Path, args: &SceneArgs) -> Result<pleat::mesh::TriMesh, String> {
+    if let Some(e) = nodes_without_gltf(input, args) {
+        return Err(e);
+    }
+    match &args.nodes {
+        Some(f) => pleat::mesh::io::gltf::read_gltf_selected(input, Some(f)),
+        None => pleat::mesh::io::read_mesh(input),
+    }
+    .map_err(|e| e.to_string())
+}
+
+/// The merged appearance of `input` (textured bakes): the nodes `--nodes` selects, or the whole
+/// file.
+pub fn read_merged_appearance(
+    input: &Path,
+    args: &SceneArgs,
+) -> Result<pleat::bake::Appearance, String> {
+    if let Some(e) = nodes_without_gltf(input, args) {
+        return Err(e);
+    }
+    match &args.nodes {
+        Some(f) => pleat::bake::read_gltf_appearance_selected(input, Some(f)),
+        None => pleat::bake::read_appearance(input),
+    }
+    .map_err(|e| e.to_string())
 }
 
 fn parse_skin_error(s: &str) -> Result<f64, String> {
@@ -45,14 +99,8 @@ fn parse_skin_error(s: &str) -> Result<f64, String> {
 
 /// Whether `input` → `output` runs as a scene (glTF in, `.glb` out, no `--merge`).
 pub fn applies(input: &Path, args: &BakeArgs) -> bool {
-    let ext = |p: &Path| {
-        p.extension()
-            .and_then(|e| e.to_str())
-            .unwrap_or("")
-            .to_ascii_lowercase()
-    };
-    let gltf_in = matches!(ext(input).as_str(), "glb" | "gltf");
-    let glb_out = args.output.as_deref().is_some_and(|o| ext(o) == "glb");
+    let gltf_in = is_gltf(input);
+    let glb_out = args.output.as_deref().is_some_and(is_glb);
     if gltf_in && !args.scene.merge && !glb_out && !args.quiet {
         eprintln!(
             "pleat: the output is not .glb, so the glTF input is merged into one mesh (as with \
@@ -60,6 +108,55 @@ pub fn applies(input: &Path, args: &BakeArgs) -> bool {
         );
     }
     gltf_in && !args.scene.merge && glb_out
+}
+
+/// The scene parameters of the command line, with the levels `sizes` and LOD parameters `lod`.
+pub fn scene_params(
+    args: &BakeArgs,
+    sizes: &[f64],
+    lod: pleat::lowpoly::LodParams,
+    cage: bool,
+) -> SceneParams {
+    let bake = args.textures.bake.then(|| BakeParams {
+        atlas: AtlasParams {
+            size: args.textures.texture_size,
+            ..AtlasParams::default()
+        },
+        vertex_colors: args.textures.vertex_colors.into(),
+        ..BakeParams::default()
+    });
+    SceneParams {
+        screen_sizes: sizes.to_vec(),
+        lod,
+        cage,
+        bake,
+        skin_error: args.scene.skin_error.unwrap_or(0.0),
+        nodes: args.scene.nodes.clone(),
+    }
+}
+
+/// Whether a batch asset `input` → `outputs` bakes as a scene: glTF in, every output `.glb`,
+/// no `--merge` (the batch form of [`applies`], without its notice).
+pub fn applies_to_asset(input: &Path, outputs: &[std::path::PathBuf], args: &BakeArgs) -> bool {
+    is_gltf(input) && !args.scene.merge && outputs.iter().all(|o| is_glb(o))
+}
+
+/// Whether `p` ends in `.glb` (any case).
+fn is_glb(p: &Path) -> bool {
+    p.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+}
+
+/// The scene options in the form a cache key hashes (every one that changes the output).
+pub fn cache_fields(args: &SceneArgs) -> String {
+    format!(
+        "merge={} drop_original={} skin_error={:?} nodes={:?}",
+        args.merge,
+        args.drop_original,
+        args.skin_error.map(f64::to_bits),
+        args.nodes.as_ref().map(NodeFilter::patterns)
+    )
 }
 
 /// Runs the per-mesh bake of a glTF scene; `cage` bakes cages.
@@ -84,21 +181,8 @@ pub fn run(input: &Path, args: &BakeArgs, cage: bool) -> ExitCode {
             return ExitCode::from(EXIT_INPUT);
         }
     };
-    let bake = args.textures.bake.then(|| BakeParams {
-        atlas: AtlasParams {
-            size: args.textures.texture_size,
-            ..AtlasParams::default()
-        },
-        vertex_colors: args.textures.vertex_colors.into(),
-        ..BakeParams::default()
-    });
-    let params = SceneParams {
-        screen_sizes: args.screen_size.clone(),
-        lod: super::lod_params(args, &args.screen_size, args.faces),
-        cage,
-        bake,
-        skin_error: args.scene.skin_error.unwrap_or(0.0),
-    };
+    let lod = super::lod_params(args, &args.screen_size, args.faces);
+    let params = scene_params(args, &args.screen_size, lod, cage);
     let t = std::time::Instant::now();
     let bar = progress_bar(args.quiet);
     let mut prog = |p: pleat::Progress<'_>| show_progress(&bar, p);
@@ -184,7 +268,12 @@ pub fn run(input: &Path, args: &BakeArgs, cage: bool) -> ExitCode {
         }
         let skipped = scene.mesh_count() - chains.len();
         if skipped > 0 {
-            println!("{skipped} mesh(es) without triangles or instancing node: left as they are");
+            let why = if args.scene.nodes.is_some() {
+                "not instanced by the selected nodes, without triangles or instancing node"
+            } else {
+                "without triangles or instancing node"
+            };
+            println!("{skipped} mesh(es) {why}: left as they are");
         }
         let names: Vec<String> = files.iter().map(|(p, _)| p.display().to_string()).collect();
         println!(

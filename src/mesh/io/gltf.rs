@@ -38,7 +38,7 @@ use ::gltf::buffer::Source;
 use ::gltf::mesh::Mode;
 use ::gltf::{Accessor, Document, Gltf, Semantic};
 
-use super::{build_mesh, io_error, parse_error, push_vertex, MAX_RESERVE};
+use super::{build_mesh, io_error, parse_error, push_vertex, NodeFilter, MAX_RESERVE};
 use crate::mesh::TriMesh;
 use crate::{Error, Result};
 
@@ -58,6 +58,26 @@ pub fn read_gltf(path: &Path) -> Result<TriMesh> {
 /// External buffer files are resolved relative to `base_dir`; with `None`, only the GLB `BIN`
 /// chunk and `data:` URIs are available.
 pub fn read_gltf_bytes(data: &[u8], base_dir: Option<&Path>, name: &str) -> Result<TriMesh> {
+    read_gltf_bytes_selected(data, base_dir, name, None)
+}
+
+/// Reads a `.glb` or `.gltf` file as [`read_gltf`] does, instancing only the nodes `filter`
+/// selects (matched nodes and their subtrees, see [`NodeFilter`]); `None` reads every node.
+/// Errors as [`read_gltf`], plus `InvalidArgument` when the filter matches no node.
+pub fn read_gltf_selected(path: &Path, filter: Option<&NodeFilter>) -> Result<TriMesh> {
+    let name = path.display().to_string();
+    let data = std::fs::read(path).map_err(|e| io_error(&name, &e))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    read_gltf_bytes_selected(&data, Some(base), &name, filter)
+}
+
+/// [`read_gltf_bytes`] with a node filter (see [`read_gltf_selected`]).
+pub fn read_gltf_bytes_selected(
+    data: &[u8],
+    base_dir: Option<&Path>,
+    name: &str,
+    filter: Option<&NodeFilter>,
+) -> Result<TriMesh> {
     check_glb_header(data, name)?;
     let gltf = Gltf::from_slice_without_validation(data)
         .map_err(|e| parse_error(name, format!("glTF: {e}")))?;
@@ -69,7 +89,7 @@ pub fn read_gltf_bytes(data: &[u8], base_dir: Option<&Path>, name: &str) -> Resu
         buffers: &buffers,
         name,
     };
-    for_each_primitive(&document, name, &mut |prim, pos, world, what| {
+    for_each_primitive(&document, name, filter, &mut |prim, pos, world, what| {
         add_primitive(prim, pos, world, what, &ctx, &mut soup)
     })?;
     build_mesh(name, soup.positions, soup.triangles)
@@ -322,11 +342,16 @@ fn read_external(uri: &str, length: usize, base: Option<&Path>, name: &str) -> R
 /// skipped; a non-`VEC3` `POSITION` or a node reached twice is an error naming `name`.
 /// `visit` gets the primitive, its `POSITION` accessor, the world matrix and a
 /// "mesh M primitive P" label. The geometry reader and `bake::appearance` both walk with this.
+/// With a `filter`, only the meshes of selected nodes are visited (a document without scenes
+/// then has no node to select: every mesh is still visited once, untransformed, when some node
+/// matches; the filter's error otherwise).
 pub(crate) fn for_each_primitive(
     doc: &Document,
     name: &str,
+    filter: Option<&NodeFilter>,
     visit: &mut dyn FnMut(&::gltf::Primitive, &Accessor, &Mat4, &str) -> Result<()>,
 ) -> Result<()> {
+    let selected = filter.map(|f| select_nodes(doc, f)).transpose()?;
     let mut mesh_primitives = |mesh: &::gltf::Mesh, world: &Mat4| -> Result<()> {
         visit_mesh(mesh, world, name, &mut *visit)
     };
@@ -336,6 +361,7 @@ pub(crate) fn for_each_primitive(
         }
         return Ok(());
     };
+    let is_selected = |node: &::gltf::Node| selected.as_ref().is_none_or(|s| s[node.index()]);
     let mut visited = vec![false; doc.nodes().len()];
     let mut stack: Vec<(::gltf::Node, Mat4)> = scene.nodes().map(|n| (n, IDENTITY)).collect();
     stack.reverse();
@@ -351,7 +377,7 @@ pub(crate) fn for_each_primitive(
             ));
         }
         let world = mul(&parent, &to_f64(node.transform().matrix()));
-        if let Some(mesh) = node.mesh() {
+        if let Some(mesh) = node.mesh().filter(|_| is_selected(&node)) {
             mesh_primitives(&mesh, &world)?;
         }
         let first_child = stack.len();
@@ -359,6 +385,16 @@ pub(crate) fn for_each_primitive(
         stack[first_child..].reverse();
     }
     Ok(())
+}
+
+/// The nodes of `doc` that `filter` selects (by name or `#index`, with their subtrees).
+fn select_nodes(doc: &Document, filter: &NodeFilter) -> Result<Vec<bool>> {
+    let names: Vec<Option<&str>> = doc.nodes().map(|n| n.name()).collect();
+    let children: Vec<Vec<usize>> = doc
+        .nodes()
+        .map(|n| n.children().map(|c| c.index()).collect())
+        .collect();
+    filter.select(&names, &children)
 }
 
 /// The primitives of one mesh that [`for_each_primitive`] visits (triangle modes with a `VEC3`

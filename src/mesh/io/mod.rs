@@ -46,11 +46,14 @@ use crate::{Error, Result};
 
 #[cfg(feature = "io-gltf")]
 pub mod gltf;
+pub mod nodes;
 pub mod obj;
 pub mod off;
 pub mod ply;
 pub mod stl;
 mod text;
+
+pub use nodes::NodeFilter;
 
 /// The mesh file formats pleat reads and writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
