@@ -229,6 +229,28 @@ static void lods() {
         }
     }
 
+    // pleat::Deformation: the cube's two-joint skin followed by the LOD; a mismatched
+    // array is refused before pleat is called
+    {
+        std::vector<uint32_t> joints(16);
+        std::vector<float> w(16);
+        for (uint32_t v = 0; v < 8; v++)
+            joints[2 * v] = 0, joints[2 * v + 1] = 1, w[2 * v] = p[3 * v + 2], w[2 * v + 1] = 1 - p[3 * v + 2];
+        pleat::Deformation skin(8, 2, joints, w, {0, 0, 0, 0, 0, 1});
+        PleatLodParams dp = pleat::lod_params(10.0);
+        dp.deformation = skin.get();
+        pleat::Mesh followed = cube.lod(dp);
+        EXPECT(followed.report().is_watertight);
+        pleat::Deformation moved = std::move(skin);
+        EXPECT(!skin.get() && moved.get());
+        try {
+            pleat::Deformation bad(8, 2, joints, std::vector<float>(15));
+            EXPECT(false);
+        } catch (const pleat::Error &err) {
+            EXPECT(err.status() == PLEAT_STATUS_INVALID_ARGUMENT);
+        }
+    }
+
     std::vector<PleatLodStats> chain_stats;
     std::vector<pleat::Mesh> chain = cube.lod_chain({10.0, 5.0}, pleat::lod_params(), &chain_stats);
     EXPECT(chain.size() == 2 && chain_stats.size() == 2 && chain[1].report().is_watertight);

@@ -76,6 +76,9 @@
 // `struct_size`) does not change it.
 #define PLEAT_ABI_VERSION 1
 
+// Most influences per vertex `pleat_deformation_create` takes.
+#define PLEAT_DEFORMATION_MAX_INFLUENCES 64
+
 // Region growth across shared vertices (the dissertation's n-ring; default).
 #define PLEAT_ADJACENCY_VERTEX 0
 
@@ -349,6 +352,11 @@ typedef struct PleatCwf PleatCwf;
 // once; destroying it while in use is undefined.
 typedef struct PleatCwfAnimation PleatCwfAnimation;
 
+// The deformation of an input mesh (opaque), made by `pleat_deformation_create`, freed by
+// `pleat_deformation_destroy`. Immutable: one handle may serve any number of bakes, from any
+// threads, while it lives.
+typedef struct PleatDeformation PleatDeformation;
+
 // An indexed triangle mesh owned by pleat (opaque). Created by `pleat_mesh_create_*`,
 // `pleat_mesh_read_file` or an operation that returns a mesh; destroyed by
 // `pleat_mesh_destroy`. Immutable after creation, so it may be read from several threads at
@@ -556,6 +564,38 @@ typedef struct PleatBakeStats {
   // mip 0 mixes charts. Appended 2026-11-27.
   int32_t seam_clean_mip;
 } PleatBakeStats;
+
+// What `pleat_deformation_create` reads. Get the defaults (no skin, no morph, default limits)
+// from `pleat_deformation_desc_default()` and set what the input has.
+typedef struct PleatDeformationDesc {
+  // `sizeof(PleatDeformationDesc)`.
+  uint32_t struct_size;
+  // Influences per vertex k (0: no skin; at most 64).
+  uint32_t influences;
+  // Vertices of the input mesh the LOD will be made from, in its vertex order.
+  size_t vertex_count;
+  // `vertex_count × influences` joint indices (NULL when `influences` is 0).
+  const uint32_t *joints;
+  // `vertex_count × influences` weights, finite and >= 0 (need not be normalised; zero
+  // weights are ignored; NULL when `influences` is 0).
+  const float *weights;
+  // Joints with a pivot in `joint_pivots` (0: none given; the lever arm of a joint without
+  // a pivot is the input's bounding-box diagonal).
+  size_t joint_count;
+  // `joint_count × 3` bind-pose pivot coordinates (the joints' world positions, e.g. the
+  // translation of each inverse bind matrix's inverse), finite; NULL when `joint_count` is 0.
+  const double *joint_pivots;
+  // Morph targets.
+  size_t morph_count;
+  // `morph_count × vertex_count × 3` displacements (target after target), finite; NULL when
+  // `morph_count` is 0.
+  const float *morph_deltas;
+  // The largest joint rotation from the bind pose, in radians (0: 1 rad).
+  double max_rotation;
+  // The largest error the skin may add when posed, in pixels at each level's screen size
+  // (0: 0.5).
+  double max_skin_error;
+} PleatDeformationDesc;
 
 // Parameters of `pleat_cwf_design`. Get the defaults from `pleat_cwf_design_params_default()`;
 // `struct_size` versioned (at least 8).
@@ -832,6 +872,11 @@ typedef struct PleatLodParams {
   // estimate needs it. NaN, negative or > 2 is `PLEAT_STATUS_INVALID_ARGUMENT`. Appended
   // 2026-11-27; callers with an older `struct_size` get automatic.
   double offset_voxel_scale;
+  // LODs only: the skin and morph targets the levels must follow when posed
+  // (`pleat_deformation_create`, made for this input), or NULL (the default) for a static
+  // mesh. The handle must stay alive during the call. Appended 2026-12-08; callers with an
+  // older `struct_size` get NULL.
+  const struct PleatDeformation *deformation;
 } PleatLodParams;
 
 // Statistics of one baked level, filled when a non-NULL pointer is passed. Set `struct_size`
@@ -1580,6 +1625,38 @@ uint32_t pleat_abi_version(void);
 // # Safety
 // `name` is NULL or a NUL-terminated string.
 uint32_t pleat_has_feature(const char *name);
+
+// No skin, no morph target, the default limits (1 rad, half a pixel), `struct_size` set.
+struct PleatDeformationDesc pleat_deformation_desc_default(void);
+
+// Reads the deformation a LOD of an input mesh must follow: its skin (joint indices and
+// weights per vertex, joint pivots) and its morph targets' displacements, in the input's
+// vertex order. Set `PleatLodParams::deformation` to the handle: the simplification then
+// refuses a collapse that would let the posed level leave the posed input by more than
+// `max_skin_error` pixels, or a morph displacement stray more than half a pixel from its
+// blend; the level is still made in the bind pose and is as valid as any other. Carry the
+// weights onto the level with `pleat_transfer_skin` and the displacements with
+// `pleat_transfer_f32`.
+//
+// - `desc`: non-NULL, from `pleat_deformation_desc_default()` with the arrays set.
+// - `out`: non-NULL; receives the handle (destroy with `pleat_deformation_destroy`).
+//
+// Returns `PLEAT_STATUS_INVALID_ARGUMENT` naming the field for a NULL array with a non-zero
+// count, counts that overflow, more than 64 influences, a negative or non-finite weight, a
+// non-finite pivot or displacement, or negative/non-finite limits. A bake whose input has
+// another vertex count than `vertex_count` fails with `PLEAT_STATUS_INVALID_ARGUMENT`.
+//
+// # Safety
+// `desc` is NULL or valid for `desc->struct_size` bytes, and every array it points to is
+// valid for the length its counts state.
+PleatStatus pleat_deformation_create(const struct PleatDeformationDesc *desc,
+                                     struct PleatDeformation **out);
+
+// Destroys a deformation handle. NULL is accepted and ignored. No bake may be using it.
+//
+// # Safety
+// `deformation` is NULL or a handle from `pleat_deformation_create` not yet destroyed.
+void pleat_deformation_destroy(struct PleatDeformation *deformation);
 
 // The default design parameters (vertex rings, sources pinned, heat time 1, κ = γ = 1, data
 // weight 1), with `struct_size` set. Available in every build.

@@ -737,6 +737,58 @@ class Transfer {
     PleatTransfer *raw_ = nullptr;
 };
 
+/// The skin and morph targets a LOD must follow (wraps PleatDeformation): set
+/// `PleatLodParams::deformation` to `get()`. Copies every array at construction; the object
+/// must outlive the bakes that use it.
+class Deformation {
+  public:
+    Deformation() = default;
+    /// `joints` and `weights`: `influences` per input vertex; `pivots`: 3 per joint (may be
+    /// empty); `morph_deltas`: 3 per vertex per target, target after target (may be empty);
+    /// `max_rotation` in radians and `max_skin_error` in pixels (0: the defaults, 1 rad and
+    /// half a pixel).
+    Deformation(size_t vertex_count, uint32_t influences, const std::vector<uint32_t> &joints,
+                const std::vector<float> &weights, const std::vector<double> &pivots = {},
+                const std::vector<float> &morph_deltas = {}, double max_rotation = 0.0,
+                double max_skin_error = 0.0) {
+        PleatDeformationDesc d = pleat_deformation_desc_default();
+        size_t expected = vertex_count * influences;
+        if (joints.size() != expected || weights.size() != expected)
+            throw Error(PLEAT_STATUS_INVALID_ARGUMENT,
+                        "joints and weights need vertex_count x influences values each");
+        if (pivots.size() % 3 != 0 || (vertex_count != 0 && morph_deltas.size() % (3 * vertex_count) != 0))
+            throw Error(PLEAT_STATUS_INVALID_ARGUMENT,
+                        "pivots need 3 values per joint, morph_deltas 3 per vertex per target");
+        d.vertex_count = vertex_count;
+        d.influences = influences;
+        d.joints = joints.empty() ? nullptr : joints.data();
+        d.weights = weights.empty() ? nullptr : weights.data();
+        d.joint_count = pivots.size() / 3;
+        d.joint_pivots = pivots.empty() ? nullptr : pivots.data();
+        d.morph_count = vertex_count == 0 ? 0 : morph_deltas.size() / (3 * vertex_count);
+        d.morph_deltas = morph_deltas.empty() ? nullptr : morph_deltas.data();
+        d.max_rotation = max_rotation;
+        d.max_skin_error = max_skin_error;
+        check(pleat_deformation_create(&d, &raw_));
+    }
+    Deformation(const Deformation &) = delete;
+    Deformation &operator=(const Deformation &) = delete;
+    Deformation(Deformation &&o) noexcept : raw_(std::exchange(o.raw_, nullptr)) {}
+    Deformation &operator=(Deformation &&o) noexcept {
+        if (this != &o) {
+            pleat_deformation_destroy(raw_);
+            raw_ = std::exchange(o.raw_, nullptr);
+        }
+        return *this;
+    }
+    ~Deformation() { pleat_deformation_destroy(raw_); }
+
+    const PleatDeformation *get() const noexcept { return raw_; }
+
+  private:
+    PleatDeformation *raw_ = nullptr;
+};
+
 /// Default bake parameters with `screen_size` (the LOD's n_p) set.
 inline PleatBakeParams bake_params(double screen_size = 200.0) noexcept {
     PleatBakeParams p = pleat_bake_params_default();

@@ -1264,12 +1264,19 @@ fn push_deformation(d: &Deformation, src: &Value, level: &mut Value, bin: &mut B
         prim["attributes"][format!("WEIGHTS_{set}")] = json!(bin.floats(&weights, "VEC4", false));
     }
     if !d.targets.is_empty() {
+        // A target may only displace attributes the primitive has (glTF 2.0 §3.7.2.2): an
+        // unbaked level has no NORMAL or TANGENT (engines compute its normals), so their
+        // displacements are left out there.
+        let base: Vec<String> = prim["attributes"]
+            .as_object()
+            .map(|a| a.keys().cloned().collect())
+            .unwrap_or_default();
         let targets: Vec<Value> = d
             .targets
             .iter()
             .map(|t| {
                 let mut o = serde_json::Map::new();
-                for (sem, v) in t {
+                for (sem, v) in t.iter().filter(|(sem, _)| base.contains(sem)) {
                     o.insert(sem.clone(), json!(bin.floats(v, "VEC3", sem == "POSITION")));
                 }
                 Value::Object(o)

@@ -49,7 +49,8 @@ pub(crate) use requires;
 /// (`versioned!(Type, min_size, default_fn)`).
 macro_rules! versioned {
     ($t:ident, $min:literal $(, $default:ident)?) => {
-        // SAFETY: repr(C), leading `struct_size: u32`, integer and real fields only.
+        // SAFETY: repr(C), leading `struct_size: u32`, integer, real and raw-pointer fields only
+        // (any bit pattern is a valid value).
         unsafe impl $crate::ffi::boundary::Versioned for $t {
             const NAME: &'static str = stringify!($t);
             const MIN_SIZE: u32 = $min;

@@ -16,6 +16,14 @@ fn same_bytes<T: Copy>(a: &T, b: &T) -> bool {
     }
 }
 
+/// `lod::imp::to_rust` on parameters whose `deformation` is NULL (every test struct here).
+#[cfg(feature = "lod")]
+fn lod_to_rust(c: &PleatLodParams) -> crate::Result<crate::lowpoly::LodParams> {
+    assert!(c.deformation.is_null());
+    // SAFETY: no deformation handle to read.
+    unsafe { lod::imp::to_rust(c) }
+}
+
 #[cfg(feature = "lod")]
 #[test]
 fn lod_params_default_is_rust_default() {
@@ -24,7 +32,7 @@ fn lod_params_default_is_rust_default() {
         c.struct_size as usize,
         std::mem::size_of::<PleatLodParams>()
     );
-    let rust = lod::imp::to_rust(&c).expect("the C default is valid");
+    let rust = lod_to_rust(&c).expect("the C default is valid");
     assert_eq!(rust, crate::lowpoly::LodParams::default());
     assert!(same_bytes(&c, &lod::defaults_without_lod()));
 }
@@ -311,15 +319,15 @@ fn lod_params_offset_voxel_scale_is_checked() {
     use super::boundary::read_versioned;
     let mut c = pleat_lod_params_default();
     c.offset_voxel_scale = 1.5;
-    assert_eq!(lod::imp::to_rust(&c).unwrap().offset_voxel_scale, Some(1.5));
+    assert_eq!(lod_to_rust(&c).unwrap().offset_voxel_scale, Some(1.5));
     // an older caller (up to `clearance`) gets automatic
     c.struct_size = std::mem::offset_of!(PleatLodParams, offset_voxel_scale) as u32;
     // SAFETY: `c` is a full, live struct; pleat reads its first `struct_size` bytes.
     let old = unsafe { read_versioned(&c, "params") }.unwrap();
-    assert_eq!(lod::imp::to_rust(&old).unwrap().offset_voxel_scale, None);
+    assert_eq!(lod_to_rust(&old).unwrap().offset_voxel_scale, None);
     for bad in [f64::NAN, -1.0, 2.5, f64::INFINITY] {
         c.offset_voxel_scale = bad;
-        let e = lod::imp::to_rust(&c).unwrap_err().to_string();
+        let e = lod_to_rust(&c).unwrap_err().to_string();
         assert!(e.contains("params->offset_voxel_scale"), "{e}");
     }
 }

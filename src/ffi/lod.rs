@@ -10,6 +10,7 @@ use super::boundary::{full_size, requires, versioned};
 #[cfg(feature = "lod")]
 use super::common::guard_progress;
 use super::common::{PleatProgressFn, PleatStatus};
+use super::deform::PleatDeformation;
 #[cfg(feature = "lod")]
 use super::mesh::mesh_ref;
 use super::mesh::PleatMesh;
@@ -89,6 +90,11 @@ pub struct PleatLodParams {
     /// estimate needs it. NaN, negative or > 2 is `PLEAT_STATUS_INVALID_ARGUMENT`. Appended
     /// 2026-11-27; callers with an older `struct_size` get automatic.
     pub offset_voxel_scale: f64,
+    /// LODs only: the skin and morph targets the levels must follow when posed
+    /// (`pleat_deformation_create`, made for this input), or NULL (the default) for a static
+    /// mesh. The handle must stay alive during the call. Appended 2026-12-08; callers with an
+    /// older `struct_size` get NULL.
+    pub deformation: *const PleatDeformation,
 }
 
 /// `PleatLodParams::start`: the welded input when clean, else the offset surface.
@@ -243,6 +249,8 @@ impl From<&crate::lowpoly::LodParams> for PleatLodParams {
             },
             reserved: 0,
             offset_voxel_scale: p.offset_voxel_scale.unwrap_or(0.0),
+            // A Rust field has no C handle: callers set the pointer themselves.
+            deformation: std::ptr::null(),
         }
     }
 }
@@ -266,6 +274,7 @@ pub(super) fn defaults_without_lod() -> PleatLodParams {
         start: PLEAT_LOD_START_AUTO,
         reserved: 0,
         offset_voxel_scale: 0.0,
+        deformation: std::ptr::null(),
     }
 }
 
@@ -277,7 +286,10 @@ pub(super) mod imp {
 
     /// The Rust parameters of C LOD parameters (flags and `target_faces` checked here, the
     /// rest by the pipeline).
-    pub(in crate::ffi) fn to_rust(p: &PleatLodParams) -> Result<LodParams> {
+    ///
+    /// # Safety
+    /// `p.deformation` is NULL or a live handle from `pleat_deformation_create`.
+    pub(in crate::ffi) unsafe fn to_rust(p: &PleatLodParams) -> Result<LodParams> {
         let target = match p.target_faces {
             0 => None,
             n => Some(usize::try_from(n).map_err(|_| {
@@ -327,9 +339,7 @@ pub(super) mod imp {
                 Clearance::FractionOfD(p.clearance)
             },
             offset_voxel_scale: voxel_scale_to_rust(p.offset_voxel_scale)?,
-            // Deformation-aware simplification is not in the C ABI yet: C callers simplify
-            // the bind pose and carry weights over with `pleat_transfer_*`.
-            deformation: None,
+            deformation: p.deformation.as_ref().map(|d| d.field.clone()),
         })
     }
 
@@ -347,7 +357,11 @@ pub(super) mod imp {
         Ok(Some(s))
     }
 
-    pub(super) fn bake(
+    /// One LOD or cage of `m` with the C parameters `p`.
+    ///
+    /// # Safety
+    /// As [`to_rust`].
+    pub(super) unsafe fn bake(
         m: &TriMesh,
         p: &PleatLodParams,
         cage: bool,
@@ -361,7 +375,11 @@ pub(super) mod imp {
         crate::lowpoly::generate(m, &rp, prog)
     }
 
-    pub(super) fn bake_chain(
+    /// The LOD chain of `m` at `sizes` with the C parameters `p`.
+    ///
+    /// # Safety
+    /// As [`to_rust`].
+    pub(super) unsafe fn bake_chain(
         m: &TriMesh,
         sizes: &[f64],
         p: &PleatLodParams,

@@ -21,6 +21,7 @@
 mod bake;
 mod boundary;
 mod common;
+mod deform;
 mod design;
 mod edges;
 mod interpolate;
@@ -35,6 +36,7 @@ mod wrinkle;
 
 pub use bake::*;
 pub use common::*;
+pub use deform::*;
 pub use design::*;
 pub use edges::*;
 pub use interpolate::*;

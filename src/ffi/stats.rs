@@ -15,6 +15,8 @@ pub struct PleatStats {
     names: Vec<CString>,
 }
 
+// Only the offset export (feature `lod`) hands stats out.
+#[cfg_attr(not(feature = "lod"), allow(dead_code))]
 impl PleatStats {
     fn new(stats: StatEntries) -> PleatStats {
         let names = stats
@@ -35,6 +37,7 @@ impl PleatStats {
 ///
 /// # Safety
 /// `out` is NULL or valid for a write.
+#[cfg_attr(not(feature = "lod"), allow(dead_code))]
 pub(crate) unsafe fn emit_stats(out: *mut *mut PleatStats, stats: StatEntries) {
     if !out.is_null() {
         *out = Box::into_raw(Box::new(PleatStats::new(stats)));

@@ -256,6 +256,7 @@ pub fn hausdorff_sides_unless(
 /// The samples of the triangle soup `(pos, tris)` in this module's sampling (module docs) at
 /// `spacing`: its referenced vertices in id order, then the interior grid of every nonzero-area
 /// triangle in triangle order (at most `max_k` subdivisions per edge). Deterministic.
+#[cfg_attr(not(feature = "lod"), allow(dead_code))]
 pub(crate) fn surface_samples(
     pos: &[[f64; 3]],
     tris: &[[u32; 3]],
@@ -297,6 +298,7 @@ pub(crate) fn surface_samples(
 }
 
 /// How many points [`for_each_interior_sample`] gives at resolution `k`.
+#[cfg_attr(not(feature = "lod"), allow(dead_code))]
 fn interior_sample_count(k: usize) -> usize {
     let k = k.max(1);
     (k + 1) * (k + 2) / 2 - 3 + usize::from(k < 3)

@@ -138,7 +138,7 @@ _LodParams = _struct("PleatLodParams", _u32s("struct_size", "max_rounds") + _f64
                      + _u64s("target_faces") + _f64s("flow_ratio", "epsilon", "theta0_deg")
                      + _u32s("l0", "flags") + _u64s("memory_budget_bytes")
                      + _f64s("clearance") + _u32s("start", "reserved")
-                     + _f64s("offset_voxel_scale"))
+                     + _f64s("offset_voxel_scale") + [("deformation", _P)])
 _LodStats = _struct("PleatLodStats", _u32s("struct_size", "rounds")
                     + _u64s("face_count", "vertex_count", "start_face_count", "collapse_count")
                     + _f64s("seconds_total", "seconds_offset", "seconds_simplify", "seconds_flow",
@@ -497,13 +497,20 @@ _REPORT_FLAGS = ("is_closed", "is_edge_manifold", "is_manifold", "is_watertight"
 _LOD_STARTS = {"auto": 0, "offset": 1, "input": 2}
 
 
-def _lod_params(screen_size, align=True, measure_floor=False, fit=True, start="auto", **kw):
-    """PleatLodParams from the defaults and keyword overrides (names of the C fields)."""
+def _lod_params(screen_size, align=True, measure_floor=False, fit=True, start="auto",
+               deformation=None, **kw):
+    """PleatLodParams from the defaults and keyword overrides (names of the C fields);
+    ``deformation``: a ``Deformation`` (the caller keeps it alive during the call)."""
     p = _lib.pleat_lod_params_default()
+    if deformation is not None:
+        if not isinstance(deformation, Deformation):
+            raise TypeError(f"deformation must be a pleat.Deformation, got "
+                            f"{type(deformation).__name__}")
+        p.deformation = deformation._h
     unknown = set(kw) - set(_LOD_KEYS)
     if unknown:
         raise TypeError(f"unknown LOD parameter(s) {sorted(unknown)}; known: "
-                        f"{sorted(_LOD_KEYS + ('align', 'measure_floor', 'fit', 'start'))}")
+                        f"{sorted(_LOD_KEYS + ('align', 'measure_floor', 'fit', 'start', 'deformation'))}")
     if start not in _LOD_STARTS:
         raise ValueError(f"start must be one of {sorted(_LOD_STARTS)}, got {start!r}")
     p.start = _LOD_STARTS[start]
@@ -644,7 +651,9 @@ class Mesh(_Handle):
         automatic), ``align=False`` to skip the feature alignment, ``measure_floor=True`` for
         ``hausdorff_floor_relative``, ``fit=False`` to skip the final fit to this mesh's planes
         (PLEAT_LOD_NO_FIT), ``start="auto"|"offset"|"input"``: the surface the loop starts
-        from (the welded input when it is clean for ``auto``; ``stats["started_from_input"]``).
+        from (the welded input when it is clean for ``auto``; ``stats["started_from_input"]``),
+        ``deformation=Deformation(...)``: the skin and morph targets the LOD must follow when
+        posed.
         ``progress(stage, fraction)`` is called on this thread; return True to cancel
         (PleatError CANCELLED); an exception it raises comes out of this call."""
         return self._bake(_lib.pleat_lod_generate, screen_size, progress, params)
@@ -1780,3 +1789,69 @@ class Transfer(_Handle):
 
 
 __all__.append("Transfer")
+
+_DeformationDesc = _struct("PleatDeformationDesc", _u32s("struct_size", "influences")
+                           + [("vertex_count", _sz), ("joints", _U), ("weights", _F),
+                              ("joint_count", _sz), ("joint_pivots", _D), ("morph_count", _sz),
+                              ("morph_deltas", _F)]
+                           + _f64s("max_rotation", "max_skin_error"))
+for _name, _res, _args in [
+    ("pleat_deformation_desc_default", _DeformationDesc, ()),
+    ("pleat_deformation_create", _st, (_c.POINTER(_DeformationDesc), _PP)),
+    ("pleat_deformation_destroy", None, (_P,)),
+]:
+    _sig(_name, _res, *_args)
+if _lib.pleat_deformation_desc_default().struct_size != _c.sizeof(_DeformationDesc):
+    raise ImportError(f"{_path}: PleatDeformationDesc is "
+                      f"{_lib.pleat_deformation_desc_default().struct_size} bytes in the "
+                      f"library, {_c.sizeof(_DeformationDesc)} in this module")
+
+
+class Deformation(_Handle):
+    """The skin and morph targets of an input mesh, for LODs that must follow them when posed
+    (``pleat_deformation_create``; pass it as ``Mesh.lod(..., deformation=d)`` or
+    ``lod_chain``). ``vertex_count``: the input's vertices; ``joints`` and ``weights``:
+    (n, k) per-vertex influences (or None); ``pivots``: (joints, 3) bind-pose joint positions
+    (or None); ``morph_deltas``: (targets, n, 3) displacements (or None); ``max_rotation`` in
+    radians and ``max_skin_error`` in pixels (0: 1 rad and half a pixel). The arrays are copied.
+    Raises PleatError (INVALID_ARGUMENT) for mismatched shapes, negative or non-finite weights,
+    non-finite pivots or displacements."""
+
+    _destroy = "pleat_deformation_destroy"
+
+    def __init__(self, vertex_count, joints=None, weights=None, pivots=None,
+                 morph_deltas=None, max_rotation=0.0, max_skin_error=0.0):
+        n = int(vertex_count)
+        d = _lib.pleat_deformation_desc_default()
+        d.vertex_count = n
+        keep = []
+        if (joints is None) != (weights is None):
+            raise PleatError(1, "joints and weights come together (both or neither)")
+        if joints is not None:
+            j = _rows(_indices(joints, "joints").reshape(_np.shape(joints)), n, _np.uint32,
+                      "joints")
+            w = _rows(weights, n, _np.float32, "weights")
+            if j.shape != w.shape:
+                raise PleatError(1, f"joints {j.shape} and weights {w.shape} differ in shape")
+            keep += [j, w]
+            d.influences = j.shape[1]
+            d.joints, d.weights = _ptr(j, _c.c_uint32), _ptr(w, _c.c_float)
+        if pivots is not None:
+            pv = _np.ascontiguousarray(pivots, dtype=_np.float64)
+            if pv.ndim != 2 or pv.shape[1] != 3:
+                raise PleatError(1, f"pivots: shape {pv.shape}; (joints, 3) needed")
+            keep.append(pv)
+            d.joint_count, d.joint_pivots = pv.shape[0], _ptr(pv, _c.c_double)
+        if morph_deltas is not None:
+            md = _np.ascontiguousarray(morph_deltas, dtype=_np.float32)
+            if md.ndim != 3 or md.shape[1:] != (n, 3):
+                raise PleatError(1, f"morph_deltas: shape {md.shape}; (targets, {n}, 3) needed")
+            keep.append(md)
+            d.morph_count, d.morph_deltas = md.shape[0], _ptr(md, _c.c_float)
+        d.max_rotation, d.max_skin_error = float(max_rotation), float(max_skin_error)
+        h = _P()
+        _check(_lib.pleat_deformation_create(_c.byref(d), _c.byref(h)))
+        super().__init__(h)
+
+
+__all__.append("Deformation")

@@ -64,3 +64,47 @@ def test_refusals():
         t.f32(uv, mode="cubic")
     with pytest.raises(pleat.PleatError, match="max_influences"):
         t.skin(np.zeros((len(V), 1), np.uint32), np.ones((len(V), 1)), max_influences=9)
+
+
+def tube(seg=16, rings=25):
+    """A capped tube of radius 0.3 from y = 0 to 2, with two joints: joint 1 (pivot (0, 1, 0))
+    takes over from joint 0 across y in [0.8, 1.2]."""
+    r, s = np.mgrid[0:rings, 0:seg]
+    a = 2 * np.pi * s.ravel() / seg
+    V = np.stack([0.3 * np.cos(a), 2.0 * r.ravel() / (rings - 1), 0.3 * np.sin(a)], 1)
+    V = np.vstack([V, [[0, 0, 0], [0, 2, 0]]])
+    F = []
+    for i in range(rings - 1):
+        for k in range(seg):
+            a0, a1 = i * seg + k, i * seg + (k + 1) % seg
+            F += [[a0, a1 + seg, a1], [a0, a0 + seg, a1 + seg]]
+    n = rings * seg
+    for k in range(seg):
+        F += [[n, k, (k + 1) % seg], [n + 1, (rings - 1) * seg + (k + 1) % seg, (rings - 1) * seg + k]]
+    t = np.clip((V[:, 1] - 0.8) / 0.4, 0, 1)
+    joints = np.tile([0, 1], (len(V), 1)).astype(np.uint32)
+    return V, np.array(F, dtype=np.uint32), joints, np.stack([1 - t, t], 1)
+
+
+@needs("lod")
+def test_a_lod_follows_a_skin_and_refuses_a_bad_one():
+    V, F, joints, weights = tube()
+    mesh = pleat.Mesh.from_arrays(V, F)
+    plain = mesh.lod(screen_size=50)
+    with pleat.Deformation(len(V), joints, weights, pivots=[[0, 0, 0], [0, 1, 0]],
+                           morph_deltas=np.zeros((1, len(V), 3)), max_rotation=1.0) as skin:
+        followed = mesh.lod(screen_size=50, deformation=skin)
+        chain = mesh.lod_chain([100, 50], deformation=skin)
+    assert followed.triangle_count > plain.triangle_count
+    assert followed.stats["watertight"] and len(chain) == 2
+    with pytest.raises(pleat.PleatError, match="INVALID_ARGUMENT"):
+        pleat.Deformation(len(V), joints, -weights)
+    with pytest.raises(pleat.PleatError, match="shape"):
+        pleat.Deformation(len(V), joints[:-1], weights[:-1])
+    with pytest.raises(pleat.PleatError, match="morph_deltas"):
+        pleat.Deformation(len(V), morph_deltas=np.zeros((1, 3, 3)))
+    with pytest.raises(TypeError, match="Deformation"):
+        mesh.lod(screen_size=50, deformation="skin")
+    other = pleat.Deformation(len(V) - 1, joints[:-1], weights[:-1])
+    with pytest.raises(pleat.PleatError, match="deformation"):
+        mesh.lod(screen_size=50, deformation=other)
