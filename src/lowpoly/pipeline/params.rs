@@ -76,9 +76,9 @@ pub struct LodParams {
     /// guarantees forbid it or the `N` rounds run out. `None` minimises the count at error `d`.
     /// At least 4 when given.
     pub target_faces: Option<usize>,
-    /// Maximum number of rounds `N` of Alg. 3 (0 returns the offset surface). A LOD without
-    /// a face target also stops after [`STALL_ROUNDS`] rounds without a new smallest face
-    /// count ([`LodReport::stalled`]).
+    /// Maximum number of rounds `N` of Alg. 3 (0 returns the offset surface). A LOD or cage
+    /// without a face target also stops after [`STALL_ROUNDS`] rounds without a new smallest
+    /// face count ([`LodReport::stalled`]).
     pub max_rounds: u32,
     /// Flow fraction `r` in `(0, 1]` (Alg. 3 line 9).
     pub flow_ratio: f64,
