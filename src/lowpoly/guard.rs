@@ -804,21 +804,15 @@ impl<'a> Guard<'a> {
     }
 
     /// Cage mode with clearance `c`: `M_e` does not touch the input, and its distance to the
-    /// input is at least `c` or at least the distance of the patch it replaces.
+    /// input is at least `c` or at least the distance of the patch it replaces — that is, at
+    /// least `τ = min(c, old gap)`. `τ` comes first, so that the scan of the new patch stops at
+    /// the first input triangle closer than it (most operations that reach this check are
+    /// refused here).
     fn check_clearance(&self, s: &GuardScratch, st: &mut GuardCounts) -> Result<(), Reject> {
         let c = self.clearance;
+        let tau = patch_gap(self.input, s.old_patch.iter().copied(), c, st);
         let new_patch = s.m_1[..s.n_e].iter().map(|f| f.t);
-        let new_gap = patch_gap(self.input, new_patch, c, true, st).ok_or(Reject::TouchesInput)?;
-        if new_gap >= c {
-            return Ok(());
-        }
-        let old_gap =
-            patch_gap(self.input, s.old_patch.iter().copied(), c, false, st).unwrap_or(0.0);
-        if new_gap >= old_gap {
-            Ok(())
-        } else {
-            Err(Reject::Clearance)
-        }
+        patch_keeps_gap(self.input, new_patch, tau, st)
     }
 
     /// Check 6 (LOD mode with self-clearance `s`): the faces of `M_e` are at least `s` from
@@ -945,46 +939,72 @@ fn flush_bvh_parts(
 const PLANE_SKIP_MIN: f64 = 1e-9;
 
 /// The distance between the faces `patch` and the input, capped at `cap` (`> 0`): the exact
-/// minimum triangle–triangle distance over the input triangles whose boxes come within `cap`
-/// of a face's box (BVH query), `cap` when there is none. With `test_contact`, `None` when a
-/// face touches or intersects an input triangle (exact test on every candidate whose box
-/// meets the face's); without, the patch must be known not to touch the input (the patch an
-/// operation replaces).
+/// minimum triangle–triangle distance over the input triangles that may come within `cap` of
+/// a face ([`crate::spatial::TriangleBvh::query_near_triangle`]), `cap` when there is none. The
+/// patch must be known not to touch the input (the patch an operation replaces).
 fn patch_gap(
     input: &InputModel,
     patch: impl Iterator<Item = [[f64; 3]; 3]>,
     cap: f64,
-    test_contact: bool,
     st: &mut GuardCounts,
-) -> Option<f64> {
+) -> f64 {
     let mut best = cap;
     for t in patch {
         let (lo, hi) = bbox(t);
-        let pad = Vec3::splat(best);
         let tv = t.map(Vec3::from);
-        for i in input
-            .bvh
-            .query_box((lo - pad).to_array(), (hi + pad).to_array())
-        {
+        for i in input.bvh.query_near_triangle(&t, best) {
             let it = input.triangle(i);
-            let gap = box_gap((lo, hi), bbox(it));
-            if gap >= best && !(test_contact && gap == 0.0) {
+            if box_gap((lo, hi), bbox(it)) >= best {
                 continue;
             }
             let itv = it.map(Vec3::from);
-            // Far side of the face's plane by at least `best` (and clearly apart: no contact).
+            // Far side of the face's plane by at least `best`.
             let plane = plane_gap_lower_bound(&tv, &itv);
             if plane >= best && plane > PLANE_SKIP_MIN * input.diag {
                 continue;
             }
             st.exact_tests += 1;
-            if test_contact && touches_input_triangle(&t, &it, input.degenerate[i as usize]) {
-                return None;
-            }
             best = best.min(disjoint_triangle_distance(&tv, &itv, 0.0));
         }
     }
-    Some(best)
+    best
+}
+
+/// `Ok` when no face of `patch` touches the input and every one is at least `tau` (`≥ 0`) from
+/// it: `Err(TouchesInput)` at the first contact (exact test on every candidate whose box meets
+/// the face's), `Err(Clearance)` at the first input triangle closer than `tau`. The decision
+/// of [`patch_gap`]`(patch, cap ≥ tau, contact) ≥ tau`, without finishing the minimum.
+fn patch_keeps_gap(
+    input: &InputModel,
+    patch: impl Iterator<Item = [[f64; 3]; 3]>,
+    tau: f64,
+    st: &mut GuardCounts,
+) -> Result<(), Reject> {
+    for t in patch {
+        let (lo, hi) = bbox(t);
+        let tv = t.map(Vec3::from);
+        for i in input.bvh.query_near_triangle(&t, tau) {
+            let it = input.triangle(i);
+            let gap = box_gap((lo, hi), bbox(it));
+            if gap >= tau && gap != 0.0 {
+                continue;
+            }
+            let itv = it.map(Vec3::from);
+            // Far side of the face's plane by at least `tau` (and clearly apart: no contact).
+            let plane = plane_gap_lower_bound(&tv, &itv);
+            if plane >= tau && plane > PLANE_SKIP_MIN * input.diag {
+                continue;
+            }
+            st.exact_tests += 1;
+            if touches_input_triangle(&t, &it, input.degenerate[i as usize]) {
+                return Err(Reject::TouchesInput);
+            }
+            if tau > 0.0 && disjoint_triangle_distance(&tv, &itv, tau) < tau {
+                return Err(Reject::Clearance);
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Whether two faces' normals point more than 90° apart (`n_a · n_b < 0`): the two sides of a

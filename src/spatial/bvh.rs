@@ -237,6 +237,41 @@ impl TriangleBvh {
             .map(|l| self.keys.tri(l))
     }
 
+    /// Triangles that may lie within `pad` of the triangle `tri`: those whose box meets the
+    /// box of `tri` grown by `pad` and, when `tri` has a normal, lies in the slab of points
+    /// within `pad` (plus a rounding margin of `1e-9` of the coordinates) of `tri`'s plane. A
+    /// superset of the triangles at distance `≤ pad` (a point that near `tri` is that near its
+    /// plane), in tree order; for a large slanted `tri` the slab prunes most of its box.
+    pub fn query_near_triangle(
+        &self,
+        tri: &[[f64; 3]; 3],
+        pad: f64,
+    ) -> impl Iterator<Item = u32> + '_ {
+        let (lo, hi) = corners_box(tri);
+        let lo = Vector::from(lo) - Vector::splat(pad);
+        let hi = Vector::from(hi) + Vector::splat(pad);
+        let query = BvhNode::leaf(Aabb::new(lo, hi), 0);
+        let [a, b, c] = tri.map(Vector::from);
+        let n = (b - a).cross(c - a).normalize_or_zero();
+        let offset = n.dot(a);
+        // Rounding of the dot products below stays far under 1e-9 of the magnitudes involved.
+        let margin = 1e-9 * (lo.abs().max(hi.abs()).max_element() + (hi - lo).length());
+        self.bvh
+            .leaves(move |node: &BvhNode| {
+                if !node.intersects(&query) {
+                    return false;
+                }
+                if n == Vector::ZERO {
+                    return true;
+                }
+                let (mins, maxs) = (node.mins(), node.maxs());
+                let centre = n.dot((mins + maxs) * 0.5) - offset;
+                let reach = n.abs().dot((maxs - mins) * 0.5);
+                centre.abs() - reach <= pad + margin + 1e-9 * (reach + centre.abs())
+            })
+            .map(|l| self.keys.tri(l))
+    }
+
     /// Triangles whose box meets the box of the triangle `tri` (given by its corners).
     pub fn query_triangle(&self, tri: &[[f64; 3]; 3]) -> impl Iterator<Item = u32> + '_ {
         let (lo, hi) = corners_box(tri);
@@ -357,6 +392,71 @@ pub fn corners_box(p: &[[f64; 3]; 3]) -> ([f64; 3], [f64; 3]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `query_near_triangle` returns every triangle within `pad` of the query (brute force
+    /// over a noisy grid of small triangles against slanted queries) and, for a slanted query,
+    /// far fewer than its box holds.
+    #[test]
+    fn near_triangle_query_is_a_superset_of_the_near_triangles() {
+        use crate::geom::Vec3;
+        use crate::spatial::closest::disjoint_triangle_distance;
+        let mut p = Vec::new();
+        let mut t = Vec::new();
+        let mut seed = 7u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for i in 0..20 {
+            for j in 0..20 {
+                for k in 0..5 {
+                    let c = [i as f64 * 0.1, j as f64 * 0.1, k as f64 * 0.1];
+                    let base = p.len() as u32;
+                    for _ in 0..3 {
+                        p.push([
+                            c[0] + 0.05 * rnd(),
+                            c[1] + 0.05 * rnd(),
+                            c[2] + 0.05 * rnd(),
+                        ]);
+                    }
+                    t.push([base, base + 1, base + 2]);
+                }
+            }
+        }
+        let bvh = TriangleBvh::new(&p, &t);
+        let queries = [
+            [[0.0, 0.0, 0.0], [2.0, 0.1, 0.5], [0.3, 2.0, 0.2]],
+            [[1.0, 1.0, -0.2], [1.9, 0.2, 0.7], [0.1, 1.8, 0.6]],
+            [[0.5, 0.5, 0.25], [0.6, 0.5, 0.25], [0.5, 0.6, 0.25]],
+        ];
+        for q in &queries {
+            let qv = q.map(Vec3::from);
+            for pad in [0.0, 0.01, 0.05] {
+                let got: std::collections::HashSet<u32> = bvh.query_near_triangle(q, pad).collect();
+                let in_box: usize = {
+                    let (lo, hi) = corners_box(q);
+                    bvh.query_box(lo.map(|x| x - pad), hi.map(|x| x + pad))
+                        .count()
+                };
+                for (i, tri) in t.iter().enumerate() {
+                    let tv = tri.map(|v| Vec3::from(p[v as usize]));
+                    // Intersecting pairs count as near (distance 0): the exact decision is
+                    // the caller's; only far triangles may be left out.
+                    let d = disjoint_triangle_distance(&qv, &tv, 0.0);
+                    if d <= pad {
+                        assert!(got.contains(&(i as u32)), "triangle {i} at {d} missed");
+                    }
+                }
+                assert!(got.len() <= in_box);
+            }
+        }
+        let slanted = bvh.query_near_triangle(&queries[0], 0.01).count();
+        let (lo, hi) = corners_box(&queries[0]);
+        let boxed = bvh.query_box(lo, hi).count();
+        assert!(slanted * 2 < boxed, "{slanted} of {boxed}");
+    }
 
     /// A strip of `n` unit right triangles along x, plus positions.
     fn strip(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
