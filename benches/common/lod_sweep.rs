@@ -226,8 +226,10 @@ impl Row {
     }
 }
 
-/// Stage columns of the CSV (seconds from `LodReport::stages`, by `LodStage` name).
-pub const STAGES: [&str; 7] = [
+/// Stage columns of the CSV (seconds from `LodReport::stages`, by `LodStage` name); `fit`
+/// (LODs: the final input-plane fit) and `clearance` (cages) come last, so older CSVs without
+/// them still parse.
+pub const STAGES: [&str; 9] = [
     "offset",
     "simplify",
     "flow",
@@ -235,6 +237,8 @@ pub const STAGES: [&str; 7] = [
     "convergence",
     "verify",
     "measure",
+    "fit",
+    "clearance",
 ];
 
 /// Splits one CSV line, honouring double-quoted fields with `""` escapes.
@@ -596,7 +600,12 @@ fn csv_line(r: &Row, cage: bool) -> String {
         f.push(if ok { c.to_string() } else { String::new() });
     }
     for st in STAGES {
-        let t: f64 = r.stages.iter().filter(|s| s.0 == st).map(|s| s.1).sum();
+        // fold from +0.0: an empty `sum` of floats is -0.0, printed "-0.0000"
+        let t: f64 = r
+            .stages
+            .iter()
+            .filter(|s| s.0 == st)
+            .fold(0.0, |a, s| a + s.1);
         f.push(if ok { format!("{t:.4}") } else { String::new() });
     }
     f.join(",")
