@@ -220,7 +220,7 @@ impl Coverage {
     /// Whether the faces `new` keep every sample of `relying` (from [`Coverage::relying_on`])
     /// within its budget; counts a refusal.
     pub fn keeps(&mut self, relying: &[Relying], new: &[[Vec3; 3]]) -> bool {
-        self.keeps_within(relying, new, None)
+        self.keeps_within(relying, new, None, &mut 0)
     }
 
     /// [`Coverage::keeps`]; with `moved = Some(δ)`, face `k` of `new` is face `k` of the
@@ -229,7 +229,19 @@ impl Coverage {
     /// without a distance: `dist(s, new_k) ≤ dist(s, old_k) + δ ≤ b` (the triangle
     /// inequality, each point of the face moving at most `δ`). The answer is the exact
     /// predicate's, as with the box test.
-    fn keeps_within(&mut self, relying: &[Relying], new: &[[Vec3; 3]], moved: Option<f64>) -> bool {
+    ///
+    /// `hint` indexes `relying`: that sample is tested first and, on a refusal, becomes a
+    /// sample that failed. A line search's trials share `relying` and one hint, so a shorter
+    /// step that fails on the same sample costs one test instead of a scan (up to
+    /// `flow::MAX_HALVINGS` + 1 trials per move, most of them refused on large inputs). The
+    /// answer is a conjunction, the same whatever the order.
+    fn keeps_within(
+        &mut self,
+        relying: &[Relying],
+        new: &[[Vec3; 3]],
+        moved: Option<f64>,
+        hint: &mut usize,
+    ) -> bool {
         let patch = Patch::new(new);
         let kept = |r: &Relying| {
             let s = r.sample as usize;
@@ -239,16 +251,23 @@ impl Coverage {
             }
             patch.face_within(p, b, r.face as usize).is_some()
         };
-        // a conjunction: the same answer in any order
-        let ok = if relying.len() >= PARALLEL_MIN {
-            relying.par_iter().with_min_len(64).all(kept)
-        } else {
-            relying.iter().all(kept)
+        let failing = match relying.get(*hint) {
+            Some(r) if !kept(r) => Some(*hint),
+            // which failing sample a parallel scan reports varies; it only becomes the hint
+            _ if relying.len() >= PARALLEL_MIN => relying
+                .par_iter()
+                .with_min_len(64)
+                .position_any(|r| !kept(r)),
+            _ => relying.iter().position(|r| !kept(r)),
         };
-        if !ok {
-            self.refused += 1;
+        match failing {
+            Some(i) => {
+                *hint = i;
+                self.refused += 1;
+                false
+            }
+            None => true,
         }
-        ok
     }
 
     /// [`Coverage::relying_on`] the one-ring of `v`, for [`Coverage::keeps_move`] with moves of
@@ -269,12 +288,14 @@ impl Coverage {
 
     /// [`Coverage::keeps`] for moving `v` of `m` to `q` (its one-ring after the move);
     /// `relying` from [`Coverage::relying_on_ring`] with a `max_move` of at least the move.
+    /// `hint`: as for `keeps_within` (one per line search, starting at 0).
     pub fn keeps_move(
         &mut self,
         relying: &[Relying],
         m: &HalfEdgeMesh,
         v: VertexId,
         q: Vec3,
+        hint: &mut usize,
     ) -> bool {
         let moved = q.distance(Vec3::from(m.position(v)));
         let new: Vec<[Vec3; 3]> = m
@@ -291,7 +312,7 @@ impl Coverage {
             })
             .collect();
         // the one-ring in the order `relying_on_ring` saw it, only `v` moved (by `moved`)
-        self.keeps_within(relying, &new, Some(moved))
+        self.keeps_within(relying, &new, Some(moved), hint)
     }
 }
 

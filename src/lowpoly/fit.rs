@@ -304,7 +304,9 @@ fn place_vertices(
             // (measured as `|(p + s) − p|`, rounding included) less than this
             let max_move = step.length() + 1e-9 * (p.abs().max_element() + step.length());
             let relying = cov.relying_on_ring(g.mesh(), v, max_move);
-            let mut keeps = |g: &Guard<'_>, v, q| cov.keeps_move(&relying, g.mesh(), v, q);
+            let mut hint = 0;
+            let mut keeps =
+                |g: &Guard<'_>, v, q| cov.keeps_move(&relying, g.mesh(), v, q, &mut hint);
             local_update_if(g, v, step, &mut keeps)
         });
         record(&mut rep, moved);
