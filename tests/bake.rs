@@ -5,6 +5,9 @@
 //! absent.
 #![cfg(feature = "bake")]
 
+#[path = "common/gltf_build.rs"]
+mod gltf_build;
+use gltf_build::glb;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
@@ -26,25 +29,6 @@ fn png(w: u32, h: u32, rgba: &[u8]) -> Vec<u8> {
     image::codecs::png::PngEncoder::new(&mut out)
         .write_image(rgba, w, h, image::ExtendedColorType::Rgba8)
         .unwrap();
-    out
-}
-
-/// A GLB from a JSON document and its BIN chunk.
-fn glb(doc: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
-    let mut j = serde_json::to_vec(doc).unwrap();
-    j.resize(j.len().next_multiple_of(4), b' ');
-    let mut b = bin.to_vec();
-    b.resize(b.len().next_multiple_of(4), 0);
-    let mut out = Vec::new();
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&((12 + 8 + j.len() + 8 + b.len()) as u32).to_le_bytes());
-    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&j);
-    out.extend_from_slice(&(b.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&b);
     out
 }
 

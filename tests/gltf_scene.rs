@@ -1468,11 +1468,8 @@ fn eight_influence_scene() -> Vec<u8> {
         "animations": [{"name": "Turn", "channels": [
             {"sampler": 0, "target": {"node": 5, "path": "rotation"}}],
             "samplers": [{"input": times, "output": rots, "interpolation": "LINEAR"}]}],
-        "accessors": b.accessors,
-        "bufferViews": b.views,
-        "buffers": [{"byteLength": b.bin.len().next_multiple_of(4)}],
     });
-    glb(&doc, &b.bin)
+    b.into_glb(doc)
 }
 
 /// The 8-influence tube through `pleat lod`, plain and `--bake`: the glTF-Validator accepts

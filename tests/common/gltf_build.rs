@@ -1,6 +1,6 @@
 //! glTF test scenes built by hand: a GLB writer, a buffer/accessor builder, a gridded box and
 //! a scene of many instances of a few meshes. Shared by `tests/gltf_scene.rs` and
-//! `benches/scene.rs`.
+//! `benches/scene.rs` (and the GLB writer by `tests/bake.rs`).
 #![allow(dead_code)]
 
 use serde_json::{json, Value};
@@ -34,6 +34,14 @@ pub struct Builder {
 }
 
 impl Builder {
+    /// The GLB of `doc` with this builder's accessors, buffer views and one buffer.
+    pub fn into_glb(self, mut doc: Value) -> Vec<u8> {
+        doc["accessors"] = json!(self.accessors);
+        doc["bufferViews"] = json!(self.views);
+        doc["buffers"] = json!([{"byteLength": self.bin.len().next_multiple_of(4)}]);
+        glb(&doc, &self.bin)
+    }
+
     pub fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
         self.bin.resize(self.bin.len().next_multiple_of(4), 0);
         let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
