@@ -1364,28 +1364,13 @@ fn eight_influence_scene() -> Vec<u8> {
     let mut b = Builder::default();
     let (p, t) = tube(0.3, 2.0, 16, 28);
     let joint_y = |j: usize| 2.0 * j as f32 / 7.0;
-    let mut normals = vec![[0.0f32; 3]; p.len()];
-    for tri in &t {
-        let [a, bb, c] = tri.map(|i| p[i as usize]);
-        let (u, v) = (
-            [bb[0] - a[0], bb[1] - a[1], bb[2] - a[2]],
-            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
-        );
-        let n = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        for &i in tri {
-            for k in 0..3 {
-                normals[i as usize][k] += n[k];
-            }
-        }
-    }
-    for n in &mut normals {
-        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        *n = n.map(|x| x / len);
-    }
+    // Area-weighted vertex normals (the tube is welded and closed).
+    let welded =
+        pleat::mesh::TriMesh::new(p.iter().map(|x| x.map(f64::from)).collect(), t.clone()).unwrap();
+    let normals: Vec<[f32; 3]> = pleat::transfer::provenance::vertex_normals(&welded)
+        .into_iter()
+        .map(|n| n.map(|c| c as f32))
+        .collect();
     let mut weights = Vec::new();
     for x in &p {
         let raw: Vec<f32> = (0..8)

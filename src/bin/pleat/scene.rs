@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use pleat::bake::scene::{lod_scene, scene_glb, GltfScene, SceneParams, WriteOptions};
 use pleat::bake::{AtlasParams, BakeParams};
-use pleat::mesh::io::NodeFilter;
+use pleat::mesh::io::{MeshFormat, NodeFilter};
 
 use super::{
     failure_code, output_path, progress_bar, show_progress, BakeArgs, EXIT_FAILED, EXIT_INPUT,
@@ -46,25 +46,26 @@ fn parse_nodes(s: &str) -> Result<NodeFilter, String> {
 
 /// Whether `p` names a glTF file (`.glb`, `.gltf`, any case).
 fn is_gltf(p: &Path) -> bool {
-    let ext = p.extension().and_then(|e| e.to_str()).unwrap_or("");
-    ext.eq_ignore_ascii_case("glb") || ext.eq_ignore_ascii_case("gltf")
+    matches!(
+        MeshFormat::from_path(p),
+        Ok(MeshFormat::Glb | MeshFormat::Gltf)
+    )
 }
 
-/// `--nodes` on an input that is not glTF: the message (nodes are glTF's).
-fn nodes_without_gltf(input: &Path, args: &SceneArgs) -> Option<String> {
-    (args.nodes.is_some() && !is_gltf(input)).then(|| {
-        format!(
+/// Refuses `--nodes` on an input that is not glTF (nodes are glTF's).
+fn nodes_need_gltf(input: &Path, args: &SceneArgs) -> Result<(), String> {
+    if args.nodes.is_some() && !is_gltf(input) {
+        return Err(format!(
             "--nodes selects glTF nodes, and '{}' is not a .glb or .gltf file",
             input.display()
-        )
-    })
+        ));
+    }
+    Ok(())
 }
 
 /// The merged geometry of `input`: the nodes `--nodes` selects, or the whole file.
 pub fn read_merged(input: &Path, args: &SceneArgs) -> Result<pleat::mesh::TriMesh, String> {
-    if let Some(e) = nodes_without_gltf(input, args) {
-        return Err(e);
-    }
+    nodes_need_gltf(input, args)?;
     match &args.nodes {
         Some(f) => pleat::mesh::io::gltf::read_gltf_selected(input, Some(f)),
         None => pleat::mesh::io::read_mesh(input),
@@ -78,9 +79,7 @@ pub fn read_merged_appearance(
     input: &Path,
     args: &SceneArgs,
 ) -> Result<pleat::bake::Appearance, String> {
-    if let Some(e) = nodes_without_gltf(input, args) {
-        return Err(e);
-    }
+    nodes_need_gltf(input, args)?;
     match &args.nodes {
         Some(f) => pleat::bake::read_gltf_appearance_selected(input, Some(f)),
         None => pleat::bake::read_appearance(input),
@@ -143,9 +142,7 @@ pub fn applies_to_asset(input: &Path, outputs: &[std::path::PathBuf], args: &Bak
 
 /// Whether `p` ends in `.glb` (any case).
 fn is_glb(p: &Path) -> bool {
-    p.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+    matches!(MeshFormat::from_path(p), Ok(MeshFormat::Glb))
 }
 
 /// The scene options in the form a cache key hashes (every one that changes the output).
